@@ -1,0 +1,18 @@
+"""Symbolic derivations of rotorred's element matrices and contact tangents.
+
+``python -m derivations`` writes every module listed in :data:`TARGETS`.
+"""
+
+from __future__ import annotations
+
+
+def _timoshenko() -> str:
+    from derivations.timoshenko import module_text
+
+    return module_text()
+
+
+#: (path relative to the project root, function returning the module text)
+TARGETS: list[tuple[str, object]] = [
+    ("rotorred/_generated/timoshenko.py", _timoshenko),
+]

@@ -1,0 +1,1 @@
+"""rotorred: rotordynamics of dual-rotor machines with rub-impact faults."""

@@ -1,0 +1,183 @@
+"""Assembly of the global matrices M, K, C and one gyroscopic matrix per spool.
+
+The equation of motion (Xu et al. 2016, Eq. 13, with two spools) is
+
+    M q'' + (C + sum_s Omega_s G_s) q' + K q = F(t) + F_L,
+
+where ``M = M_T + M_R`` (translational and rotary), ``K`` includes bearing stiffness,
+``C`` bearing and (optional) Rayleigh shaft damping, and ``G_s`` collects the shaft and disk
+gyroscopic matrices of spool ``s`` per unit spin speed (1 rad/s).
+
+Matrices are dense ndarrays: rotorred's models have at most a few thousand DOFs, where
+dense LAPACK beats sparse solvers and keeps eigen-analysis simple. They are built from COO
+triplets in one pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+from scipy.sparse import coo_matrix
+
+from rotorred.model import Rotor
+
+DIRECTIONS = ("x", "y", "theta_x", "theta_y")
+_DIR_ALIASES = {"x": 0, "y": 1, "theta_x": 2, "theta_y": 3, "tx": 2, "ty": 3}
+
+
+@dataclass(frozen=True)
+class DofMap:
+    """Global DOF numbering: 4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order.
+
+    Parameters
+    ----------
+    nodes : tuple of int
+        Node numbers in DOF order.
+    """
+
+    nodes: tuple[int, ...]
+    _pos: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "_pos", {n: i for i, n in enumerate(self.nodes)})
+
+    @property
+    def n_dof(self) -> int:
+        """Number of DOFs."""
+        return 4 * len(self.nodes)
+
+    def node_dofs(self, node: int) -> np.ndarray:
+        """Global indices of the 4 DOFs of ``node``, shape (4,)."""
+        return 4 * self._node_pos(node) + np.arange(4)
+
+    def index(self, node: int, direction: str) -> int:
+        """Global index of ``direction`` (``"x"``, ``"y"``, ``"theta_x"``, ``"theta_y"``) at ``node``."""
+        if direction not in _DIR_ALIASES:
+            raise ValueError(f"`direction` must be one of {DIRECTIONS}, got {direction!r}")
+        return 4 * self._node_pos(node) + _DIR_ALIASES[direction]
+
+    def label(self, dof: int) -> str:
+        """Human label of a global DOF, e.g. ``"node 18 y"``."""
+        if not 0 <= dof < self.n_dof:
+            raise ValueError(f"`dof` must be in [0, {self.n_dof}), got {dof}")
+        return f"node {self.nodes[dof // 4]} {DIRECTIONS[dof % 4]}"
+
+    def _node_pos(self, node: int) -> int:
+        try:
+            return self._pos[node]
+        except (KeyError, TypeError):
+            raise ValueError(f"node {node!r} does not exist; nodes are {sorted(self.nodes)}") from None
+
+
+@dataclass(frozen=True)
+class SystemMatrices:
+    """Global matrices of a rotor.
+
+    Attributes
+    ----------
+    M : ndarray, shape (n, n)
+        Mass (translational + rotary), symmetric positive definite.
+    K : ndarray, shape (n, n)
+        Stiffness of shafts, bearings and inter-shaft bearings.
+    C : ndarray, shape (n, n)
+        Damping of bearings, inter-shaft bearings and Rayleigh shaft damping.
+    G : dict of str to ndarray, shape (n, n)
+        Skew-symmetric gyroscopic matrix of each spool per unit spin speed (1 rad/s).
+    dofs : DofMap
+    """
+
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    G: Mapping[str, np.ndarray]
+    dofs: DofMap
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    @property
+    def spools(self) -> tuple[str, ...]:
+        return tuple(self.G)
+
+    def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
+        unknown = set(speeds) - set(self.G)
+        if unknown:
+            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
+        out = np.zeros_like(self.M)
+        for name, Omega in speeds.items():
+            if Omega:
+                out += Omega * self.G[name]
+        return out
+
+    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``C + sum_s Omega_s G_s`` (N s/m), shape (n, n)."""
+        return self.C + self.gyroscopic(speeds)
+
+
+class _Triplets:
+    def __init__(self):
+        self.rows: list[np.ndarray] = []
+        self.cols: list[np.ndarray] = []
+        self.vals: list[np.ndarray] = []
+
+    def add(self, dofs: np.ndarray, block: np.ndarray):
+        r, c = np.meshgrid(dofs, dofs, indexing="ij")
+        self.rows.append(r.ravel())
+        self.cols.append(c.ravel())
+        self.vals.append(np.asarray(block, dtype=float).ravel())
+
+    def dense(self, n: int) -> np.ndarray:
+        if not self.vals:
+            return np.zeros((n, n))
+        rows, cols, vals = (np.concatenate(x) for x in (self.rows, self.cols, self.vals))
+        return coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
+
+
+def assemble(rotor: Rotor) -> SystemMatrices:
+    """Assemble the global matrices of ``rotor``.
+
+    Parameters
+    ----------
+    rotor : Rotor
+
+    Returns
+    -------
+    SystemMatrices
+    """
+    dofs = DofMap(rotor.nodes)
+    n = dofs.n_dof
+    M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
+    G = {s.name: _Triplets() for s in rotor.spools}
+    for s in rotor.spools:
+        for e in s.elements:
+            idx = np.concatenate([dofs.node_dofs(e.left), dofs.node_dofs(e.right)])
+            Me, Ke = e.M(), e.K()
+            M.add(idx, Me)
+            K.add(idx, Ke)
+            M_shaft.add(idx, Me)
+            K_shaft.add(idx, Ke)
+            G[s.name].add(idx, e.G())
+    spool_of = rotor.spool_of
+    for d in rotor.disks:
+        idx = dofs.node_dofs(d.node)
+        M.add(idx, d.M())
+        G[spool_of[d.node]].add(idx, d.G())
+    for b in rotor.bearings:
+        idx = dofs.node_dofs(b.node)[:2]
+        K.add(idx, b.K)
+        C.add(idx, b.C)
+    coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    for b in rotor.intershaft_bearings:
+        a, c = dofs.node_dofs(b.node_a)[:2], dofs.node_dofs(b.node_b)[:2]
+        idx = np.concatenate([a, c])
+        K.add(idx, np.kron(coupling, b.K))
+        C.add(idx, np.kron(coupling, b.C))
+    Cm = C.dense(n)
+    alpha, beta = rotor.rayleigh
+    if alpha or beta:
+        Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
+    return SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs)
