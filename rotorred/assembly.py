@@ -117,6 +117,28 @@ class SystemMatrices:
         """``C + sum_s Omega_s G_s`` (N s/m), shape (n, n)."""
         return self.C + self.gyroscopic(speeds)
 
+    def physical_index(self, node: int, direction: str) -> int:
+        """Index of the physical DOF ``direction`` at ``node`` in this model's coordinates."""
+        return self.dofs.index(node, direction)
+
+    def output_rows(self, outputs) -> np.ndarray:
+        """Rows mapping model coordinates to physical DOFs.
+
+        Parameters
+        ----------
+        outputs : sequence of (int, str)
+            (node, direction) pairs.
+
+        Returns
+        -------
+        ndarray, shape (len(outputs), n)
+            ``rows @ q`` gives the physical displacements.
+        """
+        rows = np.zeros((len(outputs), self.n_dof))
+        for i, (node, direction) in enumerate(outputs):
+            rows[i, self.dofs.index(node, direction)] = 1.0
+        return rows
+
 
 class _Triplets:
     def __init__(self):
