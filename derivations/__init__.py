@@ -12,7 +12,14 @@ def _timoshenko() -> str:
     return module_text()
 
 
+def _contact() -> str:
+    from derivations.contact import module_text
+
+    return module_text()
+
+
 #: (path relative to the project root, function returning the module text)
 TARGETS: list[tuple[str, object]] = [
     ("rotorred/_generated/timoshenko.py", _timoshenko),
+    ("rotorred/_generated/contact.py", _contact),
 ]

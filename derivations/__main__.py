@@ -14,6 +14,16 @@ from pathlib import Path
 
 from derivations import TARGETS
 
+# Derivations are deterministic: within one process each module's text is computed once.
+_TEXT: dict[str, str] = {}
+
+
+def module_text(relative: str, text_fn) -> str:
+    """Text of the generated module ``relative`` (cached per process)."""
+    if relative not in _TEXT:
+        _TEXT[relative] = text_fn()
+    return _TEXT[relative]
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m derivations", description=__doc__.splitlines()[0])
@@ -24,7 +34,7 @@ def main(argv: list[str] | None = None) -> int:
     stale = []
     for relative, text_fn in TARGETS:
         path = args.root / relative
-        text = text_fn()
+        text = module_text(relative, text_fn)
         if args.check:
             if not path.exists() or path.read_text() != text:
                 stale.append(relative)

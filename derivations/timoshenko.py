@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from derivations.shape_functions import L, phi, spatial_shape_functions, z
+from derivations.shape_functions import L, hierarchical_shape_functions, phi, spatial_shape_functions, z
 
 rho, A, I, E = sp.symbols("rho A I E", positive=True)
 
@@ -33,8 +33,14 @@ def _integrate(expr: sp.Matrix) -> sp.Matrix:
     return expr.applyfunc(lambda e: sp.factor(sp.integrate(sp.expand(e), (z, 0, L))))
 
 
-def shaft_matrices() -> dict[str, sp.Matrix]:
-    """Return the 8x8 element matrices of a uniform Timoshenko shaft element.
+def shaft_matrices(formulation: str = "nelson") -> dict[str, sp.Matrix]:
+    """Return the element matrices of a uniform Timoshenko shaft element.
+
+    Parameters
+    ----------
+    formulation : {"nelson", "hierarchical"}
+        ``"nelson"``: interdependent interpolation, 8x8 (nodal DOFs only).
+        ``"hierarchical"``: cubic/quadratic interpolation with 6 internal bubble DOFs, 14x14.
 
     Returns
     -------
@@ -43,7 +49,7 @@ def shaft_matrices() -> dict[str, sp.Matrix]:
         ``"stiffness"`` (E, I, L, phi), ``"gyroscopic"`` (rho, I, L, phi), each a
         sympy.Matrix, shape (8, 8), in the DOF order (x1, y1, theta_x1, theta_y1, x2, ...).
     """
-    N = spatial_shape_functions()
+    N = spatial_shape_functions() if formulation == "nelson" else hierarchical_shape_functions()
     Nx, Ny, Ntx, Nty = N["x"], N["y"], N["theta_x"], N["theta_y"]
     M_t = rho * A * _integrate(Nx.T * Nx + Ny.T * Ny)
     M_r = rho * I * _integrate(Ntx.T * Ntx + Nty.T * Nty)
@@ -56,7 +62,8 @@ def shaft_matrices() -> dict[str, sp.Matrix]:
     kGA = 12 * E * I / (phi * L**2)
     K_b = E * I * _integrate(dpsi_xz.T * dpsi_xz + dpsi_yz.T * dpsi_yz)
     # The shear strain of the interdependent interpolation is proportional to phi, so the
-    # shear energy stays finite as phi -> 0; cancel phi before integrating.
+    # shear energy stays finite as phi -> 0; cancel phi before integrating. (The hierarchical
+    # element keeps kappa G A = 12 E I / (phi L^2): it needs phi > 0.)
     K_s = (kGA * (gamma_xz.T * gamma_xz + gamma_yz.T * gamma_yz)).applyfunc(sp.cancel)
     K = (K_b + _integrate(K_s)).applyfunc(sp.factor)
     return {
@@ -127,6 +134,25 @@ def module_text() -> str:
             " the polar moment is 2 I.\n\n"
             f"    Returns\n    -------\n    ndarray, shape (8, 8)\n        Skew-symmetric, DOF order {order}.\n",
         ),
+    ]
+    hi = shaft_matrices("hierarchical")
+    order_h = ("(x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y);"
+               " a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py)")
+    for key, args, what, unit_doc in (
+        ("mass_translational", (L, rho, A, phi), "Translational mass matrix",
+         "    rho : float\n        Density (kg/m^3).\n    A : float\n        Cross-section area (m^2).\n"),
+        ("mass_rotary", (L, rho, I, phi), "Rotary (section) inertia matrix",
+         "    rho : float\n        Density (kg/m^3).\n    I : float\n        Diametral area moment (m^4).\n"),
+        ("stiffness", (L, E, I, phi), "Bending-plus-shear stiffness matrix (phi > 0)",
+         "    E : float\n        Young's modulus (Pa).\n    I : float\n        Diametral area moment (m^4).\n"),
+        ("gyroscopic", (L, rho, I, phi), "Gyroscopic matrix per unit spin speed (1 rad/s)",
+         "    rho : float\n        Density (kg/m^3).\n    I : float\n        Diametral area moment (m^4).\n"),
+    ):
+        fns.append(GeneratedFunction(
+            f"hierarchical_{key}", args, hi[key],
+            f"{what} of the hierarchical (cubic/quadratic) Timoshenko element.\n{common}{unit_doc}\n"
+            f"    Returns\n    -------\n    ndarray, shape (14, 14)\n        DOF order {order_h}.\n"))
+    fns += [
         GeneratedFunction(
             "disk_mass", (m, I_d), dk["mass"],
             "Mass matrix of a rigid disk.\n\n    Parameters\n    ----------\n"

@@ -29,15 +29,23 @@ _DIR_ALIASES = {"x": 0, "y": 1, "theta_x": 2, "theta_y": 3, "tx": 2, "ty": 3}
 
 @dataclass(frozen=True)
 class DofMap:
-    """Global DOF numbering: 4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order.
+    """Global DOF numbering.
+
+    4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order, indices
+    ``4 * position + direction``; then the internal (bubble) DOFs of hierarchical shaft
+    elements, ``n_internal`` of them, after all nodal DOFs. Code that needs physical DOFs uses
+    :meth:`index` or :meth:`node_dofs`, never ``n_dof // 4``.
 
     Parameters
     ----------
     nodes : tuple of int
         Node numbers in DOF order.
+    n_internal : int
+        Number of internal DOFs (0 for a model of Nelson elements only).
     """
 
     nodes: tuple[int, ...]
+    n_internal: int = 0
     _pos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -46,7 +54,12 @@ class DofMap:
     @property
     def n_dof(self) -> int:
         """Number of DOFs."""
-        return 4 * len(self.nodes)
+        return 4 * len(self.nodes) + self.n_internal
+
+    @property
+    def nodal(self) -> np.ndarray:
+        """Indices of all nodal DOFs as an array, shape (n_nodes, 4): row k is node ``nodes[k]``."""
+        return np.arange(4 * len(self.nodes)).reshape(-1, 4)
 
     def node_dofs(self, node: int) -> np.ndarray:
         """Global indices of the 4 DOFs of ``node``, shape (4,)."""
@@ -62,6 +75,8 @@ class DofMap:
         """Human label of a global DOF, e.g. ``"node 18 y"``."""
         if not 0 <= dof < self.n_dof:
             raise ValueError(f"`dof` must be in [0, {self.n_dof}), got {dof}")
+        if dof >= 4 * len(self.nodes):
+            return f"internal {dof - 4 * len(self.nodes)}"
         return f"node {self.nodes[dof // 4]} {DIRECTIONS[dof % 4]}"
 
     def _node_pos(self, node: int) -> int:
@@ -170,13 +185,17 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     -------
     SystemMatrices
     """
-    dofs = DofMap(rotor.nodes)
+    n_internal = sum(e.n_internal for s in rotor.spools for e in s.elements)
+    dofs = DofMap(rotor.nodes, n_internal)
     n = dofs.n_dof
+    next_internal = 4 * len(rotor.nodes)
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
     G = {s.name: _Triplets() for s in rotor.spools}
     for s in rotor.spools:
         for e in s.elements:
-            idx = np.concatenate([dofs.node_dofs(e.left), dofs.node_dofs(e.right)])
+            internal = np.arange(next_internal, next_internal + e.n_internal)
+            next_internal += e.n_internal
+            idx = np.concatenate([dofs.node_dofs(e.left), dofs.node_dofs(e.right), internal])
             Me, Ke = e.M(), e.K()
             M.add(idx, Me)
             K.add(idx, Ke)

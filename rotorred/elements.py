@@ -18,6 +18,7 @@ import numpy as np
 from rotorred._generated import timoshenko as _gen
 
 SHEAR_METHODS = ("cowper", "hutchinson", "none")
+FORMULATIONS = ("nelson", "hierarchical")
 
 
 def _positive(name: str, value: float, unit: str = "") -> None:
@@ -120,6 +121,12 @@ class ShaftElement:
     shear : {"cowper", "hutchinson", "none"}
         Shear coefficient formula; ``"none"`` gives the Euler-Bernoulli element (phi = 0)
         with rotary inertia (Rayleigh beam).
+    element : {"nelson", "hierarchical"}
+        ``"nelson"`` (default): interdependent interpolation (Nelson 1980), 4 DOFs per node,
+        exact in statics; its constant shear strain makes eigenvalues converge as h^2 with a
+        small constant. ``"hierarchical"``: cubic displacement and quadratic rotation with 6
+        internal bubble DOFs per element (``n_internal``); eigenvalues converge as h^4. See
+        docs/model.md, "Shaft element".
     """
 
     left: int
@@ -129,6 +136,7 @@ class ShaftElement:
     D_i: float
     material: Material
     shear: str = "cowper"
+    element: str = "nelson"
 
     def __post_init__(self):
         for name in ("left", "right"):
@@ -144,6 +152,16 @@ class ShaftElement:
             raise ValueError(f"`D_i` must be smaller than `D_o` = {self.D_o!r} m, got {self.D_i!r} m")
         if self.shear not in SHEAR_METHODS:
             raise ValueError(f"`shear` must be one of {SHEAR_METHODS}, got {self.shear!r}")
+        if self.element not in FORMULATIONS:
+            raise ValueError(f"`element` must be one of {FORMULATIONS}, got {self.element!r}")
+        if self.element == "hierarchical" and self.shear == "none":
+            raise ValueError('`element` "hierarchical" needs shear flexibility; use shear="cowper" or "hutchinson" '
+                             '(or element="nelson" for an Euler-Bernoulli element)')
+
+    @property
+    def n_internal(self) -> int:
+        """Number of internal (bubble) DOFs: 0 for ``"nelson"``, 6 for ``"hierarchical"``."""
+        return 6 if self.element == "hierarchical" else 0
 
     @property
     def A(self) -> float:
@@ -176,24 +194,31 @@ class ShaftElement:
         return self.material.rho * self.A * self.L
 
     def M(self) -> np.ndarray:
-        """Mass matrix (translational + rotary), shape (8, 8) (kg, kg m, kg m^2)."""
+        """Mass matrix (translational + rotary), shape (8 + n_internal,) * 2 (kg, kg m, kg m^2)."""
         rho, phi = self.material.rho, self.phi
+        if self.element == "hierarchical":
+            return (_gen.hierarchical_mass_translational(self.L, rho, self.A, phi)
+                    + _gen.hierarchical_mass_rotary(self.L, rho, self.I, phi))
         return (_gen.timoshenko_mass_translational(self.L, rho, self.A, phi)
                 + _gen.timoshenko_mass_rotary(self.L, rho, self.I, phi))
 
     def K(self) -> np.ndarray:
-        """Stiffness matrix, shape (8, 8) (N/m, N, N m)."""
+        """Stiffness matrix, shape (8 + n_internal,) * 2 (N/m, N, N m)."""
+        if self.element == "hierarchical":
+            return _gen.hierarchical_stiffness(self.L, self.material.E, self.I, self.phi)
         return _gen.timoshenko_stiffness(self.L, self.material.E, self.I, self.phi)
 
     def G(self) -> np.ndarray:
-        """Gyroscopic matrix per unit spin speed, shape (8, 8) (kg m^2 per rad)."""
+        """Gyroscopic matrix per unit spin speed, shape (8 + n_internal,) * 2 (kg m^2 per rad)."""
+        if self.element == "hierarchical":
+            return _gen.hierarchical_gyroscopic(self.L, self.material.rho, self.I, self.phi)
         return _gen.timoshenko_gyroscopic(self.L, self.material.rho, self.I, self.phi)
 
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1)."""
         chain = [self.left, *new_nodes, self.right]
-        return [ShaftElement(chain[i], chain[i + 1], self.L / n, self.D_o, self.D_i, self.material, self.shear)
-                for i in range(n)]
+        return [ShaftElement(chain[i], chain[i + 1], self.L / n, self.D_o, self.D_i, self.material, self.shear,
+                             self.element) for i in range(n)]
 
 
 @dataclass(frozen=True)

@@ -278,6 +278,266 @@ def timoshenko_gyroscopic(L, rho, I, phi):
     return out
 
 
+def hierarchical_mass_translational(L, rho, A, phi):
+    """Translational mass matrix of the hierarchical (cubic/quadratic) Timoshenko element.
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    rho : float
+        Density (kg/m^3).
+    A : float
+        Cross-section area (m^2).
+
+    Returns
+    -------
+    ndarray, shape (14, 14)
+        DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y); a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py).
+    """
+    _t0 = A*L*rho
+    _t1 = ((1.0/3.0))*_t0
+    _t2 = ((1.0/6.0))*_t0
+    _t3 = ((1.0/12.0))*_t0
+    _t4 = ((1.0/60.0))*_t0
+    _t5 = -_t4
+    _t6 = ((1.0/30.0))*_t0
+    _t7 = ((1.0/210.0))*_t0
+    out = np.zeros((14, 14))
+    out[0, 0] = _t1
+    out[0, 4] = _t2
+    out[0, 8] = _t3
+    out[0, 9] = _t4
+    out[1, 1] = _t1
+    out[1, 5] = _t2
+    out[1, 10] = _t3
+    out[1, 11] = _t4
+    out[4, 0] = _t2
+    out[4, 4] = _t1
+    out[4, 8] = _t3
+    out[4, 9] = _t5
+    out[5, 1] = _t2
+    out[5, 5] = _t1
+    out[5, 10] = _t3
+    out[5, 11] = _t5
+    out[8, 0] = _t3
+    out[8, 4] = _t3
+    out[8, 8] = _t6
+    out[9, 0] = _t4
+    out[9, 4] = _t5
+    out[9, 9] = _t7
+    out[10, 1] = _t3
+    out[10, 5] = _t3
+    out[10, 10] = _t6
+    out[11, 1] = _t4
+    out[11, 5] = _t5
+    out[11, 11] = _t7
+    return out
+
+
+def hierarchical_mass_rotary(L, rho, I, phi):
+    """Rotary (section) inertia matrix of the hierarchical (cubic/quadratic) Timoshenko element.
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    rho : float
+        Density (kg/m^3).
+    I : float
+        Diametral area moment (m^4).
+
+    Returns
+    -------
+    ndarray, shape (14, 14)
+        DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y); a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py).
+    """
+    _t0 = I*L*rho
+    _t1 = ((1.0/3.0))*_t0
+    _t2 = ((1.0/6.0))*_t0
+    _t3 = ((1.0/12.0))*_t0
+    _t4 = ((1.0/30.0))*_t0
+    out = np.zeros((14, 14))
+    out[2, 2] = _t1
+    out[2, 6] = _t2
+    out[2, 12] = _t3
+    out[3, 3] = _t1
+    out[3, 7] = _t2
+    out[3, 13] = _t3
+    out[6, 2] = _t2
+    out[6, 6] = _t1
+    out[6, 12] = _t3
+    out[7, 3] = _t2
+    out[7, 7] = _t1
+    out[7, 13] = _t3
+    out[12, 2] = _t3
+    out[12, 6] = _t3
+    out[12, 12] = _t4
+    out[13, 3] = _t3
+    out[13, 7] = _t3
+    out[13, 13] = _t4
+    return out
+
+
+def hierarchical_stiffness(L, E, I, phi):
+    """Bending-plus-shear stiffness matrix (phi > 0) of the hierarchical (cubic/quadratic) Timoshenko element.
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    E : float
+        Young's modulus (Pa).
+    I : float
+        Diametral area moment (m^4).
+
+    Returns
+    -------
+    ndarray, shape (14, 14)
+        DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y); a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py).
+    """
+    _t0 = E*I/phi
+    _t1 = _t0/L**3.0
+    _t2 = 12.0*_t1
+    _t3 = _t0/L**2.0
+    _t4 = 6.0*_t3
+    _t5 = -_t2
+    _t6 = 2.0*_t3
+    _t7 = -_t4
+    _t8 = -_t6
+    _t9 = _t0/L
+    _t10 = _t9*(phi + 4.0)
+    _t11 = -_t9*(phi - 2.0)
+    _t12 = 4.0*_t1
+    _t13 = ((12.0/5.0))*_t1
+    _t14 = ((2.0/5.0))*_t3
+    _t15 = -_t14
+    _t16 = ((1.0/15.0))*_t9*(5.0*phi + 6.0)
+    out = np.zeros((14, 14))
+    out[0, 0] = _t2
+    out[0, 3] = _t4
+    out[0, 4] = _t5
+    out[0, 7] = _t4
+    out[0, 13] = _t6
+    out[1, 1] = _t2
+    out[1, 2] = _t7
+    out[1, 5] = _t5
+    out[1, 6] = _t7
+    out[1, 12] = _t8
+    out[2, 1] = _t7
+    out[2, 2] = _t10
+    out[2, 5] = _t4
+    out[2, 6] = _t11
+    out[2, 10] = _t6
+    out[2, 12] = _t9
+    out[3, 0] = _t4
+    out[3, 3] = _t10
+    out[3, 4] = _t7
+    out[3, 7] = _t11
+    out[3, 8] = _t8
+    out[3, 13] = _t9
+    out[4, 0] = _t5
+    out[4, 3] = _t7
+    out[4, 4] = _t2
+    out[4, 7] = _t7
+    out[4, 13] = _t8
+    out[5, 1] = _t5
+    out[5, 2] = _t4
+    out[5, 5] = _t2
+    out[5, 6] = _t4
+    out[5, 12] = _t6
+    out[6, 1] = _t7
+    out[6, 2] = _t11
+    out[6, 5] = _t4
+    out[6, 6] = _t10
+    out[6, 10] = _t8
+    out[6, 12] = _t9
+    out[7, 0] = _t4
+    out[7, 3] = _t11
+    out[7, 4] = _t7
+    out[7, 7] = _t10
+    out[7, 8] = _t6
+    out[7, 13] = _t9
+    out[8, 3] = _t8
+    out[8, 7] = _t6
+    out[8, 8] = _t12
+    out[9, 9] = _t13
+    out[9, 13] = _t14
+    out[10, 2] = _t6
+    out[10, 6] = _t8
+    out[10, 10] = _t12
+    out[11, 11] = _t13
+    out[11, 12] = _t15
+    out[12, 1] = _t8
+    out[12, 2] = _t9
+    out[12, 5] = _t6
+    out[12, 6] = _t9
+    out[12, 11] = _t15
+    out[12, 12] = _t16
+    out[13, 0] = _t6
+    out[13, 3] = _t9
+    out[13, 4] = _t8
+    out[13, 7] = _t9
+    out[13, 9] = _t14
+    out[13, 13] = _t16
+    return out
+
+
+def hierarchical_gyroscopic(L, rho, I, phi):
+    """Gyroscopic matrix per unit spin speed (1 rad/s) of the hierarchical (cubic/quadratic) Timoshenko element.
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    rho : float
+        Density (kg/m^3).
+    I : float
+        Diametral area moment (m^4).
+
+    Returns
+    -------
+    ndarray, shape (14, 14)
+        DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y); a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py).
+    """
+    _t0 = I*L*rho
+    _t1 = ((2.0/3.0))*_t0
+    _t2 = ((1.0/3.0))*_t0
+    _t3 = ((1.0/6.0))*_t0
+    _t4 = -_t1
+    _t5 = -_t2
+    _t6 = -_t3
+    _t7 = ((1.0/15.0))*_t0
+    out = np.zeros((14, 14))
+    out[2, 3] = _t1
+    out[2, 7] = _t2
+    out[2, 13] = _t3
+    out[3, 2] = _t4
+    out[3, 6] = _t5
+    out[3, 12] = _t6
+    out[6, 3] = _t2
+    out[6, 7] = _t1
+    out[6, 13] = _t3
+    out[7, 2] = _t5
+    out[7, 6] = _t4
+    out[7, 12] = _t6
+    out[12, 3] = _t3
+    out[12, 7] = _t3
+    out[12, 13] = _t7
+    out[13, 2] = _t6
+    out[13, 6] = _t6
+    out[13, 12] = -_t7
+    return out
+
+
 def disk_mass(m, I_d):
     """Mass matrix of a rigid disk.
 

@@ -1,0 +1,200 @@
+"""Invariants of the generated Timoshenko shaft element and rigid disk."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rotorred._generated import timoshenko as gen
+from rotorred.elements import Disk, Material, ShaftElement, shear_coefficient
+
+STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
+
+# (L, D_o, D_i): slender solid, stubby solid (large phi), thin tube
+SECTIONS = [(0.1, 0.02, 0.0), (0.02, 0.06, 0.0), (0.05, 0.065, 0.055)]
+
+
+@pytest.fixture(params=[(s, f) for f in ("nelson", "hierarchical") for s in SECTIONS],
+                ids=[f"{f}-{n}" for f in ("nelson", "hierarchical") for n in ("slender", "stubby", "tube")])
+def element(request):
+    (L, D_o, D_i), formulation = request.param
+    return ShaftElement(1, 2, L, D_o, D_i, STEEL, element=formulation)
+
+
+def rigid_body_vectors(L, n_internal=0):
+    """Translations in x and y, rotations about x and y, in element DOFs (bubbles at rest:
+    both interpolations hold every rigid motion with zero internal amplitudes)."""
+    pad = [0.0] * n_internal
+    tx = np.array([1, 0, 0, 0, 1, 0, 0, 0] + pad, float)
+    ty = np.array([0, 1, 0, 0, 0, 1, 0, 0] + pad, float)
+    # rotation about y by 1 rad: x = z, theta_y = 1 ; about x: y = -z, theta_x = 1
+    ry = np.array([0, 0, 0, 1, L, 0, 0, 1] + pad, float)
+    rx = np.array([0, 0, 1, 0, 0, -L, 1, 0] + pad, float)
+    return [tx, ty, rx, ry]
+
+
+def test_symmetry_and_skewness(element):
+    M, K, G = element.M(), element.K(), element.G()
+    scale = np.abs(M).max(), np.abs(K).max(), np.abs(G).max()
+    assert np.allclose(M, M.T, rtol=0, atol=1e-14 * scale[0])
+    assert np.allclose(K, K.T, rtol=0, atol=1e-14 * scale[1])
+    assert np.allclose(G, -G.T, rtol=0, atol=1e-14 * scale[2])
+    assert np.abs(G).max() > 0
+
+
+def test_mass_positive_definite(element):
+    assert np.linalg.eigvalsh(element.M()).min() > 0
+
+
+def test_rigid_body_modes_in_null_space(element):
+    K = element.K()
+    for r in rigid_body_vectors(element.L, element.n_internal):
+        # round-off of an 8x8 product of entries up to |K|max: 1e-12 relative
+        assert np.abs(K @ r).max() < 1e-12 * np.abs(K).max() * max(1.0, element.L)
+
+
+def test_stiffness_has_exactly_four_rigid_modes(element):
+    ev = np.linalg.eigvalsh(element.K())
+    assert np.sum(np.abs(ev) < 1e-10 * ev.max()) == 4
+
+
+def test_translation_mass_is_rho_A_L(element):
+    M = element.M()
+    for r in rigid_body_vectors(element.L, element.n_internal)[:2]:
+        assert r @ M @ r == pytest.approx(element.mass, rel=1e-13)
+
+
+@pytest.mark.parametrize("formulation", ["nelson", "hierarchical"])
+def test_rigid_rotation_inertia(formulation):
+    # A rigid rotation about the element's left end: r^T M r = rho A L^3 / 3 + rho I L
+    # (translational second moment plus the rotary inertia of the sections).
+    e = ShaftElement(1, 2, 0.1, 0.03, 0.01, STEEL, element=formulation)
+    for r in rigid_body_vectors(e.L, e.n_internal)[2:]:
+        expected = STEEL.rho * e.A * e.L**3 / 3 + STEEL.rho * e.I * e.L
+        assert r @ e.M() @ r == pytest.approx(expected, rel=1e-12)
+
+
+def test_euler_bernoulli_limit():
+    """phi = 0 gives the textbook consistent Euler-Bernoulli matrices (Przemieniecki 1968)."""
+    L, rho, A, E, I = 0.3, 7800.0, 2e-4, 2e11, 3e-9
+    Mt = gen.timoshenko_mass_translational(L, rho, A, 0.0)
+    Mr = gen.timoshenko_mass_rotary(L, rho, I, 0.0)
+    K = gen.timoshenko_stiffness(L, E, I, 0.0)
+    # x-z plane DOFs (x1, theta_y1, x2, theta_y2) = indices (0, 3, 4, 7)
+    xz = np.ix_([0, 3, 4, 7], [0, 3, 4, 7])
+    Mt_eb = rho * A * L / 420 * np.array([[156, 22 * L, 54, -13 * L], [22 * L, 4 * L**2, 13 * L, -3 * L**2],
+                                          [54, 13 * L, 156, -22 * L], [-13 * L, -3 * L**2, -22 * L, 4 * L**2]])
+    Mr_eb = rho * I / (30 * L) * np.array([[36, 3 * L, -36, 3 * L], [3 * L, 4 * L**2, -3 * L, -L**2],
+                                           [-36, -3 * L, 36, -3 * L], [3 * L, -L**2, -3 * L, 4 * L**2]])
+    K_eb = E * I / L**3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L**2, -6 * L, 2 * L**2],
+                                    [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L**2, -6 * L, 4 * L**2]])
+    np.testing.assert_allclose(Mt[xz], Mt_eb, rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(Mr[xz], Mr_eb, rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(K[xz], K_eb, rtol=1e-13, atol=1e-6)
+    # y-z plane: (y, -theta_x) behaves as (x, theta_y)
+    S = np.diag([1.0, -1.0, 1.0, -1.0])
+    yz = np.ix_([1, 2, 5, 6], [1, 2, 5, 6])
+    np.testing.assert_allclose(S @ K[yz] @ S, K_eb, rtol=1e-13, atol=1e-6)
+    np.testing.assert_allclose(S @ Mt[yz] @ S, Mt_eb, rtol=1e-13, atol=1e-16)
+
+
+def test_small_phi_converges_to_euler_bernoulli():
+    L, E, I = 0.3, 2e11, 3e-9
+    K0 = gen.timoshenko_stiffness(L, E, I, 0.0)
+    errs = [np.abs(gen.timoshenko_stiffness(L, E, I, p) - K0).max() for p in (1e-2, 1e-3, 1e-4)]
+    assert errs[0] > errs[1] > errs[2] and errs[2] < 1e-3 * np.abs(K0).max()
+
+
+@pytest.mark.parametrize("formulation", ["nelson", "hierarchical"])
+def test_cantilever_tip_deflection_is_exact_timoshenko(formulation):
+    """One element reproduces the exact static Timoshenko cantilever (both interpolations hold
+    the exact static solution, a cubic w with quadratic psi):
+    delta = P L^3 / (3 E I) + P L / (kappa G A) (shear adds the second term)."""
+    e = ShaftElement(1, 2, 0.05, 0.06, 0.02, STEEL, element=formulation)
+    K = e.K()
+    free = [4, 7] + list(range(8, 8 + e.n_internal))  # x2, theta_y2 and bubbles (node 1 clamped)
+    P = 1000.0
+    f = np.zeros(len(free))
+    f[0] = P
+    u = np.linalg.solve(K[np.ix_(free, free)], f)
+    exact = P * e.L**3 / (3 * STEEL.E * e.I) + P * e.L / (e.kappa * STEEL.G_s * e.A)
+    assert u[0] == pytest.approx(exact, rel=1e-12)
+    # and shear matters here (stubby element): more than 5 % of the deflection
+    assert P * e.L / (e.kappa * STEEL.G_s * e.A) > 0.05 * exact
+
+
+def test_gyroscopic_coupling_of_rigid_tilt_is_polar_inertia(element):
+    """For the rigid rotations r_x, r_y the section rotations are uniform (theta_x = 1, resp.
+    theta_y = 1, exactly, as the interdependent interpolation contains every rigid motion), so
+    r_x^T G r_y = int 2 rho I dz = 2 rho I L: the element's polar inertia, as I_p for a disk."""
+    _, _, rx, ry = rigid_body_vectors(element.L, element.n_internal)
+    polar = 2 * element.material.rho * element.I * element.L
+    assert rx @ element.G() @ ry == pytest.approx(polar, rel=1e-12)
+    assert ry @ element.G() @ rx == pytest.approx(-polar, rel=1e-12)
+
+
+def test_disk_matrices():
+    d = Disk(3, m=2.0, I_d=0.01, I_p=0.02)
+    np.testing.assert_array_equal(d.M(), np.diag([2.0, 2.0, 0.01, 0.01]))
+    G = d.G()
+    assert G[2, 3] == 0.02 and G[3, 2] == -0.02 and np.count_nonzero(G) == 2
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
+def test_shear_coefficients(nu):
+    # Solid circle: Cowper 6(1+nu)/(7+6nu), Hutchinson 6(1+nu)^2/(7+12nu+4nu^2) (published closed forms).
+    assert shear_coefficient(1.0, 0.0, nu, "cowper") == pytest.approx(6 * (1 + nu) / (7 + 6 * nu), rel=1e-15)
+    assert shear_coefficient(1.0, 0.0, nu, "hutchinson") == pytest.approx(
+        6 * (1 + nu) ** 2 / (7 + 12 * nu + 4 * nu**2), rel=1e-15)
+    # Thin-walled tube limit (D_i -> D_o): Cowper 2(1+nu)/(4+3nu)
+    assert shear_coefficient(1.0, 1.0 - 1e-9, nu, "cowper") == pytest.approx(2 * (1 + nu) / (4 + 3 * nu), rel=1e-8)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
+@pytest.mark.parametrize("ratio", [0.0, 0.4, 0.8, 0.99])
+def test_hutchinson_against_cowper(nu, ratio):
+    """Both formulas coincide at nu = 0 (Hutchinson 2001, Sec. 5) and differ by under 10 % up to
+    nu = 0.45. ROSS's line drops the (1+nu)^2 factor, which would put it 1.69x lower at nu = 0.3
+    and fail this comparison."""
+    k_h = shear_coefficient(1.0, ratio, nu, "hutchinson")
+    k_c = shear_coefficient(1.0, ratio, nu, "cowper")
+    if nu == 0.0:
+        assert k_h == pytest.approx(k_c, rel=1e-14)
+    else:
+        assert 1.0 < k_h / k_c < 1.10
+
+
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        (dict(L=-0.1), "`L`"),
+        (dict(L=0.0), "`L`"),
+        (dict(D_i=0.05), "`D_i`"),
+        (dict(D_i=0.06), "`D_i`"),
+        (dict(D_o=float("nan")), "`D_o`"),
+        (dict(shear="reissner"), "`shear`"),
+        (dict(right=1), "`left` and `right`"),
+        (dict(element="p5"), "`element`"),
+        (dict(element="hierarchical", shear="none"), "`element`"),
+    ],
+)
+def test_bad_shaft_element(kwargs, field):
+    base = dict(left=1, right=2, L=0.1, D_o=0.05, D_i=0.0, material=STEEL)
+    base.update(kwargs)
+    with pytest.raises(ValueError, match=field):
+        ShaftElement(**base)
+
+
+@pytest.mark.parametrize("kwargs, field", [(dict(rho=-1.0), "`rho`"), (dict(E=0.0), "`E`"), (dict(nu=0.6), "`nu`")])
+def test_bad_material(kwargs, field):
+    base = dict(name="s", E=2e11, rho=7800.0, nu=0.3)
+    base.update(kwargs)
+    with pytest.raises(ValueError, match=field):
+        Material(**base)
+
+
+def test_phi_definition():
+    e = ShaftElement(1, 2, 0.1, 0.05, 0.01, STEEL)
+    assert e.phi == pytest.approx(12 * STEEL.E * e.I / (e.kappa * STEEL.G_s * e.A * e.L**2), rel=1e-15)
+    assert ShaftElement(1, 2, 0.1, 0.05, 0.01, STEEL, shear="none").phi == 0.0
+    assert math.isclose(e.A, math.pi * (0.05**2 - 0.01**2) / 4)
