@@ -1,0 +1,323 @@
+"""Plot helpers for waveforms, spectra and orbits (matplotlib, Agg; plain arrays in).
+
+Every helper takes SI arrays (s, m, Hz), plots displacements in µm by default
+(``scale=1e6``, ``unit="µm"``), writes one file and returns its path. Figures are built
+with :class:`matplotlib.figure.Figure` (no pyplot state, no GUI; ``savefig`` renders with
+Agg), so the helpers are safe in scripts, tests and threads.
+
+Data may be one panel or several:
+
+* one panel: ``{"normal": y1, "rub": y2}``;
+* several panels (stacked, or side by side for orbits):
+  ``{"node 13 (inner)": {"normal": y1, "rub": y2}, "node 14 (outer)": {...}}``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from .lines import SpectralLine
+from .spectra import Spectrum
+
+__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits"]
+
+
+# --------------------------------------------------------------------------- helpers
+def _panels(data, what: str) -> dict[str, dict[str, object]]:
+    """Normalise one-panel or multi-panel mappings to {panel title: {label: item}}."""
+    if not isinstance(data, Mapping) or not data:
+        raise ValueError(f"`{what}` must be a non-empty mapping label -> data, got {data!r:.80}")
+    nested = [isinstance(v, Mapping) for v in data.values()]
+    if all(nested):
+        out = {}
+        for title, series in data.items():
+            if not series:
+                raise ValueError(f"`{what}` panel {title!r} is empty")
+            out[str(title)] = dict(series)
+        return out
+    if any(nested):
+        raise ValueError(f"`{what}` mixes panels (mappings) and series; use one form")
+    return {"": dict(data)}
+
+
+def _check_scale(scale) -> float:
+    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
+        raise ValueError(f"`scale` must be a positive finite number, got {scale!r}")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"`scale` must be a positive finite number, got {scale!r}")
+    return float(scale)
+
+
+def _vector(name: str, y, n: int | None = None) -> np.ndarray:
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 1 or y.size < 2:
+        raise ValueError(f"`{name}` must be a 1-D array of at least 2 samples, got shape {y.shape}")
+    if n is not None and y.size != n:
+        raise ValueError(f"`{name}` has {y.size} samples, expected {n} (the length of `t`)")
+    return y
+
+
+def _path(path) -> Path:
+    p = Path(path)
+    if not p.suffix:
+        raise ValueError(f"`path` must have a file extension (e.g. .png), got {str(path)!r}")
+    p.parent.mkdir(parents=True, exist_ok=True)
+    return p
+
+
+def _save(fig: Figure, path: Path, title: str | None) -> Path:
+    if title:
+        fig.suptitle(title)
+    fig.savefig(path, dpi=120)
+    return path
+
+
+# --------------------------------------------------------------------------- waveforms
+def plot_waveforms(
+    t,
+    signals,
+    path,
+    *,
+    title: str | None = None,
+    t_window: tuple[float, float] | None = None,
+    scale: float = 1e6,
+    unit: str = "µm",
+    quantity: str = "Displacement",
+) -> Path:
+    """Time histories, one panel per group, sharing the time axis.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Time (s).
+    signals : mapping
+        ``{label: y}`` or ``{panel title: {label: y}}``, each ``y`` shape (n,) in SI (m).
+    path : str or Path
+        Output file (the extension picks the format, e.g. .png).
+    title : str, optional
+        Figure title.
+    t_window : (float, float), optional
+        Time range shown (s), e.g. the paper's (2.44, 2.58).
+    scale, unit : float, str
+        Plotted values are ``scale * y`` in ``unit`` (default µm from m).
+    quantity : str
+        Name on the y axis.
+
+    Returns
+    -------
+    Path
+    """
+    t = _vector("t", t)
+    scale = _check_scale(scale)
+    panels = _panels(signals, "signals")
+    if t_window is not None:
+        lo, hi = (float(v) for v in t_window)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ValueError(f"`t_window` must be (start, end) with start < end (s), got {t_window!r}")
+        keep = (t >= lo) & (t <= hi)
+        if keep.sum() < 2:
+            raise ValueError(f"`t_window`={t_window!r} holds fewer than 2 samples of `t`")
+    else:
+        keep = np.ones(t.size, dtype=bool)
+    path = _path(path)
+    fig = Figure(figsize=(9, 2.6 * len(panels) + 0.8), layout="constrained")
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, (panel, series) in zip(axes, panels.items()):
+        for label, y in series.items():
+            y = _vector(f"signals[{label!r}]", y, t.size)
+            ax.plot(t[keep], scale * y[keep], lw=1.0, label=str(label))
+        ax.set_ylabel(f"{quantity} ({unit})")
+        if panel:
+            ax.set_title(panel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("Time (s)")
+    axes[-1].set_xlim(t[keep][0], t[keep][-1])
+    return _save(fig, path, title)
+
+
+# --------------------------------------------------------------------------- spectra
+def _spectrum_arrays(name: str, item) -> tuple[np.ndarray, np.ndarray]:
+    if isinstance(item, Spectrum):
+        return np.asarray(item.frequencies, float), np.asarray(item.amplitudes, float)
+    if isinstance(item, Sequence) and len(item) == 2:
+        f = _vector(f"{name} frequencies", item[0])
+        a = _vector(f"{name} amplitudes", item[1], f.size)
+        return f, a
+    raise ValueError(
+        f"`spectra[{name!r}]` must be a Spectrum or (frequencies Hz, amplitudes), "
+        f"got {type(item).__name__}"
+    )
+
+
+def plot_spectra(
+    spectra,
+    path,
+    *,
+    lines: Mapping[str, Sequence[SpectralLine]] | None = None,
+    title: str | None = None,
+    f_max: float | None = None,
+    log_y: bool = False,
+    dynamic_range: float = 1e6,
+    scale: float = 1e6,
+    unit: str = "µm",
+) -> Path:
+    """Single-sided amplitude spectra, optionally with combination labels at the peaks.
+
+    Parameters
+    ----------
+    spectra : mapping
+        ``{label: spectrum}`` or ``{panel title: {label: spectrum}}``; a spectrum is a
+        :class:`rotorred.spectra.Spectrum` or a pair ``(frequencies (Hz), amplitudes (m))``.
+    path : str or Path
+        Output file.
+    lines : mapping, optional
+        ``{label: [SpectralLine, ...]}`` (from :func:`rotorred.lines.label_lines`) for the
+        series of the same label; each known line is marked and labelled ("2f_H−f_L").
+    title : str, optional
+    f_max : float, optional
+        Upper frequency shown (Hz); default: the largest labelled line plus 10 %, or all.
+    log_y : bool
+        Logarithmic amplitude axis (as the paper's Fig. 11).
+    dynamic_range : float
+        With ``log_y``, the axis spans ``max / dynamic_range`` to ``max`` (rounding-level
+        bins of an exact on-bin spectrum would otherwise stretch it to 1e-20).
+    scale, unit : float, str
+        Plotted amplitudes are ``scale * amplitude`` in ``unit`` (default µm from m).
+
+    Returns
+    -------
+    Path
+    """
+    scale = _check_scale(scale)
+    panels = _panels(spectra, "spectra")
+    lines = {} if lines is None else dict(lines)
+    if not (math.isfinite(dynamic_range) and dynamic_range > 1):
+        raise ValueError(f"`dynamic_range` must be a finite number > 1, got {dynamic_range!r}")
+    all_labels = {str(k) for series in panels.values() for k in series}
+    for key in lines:
+        if str(key) not in all_labels:
+            raise ValueError(f"`lines` key {key!r} is not a series of `spectra` ({sorted(all_labels)})")
+    if f_max is None:
+        known = [ln.frequency_hz for seq in lines.values() for ln in seq if ln.known]
+        f_max = 1.1 * max(known) if known else None
+    elif not (math.isfinite(f_max) and f_max > 0):
+        raise ValueError(f"`f_max` must be a positive finite frequency (Hz), got {f_max!r}")
+    path = _path(path)
+    fig = Figure(figsize=(10, 3.4 * len(panels) + 0.8), layout="constrained")
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, (panel, series) in zip(axes, panels.items()):
+        top = 0.0
+        n_series = len(series)
+        for i, (label, item) in enumerate(series.items()):
+            f, a = _spectrum_arrays(str(label), item)
+            show = f <= f_max if f_max is not None else np.ones(f.size, bool)
+            # Earlier series are drawn wider, so a line shared by "normal" and "rub" shows
+            # both colours instead of the later one hiding the earlier.
+            lw = 0.9 + 1.6 * (n_series - 1 - i)
+            (handle,) = ax.plot(f[show], scale * a[show], lw=lw, label=str(label))
+            top = max(top, float(np.max(scale * a[show][f[show] > 0], initial=0.0)))
+            for ln in lines.get(str(label), ()):
+                if not ln.known or (f_max is not None and ln.frequency_hz > f_max):
+                    continue
+                y = scale * ln.amplitude
+                ax.plot(ln.frequency_hz, y, "v", ms=4, color=handle.get_color())
+                ax.annotate(
+                    ln.label_math, (ln.frequency_hz, y), xytext=(0, 6),
+                    textcoords="offset points", rotation=90, ha="center", va="bottom",
+                    fontsize=8, color=handle.get_color(),
+                )
+        if log_y:
+            ax.set_yscale("log")
+            ax.set_ylim(top / dynamic_range, top * 30)  # headroom for rotated labels
+        else:
+            ax.set_ylim(0, top * 1.35 if top > 0 else 1)
+        ax.set_ylabel(f"Amplitude ({unit})")
+        if panel:
+            ax.set_title(panel)
+        ax.grid(True, alpha=0.3, which="both" if not log_y else "major")
+        ax.legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("Frequency (Hz)")
+    axes[-1].set_xlim(0, f_max if f_max is not None else None)
+    return _save(fig, path, title)
+
+
+# --------------------------------------------------------------------------- orbits
+def plot_orbits(
+    orbits,
+    path,
+    *,
+    title: str | None = None,
+    clearance: float | Mapping[str, float] | None = None,
+    scale: float = 1e6,
+    unit: str = "µm",
+) -> Path:
+    """Orbits (y against x) with equal axes, e.g. normal and rub overlaid.
+
+    Parameters
+    ----------
+    orbits : mapping
+        ``{label: (x, y)}`` or ``{panel title: {label: (x, y)}}``; ``x``, ``y`` shape (n,)
+        in SI (m). Panels are placed side by side.
+    path : str or Path
+        Output file.
+    title : str, optional
+    clearance : float or mapping, optional
+        Radial clearance (m), drawn as a dashed circle about the origin: one value for every
+        panel, or ``{panel title: radius}`` (e.g. only for the rubbing node).
+    scale, unit : float, str
+        Plotted values are ``scale * x`` in ``unit`` (default µm from m).
+
+    Returns
+    -------
+    Path
+    """
+    scale = _check_scale(scale)
+    panels = _panels(orbits, "orbits")
+    if clearance is None:
+        clearances = {}
+    elif isinstance(clearance, Mapping):
+        unknown = set(map(str, clearance)) - set(panels)
+        if unknown:
+            raise ValueError(f"`clearance` keys {sorted(unknown)} are not panels of `orbits`")
+        clearances = {str(k): v for k, v in clearance.items()}
+    else:
+        clearances = {panel: clearance for panel in panels}
+    for panel, radius in clearances.items():
+        if isinstance(radius, bool) or not isinstance(radius, (int, float, np.floating)) or not (
+            math.isfinite(radius) and radius > 0
+        ):
+            raise ValueError(f"`clearance` must be a positive finite radius (m), got {radius!r}")
+    path = _path(path)
+    n = len(panels)
+    fig = Figure(figsize=(4.6 * n + 0.4, 5.0), layout="constrained")
+    axes = fig.subplots(1, n, squeeze=False)[0]
+    for ax, (panel, series) in zip(axes, panels.items()):
+        for label, xy in series.items():
+            if not (isinstance(xy, Sequence) and len(xy) == 2):
+                raise ValueError(f"`orbits[{label!r}]` must be a pair (x, y), got {type(xy).__name__}")
+            x = _vector(f"orbits[{label!r}] x", xy[0])
+            y = _vector(f"orbits[{label!r}] y", xy[1], x.size)
+            ax.plot(scale * x, scale * y, lw=0.9, label=str(label))
+        radius = clearances.get(panel)
+        if radius is not None:
+            ax.add_patch(
+                Circle((0, 0), scale * radius, fill=False, ls="--", lw=1.0, color="0.4",
+                       label=f"clearance {scale * radius:.3g} {unit}")
+            )
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel(f"X ({unit})")
+        ax.set_ylabel(f"Y ({unit})")
+        ax.axhline(0, color="0.8", lw=0.6, zorder=0)
+        ax.axvline(0, color="0.8", lw=0.6, zorder=0)
+        if panel:
+            ax.set_title(panel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    return _save(fig, path, title)

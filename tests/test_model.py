@@ -1,0 +1,142 @@
+"""Rotor model, DOF map and assembly invariants."""
+
+import numpy as np
+import pytest
+
+from rotorred.assembly import assemble
+from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.io import load_rotor
+from rotorred.model import Rotor, Spool
+
+STEEL = Material("steel", 2.1e11, 7850.0, 0.3)
+
+
+@pytest.fixture(scope="module")
+def rig():
+    return load_rotor("seed-rig")
+
+
+def test_rig_topology(rig):
+    assert rig.spool("inner").nodes == tuple(range(1, 14))
+    assert rig.spool("outer").nodes == tuple(range(14, 21))
+    assert sorted(d.node for d in rig.disks) == [3, 11, 16, 18]
+    assert sorted(b.node for b in rig.bearings) == [1, 13, 14]
+    (ib,) = rig.intershaft_bearings
+    assert {ib.node_a, ib.node_b} == {20, 9}
+    # the inter-shaft bearing joins two nodes at the same axial position
+    assert rig.positions[20] == pytest.approx(rig.positions[9])
+    assert rig.speeds["inner"] == pytest.approx(2 * np.pi * 70)
+    assert rig.speeds["outer"] == pytest.approx(2 * np.pi * 90)
+    assert rig.disk_at(18).radius > 0
+
+
+def test_assembled_invariants(rig):
+    S = assemble(rig)
+    assert np.allclose(S.M, S.M.T, atol=1e-14 * np.abs(S.M).max())
+    assert np.allclose(S.K, S.K.T, atol=1e-14 * np.abs(S.K).max())
+    assert np.allclose(S.C, S.C.T)
+    for G in S.G.values():
+        assert np.allclose(G, -G.T, atol=1e-14 * np.abs(G).max())
+    assert np.linalg.eigvalsh(S.M).min() > 0
+    assert np.linalg.eigvalsh(S.K).min() > 0  # supported: no rigid-body mode left
+    # total translational mass: u = unit x translation of every node
+    u = np.zeros(S.n_dof)
+    u[S.dofs.nodal[:, 0]] = 1.0
+    assert u @ S.M @ u == pytest.approx(rig.mass, rel=1e-12)
+
+
+def test_gyroscopic_per_spool_lives_on_its_spool(rig):
+    S = assemble(rig)
+    inner = np.concatenate([S.dofs.node_dofs(n) for n in rig.spool("inner").nodes])
+    outer = np.concatenate([S.dofs.node_dofs(n) for n in rig.spool("outer").nodes])
+    assert np.abs(S.G["inner"][np.ix_(outer, outer)]).max() == 0
+    assert np.abs(S.G["outer"][np.ix_(inner, inner)]).max() == 0
+    speeds = {"inner": 100.0, "outer": 250.0}
+    np.testing.assert_allclose(S.gyroscopic(speeds), 100.0 * S.G["inner"] + 250.0 * S.G["outer"])
+
+
+def test_free_rotor_rigid_modes_in_null_space_of_K():
+    """Without bearings, the four rigid motions (two translations, two tilts) of a spool are
+    in the null space of K, also across an inter-shaft bearing when both spools move together."""
+    rig = load_rotor("seed-rig")
+    free = Rotor(rig.spools, rig.disks, (), rig.intershaft_bearings)
+    S = assemble(free)
+    z = free.positions
+    for direction in ("x", "y"):
+        u = np.zeros(S.n_dof)
+        for n in free.nodes:
+            u[S.dofs.index(n, direction)] = 1.0
+        assert np.abs(S.K @ u).max() < 1e-6 * np.abs(S.K).max()
+    tilt = np.zeros(S.n_dof)  # rotation about y by 1 rad: x = z, theta_y = 1
+    for n in free.nodes:
+        tilt[S.dofs.index(n, "x")] = z[n]
+        tilt[S.dofs.index(n, "theta_y")] = 1.0
+    assert np.abs(S.K @ tilt).max() < 1e-6 * np.abs(S.K).max()
+
+
+def test_refined_keeps_nodes_and_mass(rig):
+    r4 = rig.refined(4)
+    assert set(rig.nodes) <= set(r4.nodes)
+    for n in rig.nodes:
+        assert r4.positions[n] == pytest.approx(rig.positions[n], abs=1e-12)
+    assert r4.mass == pytest.approx(rig.mass, rel=1e-12)
+    assert len(r4.spool("inner").elements) == 4 * len(rig.spool("inner").elements)
+    assert min(set(r4.nodes) - set(rig.nodes)) == max(rig.nodes) + 1
+    S4 = assemble(r4)
+    assert S4.n_dof == 4 * len(r4.nodes)
+
+
+def test_refined_frequencies_converge(rig):
+    """The rig's lowest non-spinning frequencies change by less on each refinement."""
+    from scipy.linalg import eigh
+
+    def f(r):
+        S = assemble(r)
+        return np.sqrt(eigh(S.K, S.M, eigvals_only=True, subset_by_index=(0, 7)))
+
+    f1, f2, f4 = f(rig), f(rig.refined(2)), f(rig.refined(4))
+    d12, d24 = np.abs(f2 / f1 - 1).max(), np.abs(f4 / f2 - 1).max()
+    assert d24 < d12 / 3  # at least order ~1.6; Nelson element gives ~h^2 (test_convergence)
+
+
+def test_hierarchical_internal_dofs_come_after_nodal():
+    els = tuple(ShaftElement(i, i + 1, 0.1, 0.03, 0.0, STEEL, element="hierarchical") for i in range(3))
+    S = assemble(Rotor((Spool("s", els),), bearings=(Bearing(k_xx=1e7, k_yy=1e7, node=0),)))
+    assert S.n_dof == 4 * 4 + 3 * 6
+    assert S.dofs.index(3, "theta_y") == 15
+    assert S.dofs.label(16) == "internal 0"
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Spool("s", ()), "at least one shaft element"),
+        (lambda: Spool("s", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL), ShaftElement(3, 4, 0.1, 0.02, 0, STEEL))),
+         "chain"),
+        (lambda: Rotor(()), "at least one spool"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
+                       disks=(Disk(7, 1.0, 0.01, 0.02),)), "`node` 7 does not exist"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
+                       bearings=(Bearing(k_xx=1.0, node=9),)), "bearings\\[0\\].*`node` 9 does not exist"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
+                       intershaft_bearings=(IntershaftBearing(node_a=1, node_b=2),)), "two different spools"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),
+                        Spool("b", (ShaftElement(2, 3, 0.1, 0.02, 0, STEEL),)))), "node 2 belongs"),
+        (lambda: Bearing(k_xx=-1.0, node=1), "`k_xx`"),
+        (lambda: Disk(1, m=-2.0, I_d=0.0, I_p=0.0), "`m`"),
+        (lambda: load_rotor("seed-rig").refined(0), "`n`"),
+    ],
+)
+def test_bad_model_input(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_dofmap_errors(rig):
+    S = assemble(rig)
+    with pytest.raises(ValueError, match="node 99 does not exist"):
+        S.dofs.index(99, "x")
+    with pytest.raises(ValueError, match="`direction`"):
+        S.dofs.index(18, "z")
+    with pytest.raises(ValueError, match="unknown spool"):
+        S.gyroscopic({"fan": 1.0})
