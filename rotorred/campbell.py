@@ -1,0 +1,523 @@
+"""Campbell diagram: whirl frequencies against speed, whirl direction, critical speeds.
+
+The spools turn at fixed ratios: the x-axis is the speed Omega of a *reference* spool, and
+spool ``s`` turns at ``r_s Omega`` (``r_ref = 1``). At each speed the damped eigenproblem
+
+    M q'' + (C + Omega sum_s r_s G_s) q' + K q = 0
+
+(Xu et al. 2016, Eq. 13 with one gyroscopic matrix per spool) is solved with
+:func:`rotorred.modal.eigen`. Modes are followed from speed to speed by the modal assurance
+criterion (MAC, :func:`rotorred.modal.mac`) with an optimal one-to-one assignment
+(:func:`scipy.optimize.linear_sum_assignment`), so a curve keeps its identity where two curves
+cross. A critical speed is a speed where a tracked curve omega_j(Omega) meets an excitation line
+``h r_s Omega`` (harmonic ``h`` of spool ``s``); it is bracketed on the speed grid and refined with
+:func:`scipy.optimize.brentq`, solving the eigenproblem at the intermediate speeds.
+
+Whirl direction (spin about +z): at a node with complex amplitudes X, Y of x and y,
+``x + i y = (X + iY)/2 e^{i w t} + conj(X - iY)/2 e^{-i w t}``, so the forward (counter-clockwise,
+with the spin) amplitude is |X + iY| and the backward one |X - iY|. A mode is forward (backward) if
+the nodes whirling backward (forward) carry at most 1 % of sum_n |X_n|^2 + |Y_n|^2, else mixed; planar
+if every orbit is a line. The eigenvectors of a multiple eigenvalue (an isotropic rotor at rest) are
+rotated into the forward/backward pair that the gyroscopic split selects as Omega -> 0+.
+
+Cost: one dense eigen-solve of the 2n state matrix per grid speed (modes for the MAC); crossings are
+refined by Newton iterations on the quadratic eigenproblem (one (n+1)^2 complex solve each), with
+the full eigen-solve as fallback.
+
+References
+----------
+Xu, Wang, Jiang, Han, Li, Shock and Vibration 2016, 6239281, Eq. 13.
+Allemang, "The modal assurance criterion - twenty years of use and abuse", Sound and Vibration 37 (2003).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+from scipy.optimize import brentq, linear_sum_assignment
+
+from rotorred.assembly import SystemMatrices, assemble
+from rotorred.modal import eigen, mac
+from rotorred.model import Rotor
+
+WHIRL_LABELS = ("forward", "backward", "mixed", "planar")
+
+#: a mode whirls forward (backward) if the nodes whirling the other way carry at most this share of
+#: sum_n (|X_n|^2 + |Y_n|^2); otherwise it is "mixed". Near a node of the mode shape of an anisotropic
+#: rotor the orbit of a node with ~1 % of the largest amplitude often turns the other way: that does not
+#: make the mode "mixed" (such nodes carry ~1e-4 of the sum).
+_MIXED_SHARE = 0.01
+#: (|X+iY|^2 - |X-iY|^2) / (|X+iY|^2 + |X-iY|^2) below this in magnitude is a straight-line (planar)
+#: orbit; roundoff in an eigenvector of unit norm is ~1e-13 at the significant nodes.
+_PLANAR_TOL = 1e-9
+#: eigenvalues closer than this (relative) are treated as one multiple eigenvalue, whose
+#: eigenvectors are any basis of a subspace; such a basis is rotated into forward/backward orbits.
+_DEGENERATE_RTOL = 1e-7
+#: weight of the frequency jump (relative) added to -MAC in the tracking cost, only to break ties
+#: between candidates of equal MAC (e.g. inside a multiple eigenvalue).
+_FREQ_TIEBREAK = 1e-3
+
+
+@dataclass(frozen=True)
+class CriticalSpeed:
+    """A crossing of a whirl curve with an excitation line h x Omega_s.
+
+    Attributes
+    ----------
+    speed : float
+        Speed of the reference spool (rad/s).
+    spool : str
+        The spool whose excitation line is crossed.
+    harmonic : float
+        Multiple h of that spool's speed.
+    mode : int
+        Column of :attr:`CampbellResult.frequencies` (0-based tracked mode).
+    frequency : float
+        Whirl frequency at the crossing (rad/s) = h x speed of ``spool``.
+    whirl : str
+        ``"forward"``, ``"backward"``, ``"mixed"`` or ``"planar"``.
+    log_dec : float
+        Logarithmic decrement of the mode at the crossing (-).
+    """
+
+    speed: float
+    spool: str
+    harmonic: float
+    mode: int
+    frequency: float
+    whirl: str
+    log_dec: float
+
+    @property
+    def speed_rpm(self) -> float:
+        """Speed of the reference spool (rpm)."""
+        return self.speed * 30.0 / math.pi
+
+    @property
+    def frequency_hz(self) -> float:
+        """Whirl frequency (Hz)."""
+        return self.frequency / (2.0 * math.pi)
+
+    @property
+    def spool_speed(self) -> float:
+        """Speed of the excited spool at the crossing (rad/s)."""
+        return self.frequency / self.harmonic
+
+    @property
+    def line(self) -> str:
+        """Label of the excitation line, e.g. ``"1× inner"``."""
+        return excitation_label(self.harmonic, self.spool)
+
+
+@dataclass(frozen=True)
+class CampbellResult:
+    """Whirl frequencies of tracked modes against the speed of a reference spool.
+
+    Attributes
+    ----------
+    speeds : ndarray, shape (n_speeds,)
+        Speed of the reference spool (rad/s).
+    frequencies : ndarray, shape (n_speeds, n_modes)
+        Damped whirl frequency Im(lambda) of each tracked mode (rad/s); column j follows one mode
+        (by MAC), numbered by its frequency order at ``speeds[0]``.
+    log_dec : ndarray, shape (n_speeds, n_modes)
+        Logarithmic decrement -2 pi Re(lambda) / Im(lambda) (-).
+    whirl : ndarray of str, shape (n_speeds, n_modes)
+        ``"forward"``, ``"backward"``, ``"mixed"`` (nodes whirl in both directions) or
+        ``"planar"`` (straight-line orbits, e.g. an anisotropic rotor at rest).
+    tracking_mac : ndarray, shape (n_speeds - 1, n_modes)
+        MAC between a tracked mode's shapes at consecutive speeds (1 = unchanged shape).
+    critical_speeds : tuple of CriticalSpeed
+        Sorted by speed.
+    reference : str
+        Name of the reference spool.
+    speed_ratios : dict of str to float
+        Omega_s / Omega_reference of each spool.
+    harmonics : tuple of float
+        Multiples of each spool's speed used as excitation lines.
+    rotor_name : str
+    """
+
+    speeds: np.ndarray
+    frequencies: np.ndarray
+    log_dec: np.ndarray
+    whirl: np.ndarray
+    tracking_mac: np.ndarray
+    critical_speeds: tuple[CriticalSpeed, ...]
+    reference: str
+    speed_ratios: Mapping[str, float]
+    harmonics: tuple[float, ...]
+    rotor_name: str = ""
+
+    def __post_init__(self):
+        for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
+            a = np.array(getattr(self, f))
+            a.setflags(write=False)
+            object.__setattr__(self, f, a)
+        object.__setattr__(self, "speed_ratios", dict(self.speed_ratios))
+
+    @property
+    def n_modes(self) -> int:
+        return self.frequencies.shape[1]
+
+    @property
+    def speeds_rpm(self) -> np.ndarray:
+        """Reference speeds (rpm), shape (n_speeds,)."""
+        return self.speeds * 30.0 / np.pi
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Whirl frequencies (Hz), shape (n_speeds, n_modes)."""
+        return self.frequencies / (2.0 * np.pi)
+
+    @property
+    def excitation_lines(self) -> tuple[tuple[str, float, float], ...]:
+        """(spool, harmonic, slope) of each excitation line; frequency (rad/s) = slope x reference speed."""
+        return tuple((s, h, h * r) for s, r in self.speed_ratios.items() if r > 0 for h in self.harmonics)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec``."""
+        path = Path(path)
+        with path.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"])
+            for i, rpm in enumerate(self.speeds_rpm):
+                for j in range(self.n_modes):
+                    w.writerow([f"{rpm:.10g}", j, f"{self.frequencies_hz[i, j]:.9g}", self.whirl[i, j],
+                                f"{self.log_dec[i, j]:.6g}"])
+        return path
+
+    def plot(self, path: str | Path, **kwargs) -> Path:
+        """Write the Campbell diagram as a PNG; see :func:`rotorred.campbell_plot.plot_campbell`."""
+        from rotorred.campbell_plot import plot_campbell
+
+        return plot_campbell(self, path, **kwargs)
+
+
+def excitation_label(harmonic: float, spool: str) -> str:
+    """``"1× inner"``, ``"0.5× outer"``."""
+    return f"{harmonic:g}× {spool}"
+
+
+# --- whirl direction ---------------------------------------------------------------------------
+
+def _xy_rows(dofs) -> tuple[np.ndarray, np.ndarray]:
+    x = np.array([dofs.index(n, "x") for n in dofs.nodes])
+    y = np.array([dofs.index(n, "y") for n in dofs.nodes])
+    return x, y
+
+
+def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -> list[str]:
+    """Classify the whirl of each mode from its node orbits.
+
+    Parameters
+    ----------
+    modes : ndarray, shape (n, k), complex
+        Mode shapes (columns).
+    x_rows, y_rows : ndarray of int, shape (n_nodes,)
+        Rows of the x and y displacement of each node.
+
+    Returns
+    -------
+    list of str, length k
+        ``"forward"`` if the nodes whirling forward (|X + iY| > |X - iY|) carry all but at most 1 % of
+        the mode's orbit size sum_n (|X_n|^2 + |Y_n|^2), ``"backward"`` likewise, ``"mixed"`` otherwise,
+        ``"planar"`` if every orbit is a straight line (|X + iY| = |X - iY|).
+    """
+    X, Y = modes[x_rows], modes[y_rows]
+    f2, b2 = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+    amp = f2 + b2  # = 2 (|X|^2 + |Y|^2)
+    d = (f2 - b2) / np.where(amp > 0, amp, 1.0)
+    fwd = np.sum(np.where(d > _PLANAR_TOL, amp, 0.0), axis=0)
+    bwd = np.sum(np.where(d < -_PLANAR_TOL, amp, 0.0), axis=0)
+    out = []
+    for f, b in zip(fwd, bwd):
+        if f == 0 and b == 0:
+            out.append("planar")
+        elif b <= _MIXED_SHARE * (f + b):
+            out.append("forward")
+        elif f <= _MIXED_SHARE * (f + b):
+            out.append("backward")
+        else:
+            out.append("mixed")
+    return out
+
+
+def _canonical_basis(lam: np.ndarray, modes: np.ndarray, x_rows, y_rows) -> np.ndarray:
+    """Rotate the eigenvectors of each multiple eigenvalue into forward/backward orbits.
+
+    For a multiple eigenvalue (e.g. an isotropic rotor at rest) any basis of the eigenspace is
+    valid and LAPACK returns an arbitrary one. The basis that extremises the forward content
+    ||F w||^2 / ||w||^2, F w = (X_n + i Y_n)_n, is the limit of the forward and backward whirl modes as
+    the gyroscopic split goes to zero; the most forward vector goes to the higher frequency.
+    """
+    modes = modes.copy()
+    k = len(lam)
+    j = 0
+    while j < k:
+        e = j + 1
+        while e < k and abs(lam[e] - lam[j]) <= _DEGENERATE_RTOL * abs(lam[j]):
+            e += 1
+        if e - j > 1:
+            Q = np.linalg.qr(modes[:, j:e])[0]  # orthonormal basis of the eigenspace
+            FQ = Q[x_rows] + 1j * Q[y_rows]
+            V = np.linalg.eigh(FQ.conj().T @ FQ)[1]  # ascending forward content
+            W = Q @ V
+            modes[:, j:e] = W / np.linalg.norm(W, axis=0)
+        j = e
+    return modes
+
+
+# --- the analysis ------------------------------------------------------------------------------
+
+def speed_ratios(rotor: Rotor, ratio: float | None = None, reference: str | None = None) -> dict[str, float]:
+    """Omega_s / Omega_reference of each spool.
+
+    Parameters
+    ----------
+    rotor : Rotor
+    ratio : float, optional
+        Two-spool rotors only: Omega of the second spool / Omega of the first, in
+        ``rotor.spools`` order (for the seed rig (inner, outer): Omega_H / Omega_L), >= 0.
+        Default: the ratio of the spools' nominal speeds.
+    reference : str, optional
+        The spool on the x-axis (default the first).
+
+    Returns
+    -------
+    dict of str to float
+    """
+    names = [s.name for s in rotor.spools]
+    if reference is None:
+        reference = names[0]
+    if reference not in names:
+        raise ValueError(f"`reference` must be one of the spools {names}, got {reference!r}")
+    if ratio is not None:
+        if len(names) != 2:
+            raise ValueError(f"`ratio` applies to two-spool rotors only; rotor {rotor.name!r} has "
+                             f"{len(names)} spool(s) {names}; leave `ratio` unset")
+        if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not (math.isfinite(ratio) and ratio >= 0):
+            raise ValueError(f"`ratio` (Omega_{names[1]} / Omega_{names[0]}) must be a finite number >= 0, "
+                             f"got {ratio!r}")
+        absolute = {names[0]: 1.0, names[1]: float(ratio)}
+    else:
+        absolute = dict(rotor.speeds)
+        if len(names) == 1:
+            absolute = {names[0]: 1.0}
+    if absolute[reference] <= 0:
+        raise ValueError(f"the reference spool {reference!r} has nominal speed 0, so the speed ratios are "
+                         f"undefined; give `ratio` or choose another `reference`")
+    return {n: absolute[n] / absolute[reference] for n in names}
+
+
+def _check_speeds(speeds) -> np.ndarray:
+    try:
+        s = np.asarray(speeds, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"`speeds` must be a 1-D sequence of numbers (rad/s), got {speeds!r}") from None
+    if s.ndim != 1 or s.size < 2:
+        raise ValueError(f"`speeds` must be a 1-D sequence of at least 2 speeds (rad/s), got shape {s.shape}")
+    if not np.all(np.isfinite(s)) or np.any(s < 0):
+        raise ValueError(f"`speeds` must be finite and >= 0 (rad/s), got min {s.min()!r}")
+    if np.any(np.diff(s) <= 0):
+        i = int(np.argmax(np.diff(s) <= 0))
+        raise ValueError(f"`speeds` must be strictly increasing; speeds[{i}] = {s[i]!r} is followed by "
+                         f"{s[i + 1]!r}")
+    return s
+
+
+def _check_harmonics(harmonics) -> tuple[float, ...]:
+    try:
+        h = tuple(float(v) for v in harmonics)
+    except (TypeError, ValueError):
+        raise ValueError(f"`harmonics` must be a sequence of positive numbers, got {harmonics!r}") from None
+    if not h or not all(math.isfinite(v) and v > 0 for v in h):
+        raise ValueError(f"`harmonics` must be a non-empty sequence of positive numbers, got {harmonics!r}")
+    return tuple(sorted(set(h)))
+
+
+class _Solver:
+    """Eigen-solves of one rotor along the speed axis (matrices assembled once)."""
+
+    def __init__(self, sm: SystemMatrices, ratios: Mapping[str, float], n_candidates: int):
+        self.M, self.K, self.C = sm.M, sm.K, sm.C
+        self.G = sm.gyroscopic(ratios)  # sum_s r_s G_s, per unit reference speed
+        self.n_candidates = n_candidates
+        self.x_rows, self.y_rows = _xy_rows(sm.dofs)
+
+    def solve(self, Omega: float):
+        sol = eigen(self.M, self.C + Omega * self.G, self.K, n_modes=self.n_candidates)
+        return sol.eigenvalues, _canonical_basis(sol.eigenvalues, sol.modes, self.x_rows, self.y_rows)
+
+    def local(self, Omega: float, lam0: complex, v0: np.ndarray, max_iter: int = 12):
+        """Eigenpair of (lam^2 M + lam D + K) v = 0 near (lam0, v0) by Newton's method, or None.
+
+        Unknowns (v, lam) with the normalisation v0^H v = v0^H v0; each step solves the bordered
+        system [[Q(lam), Q'(lam) v], [v0^H, 0]] [dv; dlam] = -[Q(lam) v; 0], Q' = 2 lam M + D.
+        Converges quadratically from a close start; returns None if it does not converge (e.g. at a
+        multiple eigenvalue, where the bordered matrix is singular).
+        """
+        D = self.C + Omega * self.G
+        n = len(v0)
+        lam, v = complex(lam0), v0.astype(complex)
+        J = np.zeros((n + 1, n + 1), complex)
+        J[n, :n] = v0.conj()
+        rhs = np.zeros(n + 1, complex)
+        previous = np.inf
+        for _ in range(max_iter):
+            J[:n, :n] = lam * lam * self.M + lam * D + self.K
+            J[:n, n] = (2.0 * lam * self.M + D) @ v
+            rhs[:n] = -(J[:n, :n] @ v)
+            try:
+                step = np.linalg.solve(J, rhs)
+            except np.linalg.LinAlgError:
+                return None
+            if not np.all(np.isfinite(step)):
+                return None
+            v, lam = v + step[:n], lam + step[n]
+            # converged when the update is at roundoff level (a residual test relative to ||K|| would
+            # accept a wrong eigenvalue of a soft mode on a stiff structure): below 1e-13 |lam|, or
+            # stagnating below 1e-9 |lam| (the roundoff floor of Q(lam) v when ||K|| >> |lam|^2 ||M||)
+            d = abs(step[n])
+            if np.linalg.norm(step[:n]) <= 1e-7 * np.linalg.norm(v) and (
+                    d <= 1e-13 * abs(lam) or (d <= 1e-9 * abs(lam) and d >= 0.5 * previous)):
+                return lam, v / np.linalg.norm(v)
+            previous = d
+        return None
+
+
+def _assign(prev_modes, prev_freq, lam, modes):
+    """Columns of ``modes`` continuing each of ``prev_modes`` (one-to-one, max total MAC)."""
+    m = mac(prev_modes, modes)
+    jump = np.abs(lam.imag[None, :] - prev_freq[:, None]) / prev_freq[:, None]
+    rows, cols = linear_sum_assignment(-m + _FREQ_TIEBREAK * jump)
+    return cols[np.argsort(rows)], m[rows, cols][np.argsort(rows)]
+
+
+def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = None, reference: str | None = None,
+             n_modes: int = 6, harmonics: Sequence[float] = (1,)) -> CampbellResult:
+    """Campbell diagram of ``rotor`` with critical speeds.
+
+    Parameters
+    ----------
+    rotor : Rotor
+    speeds : sequence of float, shape (n_speeds,)
+        Speeds of the reference spool (rad/s), >= 0, strictly increasing, at least 2.
+    ratio : float, optional
+        Two-spool rotors: Omega of the second spool / Omega of the first (``rotor.spools`` order;
+        Omega_H / Omega_L for the seed rig). Default: ratio of the nominal spool speeds.
+    reference : str, optional
+        Spool whose speed is the x-axis (default the first spool).
+    n_modes : int
+        Number of modes tracked: the lowest ``n_modes`` at ``speeds[0]``.
+    harmonics : sequence of float
+        Excitation lines h x Omega_s for each h and each spinning spool s (default 1x).
+
+    Returns
+    -------
+    CampbellResult
+    """
+    Omega = _check_speeds(speeds)
+    if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
+        raise ValueError(f"`n_modes` must be an integer >= 1, got {n_modes!r}")
+    h = _check_harmonics(harmonics)
+    ratios = speed_ratios(rotor, ratio, reference)
+    reference = reference or rotor.spools[0].name
+    sm = assemble(rotor)
+    n_available = sm.n_dof  # at most one frequency per DOF
+    if n_modes > n_available:
+        raise ValueError(f"`n_modes` must be <= {n_available} (the number of DOFs), got {n_modes}")
+    solver = _Solver(sm, ratios, min(n_available, 2 * n_modes + 4))
+
+    n_s = len(Omega)
+    lam_all = np.empty((n_s, n_modes), complex)
+    shapes = []
+    tracking = np.ones((n_s - 1, n_modes))
+    lam, modes = solver.solve(Omega[0])
+    if len(lam) < n_modes:
+        raise ValueError(f"`n_modes` = {n_modes} but the rotor has only {len(lam)} oscillating modes at "
+                         f"{Omega[0]:g} rad/s")
+    lam_all[0], cur = lam[:n_modes], modes[:, :n_modes]
+    shapes.append(cur)
+    for i in range(1, n_s):
+        lam, modes = solver.solve(Omega[i])
+        if len(lam) < n_modes:
+            raise ValueError(f"only {len(lam)} oscillating modes at {Omega[i]:g} rad/s, fewer than "
+                             f"`n_modes` = {n_modes}")
+        cols, m = _assign(cur, lam_all[i - 1].imag, lam, modes)
+        lam_all[i], cur = lam[cols], modes[:, cols]
+        tracking[i - 1] = m
+        shapes.append(cur)
+
+    freq = lam_all.imag
+    log_dec = -2.0 * np.pi * lam_all.real / freq
+    whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
+
+    lines = [(s, hh, hh * r) for s, r in ratios.items() if r > 0 for hh in h]
+    crit = []
+    for spool, hh, slope in lines:
+        g = freq - slope * Omega[:, None]
+        for j in range(n_modes):
+            for i in range(n_s - 1):
+                if g[i, j] == 0 and i > 0:
+                    continue  # counted as the right end of interval i - 1
+                if g[i, j] * g[i + 1, j] > 0:
+                    continue
+                crit.append(_refine(solver, Omega, freq, lam_all, shapes, whirl, i, j, spool, hh, slope))
+    crit.sort(key=lambda c: (c.speed, c.mode))
+    return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
+                          critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
+                          harmonics=h, rotor_name=rotor.name)
+
+
+def _refine(solver: _Solver, Omega, freq, lam_grid, shapes, whirl, i, j, spool, harmonic, slope) -> CriticalSpeed:
+    """Brent's root of omega_j(Omega) - slope Omega on [Omega_i, Omega_i+1], mode j tracked by MAC.
+
+    At intermediate speeds the eigenpair is found by Newton's method started from the linear
+    interpolation of the bracketing eigenpairs; it is accepted if its shape has MAC >= 0.9 with a
+    bracketing shape, otherwise the full eigenproblem is solved and the candidate with the largest
+    MAC to the bracketing shapes is taken.
+    """
+    a, b = Omega[i], Omega[i + 1]
+    va, vb = shapes[i][:, j], shapes[i + 1][:, j]
+    vb = vb * np.exp(-1j * np.angle(np.vdot(va, vb)))  # align phases for interpolation
+    ends = np.column_stack([va, vb])
+    found = {}
+
+    def pick(W):
+        t = (W - a) / (b - a)
+        lam0 = (1 - t) * lam_grid[i, j] + t * lam_grid[i + 1, j]
+        pair = solver.local(W, lam0, (1 - t) * va + t * vb)
+        if pair is None or mac(ends, pair[1][:, None]).max() < 0.9:
+            lam, modes = solver.solve(W)
+            k = int(np.argmax(mac(ends, modes).sum(axis=0)))
+            pair = lam[k], modes[:, k]
+        found[W] = pair
+        return pair[0]
+
+    def g(W):
+        if W == a:
+            return freq[i, j] - slope * a
+        if W == b:
+            return freq[i + 1, j] - slope * b
+        return pick(W).imag - slope * W
+
+    # rtol 1e-10: the eigenvalues themselves carry ~1e-12 relative roundoff
+    root = brentq(g, a, b, xtol=1e-12 * max(b, 1.0), rtol=1e-10)
+    if root == a:
+        lam, shape = lam_grid[i, j], shapes[i][:, j]
+    elif root == b:
+        lam, shape = lam_grid[i + 1, j], shapes[i + 1][:, j]
+    else:
+        lam, shape = found[root] if root in found else (pick(root), found[root][1])
+    if whirl[i, j] == whirl[i + 1, j]:
+        label = str(whirl[i, j])  # also right inside a multiple eigenvalue, where the shape is any basis vector
+    else:
+        label = whirl_direction(shape[:, None], solver.x_rows, solver.y_rows)[0]
+    return CriticalSpeed(speed=float(root), spool=spool, harmonic=harmonic, mode=j, frequency=float(lam.imag),
+                         whirl=label, log_dec=float(-2.0 * np.pi * lam.real / lam.imag))

@@ -1,0 +1,376 @@
+"""Campbell diagram: closed-form rigid rotor, Nelson-McVaugh vs ROSS, two spools, MAC tracking,
+critical speeds against an independent formulation, the seed rig's margins, CLI and bad input."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from rotorred.assembly import assemble
+from rotorred.campbell import CampbellResult, campbell, whirl_direction
+from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.modal import eigen
+from rotorred.model import Rotor, Spool
+
+VALIDATION = Path(__file__).resolve().parents[1] / "validation"
+
+
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(name, VALIDATION / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+nelson = _load("nelson_mcvaugh")
+
+
+# --- a rigid rotor with closed-form whirl ---------------------------------------------------------
+# Disk (m, I_d, I_p) at the middle of a uniform shaft of length 2a, bearings k at both ends (+-a).
+# The shaft moves as a rigid body when E -> inf; its mass and inertia are included in the closed form:
+#   m = m_disk + rho A L,  I_d = I_d,disk + rho A L^3/12 + rho I L,  I_p = I_p,disk + 2 rho I L
+# (cubic Timoshenko shape functions reproduce rigid-body motion, so the consistent mass matrix gives
+# these exactly). By symmetry translation and tilt decouple:
+#   cylindrical  m w^2 = 2 k,   conical  I_d w^2 -+ I_p Omega w - k_theta = 0,  k_theta = 2 k a^2.
+# With I_d > m a^2 the forward conical curve starts below the cylindrical pair and crosses it.
+A_HALF, K_BRG, M_DISK, ID_DISK, IP_DISK, D_SHAFT = 0.1, 1.0e6, 10.0, 0.2, 0.4, 0.05
+
+
+def rigid_rotor(E: float, c: float = 0.0) -> Rotor:
+    steel = Material("stiff steel", E=E, rho=7850.0, nu=0.3)
+    L = 2 * A_HALF / 4
+    shaft = Spool("shaft", tuple(ShaftElement(i, i + 1, L, D_SHAFT, 0.0, steel) for i in range(4)), speed=100.0)
+    return Rotor((shaft,), disks=(Disk(2, M_DISK, ID_DISK, IP_DISK),),
+                 bearings=(Bearing(k_xx=K_BRG, k_yy=K_BRG, c_xx=c, c_yy=c, node=0),
+                           Bearing(k_xx=K_BRG, k_yy=K_BRG, c_xx=c, c_yy=c, node=4)), name="rigid")
+
+
+def rigid_body_properties() -> tuple[float, float, float]:
+    rho, L = 7850.0, 2 * A_HALF
+    A, I = math.pi * D_SHAFT**2 / 4, math.pi * D_SHAFT**4 / 64
+    return M_DISK + rho * A * L, ID_DISK + rho * A * L**3 / 12 + rho * I * L, IP_DISK + 2 * rho * I * L
+
+
+def conical_roots(Omega: float) -> tuple[float, float]:
+    """(backward, forward) roots of I_d w^2 +- I_p Omega w - k_theta = 0, by brentq."""
+    _, I_d, I_p = rigid_body_properties()
+    k_theta = 2 * K_BRG * A_HALF**2
+    hi = (I_p * Omega + math.sqrt(k_theta * I_d)) / I_d * 2 + 1.0
+    backward = brentq(lambda w: I_d * w * w + I_p * Omega * w - k_theta, 0.0, hi)
+    forward = brentq(lambda w: I_d * w * w - I_p * Omega * w - k_theta, 0.0, hi)
+    return backward, forward
+
+
+SPEEDS_RIGID = np.linspace(0.0, 500.0, 51)  # rad/s; grid step 10 rad/s, no grid point at a crossing
+
+
+def _rigid_errors(E: float) -> tuple[float, CampbellResult]:
+    result = campbell(rigid_rotor(E), SPEEDS_RIGID, n_modes=4)
+    m, _, _ = rigid_body_properties()
+    w_cyl = math.sqrt(2 * K_BRG / m)
+    expected = np.array([[*conical_roots(W), w_cyl, w_cyl] for W in SPEEDS_RIGID])
+    return float(np.max(np.abs(result.frequencies - expected) / expected)), result
+
+
+def test_rigid_rotor_tilt_campbell_matches_closed_form_and_tracks_through_crossing():
+    # Shaft E = 100 x steel. Residual flexibility: the cylindrical mode sees the bearings (2k) in series
+    # with the shaft (48 E I / L^3 at mid-span), so w drops by ~ k L^3 / (48 E I) = 2.6e-5 (relative);
+    # measured: cylindrical 2.4e-5, conical up to 5.4e-5 (backward at 500 rad/s). Tolerance: 3x the ratio.
+    E = 2.1e13
+    flex = K_BRG * (2 * A_HALF) ** 3 / (48 * E * math.pi * D_SHAFT**4 / 64)
+    err, result = _rigid_errors(E)
+    assert err < 3 * flex
+    # the mismatch is the shaft's residual flexibility, first order in 1/E: 10x stiffer -> ~10x smaller
+    err_stiffer, _ = _rigid_errors(10 * E)
+    assert err / 12 < err_stiffer < err / 8
+    # columns 0, 1 are the backward and forward conical modes, 2, 3 the cylindrical pair
+    assert np.all(result.whirl[:, 0] == "backward") and np.all(result.whirl[:, 1] == "forward")
+    # the forward conical curve really crosses the cylindrical pair: sorting by frequency would
+    # swap the columns after the crossing; MAC tracking keeps each curve continuous
+    assert result.frequencies[0, 1] < result.frequencies[0, 2] and result.frequencies[-1, 1] > result.frequencies[-1, 3]
+    assert result.tracking_mac.min() > 0.99
+
+
+def test_rigid_rotor_critical_speeds_closed_form():
+    _, result = _rigid_errors(2.1e14)
+    m, I_d, I_p = rigid_body_properties()
+    k_theta = 2 * K_BRG * A_HALF**2
+    # 1x line meets: backward conical at I_d W^2 + I_p W^2 = k_theta; cylindrical pair at W^2 = 2k/m;
+    # forward conical never (I_p > I_d: it rises faster than 1x)
+    backward = brentq(lambda W: (I_d + I_p) * W * W - k_theta, 1.0, 1e4)
+    cylindrical = brentq(lambda W: m * W * W - 2 * K_BRG, 1.0, 1e4)
+    crit = result.critical_speeds
+    assert [c.mode for c in crit] == [0, 2, 3]
+    assert crit[0].whirl == "backward" and {crit[1].whirl, crit[2].whirl} == {"forward", "backward"}
+    expected = [backward, cylindrical, cylindrical]
+    # same residual-flexibility error as the whirl frequencies (err < 1e-5 with this shaft)
+    for c, W in zip(crit, expected):
+        assert abs(c.speed - W) / W < 2e-5
+        # on the 1x line; the pair's eigenvalues carry ~eps w_max^2 / w ~ 1e-8 roundoff in this stiff model
+        assert abs(c.frequency - c.speed) / W < 1e-7
+        assert c.spool == "shaft" and c.harmonic == 1.0
+
+
+def test_log_decrement_of_damped_rigid_rotor():
+    # bearing damping c: cylindrical m x'' + 2c x' + 2k x = 0 (unaffected by spin);
+    # conical at rest I_d th'' + 2 c a^2 th' + k_theta th = 0; log dec = 2 pi zeta / sqrt(1 - zeta^2)
+    c = 150.0
+    result = campbell(rigid_rotor(2.1e14, c=c), np.array([0.0, 200.0, 400.0]), n_modes=4)
+    m, I_d, _ = rigid_body_properties()
+    k_theta = 2 * K_BRG * A_HALF**2
+    zeta_cyl = 2 * c / (2 * math.sqrt(2 * K_BRG * m))
+    zeta_con = 2 * c * A_HALF**2 / (2 * math.sqrt(k_theta * I_d))
+    delta = lambda z: 2 * math.pi * z / math.sqrt(1 - z * z)  # noqa: E731
+    # residual shaft flexibility (~1e-6) and the bearing damping acting through it: 1e-5
+    assert np.allclose(result.log_dec[:, 2:], delta(zeta_cyl), rtol=1e-5)
+    assert np.allclose(result.log_dec[0, :2], delta(zeta_con), rtol=1e-5)
+    w_d = math.sqrt(2 * K_BRG / m) * math.sqrt(1 - zeta_cyl**2)
+    assert np.allclose(result.frequencies[:, 2:], w_d, rtol=1e-5)
+    assert zeta_cyl > 0.01  # the check is not trivially satisfied by an undamped result
+
+
+# --- whirl direction -------------------------------------------------------------------------------
+def test_whirl_direction_convention():
+    # x + i y = e^{+i w t}: X = 1, Y = -i (x = cos, y = sin: counter-clockwise, with the spin about +z)
+    x_rows, y_rows = np.array([0, 2]), np.array([1, 3])
+    forward = np.array([1, -1j, 0.5, -0.5j])
+    backward = np.array([1, 1j, 0.5, 0.5j])
+    planar = np.array([1, 0.3, 0.5, 0.15])
+    mixed = np.array([1, -1j, 0.5, 0.5j])  # second node backward with 20 % of sum |X|^2 + |Y|^2
+    mostly_backward = np.array([1, 1j, 0.07, -0.07j])  # a forward node with 0.5 % of it
+    elliptic = np.array([1, -0.2j, 0.5, -0.1j])  # forward ellipses
+    modes = np.column_stack([forward, backward, planar, mixed, mostly_backward, elliptic])
+    assert whirl_direction(modes, x_rows, y_rows) == ["forward", "backward", "planar", "mixed", "backward",
+                                                      "forward"]
+
+
+def test_orthotropic_modes_at_rest_are_planar_and_elliptic_when_spinning():
+    # cross-coupled (symmetric) bearings: at rest the modes are straight lines in the bearings'
+    # principal directions; spinning makes them elliptic
+    result = campbell(nelson.rotor("orthotropic"), np.array([0.0, 10000.0]) * math.pi / 30, n_modes=4)
+    assert list(result.whirl[0]) == ["planar"] * 4
+    assert set(result.whirl[1]) <= {"forward", "backward", "mixed"}
+    assert "forward" in result.whirl[1] and "backward" in result.whirl[1]
+
+
+# --- Nelson-McVaugh against ROSS ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("case", ["isotropic", "orthotropic"])
+def test_nelson_mcvaugh_whirl_speeds_match_ross(case):
+    # the reference is printed to 0.1 rpm (<= 4e-6 relative); both codes use the same Timoshenko
+    # element with Cowper's kappa, so the agreement is at that rounding level: 1e-5 leaves 2.5x margin
+    # (the brief asks for 0.1 %)
+    rpm, ours, ref = nelson.whirl_speeds(case)
+    assert len(rpm) == 4 and ours.shape == (4, 6)
+    assert np.max(np.abs(ours - ref) / ref) < 1e-5
+
+
+rig = _load("campbell_rig")
+undamped_critical_speeds = rig.undamped_critical_speeds
+
+
+def _check_critical_speeds(result, rotor, spool, harmonic):
+    """Critical speeds of ``result`` on line ``harmonic`` x ``spool`` against the Hermitian formulation."""
+    ours = np.sort([c.speed for c in result.critical_speeds if c.spool == spool and c.harmonic == harmonic])
+    exact = undamped_critical_speeds(rotor, result.speed_ratios, spool, harmonic, result.speeds[-1])
+    # every crossing found is an exact critical speed; the eigh reference (Cholesky of K, whose condition
+    # number is ~1e9 for these meshes) is accurate to ~1e-9, brentq to 1e-10: 1e-8
+    assert len(ours) >= 2
+    assert all(np.min(np.abs(exact - W)) < 1e-8 * W for W in ours)
+    # every exact critical on a tracked curve is found: tracked curves pass through (W, c W) there
+    slope = harmonic * result.speed_ratios[spool]
+    for W in exact:
+        on_curve = [np.interp(W, result.speeds, result.frequencies[:, j]) for j in range(result.n_modes)]
+        if np.min(np.abs(np.array(on_curve) - slope * W)) < 1e-3 * slope * W:
+            assert np.min(np.abs(ours - W)) < 1e-8 * W
+
+
+def test_critical_speeds_match_hermitian_formulation():
+    rotor = nelson.rotor("isotropic")
+    result = campbell(rotor, np.linspace(0, 40000, 41) * math.pi / 30, n_modes=6, harmonics=(1, 2))
+    for h in (1.0, 2.0):
+        _check_critical_speeds(result, rotor, "shaft", h)
+
+
+# --- two spools ------------------------------------------------------------------------------------
+def two_spool_rotor(intershaft: bool = True) -> Rotor:
+    steel = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
+    inner = Spool("inner", tuple(ShaftElement(i, i + 1, 0.1, 0.02, 0.0, steel) for i in range(1, 7)),
+                  speed=300.0)
+    outer = Spool("outer", tuple(ShaftElement(i, i + 1, 0.06, 0.06, 0.04, steel) for i in range(10, 13)),
+                  speed=400.0, z0=0.25)
+    disks = (Disk(3, 4.0, 0.02, 0.04), Disk(6, 4.0, 0.02, 0.04), Disk(11, 3.0, 0.015, 0.03))
+    bearings = (Bearing(k_xx=2e7, k_yy=2e7, node=1), Bearing(k_xx=2e7, k_yy=2e7, node=7),
+                Bearing(k_xx=2e6, k_yy=2e6, node=10), Bearing(k_xx=1e6, k_yy=1e6, node=13))
+    isb = (IntershaftBearing(k_xx=1e7, k_yy=1e7, c_xx=200.0, c_yy=200.0, node_a=13, node_b=5),) if intershaft else ()
+    return Rotor((inner, outer), disks=disks, bearings=bearings, intershaft_bearings=isb, name="two-spool")
+
+
+SPEEDS_2 = np.linspace(0.0, 2000.0, 11)
+
+
+def _same_curves(curves: np.ndarray, pool: np.ndarray, rtol: float) -> bool:
+    """Every column of ``curves`` (n_speeds, k) equals, at every speed, some column of ``pool``."""
+    return all(np.any(np.all(np.isclose(pool, curves[:, [j]], rtol=rtol), axis=0)) for j in range(curves.shape[1]))
+
+
+@pytest.mark.parametrize("ratio", [0.0, 1.3])
+def test_uncoupled_spools_each_equal_the_spool_alone(ratio):
+    # without the inter-shaft bearing every tracked curve is a curve of the inner spool alone at Omega
+    # or of the outer spool alone at ratio x Omega (ratio 0: outer at rest, its curves flat)
+    rotor = two_spool_rotor(intershaft=False)
+    full = campbell(rotor, SPEEDS_2, ratio=ratio, n_modes=8)
+    inner = campbell(rotor.only_spool("inner"), SPEEDS_2, n_modes=8).frequencies
+    if ratio > 0:
+        outer = campbell(rotor.only_spool("outer"), ratio * SPEEDS_2, n_modes=8).frequencies
+    else:
+        outer = np.tile(campbell(rotor.only_spool("outer"), SPEEDS_2[:2], n_modes=8).frequencies[0],
+                        (len(SPEEDS_2), 1))
+    # the same matrices solved as one block-diagonal problem: roundoff only (1e-9)
+    assert _same_curves(full.frequencies, np.hstack([inner, outer]), rtol=1e-9)
+    # both spools contribute curves (otherwise the check would be one-sided) ...
+    of_outer = [j for j in range(8) if _same_curves(full.frequencies[:, [j]], outer, 1e-9)]
+    assert 2 <= len(of_outer) <= 6
+    # ... and the outer spool's curves depend on the ratio: they are not those at the inner speed
+    if ratio > 0:
+        at_inner_speed = campbell(rotor.only_spool("outer"), SPEEDS_2, n_modes=8).frequencies
+        assert not _same_curves(full.frequencies[:, of_outer], at_inner_speed, 1e-6)
+
+
+def test_ratio_one_uses_the_sum_of_the_gyroscopic_matrices():
+    # every tracked curve is an eigenfrequency of M q'' + (C + Omega sum_s r_s G_s) q' + K q = 0
+    rotor = two_spool_rotor()
+    sm = assemble(rotor)
+    same = campbell(rotor, SPEEDS_2, ratio=1.0, n_modes=8)
+    other = campbell(rotor, SPEEDS_2, ratio=1.3, n_modes=8)
+    for i, W in enumerate(SPEEDS_2):
+        shared = eigen(sm.M, sm.C + W * (sm.G["inner"] + sm.G["outer"]), sm.K).frequencies
+        own = eigen(sm.M, sm.C + W * sm.G["inner"] + 1.3 * W * sm.G["outer"], sm.K).frequencies
+        assert np.allclose(shared[np.argmin(np.abs(shared[:, None] - same.frequencies[i]), axis=0)],
+                           same.frequencies[i], rtol=1e-10)
+        assert np.allclose(own[np.argmin(np.abs(own[:, None] - other.frequencies[i]), axis=0)],
+                           other.frequencies[i], rtol=1e-10)
+    # the lowest 8 at rest, and the ratio matters once spinning
+    assert np.allclose(same.frequencies[0], eigen(sm.M, sm.C, sm.K, n_modes=8).frequencies, rtol=1e-10)
+    assert np.max(np.abs(other.frequencies[-1] - same.frequencies[-1]) / same.frequencies[-1]) > 1e-3
+
+
+def test_reference_spool_choice_is_only_the_x_axis():
+    rotor = two_spool_rotor()
+    by_inner = campbell(rotor, SPEEDS_2, ratio=1.3, n_modes=6)
+    by_outer = campbell(rotor, 1.3 * SPEEDS_2, ratio=1.3, reference="outer", n_modes=6)
+    assert by_outer.speed_ratios == pytest.approx({"inner": 1 / 1.3, "outer": 1.0})
+    assert np.allclose(by_outer.frequencies, by_inner.frequencies, rtol=1e-10)
+    # the same physical critical speeds, on the other spool's axis
+    a = np.array([c.speed for c in by_inner.critical_speeds])
+    b = np.array([c.speed for c in by_outer.critical_speeds])
+    assert len(a) == len(b) > 0 and np.allclose(1.3 * a, b, rtol=1e-8)
+    # default ratio = nominal speeds 400/300
+    assert campbell(rotor, SPEEDS_2[:2], n_modes=2).speed_ratios["outer"] == pytest.approx(400 / 300)
+
+
+def test_two_spool_critical_speeds_match_hermitian_formulation():
+    rotor = dataclasses.replace(two_spool_rotor(), intershaft_bearings=(
+        IntershaftBearing(k_xx=1e7, k_yy=1e7, node_a=13, node_b=5),))  # undamped for the exact check
+    result = campbell(rotor, np.linspace(0.0, 3000.0, 31), ratio=1.3, n_modes=6)
+    for spool in ("inner", "outer"):
+        _check_critical_speeds(result, rotor, spool, 1.0)
+
+
+# --- the seed rig ----------------------------------------------------------------------------------
+def test_seed_rig_operating_point_is_10_percent_from_every_critical_speed():
+    result = rig.rig_campbell()
+    assert result.speed_ratios["outer"] == pytest.approx(90 / 70)
+    assert {c.spool for c in result.critical_speeds} == {"inner", "outer"}
+    # every 1x critical speed of the undamped rig (Hermitian formulation, all modes, to 1e-8) is found by
+    # the undamped Campbell with the same tracked modes, and the damped one has the same crossings:
+    # the margin check below covers all of them
+    missing, shift = rig.completeness(result)
+    assert missing == 0
+    # bearing damping (log dec <= 0.2, zeta <= 0.03) moves the crossings by a few zeta^2 (measured 0.44 %)
+    assert shift < 0.02
+    assert len(result.critical_speeds) >= 8
+    assert rig.min_margin(result) >= rig.REQUIRED_MARGIN
+    assert result.tracking_mac.min() > 0.9
+
+
+# --- output ----------------------------------------------------------------------------------------
+def test_csv_and_png(tmp_path):
+    result = campbell(rigid_rotor(2.1e13), SPEEDS_RIGID[:6], n_modes=4)
+    assert isinstance(result, CampbellResult)
+    rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
+    assert rows[0] == ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"]
+    assert len(rows) == 1 + 6 * 4
+    assert float(rows[2][2]) == pytest.approx(result.frequencies[0, 1] / (2 * math.pi), rel=1e-8)
+    png = result.plot(tmp_path / "c.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError):
+        result.frequencies[0, 0] = 1.0  # results are read-only
+
+
+def test_cli_writes_csv_png_and_prints_critical_speeds(tmp_path, capsys):
+    from rotorred.cli import main
+
+    assert main(["campbell", "nelson-mcvaugh", "--speeds", "0:30000:16", "--modes", "4",
+                 "--harmonics", "1,2", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "critical speeds" in out and "1× shaft" in out and "2× shaft" in out
+    assert (tmp_path / "campbell.csv").read_text().startswith("speed_rpm,mode,frequency_hz,whirl,log_dec\n")
+    assert (tmp_path / "campbell.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("speeds, message", [
+    ("100:0:5", "STOP must be greater than START"),
+    ("0:100:1", "COUNT must be an integer >= 2"),
+    ("-5:100:3", "START must be a finite speed >= 0"),
+    ("0:100", "START:STOP:COUNT"),
+    ("a:100:3", "must be numbers"),
+])
+def test_cli_bad_speeds(tmp_path, capsys, speeds, message):
+    from rotorred.cli import main
+
+    assert main(["campbell", "nelson-mcvaugh", f"--speeds={speeds}", "--out", str(tmp_path)]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "campbell.csv").exists()
+
+
+# --- bad input -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(speeds=[0.0]), "at least 2"),
+    (dict(speeds=[[0.0, 1.0]]), "1-D"),
+    (dict(speeds=[0.0, 2.0, 1.0]), "strictly increasing"),
+    (dict(speeds=[-1.0, 2.0]), ">= 0"),
+    (dict(speeds=[0.0, math.nan]), "finite"),
+    (dict(speeds="fast"), "`speeds`"),
+    (dict(n_modes=0), "`n_modes`"),
+    (dict(n_modes=2.5), "`n_modes`"),
+    (dict(n_modes=10_000), "`n_modes` must be <="),
+    (dict(harmonics=()), "`harmonics`"),
+    (dict(harmonics=(1, -2)), "`harmonics`"),
+    (dict(reference="fan"), "`reference` must be one of"),
+    (dict(ratio=-1.0), "`ratio`"),
+    (dict(ratio=math.inf), "`ratio`"),
+])
+def test_bad_input(kwargs, message):
+    args = dict(speeds=[0.0, 100.0])
+    args.update(kwargs)
+    speeds = args.pop("speeds")
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace("[", r"\[")):
+        campbell(two_spool_rotor(), speeds, **args)
+
+
+def test_bad_ratio_for_one_spool_and_zero_reference_speed():
+    with pytest.raises(ValueError, match="two-spool rotors only"):
+        campbell(rigid_rotor(2.1e13), [0.0, 1.0], ratio=1.2)
+    still = two_spool_rotor().with_speeds({"inner": 0.0})
+    with pytest.raises(ValueError, match="nominal speed 0"):
+        campbell(still, [0.0, 1.0])
+    assert campbell(still, [0.0, 1.0], ratio=1.5, n_modes=2).speed_ratios["outer"] == 1.5
