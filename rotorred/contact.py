@@ -1,0 +1,259 @@
+"""Rub-impact between a disk and an elastically supported plate (Xu et al. 2016, section 2.3).
+
+Geometry and sign conventions (the paper's Eqs. 5-6 are inconsistent in sign; this is the
+project's single definition)
+----------------------------------------------------------------------------------------
+* ``n = (cos theta, sin theta)`` is the plate normal, pointing from the disk centre towards
+  the plate; ``t = (-sin theta, cos theta)`` is the tangent (``n`` turned by +90 deg, the
+  direction in which the rim of a disk spinning about +z passes the contact point).
+* The plate moves as a rigid body along ``n`` (``u_n``) and ``t`` (``u_t``) on linear
+  spring-dampers (Eq. 7): ``m_p u_n'' + c_n u_n' + k_n u_n = +P`` and
+  ``m_p u_t'' + c_t u_t' + k_t u_t = -T``.
+* Gap (positive = open), with ``(x, y)`` the displacement of the disk centre:
+  ``g = clearance + u_n - (x cos theta + y sin theta)``; penetration ``p = max(0, -g)``.
+  The disk radius enters only the sliding speed.
+* The penetration is shared between plate bending and local contact deformation
+  (Eq. 4): ``p = W + delta``, with ``W = lam P + w0`` from the plate model
+  (:mod:`rotorred.plate`, Eqs. 10-11) and ``delta`` the Hertz deformation.
+* Normal force (Eq. 8, Hunt–Crossley reading of the "nonlinear spring damping model"):
+  ``P = K_nr delta^1.5 max(0, 1 + c p')`` for ``delta > 0``, else 0. The rate is the
+  approach rate ``p' = -g'`` of the disk towards the plate (the bending deflection is treated
+  as quasi-static, so ``delta'`` is replaced by ``p'``; this keeps the law algebraic in each
+  step). The damping term dissipates ``int K_nr delta^1.5 c p'^2 dt >= 0``; the clamp at 0
+  stops the law from pulling the disk back (no adhesion).
+* Friction (Eq. 8, Coulomb with static and dynamic coefficients). The relative tangential
+  velocity of the disk's contact point against the plate is
+  ``v_rel = Omega r + (x', y') . t - u_t'``: the disk's surface speed (spin about +z,
+  rim point ``r n`` moving with ``Omega z x r n = Omega r t``), plus the whirl velocity, minus
+  the plate's tangential velocity. Slip: ``T = -mu_d P sign(v_rel)``. Stick: ``v_rel = 0`` with
+  ``|T| <= mu_s P``. The integrator treats stick exactly as a constraint (no regularisation);
+  see :mod:`rotorred.newmark`.
+* Forces: on the disk ``-P n + T t``; on the plate ``+P n - T t``. In the paper's Eq. 12,
+  ``F_x = F_n cos theta + F_t sin theta``, ``F_y = F_n sin theta - F_t cos theta`` with
+  ``F_n = -P`` and ``F_t = -T`` (the paper's t axis is ``-t`` here).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rotorred._generated import contact as _gen
+from rotorred.plate import ClampedFreePlate, NavierPlate, RigidPlate
+
+PlateBending = NavierPlate | ClampedFreePlate | RigidPlate
+
+#: contact states recorded per plate
+OPEN, SLIP, STICK = 0, 1, 2
+STATE_NAMES = {OPEN: "open", SLIP: "slip", STICK: "stick"}
+
+
+def _check(name: str, value, *, minimum: float | None = None, strict: bool = False, unit: str = "") -> float:
+    ok = isinstance(value, (int, float, np.floating)) and not isinstance(value, bool) and math.isfinite(value)
+    if ok and minimum is not None:
+        ok = value > minimum if strict else value >= minimum
+    if not ok:
+        rel = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
+        raise ValueError(f"`{name}` must be a finite number{rel} ({unit}), got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class RubPlate:
+    """An elastically supported rubbing plate facing the disk at ``node`` (Xu et al. 2016, Figs. 3-4).
+
+    Defaults are plausible for the seed rig (a 250 mm steel disk at node 18 running at 90 Hz,
+    outer-rotor amplitudes of 60-100 µm); the paper gives no values.
+
+    Parameters
+    ----------
+    node : int
+        Disk node the plate faces (default 18, the rub disk of the seed rig).
+    theta : float
+        Angle of the plate normal from the x axis (rad); default pi/2 (plate above the disk,
+        the paper's strongest rub signature is in the outer rotor's y response).
+    clearance : float
+        Gap between disk rim and plate at rest (m); default 40e-6 (below the outer rotor's
+        unbalance amplitude, so it rubs). Negative values mean an interference fit.
+    K_nr : float
+        Hertz contact stiffness (N/m^1.5); default 5e9 (steel rim edge on a steel plate:
+        (4/3) E* sqrt(R) with a local radius of a few mm).
+    c : float
+        Hunt–Crossley damping coefficient (s/m); default 1.0 (coefficient of restitution
+        e ~ 1 - 2 c v / 3 ~ 0.97 at an impact speed of 0.05 m/s).
+    mu_s, mu_d : float
+        Static and dynamic Coulomb friction coefficients (-), 0 <= mu_d <= mu_s; default
+        0.2 and 0.15 (dry steel on steel with some contamination).
+    m_p : float
+        Plate mass (kg), > 0; default 0.5.
+    k_n, k_t : float
+        Support stiffness of the plate, normal and tangential (N/m); default 5e6 and 5e6.
+    c_n, c_t : float
+        Support damping of the plate, normal and tangential (N s/m); default 100 and 100.
+    bending : NavierPlate, ClampedFreePlate or RigidPlate
+        Plate bending model (Eqs. 10-11); default a simply supported 100 x 60 x 3 mm steel plate
+        loaded at its centre (compliance 1.1e-7 m/N).
+    disk_radius : float, optional
+        Rim radius of the disk (m); default: the ``radius`` of the rotor's disk at ``node``
+        (see :meth:`for_rotor`).
+    name : str
+    """
+
+    node: int = 18
+    theta: float = math.pi / 2
+    clearance: float = 40e-6
+    K_nr: float = 5e9
+    c: float = 1.0
+    mu_s: float = 0.2
+    mu_d: float = 0.15
+    m_p: float = 0.5
+    k_n: float = 5e6
+    k_t: float = 5e6
+    c_n: float = 100.0
+    c_t: float = 100.0
+    bending: PlateBending = field(default_factory=NavierPlate)
+    disk_radius: float | None = None
+    name: str = ""
+
+    def __post_init__(self):
+        if not isinstance(self.node, int) or isinstance(self.node, bool):
+            raise ValueError(f"`node` must be an integer node number, got {self.node!r}")
+        _check("theta", self.theta, unit="rad")
+        _check("clearance", self.clearance, unit="m")
+        _check("K_nr", self.K_nr, minimum=0.0, strict=True, unit="N/m^1.5")
+        _check("c", self.c, minimum=0.0, unit="s/m")
+        _check("mu_s", self.mu_s, minimum=0.0, unit="-")
+        _check("mu_d", self.mu_d, minimum=0.0, unit="-")
+        if self.mu_d > self.mu_s:
+            raise ValueError(f"`mu_d` = {self.mu_d!r} must not exceed `mu_s` = {self.mu_s!r}")
+        _check("m_p", self.m_p, minimum=0.0, strict=True, unit="kg")
+        for f in ("k_n", "k_t", "c_n", "c_t"):
+            _check(f, getattr(self, f), minimum=0.0, unit="N/m" if f[0] == "k" else "N s/m")
+        if not isinstance(self.bending, (NavierPlate, ClampedFreePlate, RigidPlate)):
+            raise ValueError(f"`bending` must be a NavierPlate, ClampedFreePlate or RigidPlate, got {self.bending!r}")
+        if self.disk_radius is not None:
+            _check("disk_radius", self.disk_radius, minimum=0.0, unit="m")
+
+    @classmethod
+    def for_rotor(cls, rotor, node: int = 18, **kwargs) -> RubPlate:
+        """A plate at ``node`` of ``rotor`` with ``disk_radius`` taken from the rotor's disk there."""
+        disk = rotor.disk_at(node)
+        if disk.radius <= 0:
+            raise ValueError(f"the disk at node {node} has no `radius`; give `disk_radius` explicitly")
+        return cls(node=node, disk_radius=disk.radius, **kwargs)
+
+    def with_(self, **changes) -> RubPlate:
+        """A copy with ``changes`` (``dataclasses.replace``)."""
+        return dataclasses.replace(self, **changes)
+
+    @property
+    def normal(self) -> np.ndarray:
+        """Unit normal n = (cos theta, sin theta), shape (2,)."""
+        return np.array([math.cos(self.theta), math.sin(self.theta)])
+
+    @property
+    def tangent(self) -> np.ndarray:
+        """Unit tangent t = (-sin theta, cos theta), shape (2,)."""
+        return np.array([-math.sin(self.theta), math.cos(self.theta)])
+
+    @property
+    def compliance(self) -> float:
+        """Bending compliance lam (m/N) of the plate model."""
+        return float(self.bending.compliance)
+
+    @property
+    def offset(self) -> float:
+        """Bending offset w0 (m) of the plate model (b0/a0 for the clamped-free fit)."""
+        return float(self.bending.offset)
+
+
+def gap(plate: RubPlate, x: float, y: float, u_n: float = 0.0) -> float:
+    """Gap g = clearance + u_n - (x cos theta + y sin theta) (m); positive = open."""
+    return plate.clearance + u_n - (x * math.cos(plate.theta) + y * math.sin(plate.theta))
+
+
+def hunt_crossley(delta: float, rate: float, K_nr: float, c: float) -> tuple[float, float, float]:
+    """Hertz force with Hunt–Crossley damping, clamped at zero, and its tangent.
+
+    Parameters
+    ----------
+    delta : float
+        Local contact deformation (m); no force for ``delta <= 0``.
+    rate : float
+        Penetration rate (m/s).
+    K_nr : float
+        Hertz stiffness (N/m^1.5).
+    c : float
+        Hunt–Crossley coefficient (s/m).
+
+    Returns
+    -------
+    force, stiffness, damping : float
+        F (N), dF/d(delta) (N/m), dF/d(rate) (N s/m).
+    """
+    if delta <= 0.0 or 1.0 + c * rate <= 0.0:
+        return 0.0, 0.0, 0.0
+    F, k, d = _gen.hunt_crossley(math.sqrt(delta), rate, K_nr, c)
+    return float(F), float(k), float(d)
+
+
+def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 1e-14) -> tuple[float, float]:
+    """Normal contact force P of the plate's series law: P = K_nr (p - w0 - lam P)^1.5 max(0, 1 + c rate).
+
+    Solved by Newton from P = 0 (the residual is increasing and concave in P for fixed
+    ``rate``, so the iterates increase monotonically to the root).
+
+    Parameters
+    ----------
+    penetration : float
+        Penetration p = -g (m); no force below the bending offset w0.
+    rate : float
+        Penetration rate p' (m/s).
+    plate : RubPlate
+
+    Returns
+    -------
+    P : float
+        Normal force (N), >= 0.
+    dP_dp : float
+        Tangent dP/dp (N/m) at fixed rate.
+    """
+    lam, w0 = plate.compliance, plate.offset
+    P = 0.0
+    for _ in range(200):
+        delta = penetration - w0 - lam * P
+        F, k, _d = hunt_crossley(delta, rate, plate.K_nr, plate.c)
+        R, dR = P - F, 1.0 + lam * k
+        step = R / dR
+        P -= step
+        if abs(step) <= tol * max(abs(P), 1e-300):
+            break
+    delta = penetration - w0 - lam * P
+    _, k, _ = hunt_crossley(delta, rate, plate.K_nr, plate.c)
+    return max(P, 0.0), k / (1.0 + lam * k)
+
+
+def contact_energy(P: float, plate: RubPlate) -> float:
+    """Elastic energy stored in bending and Hertz contact at the normal force ``P`` (J).
+
+    ``lam P^2 / 2`` (plate bending, linear part of Eqs. 10-11) plus ``2/5 K_nr delta^2.5`` with
+    ``delta = (P / K_nr)^(2/3)`` (the Hertz potential; exact for c = 0).
+    """
+    if P <= 0.0:
+        return 0.0
+    delta = (P / plate.K_nr) ** (2.0 / 3.0)
+    return 0.5 * plate.compliance * P * P + float(_gen.hertz_energy(math.sqrt(delta), plate.K_nr)[0])
+
+
+def sliding_velocity(plate: RubPlate, Omega: float, radius: float, vx: float, vy: float, v_t: float) -> float:
+    """Relative tangential velocity v_rel = Omega r + (vx, vy) . t - v_t (m/s) of the disk against the plate."""
+    return Omega * radius + (-vx * math.sin(plate.theta) + vy * math.cos(plate.theta)) - v_t
+
+
+def rotor_force(plate: RubPlate, P: float, T: float) -> tuple[float, float]:
+    """Force (F_x, F_y) (N) on the rotor node for normal force ``P`` and friction ``T`` (Eq. 12)."""
+    c, s = math.cos(plate.theta), math.sin(plate.theta)
+    return -P * c - T * s, -P * s + T * c
