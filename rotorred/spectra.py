@@ -183,8 +183,8 @@ def rfft_plan(n: int, dtype=np.float64) -> pyfftw.FFTW:
     Returns
     -------
     pyfftw.FFTW
-        Call it as ``plan(input_array=x)``; the result is its internal output array,
-        shape (n // 2 + 1,), complex.
+        Fill ``plan.input_array``, call ``plan.execute()`` and copy ``plan.output_array``,
+        shape (n // 2 + 1,), complex (as :func:`amplitude_spectrum` does).
     """
     return _plan_entry(n, dtype)[0]
 
@@ -228,7 +228,11 @@ def plan_cache_clear() -> None:
 def _rfft(x: np.ndarray) -> np.ndarray:
     plan, lock = _plan_entry(x.size, x.dtype)
     with lock:  # the plan owns its input/output arrays; one caller at a time
-        return plan(input_array=x).copy()
+        # Copy into the plan's own aligned input: calling ``plan(input_array=x)`` would let the
+        # plan adopt ``x`` as its input buffer, and a later call would overwrite the caller's array.
+        plan.input_array[:] = x
+        plan.execute()
+        return plan.output_array.copy()
 
 
 # --------------------------------------------------------------------------- spectrum

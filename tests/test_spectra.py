@@ -213,3 +213,17 @@ def test_settled_spectrum_exact_and_fallback():
         assert abs(20 * np.log10(peak / a)) <= 0.0045 + 20 * np.log10(1 + 60 / a * 1.8e-5)
     with pytest.raises(ValueError, match="`f_L`"):  # bad input is not a fallback
         settled_spectrum(y, dt, -1.0, f_H)
+
+
+def test_spectra_never_write_into_the_callers_records():
+    """Regression: a cached pyFFTW plan must not adopt a caller's array as its input buffer
+    (a later call on another, misaligned record would then overwrite the first one)."""
+    from rotorred.spectra import settled_spectrum
+
+    rng = np.random.default_rng(1)
+    dt = 1e-4
+    records = rng.standard_normal((6, 3001))
+    kept = records.copy()
+    for row in records:  # rows of a C array: alternately aligned and misaligned views
+        settled_spectrum(row, dt, 70.0, 90.0)
+    np.testing.assert_array_equal(records, kept)

@@ -1,0 +1,233 @@
+"""The scene pipeline: harmonic vs time stepping, only what is needed, spectra, files, CLI, the paper."""
+
+from __future__ import annotations
+
+import copy
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rotorred.harmonic import unbalance_response
+from rotorred.run import build_model, harmonic_outputs, run_scene, settled_state, write_outputs
+from rotorred.scene import scene_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: a short linear scene on the full seed-rig model; alpha = 40 1/s makes every mode decay with
+#: sigma >= alpha / 2 = 20 1/s, so a start-up from rest has settled to e^-34 after 1.7 s
+LINEAR = {
+    "name": "linear",
+    "rotor": {"preset": "seed-rig", "rayleigh_alpha": 40.0, "rayleigh_beta": 2e-5},
+    "speeds": {"inner": 70.0, "outer": 90.0},
+    "unbalance": [{"node": 11, "m_e": 1e-4}, {"node": 18, "m_e": 1e-3, "phase_deg": 40.0}],
+    "solver": {"model": "full", "dt": 2e-5, "duration": 0.5, "record_start": 0.3},
+    "output": {"nodes": [13, 14], "directions": ["x", "y"], "plot_window": [0.3, 0.4]},
+}
+
+
+def _scene(**changes):
+    data = copy.deepcopy(LINEAR)
+    for path, value in changes.items():
+        section, _, key = path.partition("__")
+        if key:
+            data.setdefault(section, {})[key] = value
+        else:
+            data[section] = value
+    return scene_from_dict(data)
+
+
+@pytest.fixture(scope="module")
+def linear():
+    sc = _scene()
+    return sc, run_scene(sc)
+
+
+def test_linear_settled_scene_gets_the_harmonic_solution(linear):
+    sc, res = linear
+    assert res.method == "harmonic" and res.n_steps == 0 and res.contacts == ()
+    # only the requested DOFs, only the recorded window
+    assert list(res.outputs) == [(13, "x"), (13, "y"), (14, "x"), (14, "y")]
+    assert res.t[0] == pytest.approx(0.3, abs=1e-12) and res.t[-1] == pytest.approx(0.5, abs=1e-12)
+    assert len(res.t) == 10001 and all(len(v) == len(res.t) for v in res.outputs.values())
+
+
+def test_spectrum_reads_the_phasor_amplitudes_exactly(linear):
+    """The spectral lines at f_L and f_H equal |Q| of the independent harmonic module.
+
+    The record (0.2 s, two common periods) puts both tones on bins, where the rectangular window
+    reads them exactly; the only error is rounding (1e-9 relative).
+    """
+    sc, res = linear
+    model = build_model(sc).model
+    ref = unbalance_response(model, sc.unbalances, [sc.speeds["inner"]], ratios={"outer": 90.0 / 70.0},
+                             outputs=sc.output.dofs, spool_of=sc.rotor.spool_of, reference_spool="inner")
+    for d in sc.output.dofs:
+        spec = res.spectra[d]
+        for spool, f in (("inner", 70.0), ("outer", 90.0)):
+            assert spec.amplitude_at(f) == pytest.approx(abs(ref.phasors[spool][d][0]), rel=1e-9)
+        assert sorted(ln.label_ascii for ln in res.lines[d]) == ["f_H", "f_L"]
+
+
+def test_spectra_leave_the_records_unchanged(linear):
+    """The recorded arrays are not overwritten by the FFT (pyFFTW plans adopt aligned inputs)."""
+    sc, res = linear
+    again = harmonic_outputs(sc, build_model(sc).model, res.t)
+    for d in sc.output.dofs:
+        np.testing.assert_array_equal(res.outputs[d], again[d])
+
+
+def test_startup_from_rest_converges_to_the_harmonic_solution(linear):
+    """Independent check of the harmonic path: Newmark time stepping from rest.
+
+    Tolerance: the start-up transient has decayed to e^-34 by 1.7 s (sigma >= 20 1/s); what is
+    left is Newmark's period error, a relative frequency error (Omega dt)^2 / 12, i.e. a phase
+    drift of Omega t (Omega dt)^2 / 12 for the fastest tone by t = 2 s; twice that bounds the
+    difference relative to the peak.
+    """
+    sc, res = linear
+    rest = _scene(solver={"model": "full", "dt": 2e-5, "duration": 2.0, "record_start": 1.7, "start": "rest"},
+                  output={"nodes": [13, 14], "directions": ["x", "y"], "plots": [], "formats": []})
+    res_rest = run_scene(rest)
+    assert res_rest.method == "transient" and res_rest.n_steps == 100_000
+    assert res_rest.counters["n_contact_steps"] == 0 and res_rest.contacts == ()  # no plate, no contact work
+    harmonic = harmonic_outputs(rest, build_model(rest).model, res_rest.t)
+    w = 2 * math.pi * 90.0
+    tol = 2 * w * 2.0 * (w * 2e-5) ** 2 / 12
+    for d in rest.output.dofs:
+        err = np.max(np.abs(res_rest.outputs[d] - harmonic[d])) / np.max(np.abs(harmonic[d]))
+        assert err < tol, (d, err, tol)
+
+
+def test_settled_state_is_the_harmonic_solution_at_t0(linear):
+    sc, _ = linear
+    model = build_model(sc).model
+    q0, v0 = settled_state(sc, model)
+    R = model.output_rows(sc.output.dofs)
+    t = np.array([0.0, 1e-7])
+    y = harmonic_outputs(sc, model, t)
+    for j, d in enumerate(sc.output.dofs):
+        assert R[j] @ q0 == pytest.approx(y[d][0], rel=1e-12)
+        # velocity against a central difference of the harmonic solution (error O(Omega^2 h) ~ 1e-4)
+        assert R[j] @ v0 == pytest.approx((y[d][1] - y[d][0]) / 1e-7, rel=1e-3)
+
+
+@pytest.fixture(scope="module")
+def rub():
+    """paper-rub on a short window: 0.6 s from the settled state (the rub settles in < 0.3 s)."""
+    from rotorred.scene import load_scene
+    sc = load_scene("paper-rub", {"solver.duration": 0.6, "solver.record_start": 0.4,
+                                  "output.plot_window": [0.4, 0.54]})
+    return sc, run_scene(sc)
+
+
+def test_rub_scene_records_contact_and_a_normal_comparison(rub):
+    sc, res = rub
+    assert res.method == "transient" and len(res.contacts) == 1
+    assert 0 < res.contact_fraction() < 0.5
+    assert res.n_impacts() >= 2  # at least one impact per common period of 0.1 s
+    assert res.normal is not None and res.normal.method == "harmonic"
+    # combination lines appear with the rub, and only f_L, f_H without it
+    labels = {ln.label_ascii for ln in res.lines[(14, "y")]}
+    assert {"f_H-f_L", "2f_H", "3f_H-2f_L"} <= labels
+    assert {ln.label_ascii for ln in res.normal.lines[(14, "y")]} <= {"f_L", "f_H"}
+
+
+def test_rub_beyond_the_free_orbit_is_the_linear_response():
+    """A plate that is never reached changes nothing: the transient stays on the harmonic solution."""
+    from rotorred.scene import load_scene
+    sc = load_scene("paper-rub", {"rub.clearance": 60e-6, "solver.duration": 0.3, "solver.record_start": 0.1,
+                                  "output.plot_window": [0.1, 0.2], "solver.model": "full"})
+    res = run_scene(sc)
+    assert res.contact_fraction() == 0 and res.n_impacts() == 0
+    # tolerance: Newmark's phase drift of the 90 Hz tone by 0.3 s, (Omega dt)^2 / 12 * Omega t, doubled
+    w = 2 * math.pi * 90.0
+    tol = 2 * w * 0.3 * (w * 2e-5) ** 2 / 12
+    for d in sc.output.dofs:
+        ref = res.normal.outputs[d]
+        assert np.max(np.abs(res.outputs[d] - ref)) / np.max(np.abs(ref)) < tol
+
+
+def test_write_outputs(rub, tmp_path):
+    from scipy.io import loadmat
+    sc, res = rub
+    files = write_outputs(res, tmp_path)
+    names = {f.name for f in files}
+    assert {"waveforms.png", "spectra_node13.png", "spectra_node14.png", "spectra_node18.png", "orbits.png",
+            "result.npz", "result.mat", "timeseries.csv", "spectra.csv", "lines.csv", "summary.txt"} == names
+    for f in files:
+        assert f.stat().st_size > 0
+    npz = np.load(tmp_path / "result.npz")
+    mat = loadmat(tmp_path / "result.mat")
+    for key in ("t", "rub_14_y", "normal_14_y", "rub_amp_14_y", "frequency", "plate0_normal_force", "plate0_state"):
+        assert key in npz and key in mat
+        np.testing.assert_array_equal(np.ravel(mat[key]), np.ravel(npz[key]))
+    np.testing.assert_array_equal(npz["rub_14_y"], res.outputs[(14, "y")])
+    header = (tmp_path / "timeseries.csv").read_text().splitlines()[0].split(",")
+    assert header[0] == "t (s)" and "rub node 14 y (um)" in header and "plate 0 state" in header
+    column = header.index("rub node 14 y (um)")
+    csv_y = np.loadtxt(tmp_path / "timeseries.csv", delimiter=",", skiprows=1, usecols=column)
+    np.testing.assert_allclose(csv_y, 1e6 * res.outputs[(14, "y")], rtol=1e-8, atol=1e-12)
+    summary = (tmp_path / "summary.txt").read_text()
+    assert "Frequency (Hz) | Component" in summary and "impacts" in summary and "contact" in summary
+
+
+def test_cli_run(tmp_path, capsys):
+    from rotorred.cli import main
+    path = tmp_path / "linear.toml"
+    path.write_text('name = "cli"\n[rotor]\npreset = "seed-rig"\n[[unbalance]]\nnode = 18\nm_e = 1e-3\n'
+                    '[solver]\nmodel = "full"\nduration = 0.5\nrecord_start = 0.3\n'
+                    '[output]\nnodes = [14]\nplots = ["spectra"]\nformats = ["npz"]\n')
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "harmonic steady state" in out and "wall time" in out
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["result.npz", "spectra_node14.png", "summary.txt"]
+
+
+def _load_validation(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "validation" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_paper_reproduction():
+    """The paper's signatures with the built-in scenes (validation/paper_reproduction.py)."""
+    v = _load_validation("paper_reproduction")
+    # normal state: only f_L and f_H above 1 % at nodes 13 and 14
+    for node in (13, 14):
+        for d in ("x", "y"):
+            labels = {ln.label_ascii for ln in v.normal_lines(node, d)}
+            assert "f_H" in labels and labels <= {"f_L", "f_H"}, (node, d, labels)
+    # rub: at least 18 of the 24 Table 1 components, each with the paper's label
+    assert v.n_table1_found() >= 18
+    # the orbit at the rub node contracts on the plate side; the inner rotor changes less than the outer
+    rub_reach, normal_reach = v.plate_side_reach(18)
+    assert rub_reach < normal_reach
+    assert v.relative_change(13) < v.relative_change(14)
+    # the settled response is periodic with 0.1 s (transients have decayed)
+    assert v.period_mismatch() < 1e-3
+
+
+def test_gravity_settled_state_matches_time_stepping():
+    """With gravity, the harmonic path adds the static sag K^-1 F_g; time stepping from the same settled
+    state (a plate 1 m away forces the transient path) must stay on it.
+
+    Tolerance as above: Newmark's phase drift of the 90 Hz tone over 0.3 s, doubled, relative to the
+    unbalance amplitude; the static part is exact for Newmark (a constant load is integrated exactly).
+    """
+    base = dict(solver={"model": "full", "dt": 2e-5, "duration": 0.3, "record_start": 0.1, "gravity": 9.81},
+                output={"nodes": [14, 18], "directions": ["x", "y"], "plots": [], "formats": [],
+                        "plot_window": [0.1, 0.2]})
+    harmonic = run_scene(_scene(**base))
+    stepped = run_scene(_scene(**base, rub=[{"node": 18, "clearance": 1.0}]))
+    assert harmonic.method == "harmonic" and stepped.method == "transient" and stepped.contact_fraction() == 0
+    sag = np.mean(harmonic.outputs[(18, "y")])
+    assert sag < -1e-5  # the seed rig sags tens of micrometres at the HP turbine disk
+    w = 2 * math.pi * 90.0
+    tol = 2 * w * 0.3 * (w * 2e-5) ** 2 / 12
+    for d in harmonic.outputs:
+        amp = np.max(np.abs(harmonic.outputs[d] - np.mean(harmonic.outputs[d])))
+        assert np.max(np.abs(stepped.outputs[d] - harmonic.outputs[d])) < tol * amp + 1e-12 * abs(sag)
