@@ -12,6 +12,10 @@ import sys
 
 #: command modules, in the order ``rotorred --help`` lists them
 COMMANDS = [
+    "campbell",
+    "harmonic",
+    "run",
+    "sweep",
 ]
 
 

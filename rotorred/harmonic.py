@@ -1,0 +1,445 @@
+"""Steady-state harmonic response: unbalance response over a speed sweep, FRFs, and the
+steady state at one operating point in model coordinates (a transient's initial condition).
+
+Works on any model with the :class:`~rotorred.assembly.SystemMatrices` interface, full or
+reduced (:class:`~rotorred.reduction.ReducedSystem`): it needs ``M, K, damping(speeds),
+spools`` and ``output_rows(outputs)``. A physical force ``f`` at (node, direction) enters
+the model's coordinates as ``rowᵀ f`` with ``row = output_rows([(node, direction)])``
+(virtual work; for a full model this is the unit vector, for a reduced one the row of the
+recovery map T, i.e. ``Tᵀ f``).
+
+Conventions
+-----------
+Unbalance ``m_e`` at phase ``phi`` on a node of spool ``s`` spinning at ``Omega_s`` gives
+(:class:`rotorred.loads.Unbalance`) ``F = m_e Omega_s² [cos(Omega_s t + phi), sin(Omega_s t + phi)]``,
+i.e. ``F = Re(F̂ e^{i Omega_s t})`` with the phasors ``F̂_x = m_e Omega_s² e^{i phi}``,
+``F̂_y = -i m_e Omega_s² e^{i phi}``. The response is ``q(t) = Re(Q e^{i Omega_s t})`` with
+
+    Q = (K - Omega_s² M + i Omega_s (C + sum_t Omega_t G_t))^-1 F̂,
+
+where every spool ``t`` spins at its own speed ``Omega_t`` (Xu et al. 2016, Eq. 13, steady
+state, F_L = 0). The spool speeds follow one reference speed at fixed ratios,
+``Omega_t = ratio_t * Omega_ref``.
+
+Two spools at different speeds excite two different frequencies: their responses add in
+time, ``q(t) = Re(Q_inner e^{i Omega_inner t}) + Re(Q_outer e^{i Omega_outer t})``, not as one
+phasor. The result therefore keeps one phasor per excitation spool, and reports as
+``peak`` the sum of the magnitudes over distinct frequencies (spools running at exactly the
+same speed are first added as phasors): an upper bound of the peak displacement of the
+two-frequency signal, reached only when the two cosines line up. With a commensurate ratio
+such as 70:90 Hz the signal is periodic and the true peak lies somewhat below the bound.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from rotorred.assembly import DIRECTIONS
+from rotorred.loads import Unbalance
+
+Output = tuple[int, str]
+
+
+@dataclass(frozen=True)
+class UnbalanceResponse:
+    """Steady-state unbalance response over a speed sweep.
+
+    Attributes
+    ----------
+    speeds : ndarray, shape (n,)
+        Reference spool speed at each sweep point (rad/s).
+    reference_spool : str
+    spool_speeds : dict of str to ndarray, shape (n,)
+        Speed of every spool (rad/s) = ratio * ``speeds``.
+    outputs : tuple of (int, str)
+        Requested physical DOFs (node, direction).
+    phasors : dict of str to dict of (int, str) to ndarray, shape (n,), complex
+        ``phasors[spool][output]``: complex amplitude Q (m) of the response to the unbalances
+        of ``spool``, at that spool's frequency: ``q(t) = Re(Q e^{i Omega_spool t})``.
+        Only spools carrying an unbalance appear.
+    """
+
+    speeds: np.ndarray
+    reference_spool: str
+    spool_speeds: Mapping[str, np.ndarray]
+    outputs: tuple[Output, ...]
+    phasors: Mapping[str, Mapping[Output, np.ndarray]]
+
+    @property
+    def excited_spools(self) -> tuple[str, ...]:
+        """Spools carrying an unbalance."""
+        return tuple(self.phasors)
+
+    def amplitude(self, output: Output, spool: str) -> np.ndarray:
+        """|Q| (m) of ``output`` at ``spool``'s frequency, shape (n,)."""
+        return np.abs(self.phasors[spool][tuple(output)])
+
+    def phase(self, output: Output, spool: str) -> np.ndarray:
+        """arg Q (rad) of ``output`` at ``spool``'s frequency, shape (n,)."""
+        return np.angle(self.phasors[spool][tuple(output)])
+
+    def peak(self, output: Output) -> np.ndarray:
+        """Upper bound of the peak displacement (m) of ``output``, shape (n,).
+
+        Phasors of spools at the same speed are added first; the magnitudes of the
+        resulting distinct-frequency phasors are then summed.
+        """
+        output = tuple(output)
+        total = np.zeros(len(self.speeds))
+        spools = list(self.phasors)
+        for k in range(len(self.speeds)):
+            groups: dict[float, complex] = {}
+            for s in spools:
+                w = float(self.spool_speeds[s][k])
+                groups[w] = groups.get(w, 0.0) + self.phasors[s][output][k]
+            total[k] = sum(abs(v) for v in groups.values())
+        return total
+
+    def time_history(self, output: Output, t: np.ndarray) -> np.ndarray:
+        """q(t) (m) of ``output`` at every sweep point, shape (n, len(t)); the superposed signal."""
+        t = np.asarray(t, dtype=float)
+        out = np.zeros((len(self.speeds), len(t)))
+        for s in self.phasors:
+            Q = self.phasors[s][tuple(output)]
+            w = self.spool_speeds[s]
+            out += np.real(Q[:, None] * np.exp(1j * w[:, None] * t[None, :]))
+        return out
+
+    def write_csv(self, path: str | Path) -> Path:
+        """Write the sweep as CSV: speeds in rpm, amplitudes in µm, phases in degrees.
+
+        Columns: ``<spool> speed (rpm)`` for every spool, then for every output and excited
+        spool ``node N dir @<spool> amplitude (um)`` and ``... phase (deg)``, then
+        ``node N dir peak bound (um)``.
+        """
+        path = Path(path)
+        header = [f"{s} speed (rpm)" for s in self.spool_speeds]
+        cols = [self.spool_speeds[s] * 60 / (2 * math.pi) for s in self.spool_speeds]
+        for o in self.outputs:
+            name = f"node {o[0]} {o[1]}"
+            for s in self.phasors:
+                header += [f"{name} @{s} amplitude (um)", f"{name} @{s} phase (deg)"]
+                cols += [1e6 * self.amplitude(o, s), np.degrees(self.phase(o, s))]
+            header.append(f"{name} peak bound (um)")
+            cols.append(1e6 * self.peak(o))
+        with path.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            for row in np.column_stack(cols):
+                w.writerow([f"{v:.10g}" for v in row])
+        return path
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    """Frequency response functions between physical DOFs at fixed spool speeds.
+
+    Attributes
+    ----------
+    frequencies : ndarray, shape (n,)
+        Excitation frequencies omega (rad/s).
+    speeds : dict of str to float
+        Spool speeds (rad/s) held during the sweep.
+    inputs, outputs : tuple of (int, str)
+        Force DOFs and response DOFs (node, direction).
+    H : ndarray, shape (n, len(outputs), len(inputs)), complex
+        Receptance (m/N): ``H[k, o, i]`` = displacement phasor at ``outputs[o]`` per unit
+        force phasor at ``inputs[i]`` at ``frequencies[k]``. Use :meth:`h` to read one pair.
+    """
+
+    frequencies: np.ndarray
+    speeds: Mapping[str, float]
+    inputs: tuple[Output, ...]
+    outputs: tuple[Output, ...]
+    H: np.ndarray
+
+    def h(self, output: Output, input: Output) -> np.ndarray:  # noqa: A002 - FRF vocabulary
+        """Receptance (m/N) from ``input`` to ``output``, shape (n,)."""
+        return self.H[:, self.outputs.index(tuple(output)), self.inputs.index(tuple(input))]
+
+    def write_csv(self, path: str | Path) -> Path:
+        """Write |H| (m/N) and phase (deg) of every pair against frequency (Hz)."""
+        path = Path(path)
+        header, cols = ["frequency (Hz)"], [self.frequencies / (2 * math.pi)]
+        for o in self.outputs:
+            for i in self.inputs:
+                name = f"node {o[0]} {o[1]} / node {i[0]} {i[1]}"
+                header += [f"{name} |H| (m/N)", f"{name} phase (deg)"]
+                cols += [np.abs(self.h(o, i)), np.degrees(np.angle(self.h(o, i)))]
+        with path.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            for row in np.column_stack(cols):
+                w.writerow([f"{v:.10g}" for v in row])
+        return path
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Steady-state unbalance response at one operating point, in the model's own coordinates.
+
+    Use it as the initial condition of a transient run, so the start-up transient of lightly
+    damped modes need not die out first: ``q(0) = displacement(0)``, ``q'(0) = velocity(0)``.
+
+    Attributes
+    ----------
+    speeds : dict of str to float
+        Spool speeds (rad/s).
+    phasors : dict of str to ndarray, shape (n,), complex
+        Complex amplitude of every model coordinate for the unbalances of each spool, at that
+        spool's frequency ``speeds[spool]``.
+    """
+
+    speeds: Mapping[str, float]
+    phasors: Mapping[str, np.ndarray]
+
+    def displacement(self, t: float) -> np.ndarray:
+        """q(t) = sum_s Re(Q_s e^{i Omega_s t}) (model coordinates), shape (n,)."""
+        return sum(np.real(Q * np.exp(1j * self.speeds[s] * t)) for s, Q in self.phasors.items())
+
+    def velocity(self, t: float) -> np.ndarray:
+        """q'(t) = sum_s Re(i Omega_s Q_s e^{i Omega_s t}), shape (n,)."""
+        return sum(np.real(1j * self.speeds[s] * Q * np.exp(1j * self.speeds[s] * t))
+                   for s, Q in self.phasors.items())
+
+
+def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, float],
+                 spool_of: Mapping[int, str] | None = None) -> SteadyState:
+    """Steady-state unbalance response of ``model`` at the spool speeds ``speeds`` (rad/s).
+
+    Parameters
+    ----------
+    model : SystemMatrices or ReducedSystem
+    unbalances : sequence of Unbalance
+    speeds : dict of str to float
+        Speed of every spool (rad/s).
+    spool_of : dict of int to str, optional
+        Spool of each node (optional for a single-spool model).
+
+    Returns
+    -------
+    SteadyState
+    """
+    spools = tuple(model.spools)
+    speeds = {s: float(w) for s, w in speeds.items()}
+    missing = [s for s in spools if s not in speeds]
+    unknown = set(speeds) - set(spools)
+    if missing or unknown:
+        raise ValueError(f"`speeds` must give the speed of every spool {list(spools)}, got {sorted(speeds)}")
+    for s, w in speeds.items():
+        if not (math.isfinite(w) and w >= 0):
+            raise ValueError(f"`speeds[{s!r}]` must be a finite speed >= 0 (rad/s), got {w!r}")
+    forces = _unbalance_forces(model, unbalances, spool_of)
+    D = model.damping(speeds)
+    phasors = {}
+    for s, f in forces.items():
+        w = speeds[s]
+        if w == 0.0:
+            phasors[s] = np.zeros(model.n_dof, dtype=complex)
+            continue
+        phasors[s] = sla.solve(model.K - w * w * model.M + 1j * w * D, w * w * f, check_finite=False)
+    return SteadyState(speeds=speeds, phasors=phasors)
+
+
+def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
+    """Force phasor per unit Omega² of each spool's unbalances, in model coordinates."""
+    spools = tuple(model.spools)
+    dofs = _full_dofs(model)
+    if spool_of is None:
+        if len(spools) != 1:
+            raise ValueError("`spool_of` (node -> spool, e.g. Rotor.spool_of) is required for a model with "
+                             f"{len(spools)} spools")
+        spool_of = {n: spools[0] for n in dofs.nodes}
+    if not unbalances:
+        raise ValueError("`unbalances` must hold at least one Unbalance, got none")
+    per_spool: dict[str, np.ndarray] = {}
+    for k, u in enumerate(unbalances):
+        if not isinstance(u, Unbalance):
+            raise ValueError(f"`unbalances[{k}]` must be an Unbalance, got {u!r}")
+        dofs.index(u.node, "x")  # ValueError naming the node if it does not exist
+        s = spool_of.get(u.node)
+        if s not in spools:
+            raise ValueError(f"`unbalances[{k}]`: node {u.node} has no spool in `spool_of` (got {s!r})")
+        rows = model.output_rows([(u.node, "x"), (u.node, "y")])
+        # per unit Omega²: F_x = m_e e^{i phi}, F_y = -i m_e e^{i phi}
+        f = u.m_e * np.exp(1j * u.phase) * (rows[0] - 1j * rows[1])
+        per_spool[s] = per_spool.get(s, 0.0) + f
+    return per_spool
+
+
+def _full_dofs(model):
+    dofs = getattr(model, "full_dofs", None)
+    return dofs if dofs is not None else model.dofs
+
+
+def _check_outputs(model, outputs, name: str) -> tuple[Output, ...]:
+    dofs = _full_dofs(model)
+    out = []
+    for o in outputs:
+        try:
+            node, direction = o
+        except (TypeError, ValueError):
+            raise ValueError(f"`{name}` entries must be (node, direction) pairs, got {o!r}") from None
+        if direction not in DIRECTIONS:
+            raise ValueError(f"`{name}`: direction must be one of {DIRECTIONS}, got {direction!r} at node {node!r}")
+        dofs.index(node, direction)  # raises ValueError naming the node if it does not exist
+        out.append((int(node), str(direction)))
+    return tuple(out)
+
+
+def _check_speeds(speeds, name: str = "speeds") -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(speeds, dtype=float))
+    if arr.ndim != 1 or len(arr) == 0 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise ValueError(f"`{name}` must be a non-empty 1-D sequence of finite values >= 0 (rad/s), got {speeds!r}")
+    return arr
+
+
+def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: Mapping[str, float] | None = None,
+                       outputs: Sequence[Output] = (), spool_of: Mapping[int, str] | None = None,
+                       reference_spool: str | None = None) -> UnbalanceResponse:
+    """Steady-state response to unbalances on any spool over a speed sweep.
+
+    Parameters
+    ----------
+    model : SystemMatrices or ReducedSystem
+    unbalances : sequence of Unbalance
+        Each rotates with the spool its node belongs to (``spool_of``).
+    speeds : array_like, shape (n,)
+        Reference spool speeds of the sweep (rad/s), >= 0.
+    ratios : dict of str to float, optional
+        Omega_spool / Omega_ref for every spool (the reference spool's is 1). Optional for a
+        single-spool model; required (for every spool other than the reference) otherwise.
+    outputs : sequence of (int, str)
+        Physical DOFs (node, direction) to report; any node of the full model.
+    spool_of : dict of int to str, optional
+        Spool of each node (``Rotor.spool_of``); optional for a single-spool model.
+    reference_spool : str, optional
+        Spool whose speed ``speeds`` gives (default the first of ``model.spools``).
+
+    Returns
+    -------
+    UnbalanceResponse
+    """
+    spools = tuple(model.spools)
+    speeds = _check_speeds(speeds)
+    outputs = _check_outputs(model, outputs, "outputs")
+    if not outputs:
+        raise ValueError("`outputs` must name at least one (node, direction) pair, got none")
+    if reference_spool is None:
+        reference_spool = spools[0]
+    if reference_spool not in spools:
+        raise ValueError(f"`reference_spool` {reference_spool!r} does not exist; spools are {list(spools)}")
+    ratios = dict(ratios or {})
+    unknown = set(ratios) - set(spools)
+    if unknown:
+        raise ValueError(f"`ratios` names unknown spool(s) {sorted(unknown)}; spools are {list(spools)}")
+    ratios.setdefault(reference_spool, 1.0)
+    if ratios[reference_spool] != 1.0:
+        raise ValueError(f"`ratios[{reference_spool!r}]` must be 1 (it is the reference spool), "
+                         f"got {ratios[reference_spool]!r}")
+    if len(spools) == 1:
+        ratios.setdefault(spools[0], 1.0)
+    missing = [s for s in spools if s not in ratios]
+    if missing:
+        raise ValueError(f"`ratios` must give the speed ratio (to {reference_spool!r}) of spool(s) {missing}")
+    for s, r in ratios.items():
+        if not (isinstance(r, (int, float, np.floating)) and math.isfinite(r) and r >= 0):
+            raise ValueError(f"`ratios[{s!r}]` must be a finite number >= 0, got {r!r}")
+    per_spool = _unbalance_forces(model, unbalances, spool_of)
+    R = model.output_rows(outputs)
+    spool_speeds = {s: ratios[s] * speeds for s in spools}
+    phasors = {s: np.zeros((len(speeds), len(outputs)), dtype=complex) for s in per_spool}
+    M, K = model.M, model.K
+    for k in range(len(speeds)):
+        D = model.damping({s: float(spool_speeds[s][k]) for s in spools})
+        for s, f in per_spool.items():
+            w = float(spool_speeds[s][k])
+            if w == 0.0:
+                continue  # no unbalance force at rest
+            Z = K - w * w * M + 1j * w * D
+            phasors[s][k] = R @ sla.solve(Z, w * w * f, check_finite=False)
+    return UnbalanceResponse(
+        speeds=speeds, reference_spool=reference_spool, spool_speeds=spool_speeds, outputs=outputs,
+        phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors})
+
+
+def response_error(reference: UnbalanceResponse, other: UnbalanceResponse, floor: float = 1e-3) -> float:
+    """Worst relative phasor error of ``other`` against ``reference`` over the sweep.
+
+    For every excited spool, output and sweep point the error is
+    ``|Q_other - Q_ref| / max(|Q_ref|, floor * max_sweep |Q_ref|)``: relative to the
+    amplitude at that point, except where the amplitude falls below ``floor`` times the
+    output's peak over the sweep (at rest, or at an anti-resonance, where a relative error
+    means nothing).
+
+    Returns
+    -------
+    float
+    """
+    if set(reference.phasors) != set(other.phasors) or reference.outputs != other.outputs \
+            or len(reference.speeds) != len(other.speeds):
+        raise ValueError("the two responses must have the same excited spools, outputs and sweep")
+    worst = 0.0
+    for s, per_output in reference.phasors.items():
+        for o, Q in per_output.items():
+            scale = np.abs(Q).max()
+            if scale == 0.0:
+                continue
+            err = np.abs(other.phasors[s][o] - Q) / np.maximum(np.abs(Q), floor * scale)
+            worst = max(worst, float(err.max()))
+    return worst
+
+
+def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output], frequencies,
+                       speeds: Mapping[str, float] | None = None) -> FrequencyResponse:
+    """Receptance FRFs H(omega) = R (K - omega² M + i omega (C + sum Omega_s G_s))^-1 Bᵀ.
+
+    Parameters
+    ----------
+    model : SystemMatrices or ReducedSystem
+    inputs, outputs : sequence of (int, str)
+        Force and response DOFs (node, direction), any node of the full model.
+    frequencies : array_like, shape (n,)
+        Excitation frequencies (rad/s), >= 0.
+    speeds : dict of str to float, optional
+        Spool speeds (rad/s) held fixed during the sweep (default: not spinning).
+
+    Returns
+    -------
+    FrequencyResponse
+    """
+    inputs = _check_outputs(model, inputs, "inputs")
+    outputs = _check_outputs(model, outputs, "outputs")
+    if not inputs or not outputs:
+        raise ValueError("`inputs` and `outputs` must each name at least one (node, direction) pair")
+    w_all = _check_speeds(frequencies, "frequencies")
+    speeds = dict(speeds or {})
+    D = model.damping(speeds)  # ValueError for unknown spools
+    B = model.output_rows(inputs).T
+    R = model.output_rows(outputs)
+    H = np.empty((len(w_all), len(outputs), len(inputs)), dtype=complex)
+    for k, w in enumerate(w_all):
+        Z = model.K - w * w * model.M + 1j * w * D
+        H[k] = R @ sla.solve(Z, B.astype(complex), check_finite=False)
+    return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H)
+
+
+def parse_dof(text: str) -> Output:
+    """``"13:x"`` -> (13, "x"); directions x, y, theta_x (tx), theta_y (ty)."""
+    aliases = {"tx": "theta_x", "ty": "theta_y"}
+    try:
+        node, direction = text.strip().split(":")
+        direction = aliases.get(direction.strip(), direction.strip())
+        node = int(node)
+    except ValueError:
+        raise ValueError(f"a DOF must be written NODE:DIRECTION (e.g. 13:x), got {text!r}") from None
+    if direction not in DIRECTIONS:
+        raise ValueError(f"DOF {text!r}: direction must be one of {DIRECTIONS}, got {direction!r}")
+    return node, direction

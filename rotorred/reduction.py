@@ -1,0 +1,568 @@
+"""Craig–Bampton reduction of a (multi-spool) rotor model.
+
+The full DOFs are split into boundary DOFs ``b`` (all four physical DOFs of each boundary
+node: bearings, inter-shaft bearings, the rub node, any node the user names) and interior
+DOFs ``i``. The Craig–Bampton basis (Craig & Bampton 1968, AIAA J. 6(7), Eqs. 8–14) is
+
+    q = T p,   T = [[I, 0], [Psi, Phi]]   (rows in (b, i) order),
+    Psi = -K_ii^-1 K_ib           static constraint modes,
+    K_ii Phi = M_ii Phi Lambda    fixed-interface normal modes (Phi^T M_ii Phi = I),
+
+computed on the non-spinning, undamped system. The reduced coordinates are
+``p = [boundary physical DOFs..., modal coordinates...]``, so a boundary DOF keeps its
+physical meaning and the rub force, bearing forces and inter-shaft forces act on it
+directly. M, K, C and every spool's G are projected with the same T
+(``M_r = T^T M T`` and so on), so the reduced equation of motion has the same form as the
+full one, ``M_r p'' + (C_r + sum_s Omega_s G_r,s) p' + K_r p = T^T F``. ``T`` is also the
+recovery map: any physical DOF, boundary or interior, is ``T[row] @ p``.
+
+With no interior mode kept the basis is Guyan's static condensation; with every interior
+mode kept ``T`` is square and invertible and the reduced eigenvalues equal the full ones.
+
+How many modes: given by count (``n_modes``), by cutoff frequency (``cutoff``, keep the
+fixed-interface modes with omega <= cutoff), or, by default, the smallest count whose whirl
+frequencies meet a relative error ``target`` against the full model over a frequency band
+(or over the first ``n_check`` whirl modes) at a few spin speeds. The choice is recorded in
+:class:`ModeSelection`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from rotorred.assembly import DofMap, SystemMatrices, assemble
+from rotorred.harmonic import response_error, unbalance_response
+from rotorred.modal import eigen
+from rotorred.model import Rotor
+
+#: default relative whirl-frequency error target of the automatic mode count (0.1 %)
+DEFAULT_TARGET = 1e-3
+#: default number of whirl modes checked by the automatic mode count when no band is given
+DEFAULT_N_CHECK = 8
+#: default spin-speed factors (times the nominal speeds) at which the automatic count is checked
+DEFAULT_SPEED_FACTORS = (0.0, 0.5, 1.0, 1.5)
+
+
+@dataclass(frozen=True)
+class ModeSelection:
+    """How the number of fixed-interface modes was chosen.
+
+    Attributes
+    ----------
+    method : {"count", "cutoff", "auto"}
+        ``"count"``: given ``n_modes``; ``"cutoff"``: modes with omega <= ``cutoff``;
+        ``"auto"``: smallest count meeting ``target``.
+    n_modes : int
+        Number of fixed-interface modes kept.
+    n_interior_dofs : int
+        Number of interior DOFs (the most modes there are).
+    cutoff : float or None
+        Cutoff frequency (rad/s) for ``"cutoff"``.
+    target : float or None
+        Relative whirl-frequency error target for ``"auto"``.
+    band : tuple of float or None
+        Frequency band (rad/s) whose full-model whirl modes were checked (``"auto"``).
+    n_check : int or None
+        Number of lowest whirl modes checked when no band was given (``"auto"``).
+    check_speeds : tuple of dict
+        Spool speeds (rad/s) at which the error was checked (``"auto"``).
+    error : float or None
+        Worst relative whirl-frequency error reached (``"auto"``).
+    response_target, response_error : float or None
+        Relative unbalance-response error target and the error reached, when a
+        :class:`ResponseCheck` was part of the automatic choice.
+    history : tuple of (int, float, float or None)
+        (modes, whirl error, response error or None when not evaluated) for every count
+        tried (``"auto"``).
+    """
+
+    method: str
+    n_modes: int
+    n_interior_dofs: int
+    cutoff: float | None = None
+    target: float | None = None
+    band: tuple[float, float] | None = None
+    n_check: int | None = None
+    check_speeds: tuple = ()
+    error: float | None = None
+    response_target: float | None = None
+    response_error: float | None = None
+    history: tuple = ()
+
+    def describe(self) -> str:
+        """One-line human description, frequencies in Hz."""
+        if self.method == "count":
+            return f"{self.n_modes} fixed-interface modes (given count)"
+        if self.method == "cutoff":
+            return (f"{self.n_modes} fixed-interface modes below the cutoff "
+                    f"{self.cutoff / (2 * math.pi):.1f} Hz")
+        what = (f"whirl modes in {self.band[0] / (2 * math.pi):.1f}-{self.band[1] / (2 * math.pi):.1f} Hz"
+                if self.band is not None else f"the first {self.n_check} whirl modes")
+        text = (f"{self.n_modes} fixed-interface modes chosen automatically: worst whirl-frequency error "
+                f"{100 * self.error:.3g} % (target {100 * self.target:.3g} %) over {what} "
+                f"at {len(self.check_speeds)} speeds")
+        if self.response_target is not None:
+            text += (f"; worst unbalance-response error {100 * self.response_error:.3g} % "
+                     f"(target {100 * self.response_target:.3g} %)")
+        return text
+
+
+@dataclass(frozen=True)
+class ResponseCheck:
+    """An unbalance-response accuracy requirement for the automatic mode count.
+
+    The reduced model's unbalance response over ``speeds`` must match the full model's
+    within ``target`` (see :func:`rotorred.harmonic.response_error`).
+
+    Parameters
+    ----------
+    unbalances : tuple of Unbalance
+    speeds : ndarray, shape (n,)
+        Reference spool speeds of the sweep (rad/s).
+    outputs : tuple of (int, str)
+        Physical DOFs checked.
+    ratios : dict of str to float, optional
+        Spool speed ratios (see :func:`rotorred.harmonic.unbalance_response`).
+    spool_of : dict of int to str, optional
+        Spool of each node.
+    target : float
+        Relative error target (default 5e-3, i.e. 0.5 %).
+    """
+
+    unbalances: tuple
+    speeds: np.ndarray
+    outputs: tuple
+    ratios: Mapping[str, float] | None = None
+    spool_of: Mapping[int, str] | None = None
+    target: float = 5e-3
+
+    def __post_init__(self):
+        object.__setattr__(self, "unbalances", tuple(self.unbalances))
+        object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
+        object.__setattr__(self, "speeds", np.asarray(self.speeds, dtype=float))
+        if not (isinstance(self.target, (int, float)) and math.isfinite(self.target) and self.target > 0):
+            raise ValueError(f"`target` must be a positive relative error, got {self.target!r}")
+
+    def run(self, model):
+        """Unbalance response of ``model`` for this check."""
+        return unbalance_response(model, self.unbalances, self.speeds, ratios=self.ratios,
+                                  outputs=self.outputs, spool_of=self.spool_of)
+
+
+@dataclass(frozen=True)
+class ReducedSystem:
+    """A Craig–Bampton reduced model, with the same interface as :class:`SystemMatrices`.
+
+    Reduced coordinates are ``p = [boundary physical DOFs..., modal coordinates...]``.
+
+    Attributes
+    ----------
+    M, K, C : ndarray, shape (m, m)
+        Reduced mass (kg), stiffness (N/m) and damping (N s/m): ``T^T X T``.
+    G : dict of str to ndarray, shape (m, m)
+        Reduced gyroscopic matrix of each spool per unit spin speed: ``T^T G_s T``.
+    T : ndarray, shape (n, m)
+        Recovery map, full physical coordinates ``q = T p``.
+    full_dofs : DofMap
+        DOF numbering of the full model (``T``'s rows).
+    boundary_nodes : tuple of int
+        Boundary nodes, in full DOF order.
+    boundary_dofs : ndarray of int, shape (4 * len(boundary_nodes),)
+        Full indices of the boundary DOFs; reduced coordinate ``j`` is full DOF
+        ``boundary_dofs[j]`` for ``j < len(boundary_dofs)``.
+    n_modes : int
+        Number of fixed-interface modes kept.
+    interior_frequencies : ndarray, shape (n_modes,)
+        Natural frequencies of the kept fixed-interface modes (rad/s).
+    selection : ModeSelection
+        Record of how ``n_modes`` was chosen.
+    """
+
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    G: Mapping[str, np.ndarray]
+    T: np.ndarray
+    full_dofs: DofMap
+    boundary_nodes: tuple[int, ...]
+    boundary_dofs: np.ndarray
+    n_modes: int
+    interior_frequencies: np.ndarray
+    selection: ModeSelection
+    _bpos: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "_bpos", {int(d): j for j, d in enumerate(self.boundary_dofs)})
+
+    @property
+    def n_dof(self) -> int:
+        """Number of reduced coordinates (boundary DOFs plus modes)."""
+        return self.M.shape[0]
+
+    @property
+    def n_boundary_dofs(self) -> int:
+        """Number of boundary (physical) DOFs."""
+        return len(self.boundary_dofs)
+
+    @property
+    def spools(self) -> tuple[str, ...]:
+        return tuple(self.G)
+
+    def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (m, m)."""
+        unknown = set(speeds) - set(self.G)
+        if unknown:
+            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
+        out = np.zeros_like(self.M)
+        for name, Omega in speeds.items():
+            if Omega:
+                out += Omega * self.G[name]
+        return out
+
+    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``C + sum_s Omega_s G_s`` (N s/m), shape (m, m)."""
+        return self.C + self.gyroscopic(speeds)
+
+    def physical_index(self, node: int, direction: str) -> int:
+        """Index of the boundary DOF ``direction`` at ``node`` in reduced coordinates.
+
+        Raises
+        ------
+        ValueError
+            If ``node`` is not a boundary node (its DOFs are then not reduced coordinates;
+            use :meth:`output_rows` to recover them).
+        """
+        full = self.full_dofs.index(node, direction)
+        if full not in self._bpos:
+            raise ValueError(f"node {node} is not a boundary node of the reduced model; boundary nodes are "
+                             f"{list(self.boundary_nodes)} (use output_rows to recover interior DOFs)")
+        return self._bpos[full]
+
+    def output_rows(self, outputs) -> np.ndarray:
+        """Rows of ``T`` mapping reduced coordinates to physical DOFs (any node).
+
+        Parameters
+        ----------
+        outputs : sequence of (int, str)
+            (node, direction) pairs.
+
+        Returns
+        -------
+        ndarray, shape (len(outputs), m)
+            ``rows @ p`` gives the physical displacements.
+        """
+        idx = [self.full_dofs.index(node, direction) for node, direction in outputs]
+        return self.T[idx, :].copy()
+
+    def recover(self, p: np.ndarray) -> np.ndarray:
+        """Full physical coordinates ``T p``; ``p`` shape (m,) or (m, k) -> (n,) or (n, k)."""
+        return self.T @ p
+
+    def project(self, F: np.ndarray) -> np.ndarray:
+        """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k)."""
+        return self.T.T @ F
+
+
+def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:
+    """Bearing nodes, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF order."""
+    nodes = {b.node for b in rotor.bearings}
+    for b in rotor.intershaft_bearings:
+        nodes.update((b.node_a, b.node_b))
+    nodes.update(extra_nodes)
+    known = set(rotor.nodes)
+    for n in extra_nodes:
+        if n not in known:
+            raise ValueError(f"boundary node {n!r} does not exist; nodes are {sorted(known)}")
+    return tuple(n for n in rotor.nodes if n in nodes)
+
+
+def _check_int(name: str, value, minimum: int = 0) -> int:
+    if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < minimum:
+        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _boundary(system: SystemMatrices, boundary_nodes) -> tuple[tuple[int, ...], np.ndarray, np.ndarray]:
+    dofs = system.dofs
+    requested = list(boundary_nodes)
+    if not requested:
+        raise ValueError("`boundary_nodes` must name at least one node, got none")
+    known = set(dofs.nodes)
+    for n in requested:
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n not in known:
+            raise ValueError(f"boundary node {n!r} does not exist; nodes are {sorted(known)}")
+    chosen = set(int(n) for n in requested)
+    nodes = tuple(n for n in dofs.nodes if n in chosen)
+    b = np.concatenate([dofs.node_dofs(n) for n in nodes])
+    mask = np.ones(dofs.n_dof, dtype=bool)
+    mask[b] = False
+    return nodes, b, np.flatnonzero(mask)
+
+
+@dataclass(frozen=True)
+class _Basis:
+    """Everything needed to build T for any number of modes."""
+
+    b: np.ndarray
+    i: np.ndarray
+    Psi: np.ndarray            # (n_i, n_b)
+    Phi: np.ndarray            # (n_i, n_i), mass-normalised, ascending frequency
+    omega: np.ndarray          # (n_i,) rad/s
+
+    def T(self, n_modes: int) -> np.ndarray:
+        n = len(self.b) + len(self.i)
+        nb = len(self.b)
+        T = np.zeros((n, nb + n_modes))
+        T[self.b, np.arange(nb)] = 1.0
+        T[np.ix_(self.i, np.arange(nb))] = self.Psi
+        T[np.ix_(self.i, nb + np.arange(n_modes))] = self.Phi[:, :n_modes]
+        return T
+
+
+def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
+    K, M = system.K, system.M
+    K_ii, M_ii, K_ib = K[np.ix_(i, i)], M[np.ix_(i, i)], K[np.ix_(i, b)]
+    if len(i) == 0:
+        return _Basis(b, i, np.zeros((0, len(b))), np.zeros((0, 0)), np.zeros(0))
+    try:
+        chol = sla.cho_factor(K_ii)
+    except np.linalg.LinAlgError:
+        raise ValueError("the interior (non-boundary) part of the model is not restrained when the boundary "
+                         "nodes are fixed (K_ii is singular); add a node of each free part to "
+                         "`boundary_nodes`") from None
+    Psi = -sla.cho_solve(chol, K_ib)
+    lam, Phi = sla.eigh(K_ii, M_ii)
+    omega = np.sqrt(np.clip(lam, 0.0, None))
+    return _Basis(b, i, Psi, Phi, omega)
+
+
+def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    def p(X):
+        return T.T @ X @ T
+    Mr, Kr = p(system.M), p(system.K)
+    # symmetrise away round-off so that M_r, K_r stay exactly symmetric
+    Mr, Kr = 0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T)
+    return Mr, Kr, p(system.C), {s: p(G) for s, G in system.G.items()}
+
+
+#: eigenvalues with a damping ratio -Re(lambda)/|lambda| at or above this are not counted as whirl modes
+WHIRL_MAX_DAMPING_RATIO = 0.5
+
+
+def whirl_frequencies(model, speeds: Mapping[str, float]) -> np.ndarray:
+    """Damped whirl frequencies Im(lambda) (rad/s) of ``model`` at spool speeds ``speeds``, ascending.
+
+    Heavily damped eigenvalues (damping ratio >= ``WHIRL_MAX_DAMPING_RATIO``, e.g. the
+    high-frequency shaft modes that stiffness-proportional Rayleigh damping makes
+    overdamped) do not whirl visibly and are left out, in the full and reduced model alike.
+    """
+    lam = eigen(model.M, model.damping(speeds), model.K).eigenvalues
+    zeta = -lam.real / np.abs(lam)
+    return lam.imag[zeta < WHIRL_MAX_DAMPING_RATIO]
+
+
+def whirl_error(reference: Sequence[np.ndarray], model, speeds_list: Sequence[Mapping[str, float]],
+                band: tuple[float, float] | None = None, n_check: int | None = None) -> float:
+    """Worst relative whirl-frequency error of ``model`` against reference frequencies.
+
+    The j-th lowest frequency of ``model`` is compared with the j-th lowest reference
+    frequency (Craig–Bampton is a Ritz method, so a missing mode shows as a large error at
+    its index rather than being skipped).
+
+    Parameters
+    ----------
+    reference : sequence of ndarray
+        Reference (full-model) whirl frequencies (rad/s), ascending, one array per speed.
+    model : SystemMatrices or ReducedSystem
+    speeds_list : sequence of dict
+        Spool speeds (rad/s), one dict per entry of ``reference``.
+    band : (float, float), optional
+        Only reference frequencies in ``[band[0], band[1]]`` (rad/s) count.
+    n_check : int, optional
+        Only the ``n_check`` lowest reference frequencies count (used when ``band`` is None).
+
+    Returns
+    -------
+    float
+        max_j |omega_model,j - omega_ref,j| / omega_ref,j (inf when the model has too few modes).
+    """
+    worst = 0.0
+    for ref, speeds in zip(reference, speeds_list):
+        if band is not None:
+            sel = np.flatnonzero((ref >= band[0]) & (ref <= band[1]))
+        else:
+            sel = np.arange(min(n_check, len(ref)))
+        if len(sel) == 0:
+            continue
+        got = whirl_frequencies(model, speeds)
+        if len(got) <= sel[-1]:
+            return math.inf
+        worst = max(worst, float(np.max(np.abs(got[sel] - ref[sel]) / ref[sel])))
+    return worst
+
+
+def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int | None = None,
+           cutoff: float | None = None, *, band: tuple[float, float] | None = None,
+           target: float = DEFAULT_TARGET, check_speeds: Sequence[Mapping[str, float]] | None = None,
+           n_check: int | None = None, response: ResponseCheck | None = None) -> ReducedSystem:
+    """Craig–Bampton reduction of ``system`` with all DOFs of ``boundary_nodes`` kept.
+
+    Parameters
+    ----------
+    system : SystemMatrices
+        Full model.
+    boundary_nodes : sequence of int
+        Nodes whose four physical DOFs stay as reduced coordinates.
+    n_modes : int, optional
+        Number of fixed-interface modes to keep (0 gives Guyan reduction).
+    cutoff : float, optional
+        Keep the fixed-interface modes with natural frequency <= ``cutoff`` (rad/s).
+        Must not lie below the upper end of ``band`` when a band is given.
+    band : (float, float), optional
+        Frequency band of interest (rad/s), 0 <= band[0] < band[1]. The automatic count
+        checks the full-model whirl modes in this band.
+    target : float
+        Relative whirl-frequency error target of the automatic count (default 1e-3).
+    check_speeds : sequence of dict, optional
+        Spool speeds (rad/s) at which the automatic count is checked (default: non-spinning).
+    n_check : int, optional
+        Without a band, the automatic count checks the ``n_check`` lowest whirl modes
+        (default 8).
+    response : ResponseCheck, optional
+        An extra requirement of the automatic count: the unbalance response must also meet
+        ``response.target`` against the full model.
+
+    Returns
+    -------
+    ReducedSystem
+
+    Notes
+    -----
+    With neither ``n_modes`` nor ``cutoff`` the number of modes is chosen automatically:
+    the full model's whirl frequencies are computed at ``check_speeds`` and modes are added
+    in ascending fixed-interface frequency until the worst relative error (see
+    :func:`whirl_error`) is at most ``target`` and, with ``response``, the unbalance
+    response error is at most ``response.target``.
+
+    References
+    ----------
+    R. R. Craig, M. C. C. Bampton, "Coupling of substructures for dynamic analyses",
+    AIAA Journal 6(7), 1968, 1313–1319.
+    """
+    if n_modes is not None and cutoff is not None:
+        raise ValueError(f"give either `n_modes` or `cutoff`, not both (got n_modes={n_modes!r}, "
+                         f"cutoff={cutoff!r})")
+    if n_modes is not None:
+        n_modes = _check_int("n_modes", n_modes)
+    if band is not None:
+        band = tuple(float(x) for x in band)
+        if len(band) != 2 or not (0 <= band[0] < band[1] and math.isfinite(band[1])):
+            raise ValueError(f"`band` must be (low, high) with 0 <= low < high (rad/s), got {band!r}")
+    if cutoff is not None:
+        if not (isinstance(cutoff, (int, float, np.floating)) and math.isfinite(cutoff) and cutoff > 0):
+            raise ValueError(f"`cutoff` must be a positive frequency (rad/s), got {cutoff!r}")
+        if band is not None and cutoff < band[1]:
+            raise ValueError(f"`cutoff` = {cutoff:.6g} rad/s ({cutoff / (2 * math.pi):.4g} Hz) lies below the "
+                             f"frequency band of interest, which ends at {band[1]:.6g} rad/s "
+                             f"({band[1] / (2 * math.pi):.4g} Hz); the cutoff must be at least the band's "
+                             f"upper end (1.5-2x is usual)")
+    if not (isinstance(target, (int, float)) and math.isfinite(target) and target > 0):
+        raise ValueError(f"`target` must be a positive relative error, got {target!r}")
+    if n_check is not None:
+        n_check = _check_int("n_check", n_check, 1)
+    if check_speeds is not None:
+        check_speeds = tuple(dict(s) for s in check_speeds)
+        for s in check_speeds:
+            unknown = set(s) - set(system.G)
+            if unknown:
+                raise ValueError(f"unknown spool(s) {sorted(unknown)} in `check_speeds`; "
+                                 f"spools are {list(system.G)}")
+    nodes, b, i = _boundary(system, boundary_nodes)
+    basis = _basis(system, b, i)
+    n_i = len(i)
+
+    if n_modes is not None:
+        if n_modes > n_i:
+            raise ValueError(f"`n_modes` = {n_modes} exceeds the number of interior DOFs ({n_i})")
+        selection = ModeSelection("count", n_modes, n_i)
+    elif cutoff is not None:
+        n_modes = int(np.count_nonzero(basis.omega <= cutoff))
+        selection = ModeSelection("cutoff", n_modes, n_i, cutoff=float(cutoff), band=band)
+    else:
+        if check_speeds is None:
+            check_speeds = ({s: 0.0 for s in system.G},)
+        if band is None and n_check is None:
+            n_check = DEFAULT_N_CHECK
+        reference = [whirl_frequencies(system, s) for s in check_speeds]
+        full_response = response.run(system) if response is not None else None
+        history = []
+        resp_err = None
+        for n in range(n_i + 1):
+            T = basis.T(n)
+            trial = _make(system, nodes, basis, T, n, ModeSelection("count", n, n_i))
+            err = whirl_error(reference, trial, check_speeds, band=band, n_check=n_check)
+            resp_err = None
+            if response is not None and err <= target:
+                resp_err = response_error(full_response, response.run(trial))
+            history.append((n, err, resp_err))
+            if err <= target and (response is None or resp_err <= response.target):
+                break
+        n_modes = n
+        selection = ModeSelection("auto", n, n_i, target=float(target), band=band,
+                                  n_check=None if band is not None else n_check,
+                                  check_speeds=tuple(check_speeds), error=err,
+                                  response_target=None if response is None else float(response.target),
+                                  response_error=resp_err, history=tuple(history))
+    return _make(system, nodes, basis, basis.T(n_modes), n_modes, selection)
+
+
+def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
+    Mr, Kr, Cr, Gr = _project(system, T)
+    return ReducedSystem(M=Mr, K=Kr, C=Cr, G=Gr, T=T, full_dofs=system.dofs, boundary_nodes=nodes,
+                         boundary_dofs=basis.b.copy(), n_modes=n_modes,
+                         interior_frequencies=basis.omega[:n_modes].copy(), selection=selection)
+
+
+def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,
+                 cutoff: float | None = None, *, band: tuple[float, float] | None = None,
+                 target: float = DEFAULT_TARGET, speed_factors: Sequence[float] = DEFAULT_SPEED_FACTORS,
+                 n_check: int | None = None, response: ResponseCheck | None = None,
+                 system: SystemMatrices | None = None) -> ReducedSystem:
+    """Craig–Bampton reduction of ``rotor`` with the default boundary.
+
+    The boundary is every bearing node, both nodes of every inter-shaft bearing and
+    ``extra_nodes`` (for the seed rig pass ``(18,)``, the rub node). The automatic mode
+    count is checked at the nominal spool speeds times each of ``speed_factors``
+    (default 0, 0.5, 1, 1.5).
+
+    Parameters
+    ----------
+    rotor : Rotor
+    extra_nodes : sequence of int
+        Additional boundary nodes (e.g. the rub node, output nodes).
+    n_modes, cutoff, band, target, n_check, response
+        As in :func:`reduce`.
+    speed_factors : sequence of float
+        Factors (>= 0) of the nominal speeds at which the automatic count is checked.
+    system : SystemMatrices, optional
+        ``assemble(rotor)`` if already at hand.
+
+    Returns
+    -------
+    ReducedSystem
+    """
+    factors = tuple(float(f) for f in speed_factors)
+    if not factors or not all(math.isfinite(f) and f >= 0 for f in factors):
+        raise ValueError(f"`speed_factors` must be non-empty factors >= 0, got {speed_factors!r}")
+    boundary = default_boundary_nodes(rotor, extra_nodes)
+    if system is None:
+        system = assemble(rotor)
+    nominal = rotor.speeds
+    check = [{s: f * w for s, w in nominal.items()} for f in factors]
+    return reduce(system, boundary, n_modes=n_modes, cutoff=cutoff, band=band, target=target,
+                  check_speeds=check, n_check=n_check, response=response)
