@@ -86,8 +86,34 @@ class DofMap:
             raise ValueError(f"node {node!r} does not exist; nodes are {sorted(self.nodes)}") from None
 
 
+class SpoolSpeedMixin:
+    """``spools``, ``gyroscopic(speeds)`` and ``damping(speeds)`` of a model with attributes
+    ``M``, ``C`` and ``G`` (dict spool -> gyroscopic matrix per unit speed); shared by the full
+    :class:`SystemMatrices` and the reduced model (:class:`rotorred.reduction.ReducedSystem`)."""
+
+    @property
+    def spools(self) -> tuple[str, ...]:
+        """Spool names, in the order of ``G``."""
+        return tuple(self.G)
+
+    def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
+        unknown = set(speeds) - set(self.G)
+        if unknown:
+            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
+        out = np.zeros_like(self.M)
+        for name, Omega in speeds.items():
+            if Omega:
+                out += Omega * self.G[name]
+        return out
+
+    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``C + sum_s Omega_s G_s`` (N s/m), shape (n, n)."""
+        return self.C + self.gyroscopic(speeds)
+
+
 @dataclass(frozen=True)
-class SystemMatrices:
+class SystemMatrices(SpoolSpeedMixin):
     """Global matrices of a rotor.
 
     Attributes
@@ -114,23 +140,9 @@ class SystemMatrices:
         return self.M.shape[0]
 
     @property
-    def spools(self) -> tuple[str, ...]:
-        return tuple(self.G)
-
-    def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
-        unknown = set(speeds) - set(self.G)
-        if unknown:
-            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
-        out = np.zeros_like(self.M)
-        for name, Omega in speeds.items():
-            if Omega:
-                out += Omega * self.G[name]
-        return out
-
-    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C + sum_s Omega_s G_s`` (N s/m), shape (n, n)."""
-        return self.C + self.gyroscopic(speeds)
+    def full_dofs(self) -> DofMap:
+        """The physical DOF numbering (the model's own, here; a reduced model's full one)."""
+        return self.dofs
 
     def physical_index(self, node: int, direction: str) -> int:
         """Index of the physical DOF ``direction`` at ``node`` in this model's coordinates."""

@@ -251,7 +251,7 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
 def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
     """Force phasor per unit Omega² of each spool's unbalances, in model coordinates."""
     spools = tuple(model.spools)
-    dofs = _full_dofs(model)
+    dofs = model.full_dofs
     if spool_of is None:
         if len(spools) != 1:
             raise ValueError("`spool_of` (node -> spool, e.g. Rotor.spool_of) is required for a model with "
@@ -274,13 +274,8 @@ def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
     return per_spool
 
 
-def _full_dofs(model):
-    dofs = getattr(model, "full_dofs", None)
-    return dofs if dofs is not None else model.dofs
-
-
 def _check_outputs(model, outputs, name: str) -> tuple[Output, ...]:
-    dofs = _full_dofs(model)
+    dofs = model.full_dofs
     out = []
     for o in outputs:
         try:

@@ -61,7 +61,7 @@ import scipy.linalg as sla
 from rotorred import _kernel
 from rotorred.assembly import DIRECTIONS
 from rotorred.contact import OPEN, SLIP, STICK, STATE_NAMES, RubPlate, normal_force, sliding_velocity
-from rotorred.loads import Unbalance
+from rotorred.loads import Unbalance, gravity_force
 
 METHODS = ("newmark", "hht")
 _CAUSES = {
@@ -285,11 +285,6 @@ def _fold_forcing(U1: np.ndarray, U0: np.ndarray, kinds: np.ndarray, omegas: np.
     return U
 
 
-def _full_dofs(model):
-    dofs = getattr(model, "full_dofs", None)
-    return dofs if dofs is not None else model.dofs
-
-
 def _dof_label(model, i: int) -> str:
     if hasattr(model, "boundary_dofs") and hasattr(model, "full_dofs"):
         nb = len(model.boundary_dofs)
@@ -301,7 +296,7 @@ def _dof_label(model, i: int) -> str:
 
 def _check_outputs(model, outputs) -> tuple[tuple[int, str], ...]:
     out = []
-    dofs = _full_dofs(model)
+    dofs = model.full_dofs
     for o in outputs:
         try:
             node, direction = o
@@ -318,19 +313,6 @@ def _positive(name, value, unit):
     if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value) and value > 0):
         raise ValueError(f"`{name}` must be a positive finite number ({unit}), got {value!r}")
     return float(value)
-
-
-def _gravity_vector(model, g: float) -> np.ndarray:
-    """Model-coordinate force of gravity g (m/s^2) along -y: M e with e a rigid unit translation in y."""
-    dofs = _full_dofs(model)
-    pairs = [(node, d) for node in dofs.nodes for d in DIRECTIONS]
-    R = model.output_rows(pairs)
-    target = np.array([1.0 if d == "y" else 0.0 for _, d in pairs])
-    e, *_ = np.linalg.lstsq(R, target, rcond=None)
-    if np.max(np.abs(R @ e - target)) > 1e-8:
-        raise ValueError("`gravity`: a rigid translation is not representable in this model's coordinates "
-                         "(a reduced model must keep every bearing node on its boundary)")
-    return -g * (model.M @ e)
 
 
 def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float = 1e-5, *,
@@ -456,7 +438,7 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
     if spool_of is None and rotor is not None:
         spool_of = rotor.spool_of
     if spool_of is None and len(spools) == 1:
-        spool_of = {n: spools[0] for n in _full_dofs(model).nodes}
+        spool_of = {n: spools[0] for n in model.full_dofs.nodes}
     outputs = _check_outputs(model, outputs)
     plates = tuple(plates)
     for k, p in enumerate(plates):
@@ -482,7 +464,7 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
     D = np.asarray(model.damping(speeds), float)
     cols, kinds, omegas = [], [], []
     if gravity:
-        cols.append(_gravity_vector(model, float(gravity)))
+        cols.append(gravity_force(model, float(gravity)))
         kinds.append(0)
         omegas.append(0.0)
     per_spool: dict[str, list[np.ndarray]] = {}

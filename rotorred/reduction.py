@@ -35,7 +35,7 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.assembly import DofMap, SystemMatrices, assemble
+from rotorred.assembly import DofMap, SpoolSpeedMixin, SystemMatrices, assemble
 from rotorred.harmonic import response_error, unbalance_response
 from rotorred.modal import eigen
 from rotorred.model import Rotor
@@ -155,7 +155,7 @@ class ResponseCheck:
 
 
 @dataclass(frozen=True)
-class ReducedSystem:
+class ReducedSystem(SpoolSpeedMixin):
     """A Craig–Bampton reduced model, with the same interface as :class:`SystemMatrices`.
 
     Reduced coordinates are ``p = [boundary physical DOFs..., modal coordinates...]``.
@@ -208,25 +208,6 @@ class ReducedSystem:
     def n_boundary_dofs(self) -> int:
         """Number of boundary (physical) DOFs."""
         return len(self.boundary_dofs)
-
-    @property
-    def spools(self) -> tuple[str, ...]:
-        return tuple(self.G)
-
-    def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (m, m)."""
-        unknown = set(speeds) - set(self.G)
-        if unknown:
-            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
-        out = np.zeros_like(self.M)
-        for name, Omega in speeds.items():
-            if Omega:
-                out += Omega * self.G[name]
-        return out
-
-    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C + sum_s Omega_s G_s`` (N s/m), shape (m, m)."""
-        return self.C + self.gyroscopic(speeds)
 
     def physical_index(self, node: int, direction: str) -> int:
         """Index of the boundary DOF ``direction`` at ``node`` in reduced coordinates.

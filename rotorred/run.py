@@ -37,7 +37,9 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.assembly import assemble
+from rotorred.harmonic import SteadyState, steady_state
 from rotorred.lines import format_table, label_lines
+from rotorred.loads import gravity_force
 from rotorred.scene import Scene
 from rotorred.spectra import WINDOWS, settled_spectrum
 
@@ -181,35 +183,11 @@ def build_model(scene: Scene) -> SceneModel:
 
 
 # --------------------------------------------------------------------------- harmonic solution
-def _gravity_force(model, g: float) -> np.ndarray:
-    """Model-coordinate gravity force (along -y): -g M e, e a rigid unit y translation."""
-    dofs = getattr(model, "full_dofs", None)
-    dofs = model.dofs if dofs is None else dofs
-    pairs = [(n, d) for n in dofs.nodes for d in ("x", "y", "theta_x", "theta_y")]
-    R = model.output_rows(pairs)
-    target = np.array([1.0 if d == "y" else 0.0 for _, d in pairs])
-    e, *_ = np.linalg.lstsq(R, target, rcond=None)
-    return -g * (model.M @ e)
-
-
-def _phasors(scene: Scene, model) -> dict[str, tuple[float, np.ndarray]]:
-    """Steady-state unbalance phasors per spool: spool -> (Omega (rad/s), P (model coordinates))."""
-    D = model.damping(scene.speeds)
-    spool_of = scene.rotor.spool_of
-    out = {}
-    for s, w in scene.speeds.items():
-        f = np.zeros(model.M.shape[0], dtype=complex)
-        for u in scene.unbalances:
-            if spool_of[u.node] != s:
-                continue
-            rx, ry = model.output_rows([(u.node, "x"), (u.node, "y")])
-            # F = m_e Omega^2 [cos(Omega t + phi), sin(Omega t + phi)] = Re(m_e Omega^2 e^{i phi} (1, -i) e^{i Omega t})
-            f += u.m_e * np.exp(1j * u.phase) * (rx - 1j * ry)
-        if w == 0 or not np.any(f):
-            continue
-        Z = model.K - w * w * model.M + 1j * w * D
-        out[s] = (w, np.linalg.solve(Z, w * w * f))
-    return out
+def _steady(scene: Scene, model) -> SteadyState | None:
+    """Linear steady state of the scene's unbalances (None without unbalances)."""
+    if not scene.unbalances:
+        return None
+    return steady_state(model, scene.unbalances, scene.speeds, scene.rotor.spool_of)
 
 
 def settled_state(scene: Scene, model) -> tuple[np.ndarray, np.ndarray]:
@@ -220,11 +198,12 @@ def settled_state(scene: Scene, model) -> tuple[np.ndarray, np.ndarray]:
     """
     q0 = np.zeros(model.M.shape[0])
     v0 = np.zeros_like(q0)
-    for w, P in _phasors(scene, model).values():
-        q0 += P.real
-        v0 += (1j * w * P).real
+    steady = _steady(scene, model)
+    if steady is not None:
+        q0 += steady.displacement(0.0)
+        v0 += steady.velocity(0.0)
     if scene.solver.gravity:
-        q0 += np.linalg.solve(model.K, _gravity_force(model, scene.solver.gravity))
+        q0 += np.linalg.solve(model.K, gravity_force(model, scene.solver.gravity))
     return q0, v0
 
 
@@ -233,10 +212,11 @@ def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
     dofs = scene.output.dofs
     R = model.output_rows(dofs)
     y = np.zeros((len(dofs), len(t)))
-    for w, P in _phasors(scene, model).values():
-        y += np.real((R @ P)[:, None] * np.exp(1j * w * t)[None, :])
+    steady = _steady(scene, model)
+    for s, P in (steady.phasors.items() if steady is not None else ()):
+        y += np.real((R @ P)[:, None] * np.exp(1j * steady.speeds[s] * t)[None, :])
     if scene.solver.gravity:
-        y += (R @ np.linalg.solve(model.K, _gravity_force(model, scene.solver.gravity)))[:, None]
+        y += (R @ np.linalg.solve(model.K, gravity_force(model, scene.solver.gravity)))[:, None]
     return {d: y[j] for j, d in enumerate(dofs)}
 
 

@@ -21,7 +21,8 @@ from typing import Sequence
 
 import numpy as np
 
-from rotorred.run import _model_key, _phasors, build_model, run_scene, table_dof
+from rotorred.loads import gravity_force
+from rotorred.run import _model_key, _steady, build_model, run_scene, table_dof
 from rotorred.scene import Scene, load_scene
 
 __all__ = ["SweepResult", "sweep", "free_reach", "plot_sweep", "write_sweep", "format_sweep"]
@@ -95,7 +96,7 @@ def free_reach(scene: Scene, model=None) -> float | None:
     """
     if not scene.plates:
         return None
-    from rotorred.run import SceneModel, _gravity_force
+    from rotorred.run import SceneModel
     if model is None:
         model = build_model(scene)
     m = model.model if isinstance(model, SceneModel) else model
@@ -106,10 +107,11 @@ def free_reach(scene: Scene, model=None) -> float | None:
     period = ratio.denominator / min(f)
     t = np.arange(0.0, period, min(scene.solver.dt, period / 2000))
     xy = np.zeros((2, len(t)))
-    for w, P in _phasors(scene, m).values():
-        xy += np.real((rows @ P)[:, None] * np.exp(1j * w * t)[None, :])
+    steady = _steady(scene, m)
+    for s, P in (steady.phasors.items() if steady is not None else ()):
+        xy += np.real((rows @ P)[:, None] * np.exp(1j * steady.speeds[s] * t)[None, :])
     if scene.solver.gravity:
-        xy += (rows @ np.linalg.solve(m.K, _gravity_force(m, scene.solver.gravity)))[:, None]
+        xy += (rows @ np.linalg.solve(m.K, gravity_force(m, scene.solver.gravity)))[:, None]
     return float(np.max(plate.normal @ xy))
 
 
