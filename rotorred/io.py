@@ -7,7 +7,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     [[material]]                       # E (Pa), rho (kg/m^3), nu (-)
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
     [[spool]]                          # a chain of elements on consecutive node numbers
-    name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"
+    name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
     elements = [ { L = 0.08, D_o = 0.02, D_i = 0.0, material = "steel", repeat = 12 } ]
     [[disk]]                           # either m, I_d, I_p (kg, kg m^2) or D_o, D_i, thickness, material
     node = 3; m = 5.7; I_d = 0.023; I_p = 0.045; radius = 0.125
@@ -36,8 +36,8 @@ except ModuleNotFoundError:  # pragma: no cover
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu"}
-_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "elements"}
-_ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear"}
+_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "elements"}
+_ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
@@ -111,6 +111,7 @@ def rotor_from_dict(data: dict[str, Any]) -> Rotor:
         if node < 0:
             raise ValueError(f"{where}: `first_node` must be >= 0, got {node}")
         default_shear = s.get("shear", "cowper")
+        default_element = s.get("element", "nelson")
         elements = []
         rows = s["elements"]
         if not isinstance(rows, list) or not rows:
@@ -127,7 +128,8 @@ def rotor_from_dict(data: dict[str, Any]) -> Rotor:
             for _ in range(repeat):
                 elements.append(_build(ew, ShaftElement, left=node, right=node + 1, L=_number(ew, e, "L"),
                                        D_o=_number(ew, e, "D_o"), D_i=_number(ew, e, "D_i", 0.0), material=mat,
-                                       shear=e.get("shear", default_shear)))
+                                       shear=e.get("shear", default_shear),
+                                       element=e.get("element", default_element)))
                 node += 1
         speed_rpm = _number(where, s, "speed_rpm", 0.0)
         if speed_rpm < 0:

@@ -66,6 +66,16 @@ def test_good_file():
     assert r.rayleigh == (0.0, 1e-5)
 
 
+def test_element_formulation_per_spool_and_element():
+    text = GOOD.replace('first_node = 10\n', 'first_node = 10\nelement = "hierarchical"\n', 1)
+    r = rotor_from_toml(text)
+    assert {e.element for e in r.spool("outer").elements} == {"hierarchical"}
+    assert {e.element for e in r.spool("inner").elements} == {"nelson"}
+    bad = GOOD.replace('repeat = 4 }', 'repeat = 4, element = "p7" }', 1)
+    with pytest.raises(RotorFileError, match="`element` must be one of"):
+        rotor_from_toml(bad)
+
+
 def test_presets():
     assert {"seed-rig", "nelson-mcvaugh"} <= set(presets())
     nm = load_rotor("nelson-mcvaugh")
