@@ -122,7 +122,7 @@ def test_hunt_crossley_dissipates_on_impact():
         sol = solve_ivp(rhs, (0, 0.1), [1e-15, v0], events=leave, rtol=1e-10, atol=1e-16, method="LSODA")
         return -sol.y_events[0][0][1]
 
-    assert rebound(0.0) == pytest.approx(v0, rel=1e-6)
+    assert rebound(0.0) == pytest.approx(v0, rel=1e-8)  # elastic: energy kept to the solver's rtol (measured 1.7e-9)
     e = rebound(1.0) / v0
     assert 0.8 < e < 1.0  # Hunt–Crossley: e ~ 1 - (2/3) c v0 = 0.93 for small c v0
     assert e == pytest.approx(1 - 2 / 3 * 1.0 * v0, abs=0.01)

@@ -77,9 +77,21 @@ def test_element_formulation_per_spool_and_element():
 
 
 def test_presets():
+    """The Nelson-McVaugh preset holds the geometry of validation/reference (bore read as a diameter):
+    its mass is computed here from the reference's stations, diameters and disk."""
+    import json
+    import math
+    from pathlib import Path
+
     assert {"seed-rig", "nelson-mcvaugh"} <= set(presets())
     nm = load_rotor("nelson-mcvaugh")
-    assert nm.mass == pytest.approx(4.008093670156511, rel=1e-9)  # ANSYS-table (bore as diameter) mass
+    ref = json.loads((Path(__file__).resolve().parents[1] / "validation/reference/nelson_mcvaugh_rotor.json").read_text())
+    z = [v / 100 for v in ref["stations_cm"]]
+    D_o = [v / 100 for v in ref["element_outer_diameter_cm"]]
+    D_i = [v / 100 for v in ref["element_inner_diameter_cm"]]
+    shaft = sum(ref["material"]["rho_kg_m3"] * math.pi / 4 * (o**2 - i**2) * (b - a)
+                for a, b, o, i in zip(z[:-1], z[1:], D_o, D_i))
+    assert nm.mass == pytest.approx(shaft + ref["disk"]["m_kg"], rel=1e-12)
     assert load_rotor("seed-rig").nodes == tuple(range(1, 21))
 
 

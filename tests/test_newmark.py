@@ -285,11 +285,12 @@ def test_jeffcott_rub_matches_radau():
     w = res.t >= 0.1 - 1e-12
     x, y = res.outputs[(1, "x")], res.outputs[(1, "y")]
     peak, peak_ref = np.hypot(x, y)[w].max(), np.hypot(x_ref, y_ref)[w].max()
-    assert abs(peak - peak_ref) / peak_ref < 1e-4
+    # the issue's requirement is 1e-4; measured here 5.0e-8 (peak) and 8.0e-7 (spectrum): Newmark's
+    # O(dt^2) error at dt = 2e-6 (halving dt quarters it). Asserted at ~10x the measured values.
+    assert abs(peak - peak_ref) / peak_ref < 5e-7
     X, X_ref = np.abs(np.fft.rfft(x[w][:-1])), np.abs(np.fft.rfft(x_ref[w][:-1]))
     top = np.argsort(X_ref)[::-1][:5]
-    # Newmark's O(dt^2) error at dt = 2e-6 is ~2e-6 here (measured: halving dt quarters it)
-    assert np.max(np.abs(X[top] - X_ref[top]) / X_ref[top]) < 1e-4
+    assert np.max(np.abs(X[top] - X_ref[top]) / X_ref[top]) < 1e-5
 
 
 def test_stick_slip_follows_coulomb():
@@ -475,21 +476,26 @@ def test_gravity_settles_to_static_sag():
 
 
 def test_hht_with_rub_converges_to_same_solution():
-    """HHT-α (alpha = -0.05) with the rub: the orbit's peak radius approaches Newmark's as dt falls."""
+    """HHT-α (alpha = -0.05) with the rub: the orbit's peak radius converges to the Radau solution of the
+    same equations as dt falls."""
     k = (2 * math.pi * 50) ** 2
     system = jeffcott(m=1.0, k=k, c=2 * 0.05 * math.sqrt(k))
     plate = RubPlate(node=1, theta=0.3, clearance=1e-5, K_nr=1e8, c=0.5, mu_s=0.2, mu_d=0.15, m_p=0.5,
                      k_n=5e6, k_t=5e6, c_n=100.0, c_t=100.0, disk_radius=0.05)
     kw = dict(unbalances=[Unbalance(1, 1e-5)], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x"), (1, "y")],
               record_start=0.1)
-    sp = {"shaft": 2 * math.pi * 40}
-    ref = simulate(system, sp, 0.2, 1e-6, **kw)
-    peak_ref = np.hypot(*ref.outputs.values()).max()
+    Omega = 2 * math.pi * 40
+    sp = {"shaft": Omega}
+    t_eval = np.arange(0.1, 0.2 + 1e-12, 1e-5)
+    x_ref, y_ref = jeffcott_rub_reference(system, plate, Omega, 1e-5, 0.2, t_eval)
+    peak_ref = np.hypot(x_ref, y_ref).max()
     errs = []
     for dt in (4e-5, 2e-5, 1e-5):
         res = simulate(system, sp, 0.2, dt, method="hht", alpha=-0.05, **kw)
         errs.append(abs(np.hypot(*res.outputs.values()).max() - peak_ref) / peak_ref)
-    assert errs[-1] < 1e-3 and errs[-1] < errs[0]
+    # second order: each halving of dt divides the error by ~4 (measured ratio over two halvings ~12,
+    # final error 1.4e-6); require a ratio above 8 and the finest error below 1e-5
+    assert errs[-1] < 1e-5 and errs[0] / errs[-1] > 8, errs
 
 
 def test_plates_on_two_disk_nodes_conserve_energy():
@@ -512,7 +518,8 @@ def test_plates_on_two_disk_nodes_conserve_energy():
         E += 0.5 * p.m_p * (vn**2 + vt**2) + 0.5 * p.k_n * un**2 + 0.5 * p.k_t * ut**2
         E += contact_energy(f.forces[k, 0], p)
     E0 = energy(system, np.zeros(system.n_dof), v0)
-    assert abs(E - E0) / E0 < 1e-3
+    # O(dt^2) energy error of the impacts: measured 2.4e-5 at dt = 1e-5; 1e-4 allowed
+    assert abs(E - E0) / E0 < 1e-4
 
 
 def test_stability_sweep_corners():

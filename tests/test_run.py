@@ -207,8 +207,11 @@ def test_paper_reproduction():
     rub_reach, normal_reach = v.plate_side_reach(18)
     assert rub_reach < normal_reach
     assert v.relative_change(13) < v.relative_change(14)
-    # the settled response is periodic with 0.1 s (transients have decayed)
-    assert v.period_mismatch() < 1e-3
+    # the settled response is periodic with 0.1 s (transients have decayed): measured 8.4e-7 of the peak
+    assert v.period_mismatch() < 1e-5
+    # against an independent reference, the same scene at half the time step: the Table 1 line amplitudes
+    # move by 2.0e-4 of the largest line (measured); 1e-3 allowed
+    assert v.reference_line_error((("solver.dt", 1e-5),))[0] < 1e-3
 
 
 def test_gravity_settled_state_matches_time_stepping():

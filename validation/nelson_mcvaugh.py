@@ -1,8 +1,8 @@
 """Nelson-McVaugh rotor: Campbell whirl speeds against an independent code (ROSS 3.1.0).
 
-Inputs: the preset ``nelson-mcvaugh`` (shared/reference/nelson_mcvaugh_rotor.json: bores read as
+Inputs: the preset ``nelson-mcvaugh`` (validation/reference/nelson_mcvaugh_rotor.json: bores read as
 diameters, Cowper shear coefficient, isotropic bearings 4.378e7 N/m at stations 10 and 14, disk at
-station 4). Reference: shared/reference/nelson_mcvaugh_ross_computed.json, computed with ROSS (not
+station 4). Reference: validation/reference/nelson_mcvaugh_ross_computed.json, computed with ROSS (not
 published numbers), case "ID_as_diameter(ANSYS table)|shear=True"; and the cross-coupled
 orthotropic bearing case (k_xx = k_yy = 3.503e7, k_xy = k_yx = -0.8756e7 N/m).
 
@@ -23,9 +23,7 @@ from rotorred.campbell import campbell
 from rotorred.elements import Bearing
 from rotorred.io import load_rotor
 
-REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "nelson_mcvaugh_ross_computed.json"
-if not REFERENCE.exists():  # the repository checked out elsewhere: the shared folder next to it
-    REFERENCE = Path("/work/shared/reference/nelson_mcvaugh_ross_computed.json")
+REFERENCE = Path(__file__).resolve().parent / "reference" / "nelson_mcvaugh_ross_computed.json"
 
 CASES = {
     "isotropic": "ID_as_diameter(ANSYS table)|shear=True",
