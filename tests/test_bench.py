@@ -92,6 +92,17 @@ def test_reference_and_grid_fields(bp, tiny):
     assert "reference: full model, 80 DOF" in text and "CB 8" in text
 
 
+def test_scene_checks(bp, tiny):
+    """The scene as shipped and with the automatic mode count, against the (here unrefined) reference."""
+    _, _, ref = tiny
+    checks = bp.scene_checks(ref, t_end=0.2, n_periods=1)
+    assert [c.label.split(":")[0] for c in checks] == ["as shipped", "automatic mode count"]
+    for c in checks:
+        assert c.errors is not None and c.wall > 0 and "Craig-Bampton" in c.label
+        assert 0 < c.errors.spectral < 1  # reduced against the full model: a difference, but not a wrong one
+    assert "as shipped" in bp.format_scene_checks(checks)
+
+
 def test_errors_definition(bp):
     """Spectral error is the worst relative error over the reference's largest lines (DC excluded)."""
     f = np.arange(6) * 10.0
