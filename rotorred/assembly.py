@@ -71,6 +71,21 @@ class DofMap:
             raise ValueError(f"`direction` must be one of {DIRECTIONS}, got {direction!r}")
         return 4 * self._node_pos(node) + _DIR_ALIASES[direction]
 
+    def checked_outputs(self, outputs, name: str = "outputs") -> tuple[tuple[int, str], ...]:
+        """Validate (node, direction) pairs; ValueError naming ``name``, the entry and what is allowed."""
+        out = []
+        for o in outputs:
+            try:
+                node, direction = o
+            except (TypeError, ValueError):
+                raise ValueError(f"`{name}` entries must be (node, direction) pairs, got {o!r}") from None
+            if direction not in DIRECTIONS:
+                raise ValueError(f"`{name}`: direction must be one of {DIRECTIONS}, got {direction!r} "
+                                 f"at node {node!r}")
+            self.index(node, direction)  # ValueError naming the node if it does not exist
+            out.append((int(node), str(direction)))
+        return tuple(out)
+
     def label(self, dof: int) -> str:
         """Human label of a global DOF, e.g. ``"node 18 y"``."""
         if not 0 <= dof < self.n_dof:

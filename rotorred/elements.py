@@ -263,9 +263,6 @@ class Disk:
         return _gen.disk_gyroscopic(self.I_p)
 
 
-_COEFFS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
-
-
 @dataclass(frozen=True)
 class _Support:
     k_xx: float = 0.0

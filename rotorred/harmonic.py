@@ -47,6 +47,16 @@ from rotorred.loads import Unbalance
 Output = tuple[int, str]
 
 
+
+def _write_columns(path: Path, header: list[str], cols: list[np.ndarray]) -> Path:
+    """Write equal-length columns as CSV (10 significant digits)."""
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for row in np.column_stack(cols):
+            w.writerow([f"{v:.10g}" for v in row])
+    return path
+
 @dataclass(frozen=True)
 class UnbalanceResponse:
     """Steady-state unbalance response over a speed sweep.
@@ -129,12 +139,7 @@ class UnbalanceResponse:
                 cols += [1e6 * self.amplitude(o, s), np.degrees(self.phase(o, s))]
             header.append(f"{name} peak bound (um)")
             cols.append(1e6 * self.peak(o))
-        with path.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            for row in np.column_stack(cols):
-                w.writerow([f"{v:.10g}" for v in row])
-        return path
+        return _write_columns(path, header, cols)
 
 
 @dataclass(frozen=True)
@@ -173,12 +178,7 @@ class FrequencyResponse:
                 name = f"node {o[0]} {o[1]} / node {i[0]} {i[1]}"
                 header += [f"{name} |H| (m/N)", f"{name} phase (deg)"]
                 cols += [np.abs(self.h(o, i)), np.degrees(np.angle(self.h(o, i)))]
-        with path.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            for row in np.column_stack(cols):
-                w.writerow([f"{v:.10g}" for v in row])
-        return path
+        return _write_columns(path, header, cols)
 
 
 @dataclass(frozen=True)
@@ -274,21 +274,6 @@ def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
     return per_spool
 
 
-def _check_outputs(model, outputs, name: str) -> tuple[Output, ...]:
-    dofs = model.full_dofs
-    out = []
-    for o in outputs:
-        try:
-            node, direction = o
-        except (TypeError, ValueError):
-            raise ValueError(f"`{name}` entries must be (node, direction) pairs, got {o!r}") from None
-        if direction not in DIRECTIONS:
-            raise ValueError(f"`{name}`: direction must be one of {DIRECTIONS}, got {direction!r} at node {node!r}")
-        dofs.index(node, direction)  # raises ValueError naming the node if it does not exist
-        out.append((int(node), str(direction)))
-    return tuple(out)
-
-
 def _check_speeds(speeds, name: str = "speeds") -> np.ndarray:
     arr = np.atleast_1d(np.asarray(speeds, dtype=float))
     if arr.ndim != 1 or len(arr) == 0 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
@@ -324,7 +309,7 @@ def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: M
     """
     spools = tuple(model.spools)
     speeds = _check_speeds(speeds)
-    outputs = _check_outputs(model, outputs, "outputs")
+    outputs = model.full_dofs.checked_outputs(outputs, "outputs")
     if not outputs:
         raise ValueError("`outputs` must name at least one (node, direction) pair, got none")
     if reference_spool is None:
@@ -410,8 +395,8 @@ def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output
     -------
     FrequencyResponse
     """
-    inputs = _check_outputs(model, inputs, "inputs")
-    outputs = _check_outputs(model, outputs, "outputs")
+    inputs = model.full_dofs.checked_outputs(inputs, "inputs")
+    outputs = model.full_dofs.checked_outputs(outputs, "outputs")
     if not inputs or not outputs:
         raise ValueError("`inputs` and `outputs` must each name at least one (node, direction) pair")
     w_all = _check_speeds(frequencies, "frequencies")

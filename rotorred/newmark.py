@@ -59,8 +59,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import _kernel
-from rotorred.assembly import DIRECTIONS
-from rotorred.contact import OPEN, SLIP, STICK, STATE_NAMES, RubPlate, normal_force, sliding_velocity
+from rotorred.contact import OPEN, SLIP, STICK, STATE_NAMES, RubPlate, normal_force
 from rotorred.loads import Unbalance, gravity_force
 
 METHODS = ("newmark", "hht")
@@ -294,21 +293,6 @@ def _dof_label(model, i: int) -> str:
     return model.dofs.label(i)
 
 
-def _check_outputs(model, outputs) -> tuple[tuple[int, str], ...]:
-    out = []
-    dofs = model.full_dofs
-    for o in outputs:
-        try:
-            node, direction = o
-        except (TypeError, ValueError):
-            raise ValueError(f"`outputs` entries must be (node, direction) pairs, got {o!r}") from None
-        if direction not in DIRECTIONS:
-            raise ValueError(f"`outputs`: direction must be one of {DIRECTIONS}, got {direction!r} at node {node!r}")
-        dofs.index(node, direction)
-        out.append((int(node), str(direction)))
-    return tuple(out)
-
-
 def _positive(name, value, unit):
     if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value) and value > 0):
         raise ValueError(f"`{name}` must be a positive finite number ({unit}), got {value!r}")
@@ -439,7 +423,7 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
         spool_of = rotor.spool_of
     if spool_of is None and len(spools) == 1:
         spool_of = {n: spools[0] for n in model.full_dofs.nodes}
-    outputs = _check_outputs(model, outputs)
+    outputs = model.full_dofs.checked_outputs(outputs)
     plates = tuple(plates)
     for k, p in enumerate(plates):
         if not isinstance(p, RubPlate):

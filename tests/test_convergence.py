@@ -15,7 +15,7 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from rotorred.assembly import assemble
-from rotorred.elements import Bearing, Material, ShaftElement
+from rotorred.elements import Material, ShaftElement
 from rotorred.modal import eigen
 from rotorred.model import Rotor, Spool
 
