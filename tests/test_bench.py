@@ -37,7 +37,7 @@ def bp():
 @pytest.fixture(scope="module")
 def tiny(bp):
     """The paper-rub case on the unrefined rig, one common period after 0.1 s, and its reference."""
-    from rotorred.assembly import assemble
+    from rotorred.model.assembly import assemble
 
     case = bp.paper_rub(1, t_end=0.2, n_periods=1)
     system = assemble(case.rotor)
@@ -47,7 +47,7 @@ def tiny(bp):
 
 def test_paper_rub_config(bp):
     """The benchmark's case is the built-in scene paper-rub on the refined rotor."""
-    from rotorred.scene import load_scene
+    from rotorred.scenes.schema import load_scene
 
     scene = load_scene("paper-rub")
     case = bp.paper_rub(2, t_end=0.3, n_periods=2)
@@ -63,7 +63,7 @@ def test_steady_state_is_the_harmonic_solution(bp, tiny):
     """Without contact the run started from steady_state stays on it: q(0.1 s) = q(0) (period 0.1 s)."""
     case, system, _ = tiny
     q0, v0 = bp.steady_state(system, case)
-    from rotorred.newmark import simulate
+    from rotorred.transient.newmark import simulate
     res = simulate(system, case.speeds, 0.1, 1e-5, unbalances=case.unbalances, rotor=case.rotor, q0=q0, v0=v0,
                    progress=False)
     # Newmark's phase error at 90 Hz and dt = 1e-5 s: (Omega dt)^2 / 12 per radian, ~1e-4 after 9 cycles
@@ -164,7 +164,7 @@ def test_ross_comparison_when_installed():
     rs, why = br.import_ross()
     if rs is None:
         pytest.skip(f"ROSS not installed ({why}); install the `bench` extra to run this comparison")
-    from rotorred.io import load_rotor
+    from rotorred.model.rotor_file import load_rotor
 
     rotor = load_rotor("nelson-mcvaugh")
     cc = br.compare_campbell(rs, rotor, rpm=np.array([0.0, 20000.0, 40000.0]), repeats=1)

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from rotorred.assembly import assemble
-from rotorred.campbell import CampbellResult, campbell, whirl_direction
-from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.modal import eigen
-from rotorred.model import Rotor, Spool
+from rotorred.model.assembly import assemble
+from rotorred.linear.campbell import CampbellResult, campbell, whirl_direction
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.linear.modal import eigen
+from rotorred.model.rotor import Rotor, Spool
 
 VALIDATION = Path(__file__).resolve().parents[1] / "validation"
 

@@ -11,10 +11,10 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rotorred import _kernel
-from rotorred.contact import (RubPlate, contact_energy, gap, hunt_crossley, normal_force, rotor_force,
+from rotorred.transient import kernel as _kernel
+from rotorred.transient.contact import (RubPlate, contact_energy, gap, hunt_crossley, normal_force, rotor_force,
                               sliding_velocity)
-from rotorred.plate import ClampedFreePlate, NavierPlate, RigidPlate, navier_series
+from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate, navier_series
 
 
 def brute_navier(a, b, xi, eta, N):

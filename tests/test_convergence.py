@@ -14,10 +14,10 @@ import pytest
 import scipy.linalg as sla
 from scipy.optimize import brentq
 
-from rotorred.assembly import assemble
-from rotorred.elements import Material, ShaftElement
-from rotorred.modal import eigen
-from rotorred.model import Rotor, Spool
+from rotorred.model.assembly import assemble
+from rotorred.model.elements import Material, ShaftElement
+from rotorred.linear.modal import eigen
+from rotorred.model.rotor import Rotor, Spool
 
 STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
 L_SHAFT, D = 1.0, 0.05

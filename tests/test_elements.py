@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rotorred._generated import timoshenko as gen
-from rotorred.elements import Disk, Material, ShaftElement, shear_coefficient
+from rotorred.model.elements import Disk, Material, ShaftElement, shear_coefficient
 
 STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
 

@@ -5,9 +5,9 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from rotorred.figures import plot_orbits, plot_spectra, plot_waveforms
-from rotorred.lines import label_lines
-from rotorred.spectra import settled_spectrum
+from rotorred.plots.scene import plot_orbits, plot_spectra, plot_waveforms
+from rotorred.signals.lines import label_lines
+from rotorred.signals.spectra import settled_spectrum
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 DT = 1e-5

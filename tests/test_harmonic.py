@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rotorred.assembly import DofMap, SystemMatrices, assemble
+from rotorred.model.assembly import DofMap, SystemMatrices, assemble
 from rotorred.cli import main
-from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.harmonic import frequency_response, parse_dof, response_error, steady_state, unbalance_response
-from rotorred.harmonic_plot import plot_bode, plot_frf, plot_polar
-from rotorred.io import load_rotor
-from rotorred.loads import Unbalance
-from rotorred.model import Rotor, Spool
-from rotorred.reduction import default_boundary_nodes, reduce, reduce_rotor
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.linear.harmonic import frequency_response, parse_dof, response_error, steady_state, unbalance_response
+from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.loads import Unbalance
+from rotorred.model.rotor import Rotor, Spool
+from rotorred.linear.reduction import default_boundary_nodes, reduce, reduce_rotor
 
 STEEL = Material("steel", 2.1e11, 7850.0, 0.3)
 
@@ -264,7 +264,7 @@ def test_cli_harmonic_full_and_reduced(tmp_path, capsys):
 
 
 def test_cli_harmonic_takes_a_scene(tmp_path, capsys):
-    from rotorred import scene
+    from rotorred.scenes import schema as scene
     loaded = scene.load_scene("paper-normal")
     out = tmp_path / "scene"
     assert main(["harmonic", "paper-normal", "--speeds", "0:6300:21", "--out", str(out)]) == 0

@@ -3,7 +3,7 @@ that names the field, the value and what is allowed."""
 
 import pytest
 
-from rotorred.io import RotorFileError, load_rotor, presets, rotor_from_toml
+from rotorred.model.rotor_file import RotorFileError, load_rotor, presets, rotor_from_toml
 
 GOOD = """
 name = "t"

@@ -5,7 +5,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from rotorred.lines import (
+from rotorred.signals.lines import (
     MINUS,
     UNKNOWN,
     XU2016_TABLE1,
@@ -19,7 +19,7 @@ from rotorred.lines import (
     label_lines,
     parse_label,
 )
-from rotorred.spectra import amplitude_spectrum, settled_spectrum
+from rotorred.signals.spectra import amplitude_spectrum, settled_spectrum
 
 F_L, F_H = 70.0, 90.0  # the paper's operating point (4200 and 5400 rpm), Sec. 3
 

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from rotorred.assembly import assemble
-from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.io import load_rotor
-from rotorred.model import Rotor, Spool
+from rotorred.model.assembly import assemble
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.rotor import Rotor, Spool
 
 STEEL = Material("steel", 2.1e11, 7850.0, 0.3)
 

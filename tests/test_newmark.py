@@ -12,13 +12,13 @@ import scipy.linalg as sla
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rotorred.assembly import DofMap, SystemMatrices, assemble
-from rotorred.contact import RubPlate, contact_energy
-from rotorred.elements import Bearing, Disk, Material, ShaftElement
-from rotorred.loads import Unbalance
-from rotorred.model import Rotor, Spool
-from rotorred.newmark import SimulationDiverged, simulate
-from rotorred.plate import NavierPlate, RigidPlate
+from rotorred.model.assembly import DofMap, SystemMatrices, assemble
+from rotorred.transient.contact import RubPlate, contact_energy
+from rotorred.model.elements import Bearing, Disk, Material, ShaftElement
+from rotorred.model.loads import Unbalance
+from rotorred.model.rotor import Rotor, Spool
+from rotorred.transient.newmark import SimulationDiverged, simulate
+from rotorred.transient.plate import NavierPlate, RigidPlate
 
 STEEL = Material("steel", 2.1e11, 7850.0, 0.3)
 
@@ -70,7 +70,7 @@ def test_energy_conserved_linear_undamped(spin):
 def test_step_matrices_reproduce_the_newmark_formulas():
     """One step of q1 = Hq q0 + Hv v0 + Ha a0 + A^-1 F1 on a damped oscillator equals the textbook
     Newmark update solved by hand (gamma = 0.6, beta = 0.3, HHT alpha = 0 and -0.2)."""
-    from rotorred.newmark import newmark_coefficients, step_matrices
+    from rotorred.transient.newmark import newmark_coefficients, step_matrices
 
     m, c, k, h, F0, F1 = 2.0, 3.0, 500.0, 0.01, 1.0, 4.0
     q0, v0 = 0.1, -0.3
@@ -151,9 +151,9 @@ def test_hht_second_order_and_damps_high_modes():
 
 def test_settles_onto_harmonic_response():
     """No contact: the transient from rest settles onto the steady unbalance response of
-    rotorred.harmonic (both spools, each at its own speed and phase) to 1e-4 relative."""
-    from rotorred.harmonic import unbalance_response
-    from rotorred.io import load_rotor
+    rotorred.linear.harmonic (both spools, each at its own speed and phase) to 1e-4 relative."""
+    from rotorred.linear.harmonic import unbalance_response
+    from rotorred.model.rotor_file import load_rotor
 
     rig = load_rotor("seed-rig")
     system = assemble(rig)
@@ -241,8 +241,8 @@ def test_frictionless_impacts_energy_error_second_order(n_plates):
 
 def jeffcott_rub_reference(system, plate, Omega, m_e, t_end, t_eval):
     """The same equations (Jeffcott rotor, plate rigid DOFs, bending + Hertz + Hunt–Crossley, Coulomb
-    slip) integrated by scipy's Radau at rtol 1e-10, the normal force from rotorred.contact.normal_force."""
-    from rotorred.contact import normal_force
+    slip) integrated by scipy's Radau at rtol 1e-10, the normal force from rotorred.transient.contact.normal_force."""
+    from rotorred.transient.contact import normal_force
 
     m, c, k = system.M[0, 0], system.C[0, 0], system.K[0, 0]
     n, t = plate.normal, plate.tangent
@@ -346,7 +346,7 @@ def test_stick_slip_follows_coulomb():
 
 
 def rig_scene():
-    from rotorred.io import load_rotor
+    from rotorred.model.rotor_file import load_rotor
 
     rig = load_rotor("seed-rig")
     unbalances = [Unbalance(18, 1.5e-3, 0.0), Unbalance(3, 5e-4, 0.0)]
@@ -372,7 +372,7 @@ def test_reduced_matches_full_with_rub():
     largest spectral amplitudes of node 14 y over 0.3-0.5 s agree within 1 % with a 2 kHz cutoff (14 modes),
     and better with 3 kHz. Each model starts from its own linear steady state, so that the comparison is
     not dominated by the start-up ringing of lightly damped high modes (which a reduced model truncates)."""
-    from rotorred.reduction import default_boundary_nodes, reduce
+    from rotorred.linear.reduction import default_boundary_nodes, reduce
 
     rig, unbalances, plate = rig_scene()
     full = assemble(rig)
@@ -458,7 +458,7 @@ def test_bad_input():
 def test_gravity_settles_to_static_sag():
     """Gravity along -y on a damped rotor, full and reduced: the response settles on K^-1 F_g,
     with F_g = -g M e_y (e_y the rigid unit translation in y)."""
-    from rotorred.reduction import reduce
+    from rotorred.linear.reduction import reduce
 
     rotor = small_rotor(damped=True)
     full = assemble(rotor)

@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from rotorred.assembly import assemble
-from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.harmonic import response_error, unbalance_response
-from rotorred.io import load_rotor
-from rotorred.loads import Unbalance
-from rotorred.modal import eigen
-from rotorred.model import Rotor, Spool
-from rotorred.reduction import (ResponseCheck, default_boundary_nodes, reduce, reduce_rotor, whirl_error,
+from rotorred.model.assembly import assemble
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.linear.harmonic import response_error, unbalance_response
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.loads import Unbalance
+from rotorred.linear.modal import eigen
+from rotorred.model.rotor import Rotor, Spool
+from rotorred.linear.reduction import (ResponseCheck, default_boundary_nodes, reduce, reduce_rotor, whirl_error,
                                 whirl_frequencies)
 
 RIG_EXTRA = (18,)  # the rub node joins the default boundary of the seed rig

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rotorred.harmonic import unbalance_response
-from rotorred.run import build_model, harmonic_outputs, run_scene, settled_state, write_outputs
-from rotorred.scene import scene_from_dict
+from rotorred.linear.harmonic import unbalance_response
+from rotorred.scenes.run import build_model, harmonic_outputs, run_scene, settled_state, write_outputs
+from rotorred.scenes.schema import scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -117,7 +117,7 @@ def test_settled_state_is_the_harmonic_solution_at_t0(linear):
 @pytest.fixture(scope="module")
 def rub():
     """paper-rub on a short window: 0.6 s from the settled state (the rub settles in < 0.3 s)."""
-    from rotorred.scene import load_scene
+    from rotorred.scenes.schema import load_scene
     sc = load_scene("paper-rub", {"solver.duration": 0.6, "solver.record_start": 0.4,
                                   "output.plot_window": [0.4, 0.54]})
     return sc, run_scene(sc)
@@ -137,7 +137,7 @@ def test_rub_scene_records_contact_and_a_normal_comparison(rub):
 
 def test_rub_beyond_the_free_orbit_is_the_linear_response():
     """A plate that is never reached changes nothing: the transient stays on the harmonic solution."""
-    from rotorred.scene import load_scene
+    from rotorred.scenes.schema import load_scene
     sc = load_scene("paper-rub", {"rub.clearance": 60e-6, "solver.duration": 0.3, "solver.record_start": 0.1,
                                   "output.plot_window": [0.1, 0.2], "solver.model": "full"})
     res = run_scene(sc)

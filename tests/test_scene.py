@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rotorred import scene as scene_mod
-from rotorred.scene import (SceneError, apply_settings, builtin_scenes, load_scene, parse_setting,
+from rotorred.scenes import schema as scene_mod
+from rotorred.scenes.schema import (SceneError, apply_settings, builtin_scenes, load_scene, parse_setting,
                             scene_from_dict)
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "scenes.md"
@@ -74,7 +74,7 @@ def test_rayleigh_override_applies_to_the_rotor():
 
 def test_rotor_file_relative_to_the_scene(tmp_path):
     from importlib import resources
-    text = resources.files("rotorred.presets").joinpath("seed-rig.toml").read_text()
+    text = resources.files("rotorred.model.presets").joinpath("seed-rig.toml").read_text()
     (tmp_path / "rig.toml").write_text(text)
     lines = ['name = "f"', '[rotor]', 'file = "rig.toml"', '[[unbalance]]', 'node = 11', 'm_e = 1e-4',
              '[solver]', 'duration = 0.5', 'record_start = 0.3']
@@ -149,15 +149,15 @@ def test_bad_scene_fails_with_a_message_naming_the_key(what, path, value, messag
 
 def test_bad_scene_fails_before_any_computation(tmp_path, monkeypatch, capsys):
     """The CLI reports a bad scene (exit status 2, the key named) without assembling anything."""
-    import rotorred.assembly
-    import rotorred.run
+    import rotorred.model.assembly
+    import rotorred.scenes.run
     from rotorred.cli import main
 
     def boom(*args, **kwargs):
         raise AssertionError("computation started for a bad scene")
-    monkeypatch.setattr(rotorred.run, "build_model", boom)
-    monkeypatch.setattr(rotorred.run, "assemble", boom)
-    monkeypatch.setattr(rotorred.assembly, "assemble", boom)
+    monkeypatch.setattr(rotorred.scenes.run, "build_model", boom)
+    monkeypatch.setattr(rotorred.scenes.run, "assemble", boom)
+    monkeypatch.setattr(rotorred.model.assembly, "assemble", boom)
     path = tmp_path / "bad.toml"
     path.write_text('[rotor]\npreset = "seed-rig"\n[[unbalance]]\nnode = 11\nm_e = 1e-4\n'
                     '[[rub]]\nnode = 18\nclearance = -5e-6\n')

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from rotorred import spectra
-from rotorred.spectra import (
+from rotorred.signals import spectra
+from rotorred.signals.spectra import (
     WINDOWS,
     NotCommensurateError,
     amplitude_spectrum,
@@ -218,7 +218,7 @@ def test_settled_spectrum_exact_and_fallback():
 def test_spectra_never_write_into_the_callers_records():
     """Regression: a cached pyFFTW plan must not adopt a caller's array as its input buffer
     (a later call on another, misaligned record would then overwrite the first one)."""
-    from rotorred.spectra import settled_spectrum
+    from rotorred.signals.spectra import settled_spectrum
 
     rng = np.random.default_rng(1)
     dt = 1e-4

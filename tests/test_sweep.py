@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import rotorred.sweep as sweep_mod
-from rotorred.harmonic import unbalance_response
-from rotorred.run import build_model
-from rotorred.scene import load_scene
-from rotorred.sweep import free_reach, sweep, write_sweep
+import rotorred.scenes.sweep as sweep_mod
+from rotorred.linear.harmonic import unbalance_response
+from rotorred.scenes.run import build_model
+from rotorred.scenes.schema import load_scene
+from rotorred.scenes.sweep import free_reach, sweep, write_sweep
 
 #: paper-rub on a short window (the rub settles within 0.3 s from the settled linear state)
 SHORT = {"solver.duration": 0.6, "solver.record_start": 0.4, "output.plot_window": [0.4, 0.5],

@@ -1,9 +1,9 @@
 """Run time against error of the rub transient: full model against Craig–Bampton, dt, Newmark against HHT-α.
 
-Scene: the built-in scene ``paper-rub`` (:mod:`rotorred.scene`; ``paper_rub`` below is the one
+Scene: the built-in scene ``paper-rub`` (:mod:`rotorred.scenes.schema`; ``paper_rub`` below is the one
 place this benchmark reads it): the seed rig with the scene's damping, inner spool 70 Hz, outer
 90 Hz, the scene's unbalances and rub plate at node 18, started from the linear steady state
-(the scene's ``start = "settled"``, :func:`rotorred.run.settled_state`). The rub response settles
+(the scene's ``start = "settled"``, :func:`rotorred.scenes.run.settled_state`). The rub response settles
 onto a period-2 orbit (period 0.2 s; 70 and 90 Hz are multiples of 10 Hz) within about 2 s, so
 each run lasts ``T_END`` = 2.5 s and the record is the last ``N_PERIODS`` = 4 common periods.
 Simulation time and record are the benchmark's (the scene runs 2.6 s and records from 2.0 s).
@@ -24,7 +24,7 @@ Error measures (meaningful for a rubbing rotor, where a pointwise time-history e
 * ``spectral``: the ten largest spectral amplitudes (0 Hz excluded) of the reference at nodes 13
   and 14 (x and y), relative error of each, worst of the 40 (the largest errors sit on the small
   combination lines, not on the 70/90 Hz lines); spectra by
-  :func:`rotorred.spectra.settled_spectrum` (rectangular window on whole common periods, every
+  :func:`rotorred.signals.spectra.settled_spectrum` (rectangular window on whole common periods, every
   line m f_H + n f_L on a bin) of the records resampled to ``SAMPLE_DT``.
 * ``orbit``: relative error of the peak orbit radius sqrt(x² + y²) at node 18 over the record.
 * ``contact``: relative error of the contact fraction (fraction of the record's steps in
@@ -54,13 +54,13 @@ from dataclasses import dataclass, field  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from rotorred.assembly import assemble  # noqa: E402
-from rotorred.model import Rotor  # noqa: E402
-from rotorred.newmark import SimulationDiverged, simulate  # noqa: E402
-from rotorred.reduction import default_boundary_nodes, reduce  # noqa: E402
-from rotorred.run import settled_state  # noqa: E402
-from rotorred.scene import Scene, load_scene  # noqa: E402
-from rotorred.spectra import settled_spectrum  # noqa: E402
+from rotorred.model.assembly import assemble  # noqa: E402
+from rotorred.model.rotor import Rotor  # noqa: E402
+from rotorred.transient.newmark import SimulationDiverged, simulate  # noqa: E402
+from rotorred.linear.reduction import default_boundary_nodes, reduce  # noqa: E402
+from rotorred.scenes.run import settled_state  # noqa: E402
+from rotorred.scenes.schema import Scene, load_scene  # noqa: E402
+from rotorred.signals.spectra import settled_spectrum  # noqa: E402
 
 REFINE = 4                   # mesh of the comparison: Rotor.refined(4) of the 20-node rig
 T_END = 2.5                  # s: the rub response settles onto a period-2 (0.2 s) orbit by about 2 s
@@ -112,7 +112,7 @@ class RubCase:
 
 
 def paper_rub(refine: int = REFINE, t_end: float = T_END, n_periods: int = N_PERIODS) -> RubCase:
-    """The built-in scene ``paper-rub`` (:mod:`rotorred.scene`) on its rotor refined ``refine`` times.
+    """The built-in scene ``paper-rub`` (:mod:`rotorred.scenes.schema`) on its rotor refined ``refine`` times.
 
     Rotor (with the scene's Rayleigh damping), spool speeds, unbalances and rub plate are the
     scene's; the run length ``t_end`` and the record (the last ``n_periods`` common periods of
@@ -129,7 +129,7 @@ def paper_rub(refine: int = REFINE, t_end: float = T_END, n_periods: int = N_PER
 def steady_state(model, case: RubCase) -> tuple[np.ndarray, np.ndarray]:
     """Linear steady unbalance response (no contact) of ``model`` at t = 0: (q0, v0) in model coordinates.
 
-    The scene's own "settled" start (:func:`rotorred.run.settled_state`) on the refined rotor.
+    The scene's own "settled" start (:func:`rotorred.scenes.run.settled_state`) on the refined rotor.
     """
     return settled_state(dataclasses.replace(case.scene, rotor=case.rotor), model)
 
@@ -384,7 +384,7 @@ class SceneCheck:
     Attributes
     ----------
     label : str
-        The scene's model (:func:`rotorred.run.build_model`), method and dt.
+        The scene's model (:func:`rotorred.scenes.run.build_model`), method and dt.
     errors : Errors or None
         None when the scene's dt does not divide the sample interval.
     wall : float
@@ -405,7 +405,7 @@ def scene_checks(ref: Reference, t_end: float = T_END, n_periods: int = N_PERIOD
     ``refined(1)`` against ``refined(REFINE)``. ``t_end`` and ``n_periods`` must be those of the
     reference's case.
     """
-    from rotorred.run import build_model
+    from rotorred.scenes.run import build_model
 
     scene = load_scene("paper-rub")
     case = paper_rub(1, t_end, n_periods)

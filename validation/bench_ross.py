@@ -6,11 +6,11 @@ at nodes 10 and 14, no damping) is rebuilt element by element in ROSS
 (``ShaftElement(L, idl=D_i, odl=D_o, shear_method_calc="cowper")``, ``DiskElement``,
 ``BearingElement``).
 
-* Campbell: first six whirl speeds at ``CAMPBELL_RPM``; ours from :func:`rotorred.campbell.campbell`,
+* Campbell: first six whirl speeds at ``CAMPBELL_RPM``; ours from :func:`rotorred.linear.campbell.campbell`,
   ROSS's from ``Rotor.run_campbell`` (its axial/torsional modes, whirl NaN, removed; ROSS 2.x has
   6 DOF per node). Agreement: largest relative difference.
 * Transient: unbalance ``M_E`` at the disk, spin ``SPEED_RPM``, Newmark average acceleration
-  (gamma = 1/2, beta = 1/4), the same dt and duration; ours :func:`rotorred.newmark.simulate`,
+  (gamma = 1/2, beta = 1/4), the same dt and duration; ours :func:`rotorred.transient.newmark.simulate`,
   ROSS's ``Rotor.run_time_response(..., method="newmark")``. Agreement: largest difference of the
   disk's x and y displacement histories relative to their peak.
   ROSS's Newmark starts every run from zero acceleration (``ross.utils.newmark`` sets
@@ -52,11 +52,11 @@ from dataclasses import dataclass  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from rotorred.assembly import assemble  # noqa: E402
-from rotorred.campbell import campbell  # noqa: E402
-from rotorred.io import load_rotor  # noqa: E402
-from rotorred.loads import Unbalance  # noqa: E402
-from rotorred.newmark import simulate  # noqa: E402
+from rotorred.model.assembly import assemble  # noqa: E402
+from rotorred.linear.campbell import campbell  # noqa: E402
+from rotorred.model.rotor_file import load_rotor  # noqa: E402
+from rotorred.model.loads import Unbalance  # noqa: E402
+from rotorred.transient.newmark import simulate  # noqa: E402
 
 CAMPBELL_RPM = np.linspace(0.0, 40000.0, 21)
 N_MODES = 6

@@ -72,7 +72,7 @@ def worker(refine: int, n_modes: int | None, steps: int, repeats: int) -> dict:
     import resource
     import tracemalloc
 
-    from rotorred.assembly import assemble
+    from rotorred.model.assembly import assemble
 
     bp = _bench_pareto()
     t_end = steps * DT
@@ -116,7 +116,7 @@ def worker(refine: int, n_modes: int | None, steps: int, repeats: int) -> dict:
 
 def _run(bp, model, case):
     q0, v0 = bp.steady_state(model, case)
-    from rotorred.newmark import simulate
+    from rotorred.transient.newmark import simulate
     return simulate(model, case.speeds, case.t_end, DT, unbalances=case.unbalances, plates=case.plates,
                     rotor=case.rotor, outputs=case.outputs, decimate=DECIMATE, q0=q0, v0=v0, progress=False)
 
@@ -146,7 +146,7 @@ def compile_times() -> dict:
 
 def first_call() -> dict:
     """Time of the first and of the second tiny rub run in this process (s)."""
-    from rotorred.assembly import assemble
+    from rotorred.model.assembly import assemble
     bp = _bench_pareto()
     case = bp.paper_rub(1, t_end=0.01, n_periods=0)
     system = assemble(case.rotor)

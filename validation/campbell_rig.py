@@ -33,10 +33,10 @@ import dataclasses
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.assembly import assemble
-from rotorred.campbell import CampbellResult, campbell
-from rotorred.io import load_rotor
-from rotorred.model import Rotor
+from rotorred.model.assembly import assemble
+from rotorred.linear.campbell import CampbellResult, campbell
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.rotor import Rotor
 
 RATIO = 90.0 / 70.0            # Omega_H / Omega_L = outer / inner
 OPERATING_RPM = 4200.0         # inner spool (70 Hz); outer 5400 rpm (90 Hz)
@@ -131,8 +131,8 @@ def timing(repeats: int = 3) -> tuple[float, float, int]:
 
 
 def eigen_time(repeats: int = 10) -> float:
-    """Best time (s) of one :func:`rotorred.modal.eigen` call on the rig (the unit of work per speed)."""
-    from rotorred.modal import eigen
+    """Best time (s) of one :func:`rotorred.linear.modal.eigen` call on the rig (the unit of work per speed)."""
+    from rotorred.linear.modal import eigen
 
     rotor = load_rotor("seed-rig")
     sm = assemble(rotor)

@@ -9,7 +9,7 @@ Sweeps ``rub.clearance`` of the built-in ``paper-rub`` scene and checks the expe
   the one just below the free reach).
 
 Run ``python validation/clearance_study.py [--plot PATH]``; :func:`study` returns the
-:class:`rotorred.sweep.SweepResult` for the tests.
+:class:`rotorred.scenes.sweep.SweepResult` for the tests.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from rotorred.sweep import format_sweep, plot_sweep, sweep
+from rotorred.scenes.sweep import format_sweep, plot_sweep, sweep
 
 #: clearances (m): from contact at rest to beyond the free orbit's reach (43 um)
 CLEARANCES = (1e-6, 4e-6, 7e-6, 10e-6, 13e-6, 16e-6, 20e-6, 25e-6, 30e-6, 35e-6, 40e-6, 42e-6, 45e-6, 50e-6, 60e-6)

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.campbell import campbell
-from rotorred.elements import Bearing
-from rotorred.io import load_rotor
+from rotorred.linear.campbell import campbell
+from rotorred.model.elements import Bearing
+from rotorred.model.rotor_file import load_rotor
 
 REFERENCE = Path(__file__).resolve().parent / "reference" / "nelson_mcvaugh_ross_computed.json"
 

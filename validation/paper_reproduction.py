@@ -27,9 +27,9 @@ import time
 
 import numpy as np
 
-from rotorred.lines import XU2016_TABLE1, compare_with_expected, format_comparison, label_lines
-from rotorred.run import run_scene, write_outputs
-from rotorred.scene import load_scene
+from rotorred.signals.lines import XU2016_TABLE1, compare_with_expected, format_comparison, label_lines
+from rotorred.scenes.run import run_scene, write_outputs
+from rotorred.scenes.schema import load_scene
 
 #: threshold of the normal-state check (fraction of the largest line), from the issue
 NORMAL_THRESHOLD = 0.01
@@ -37,7 +37,7 @@ NORMAL_THRESHOLD = 0.01
 TABLE1_THRESHOLD = 0.005
 #: the paper's Table 1 frequencies were read from a response at 69.58/90.33 Hz with 0.49 Hz
 #: bins, so they lie up to 0.8 Hz from the 70/90 Hz grid; 1 Hz pairs them with ours
-#: (rotorred.lines.compare_with_expected)
+#: (rotorred.signals.lines.compare_with_expected)
 PAIR_TOL_HZ = 1.0
 
 
@@ -108,7 +108,7 @@ def reference_line_error(settings: tuple) -> tuple[float, int]:
 
 
 def _mn(label: str):
-    from rotorred.lines import parse_label
+    from rotorred.signals.lines import parse_label
     m, n = parse_label(label)
     return m, int(n)
 

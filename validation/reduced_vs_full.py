@@ -4,7 +4,7 @@ and the Nelson–McVaugh rotor.
 For each number of fixed-interface modes the table gives the reduced size, the worst relative
 error of the first 8 whirl speeds over 0–1.5x the operating speed (7 speeds), the worst
 relative unbalance-response error at nodes 13 and 14 (x and y) over a 151-point speed sweep
-(see :func:`rotorred.harmonic.response_error`), and the wall time of the reduction, of the
+(see :func:`rotorred.linear.harmonic.response_error`), and the wall time of the reduction, of the
 eigen-analyses and of the sweep. "auto" rows are the automatic choices: whirl target 0.1 %
 alone, and whirl target plus 0.5 % response target over the sweep.
 
@@ -34,11 +34,11 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np
 
-from rotorred.assembly import assemble
-from rotorred.harmonic import response_error, unbalance_response
-from rotorred.io import load_rotor
-from rotorred.loads import Unbalance
-from rotorred.reduction import ResponseCheck, default_boundary_nodes, reduce, whirl_error, whirl_frequencies
+from rotorred.model.assembly import assemble
+from rotorred.linear.harmonic import response_error, unbalance_response
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.loads import Unbalance
+from rotorred.linear.reduction import ResponseCheck, default_boundary_nodes, reduce, whirl_error, whirl_frequencies
 
 MODE_COUNTS = (0, 2, 4, 6, 8, 10, 12, 16, 20, 24)
 SPEED_FACTORS = np.linspace(0.0, 1.5, 7)
@@ -143,7 +143,7 @@ def run_case(case: Case, mode_counts=MODE_COUNTS) -> list[Row]:
 
 def all_interior_modes_error(case: Case, factors=(0.0, 0.7, 1.5)) -> float:
     """Worst relative difference of all eigenvalues, every interior mode kept (round-off)."""
-    from rotorred.modal import eigen
+    from rotorred.linear.modal import eigen
     system = assemble(case.rotor)
     boundary = default_boundary_nodes(case.rotor, case.extra_nodes)
     red = reduce(system, boundary, n_modes=system.n_dof - 4 * len(boundary))

@@ -12,7 +12,7 @@ Grid (all combinations):
 * friction mu_s = mu_d from 0 to 0.8.
 
 Each run lasts ``T_END``. A run passes when it either finishes with finite records, or raises
-:class:`rotorred.newmark.SimulationDiverged` whose message names a time and a DOF and whose
+:class:`rotorred.transient.newmark.SimulationDiverged` whose message names a time and a DOF and whose
 partial records are finite. No NaN may be returned in either case.
 
 ROSS 3.1.0 lags its rub force one step and diverges on a dual rotor at dt = 1e-4 s; here the
@@ -31,13 +31,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotorred.assembly import assemble
-from rotorred.contact import RubPlate
-from rotorred.io import load_rotor
-from rotorred.loads import Unbalance
-from rotorred.modal import eigen
-from rotorred.newmark import SimulationDiverged, simulate
-from rotorred.reduction import default_boundary_nodes, reduce
+from rotorred.model.assembly import assemble
+from rotorred.transient.contact import RubPlate
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.loads import Unbalance
+from rotorred.linear.modal import eigen
+from rotorred.transient.newmark import SimulationDiverged, simulate
+from rotorred.linear.reduction import default_boundary_nodes, reduce
 
 DTS = (1e-6, 1e-5, 1e-4, 2e-4)
 STIFFNESSES = (1e7, 1e9, 1e11)

@@ -2,11 +2,11 @@
 
 Scene: the seed rig at its nominal speeds (inner 70 Hz, outer 90 Hz), unbalance on both spools
 (node 18: 2e-3 kg m, about 65 µm steady response there, above the 40 µm clearance; node 3:
-1e-3 kg m), one default :class:`rotorred.contact.RubPlate` facing the disk at node 18
+1e-3 kg m), one default :class:`rotorred.transient.contact.RubPlate` facing the disk at node 18
 (Navier-plate bending, Hertz with Hunt–Crossley damping, Coulomb friction). 3 s at dt = 1e-5 s
 (3e5 steps) from rest, outputs node 14 y and node 18 x, y every 10th step.
 
-Reduced model: :func:`rotorred.reduction.reduce_rotor` with the rub node on the boundary
+Reduced model: :func:`rotorred.linear.reduction.reduce_rotor` with the rub node on the boundary
 (automatic mode count). Full model: the 80-DOF assembly.
 
 Timing: one warm-up run per model loads (or compiles) the numba kernel; then ``--repeats`` runs,
@@ -32,12 +32,12 @@ import statistics  # noqa: E402
 import time  # noqa: E402
 from dataclasses import dataclass  # noqa: E402
 
-from rotorred.assembly import assemble  # noqa: E402
-from rotorred.contact import RubPlate  # noqa: E402
-from rotorred.io import load_rotor  # noqa: E402
-from rotorred.loads import Unbalance  # noqa: E402
-from rotorred.newmark import simulate  # noqa: E402
-from rotorred.reduction import reduce_rotor  # noqa: E402
+from rotorred.model.assembly import assemble  # noqa: E402
+from rotorred.transient.contact import RubPlate  # noqa: E402
+from rotorred.model.rotor_file import load_rotor  # noqa: E402
+from rotorred.model.loads import Unbalance  # noqa: E402
+from rotorred.transient.newmark import simulate  # noqa: E402
+from rotorred.linear.reduction import reduce_rotor  # noqa: E402
 
 DT = 1e-5
 T_END = 3.0

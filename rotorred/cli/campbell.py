@@ -65,8 +65,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from rotorred.campbell import campbell
-    from rotorred.io import load_rotor
+    from rotorred.linear.campbell import campbell
+    from rotorred.model.rotor_file import load_rotor
 
     speeds = parse_speeds(args.speeds)
     harmonics = parse_harmonics(args.harmonics)

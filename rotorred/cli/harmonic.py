@@ -1,7 +1,7 @@
 """``rotorred harmonic ROTOR_OR_SCENE --speeds ... --out DIR``: steady-state unbalance response sweep.
 
 ROTOR_OR_SCENE is a rotor (preset or rotor TOML file) or a scene (built-in name or scene TOML
-file, :mod:`rotorred.scene`). A scene supplies the defaults: its unbalances, its spool speeds
+file, :mod:`rotorred.scenes.schema`). A scene supplies the defaults: its unbalances, its spool speeds
 (the ratio, and the sweep 0 to 1.5x its reference speed), its output DOFs, and its solver's
 model ("full" or "reduced", with its mode count, cutoff, boundary nodes and rub nodes).
 
@@ -89,7 +89,7 @@ def _grid(text: str, name: str, unit: str) -> np.ndarray:
 
 
 def _unbalance(text: str):
-    from rotorred.loads import Unbalance
+    from rotorred.model.loads import Unbalance
     parts = text.split(":")
     try:
         if len(parts) not in (2, 3):
@@ -129,9 +129,9 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
 
 def _load(spec: str):
     """(rotor, scene or None) for a rotor or scene argument."""
-    from rotorred.io import load_rotor
+    from rotorred.model.rotor_file import load_rotor
     try:
-        from rotorred.scene import builtin_scenes, load_scene
+        from rotorred.scenes.schema import builtin_scenes, load_scene
     except ImportError:  # pragma: no cover - scenes not available
         return load_rotor(spec), None
     if spec in builtin_scenes() or _is_scene_file(spec):
@@ -153,11 +153,11 @@ def _is_scene_file(spec: str) -> bool:
 
 
 def run(args) -> int:
-    from rotorred.assembly import assemble
-    from rotorred.harmonic import frequency_response, parse_dof, unbalance_response
-    from rotorred.harmonic_plot import plot_bode, plot_frf, plot_polar
-    from rotorred.loads import Unbalance
-    from rotorred.reduction import default_boundary_nodes, reduce_rotor
+    from rotorred.model.assembly import assemble
+    from rotorred.linear.harmonic import frequency_response, parse_dof, unbalance_response
+    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+    from rotorred.model.loads import Unbalance
+    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
 
     rotor, scene = _load(str(args.rotor))
     preset = PRESET_DEFAULTS.get(str(args.rotor), {})

@@ -14,7 +14,7 @@ DEFAULT_SCENE = "paper-rub"
 
 
 def add_parser(subparsers):
-    from rotorred.scene import builtin_scenes
+    from rotorred.scenes.schema import builtin_scenes
     p = subparsers.add_parser(
         "run", help="run a scene (default paper-rub): figures, data (NPZ, CSV, .mat) and a summary",
         description="Run a scene file or built-in scene and write the paper's figures (time waveforms, spectra, "
@@ -34,8 +34,8 @@ def add_parser(subparsers):
 def run(args) -> int:
     from pathlib import Path
 
-    from rotorred.run import format_summary, run_scene, write_outputs
-    from rotorred.scene import load_scene, parse_setting
+    from rotorred.scenes.run import format_summary, run_scene, write_outputs
+    from rotorred.scenes.schema import load_scene, parse_setting
 
     t0 = time.perf_counter()
     settings = {}

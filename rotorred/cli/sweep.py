@@ -26,8 +26,8 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    from rotorred.scene import parse_setting
-    from rotorred.sweep import format_sweep, sweep, write_sweep
+    from rotorred.scenes.schema import parse_setting
+    from rotorred.scenes.sweep import format_sweep, sweep, write_sweep
 
     t0 = time.perf_counter()
     swept, fixed = None, {}

@@ -21,9 +21,9 @@ from typing import Sequence
 
 import numpy as np
 
-from rotorred.loads import gravity_force
-from rotorred.run import _model_key, _steady, build_model, run_scene, table_dof
-from rotorred.scene import Scene, load_scene
+from rotorred.model.loads import gravity_force
+from rotorred.scenes.run import _model_key, _steady, build_model, run_scene, table_dof
+from rotorred.scenes.schema import Scene, load_scene
 
 __all__ = ["SweepResult", "sweep", "free_reach", "plot_sweep", "write_sweep", "format_sweep"]
 
@@ -96,7 +96,7 @@ def free_reach(scene: Scene, model=None) -> float | None:
     """
     if not scene.plates:
         return None
-    from rotorred.run import SceneModel
+    from rotorred.scenes.run import SceneModel
     if model is None:
         model = build_model(scene)
     m = model.model if isinstance(model, SceneModel) else model
@@ -124,7 +124,7 @@ def sweep(spec, key: str, values: Sequence, settings: dict | None = None, dof: t
     spec : str or Path
         Built-in scene name or scene file.
     key : str
-        Key to sweep, "section.key" (:func:`rotorred.scene.apply_settings`), e.g. "rub.clearance".
+        Key to sweep, "section.key" (:func:`rotorred.scenes.schema.apply_settings`), e.g. "rub.clearance".
     values : sequence
         Values of ``key`` (scene units: SI).
     settings : dict, optional
@@ -236,7 +236,7 @@ def plot_sweep(result: SweepResult, path, n_lines: int = 4) -> Path:
 
 
 def _line_hz(label: str, result: SweepResult) -> float:
-    from rotorred.lines import parse_label
+    from rotorred.signals.lines import parse_label
     m, n = parse_label(label)
     return m * result.f_H + float(n) * result.f_L
 

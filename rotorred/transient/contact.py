@@ -14,7 +14,7 @@ project's single definition)
   The disk radius enters only the sliding speed.
 * The penetration is shared between plate bending and local contact deformation
   (Eq. 4): ``p = W + delta``, with ``W = lam P + w0`` from the plate model
-  (:mod:`rotorred.plate`, Eqs. 10-11) and ``delta`` the Hertz deformation.
+  (:mod:`rotorred.transient.plate`, Eqs. 10-11) and ``delta`` the Hertz deformation.
 * Normal force (Eq. 8, Hunt–Crossley reading of the "nonlinear spring damping model"):
   ``P = K_nr delta^1.5 max(0, 1 + c p')`` for ``delta > 0``, else 0. The rate is the
   approach rate ``p' = -g'`` of the disk towards the plate (the bending deflection is treated
@@ -27,7 +27,7 @@ project's single definition)
   rim point ``r n`` moving with ``Omega z x r n = Omega r t``), plus the whirl velocity, minus
   the plate's tangential velocity. Slip: ``T = -mu_d P sign(v_rel)``. Stick: ``v_rel = 0`` with
   ``|T| <= mu_s P``. The integrator treats stick exactly as a constraint (no regularisation);
-  see :mod:`rotorred.newmark`.
+  see :mod:`rotorred.transient.newmark`.
 * Forces: on the disk ``-P n + T t``; on the plate ``+P n - T t``. In the paper's Eq. 12,
   ``F_x = F_n cos theta + F_t sin theta``, ``F_y = F_n sin theta - F_t cos theta`` with
   ``F_n = -P`` and ``F_t = -T`` (the paper's t axis is ``-t`` here).
@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotorred._generated import contact as _gen
-from rotorred.plate import ClampedFreePlate, NavierPlate, RigidPlate
+from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
 PlateBending = NavierPlate | ClampedFreePlate | RigidPlate
 

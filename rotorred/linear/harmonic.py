@@ -1,8 +1,8 @@
 """Steady-state harmonic response: unbalance response over a speed sweep, FRFs, and the
 steady state at one operating point in model coordinates (a transient's initial condition).
 
-Works on any model with the :class:`~rotorred.assembly.SystemMatrices` interface, full or
-reduced (:class:`~rotorred.reduction.ReducedSystem`): it needs ``M, K, damping(speeds),
+Works on any model with the :class:`~rotorred.model.assembly.SystemMatrices` interface, full or
+reduced (:class:`~rotorred.linear.reduction.ReducedSystem`): it needs ``M, K, damping(speeds),
 spools`` and ``output_rows(outputs)``. A physical force ``f`` at (node, direction) enters
 the model's coordinates as ``rowᵀ f`` with ``row = output_rows([(node, direction)])``
 (virtual work; for a full model this is the unit vector, for a reduced one the row of the
@@ -11,7 +11,7 @@ recovery map T, i.e. ``Tᵀ f``).
 Conventions
 -----------
 Unbalance ``m_e`` at phase ``phi`` on a node of spool ``s`` spinning at ``Omega_s`` gives
-(:class:`rotorred.loads.Unbalance`) ``F = m_e Omega_s² [cos(Omega_s t + phi), sin(Omega_s t + phi)]``,
+(:class:`rotorred.model.loads.Unbalance`) ``F = m_e Omega_s² [cos(Omega_s t + phi), sin(Omega_s t + phi)]``,
 i.e. ``F = Re(F̂ e^{i Omega_s t})`` with the phasors ``F̂_x = m_e Omega_s² e^{i phi}``,
 ``F̂_y = -i m_e Omega_s² e^{i phi}``. The response is ``q(t) = Re(Q e^{i Omega_s t})`` with
 
@@ -41,8 +41,8 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.assembly import DIRECTIONS
-from rotorred.loads import Unbalance
+from rotorred.model.assembly import DIRECTIONS
+from rotorred.model.loads import Unbalance
 
 Output = tuple[int, str]
 

@@ -16,7 +16,7 @@ in ``docs/scenes.md``; in short::
     [[unbalance]]           # kg m, deg
     node = 18
     m_e = 1e-3
-    [[rub]]                 # rub plate(s), rotorred.contact.RubPlate; SI units, angles in deg
+    [[rub]]                 # rub plate(s), rotorred.transient.contact.RubPlate; SI units, angles in deg
     node = 18
     clearance = 16e-6
     [solver]
@@ -41,11 +41,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from rotorred.contact import RubPlate
-from rotorred.io import load_rotor, presets
-from rotorred.loads import Unbalance
-from rotorred.model import Rotor
-from rotorred.plate import ClampedFreePlate, NavierPlate, RigidPlate
+from rotorred.transient.contact import RubPlate
+from rotorred.model.rotor_file import load_rotor, presets
+from rotorred.model.loads import Unbalance
+from rotorred.model.rotor import Rotor
+from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
 try:  # Python >= 3.11
     import tomllib
@@ -99,7 +99,7 @@ class SolverSpec:
         Craig–Bampton reduced model (boundary: bearings, inter-shaft bearings, rub nodes,
         ``boundary_nodes``) or the full FE model.
     modes : int or None
-        Fixed-interface modes kept (None: chosen automatically, :func:`rotorred.reduction.reduce`).
+        Fixed-interface modes kept (None: chosen automatically, :func:`rotorred.linear.reduction.reduce`).
     cutoff_hz : float or None
         Keep the fixed-interface modes below this frequency (Hz) instead of a count.
     boundary_nodes : tuple of int
@@ -228,13 +228,13 @@ class Scene:
 # --------------------------------------------------------------------------- loading
 def builtin_scenes() -> list[str]:
     """Names of the built-in scenes (``rotorred/scenes/*.toml``)."""
-    return sorted(p.name[:-5] for p in resources.files("rotorred.scenes").iterdir() if p.name.endswith(".toml"))
+    return sorted(p.name[:-5] for p in resources.files("rotorred.scenes.builtin").iterdir() if p.name.endswith(".toml"))
 
 
 def _read(spec: str | Path) -> tuple[dict, str, Path | None]:
     spec_str = str(spec)
     if spec_str in builtin_scenes():
-        text = resources.files("rotorred.scenes").joinpath(f"{spec_str}.toml").read_text()
+        text = resources.files("rotorred.scenes.builtin").joinpath(f"{spec_str}.toml").read_text()
         source, base = f"scene {spec_str!r}", None
     else:
         path = Path(spec)

@@ -6,17 +6,17 @@ Solves (Xu et al. 2016, Eq. 13, with two spools)
 
 together with the rigid-body motion of every rubbing plate (Eq. 7), at constant spool speeds.
 ``simulate`` is the entry point (in the style of ``scipy.integrate.solve_ivp``): it builds the
-constant step matrices once and runs the compiled step loop of :mod:`rotorred._kernel`.
+constant step matrices once and runs the compiled step loop of :mod:`rotorred.transient.kernel`.
 
 Each step is the exact implicit Newmark (or HHT-α) step of the nonlinear system: the
 linear step is condensed onto the contact DOFs (the disk centre x, y of each plate's node)
 and the plates' rigid DOFs, and the small nonlinear contact system is solved by Newton with
-the law's analytic tangent and a Coulomb active set (see :mod:`rotorred._kernel`). No
+the law's analytic tangent and a Coulomb active set (see :mod:`rotorred.transient.kernel`). No
 contact force is lagged. A step that fails (Newton not converging, a non-finite value) is
 redone as two half steps, recursively up to ``max_halvings`` times; if that cannot cure it,
 :class:`SimulationDiverged` is raised, carrying every result computed until then.
 
-Contact in each step (details in :mod:`rotorred._kernel`)
+Contact in each step (details in :mod:`rotorred.transient.kernel`)
 --------------------------------------------------------
 * Condensation: ``q_new = q_lin + (1 + alpha) A^-1 B f`` with ``f`` the contact forces on the
   disk centres; the plates' rigid DOFs (scalar Newmark oscillators) are condensed likewise, so
@@ -58,9 +58,9 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred import _kernel
-from rotorred.contact import OPEN, SLIP, STICK, STATE_NAMES, RubPlate, normal_force
-from rotorred.loads import Unbalance, gravity_force
+from rotorred.transient import kernel as _kernel
+from rotorred.transient.contact import OPEN, SLIP, STICK, STATE_NAMES, RubPlate, normal_force
+from rotorred.model.loads import Unbalance, gravity_force
 
 METHODS = ("newmark", "hht")
 _CAUSES = {
@@ -104,7 +104,7 @@ class ContactHistory:
     friction_force : ndarray, shape (n_rec,)
         T (N): friction on the disk along the plate tangent t = (-sin theta, cos theta).
     state : ndarray of int8, shape (n_rec,)
-        0 open, 1 slip, 2 stick (:data:`rotorred.contact.STATE_NAMES`).
+        0 open, 1 slip, 2 stick (:data:`rotorred.transient.contact.STATE_NAMES`).
     u_n, u_t : ndarray, shape (n_rec,)
         Plate rigid-body displacement along n and t (m).
     sliding_velocity : ndarray, shape (n_rec,)
@@ -320,7 +320,7 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
     dt : float
         Time step (s); default 1e-5.
     unbalances : sequence of Unbalance
-        Each rotates at the speed of its node's spool, with its phase (rotorred.loads).
+        Each rotates at the speed of its node's spool, with its phase (rotorred.model.loads).
     plates : sequence of RubPlate
         Rubbing plates; several may face the same or different disks.
     rotor : Rotor, optional

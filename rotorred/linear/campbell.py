@@ -6,8 +6,8 @@ spool ``s`` turns at ``r_s Omega`` (``r_ref = 1``). At each speed the damped eig
     M q'' + (C + Omega sum_s r_s G_s) q' + K q = 0
 
 (Xu et al. 2016, Eq. 13 with one gyroscopic matrix per spool) is solved with
-:func:`rotorred.modal.eigen`. Modes are followed from speed to speed by the modal assurance
-criterion (MAC, :func:`rotorred.modal.mac`) with an optimal one-to-one assignment
+:func:`rotorred.linear.modal.eigen`. Modes are followed from speed to speed by the modal assurance
+criterion (MAC, :func:`rotorred.linear.modal.mac`) with an optimal one-to-one assignment
 (:func:`scipy.optimize.linear_sum_assignment`), so a curve keeps its identity where two curves
 cross. A critical speed is a speed where a tracked curve omega_j(Omega) meets an excitation line
 ``h r_s Omega`` (harmonic ``h`` of spool ``s``); it is bracketed on the speed grid and refined with
@@ -41,9 +41,9 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
-from rotorred.assembly import SystemMatrices, assemble
-from rotorred.modal import eigen, mac
-from rotorred.model import Rotor
+from rotorred.model.assembly import SystemMatrices, assemble
+from rotorred.linear.modal import eigen, mac
+from rotorred.model.rotor import Rotor
 
 WHIRL_LABELS = ("forward", "backward", "mixed", "planar")
 
@@ -193,8 +193,8 @@ class CampbellResult:
         return path
 
     def plot(self, path: str | Path, **kwargs) -> Path:
-        """Write the Campbell diagram as a PNG; see :func:`rotorred.campbell_plot.plot_campbell`."""
-        from rotorred.campbell_plot import plot_campbell
+        """Write the Campbell diagram as a PNG; see :func:`rotorred.plots.campbell.plot_campbell`."""
+        from rotorred.plots.campbell import plot_campbell
 
         return plot_campbell(self, path, **kwargs)
 

@@ -1,7 +1,7 @@
 """Compiled step loop of the Newmark-β / HHT-α transient with implicit rub-impact contact.
 
 Everything here is ``numba.njit(cache=True)``; no Python runs per step. The Python side
-(:mod:`rotorred.newmark`) builds the constant step matrices once per step size ("level":
+(:mod:`rotorred.transient.newmark`) builds the constant step matrices once per step size ("level":
 ``dt / 2**level``, used when a step must be halved) and calls :func:`run_steps` in chunks.
 
 One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Newmark):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.campbell import CampbellResult, excitation_label
+from rotorred.linear.campbell import CampbellResult, excitation_label
 
 #: colour and line style of each whirl direction
 WHIRL_STYLE = {

@@ -26,8 +26,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from rotorred.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.model import Rotor, Spool
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.model.rotor import Rotor, Spool
 
 try:  # Python >= 3.11
     import tomllib
@@ -49,7 +49,7 @@ class RotorFileError(ValueError):
 
 def presets() -> list[str]:
     """Names of the built-in rotors."""
-    return sorted(p.name[:-5] for p in resources.files("rotorred.presets").iterdir() if p.name.endswith(".toml"))
+    return sorted(p.name[:-5] for p in resources.files("rotorred.model.presets").iterdir() if p.name.endswith(".toml"))
 
 
 def load_rotor(spec: str | Path) -> Rotor:
@@ -66,7 +66,7 @@ def load_rotor(spec: str | Path) -> Rotor:
     """
     spec_str = str(spec)
     if spec_str in presets():
-        text = resources.files("rotorred.presets").joinpath(f"{spec_str}.toml").read_text()
+        text = resources.files("rotorred.model.presets").joinpath(f"{spec_str}.toml").read_text()
         return rotor_from_toml(text, source=f"preset {spec_str!r}")
     path = Path(spec)
     if not path.exists():

@@ -21,7 +21,7 @@ from typing import Mapping
 import numpy as np
 from scipy.sparse import coo_matrix
 
-from rotorred.model import Rotor
+from rotorred.model.rotor import Rotor
 
 DIRECTIONS = ("x", "y", "theta_x", "theta_y")
 _DIR_ALIASES = {"x": 0, "y": 1, "theta_x": 2, "theta_y": 3, "tx": 2, "ty": 3}
@@ -104,7 +104,7 @@ class DofMap:
 class SpoolSpeedMixin:
     """``spools``, ``gyroscopic(speeds)`` and ``damping(speeds)`` of a model with attributes
     ``M``, ``C`` and ``G`` (dict spool -> gyroscopic matrix per unit speed); shared by the full
-    :class:`SystemMatrices` and the reduced model (:class:`rotorred.reduction.ReducedSystem`)."""
+    :class:`SystemMatrices` and the reduced model (:class:`rotorred.linear.reduction.ReducedSystem`)."""
 
     @property
     def spools(self) -> tuple[str, ...]:

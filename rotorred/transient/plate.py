@@ -1,6 +1,6 @@
 """Bending compliance of the rubbing plate at the contact point (Xu et al. 2016, Eqs. 10-11).
 
-The rub-impact law (:mod:`rotorred.contact`) needs the deflection ``W`` of the plate at the
+The rub-impact law (:mod:`rotorred.transient.contact`) needs the deflection ``W`` of the plate at the
 contact point under the normal contact load ``F``. Two plate models of the paper are offered,
 both reduced to an affine law ``W = lam F + w0`` valid in contact (``F >= 0``):
 

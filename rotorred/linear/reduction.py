@@ -35,10 +35,10 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.assembly import DofMap, SpoolSpeedMixin, SystemMatrices, assemble
-from rotorred.harmonic import response_error, unbalance_response
-from rotorred.modal import eigen
-from rotorred.model import Rotor
+from rotorred.model.assembly import DofMap, SpoolSpeedMixin, SystemMatrices, assemble
+from rotorred.linear.harmonic import response_error, unbalance_response
+from rotorred.linear.modal import eigen
+from rotorred.model.rotor import Rotor
 
 #: default relative whirl-frequency error target of the automatic mode count (0.1 %)
 DEFAULT_TARGET = 1e-3
@@ -117,7 +117,7 @@ class ResponseCheck:
     """An unbalance-response accuracy requirement for the automatic mode count.
 
     The reduced model's unbalance response over ``speeds`` must match the full model's
-    within ``target`` (see :func:`rotorred.harmonic.response_error`).
+    within ``target`` (see :func:`rotorred.linear.harmonic.response_error`).
 
     Parameters
     ----------
@@ -127,7 +127,7 @@ class ResponseCheck:
     outputs : tuple of (int, str)
         Physical DOFs checked.
     ratios : dict of str to float, optional
-        Spool speed ratios (see :func:`rotorred.harmonic.unbalance_response`).
+        Spool speed ratios (see :func:`rotorred.linear.harmonic.unbalance_response`).
     spool_of : dict of int to str, optional
         Spool of each node.
     target : float

@@ -22,8 +22,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from .lines import SpectralLine
-from .spectra import Spectrum
+from rotorred.signals.lines import SpectralLine
+from rotorred.signals.spectra import Spectrum
 
 __all__ = ["plot_waveforms", "plot_spectra", "plot_orbits"]
 
@@ -174,11 +174,11 @@ def plot_spectra(
     ----------
     spectra : mapping
         ``{label: spectrum}`` or ``{panel title: {label: spectrum}}``; a spectrum is a
-        :class:`rotorred.spectra.Spectrum` or a pair ``(frequencies (Hz), amplitudes (m))``.
+        :class:`rotorred.signals.spectra.Spectrum` or a pair ``(frequencies (Hz), amplitudes (m))``.
     path : str or Path
         Output file.
     lines : mapping, optional
-        ``{label: [SpectralLine, ...]}`` (from :func:`rotorred.lines.label_lines`) for the
+        ``{label: [SpectralLine, ...]}`` (from :func:`rotorred.signals.lines.label_lines`) for the
         series of the same label; each known line is marked and labelled ("2f_H−f_L").
     title : str, optional
     f_max : float, optional

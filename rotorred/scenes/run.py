@@ -14,13 +14,13 @@
   static deflection), so only the transient caused by the rub has to decay, not the
   start-up of every lightly damped mode.
 
-Spectra (:func:`rotorred.spectra.settled_spectrum`, pyFFTW with reused plans): single-sided
+Spectra (:func:`rotorred.signals.spectra.settled_spectrum`, pyFFTW with reused plans): single-sided
 amplitude in metres, rectangular window over the last whole number of common periods of the
 two spools (70/90 Hz: 0.1 s), where every combination ``m f_H + n f_L`` is on a bin and is
 read without amplitude error; when the speeds are not commensurate the flat-top window is
 used (amplitude error below 0.0045 dB) and the spectrum's ``note`` says so. Lines are the
 peaks above ``output.line_threshold`` of the largest, labelled by
-:func:`rotorred.lines.label_lines` within half a bin.
+:func:`rotorred.signals.lines.label_lines` within half a bin.
 
 :func:`write_outputs` writes the figures (PNG), the data (NPZ, CSV, MATLAB .mat) and
 ``summary.txt``; the keys and columns are listed in ``docs/scenes.md``.
@@ -36,12 +36,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.assembly import assemble
-from rotorred.harmonic import SteadyState, steady_state
-from rotorred.lines import format_table, label_lines
-from rotorred.loads import gravity_force
-from rotorred.scene import Scene
-from rotorred.spectra import WINDOWS, settled_spectrum
+from rotorred.model.assembly import assemble
+from rotorred.linear.harmonic import SteadyState, steady_state
+from rotorred.signals.lines import format_table, label_lines
+from rotorred.model.loads import gravity_force
+from rotorred.scenes.schema import Scene
+from rotorred.signals.spectra import WINDOWS, settled_spectrum
 
 __all__ = ["SceneModel", "SceneResult", "build_model", "run_scene", "settled_state", "harmonic_outputs",
            "write_outputs", "format_summary", "spool_frequencies"]
@@ -82,7 +82,7 @@ class SceneResult:
         Record times (s), ``record_start .. duration``.
     outputs : dict of (int, str) to ndarray, shape (n,)
         Displacements (m) or rotations (rad) of the recorded DOFs.
-    contacts : tuple of rotorred.newmark.ContactHistory
+    contacts : tuple of rotorred.transient.newmark.ContactHistory
         One per rub plate (empty without plates).
     spectra : dict of (int, str) to Spectrum
         Amplitude spectrum of each recorded DOF (m).
@@ -162,9 +162,9 @@ def build_model(scene: Scene) -> SceneModel:
 
     The reduced model's boundary is every bearing node, both nodes of every inter-shaft
     bearing, every rub node and ``solver.boundary_nodes``
-    (:func:`rotorred.reduction.reduce_rotor`).
+    (:func:`rotorred.linear.reduction.reduce_rotor`).
     """
-    from rotorred.reduction import default_boundary_nodes, reduce_rotor
+    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
 
     t0 = time.perf_counter()
     system = assemble(scene.rotor)
@@ -240,7 +240,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     -------
     SceneResult
     """
-    from rotorred.newmark import simulate
+    from rotorred.transient.newmark import simulate
 
     if model is None:
         model = build_model(scene)
@@ -443,7 +443,7 @@ def _write_csvs(result: SceneResult, out: Path) -> list[Path]:
 
 
 def _plots(result: SceneResult, out: Path) -> list[Path]:
-    from rotorred.figures import plot_orbits, plot_spectra, plot_waveforms
+    from rotorred.plots.scene import plot_orbits, plot_spectra, plot_waveforms
 
     sc = result.scene
     plots = sc.output.plots

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.harmonic import FrequencyResponse, UnbalanceResponse
+from rotorred.linear.harmonic import FrequencyResponse, UnbalanceResponse
 
 _RPM = 60.0 / (2.0 * math.pi)
 

@@ -14,8 +14,8 @@ Matching tolerance
     ``|m f_H + n f_L - f| <= tol_hz``. The default ``tol_hz = df / 2`` (half a bin, plus
     1e-9 df for rounding) is the largest distance between a tone and the bin where it
     peaks, for any window whose kernel falls off monotonically from its centre (all of
-    :data:`rotorred.spectra.WINDOWS`). With the exact spool frequencies and a commensurate
-    record (:func:`rotorred.spectra.settled_spectrum`) every combination is exactly on a
+    :data:`rotorred.signals.spectra.WINDOWS`). With the exact spool frequencies and a commensurate
+    record (:func:`rotorred.signals.spectra.settled_spectrum`) every combination is exactly on a
     bin. Pass a larger ``tol_hz`` when ``f_L`` and ``f_H`` are only estimates: an error
     ``e`` in each moves ``m f_H + n f_L`` by up to ``(|m| + |n|) e``.
 
@@ -57,7 +57,7 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from .spectra import Spectrum
+from rotorred.signals.spectra import Spectrum
 
 __all__ = [
     "MINUS",
@@ -377,7 +377,7 @@ def find_peaks(spectrum: Spectrum, threshold: float = 0.005) -> np.ndarray:
     -----
     Two lines on adjacent bins cannot both be local maxima. With 70/90 Hz the lines are
     10 Hz apart, so use a record of at least two common periods (0.2 s, df <= 5 Hz);
-    :func:`rotorred.spectra.settled_spectrum` takes as many periods as fit.
+    :func:`rotorred.signals.spectra.settled_spectrum` takes as many periods as fit.
     """
     if not isinstance(spectrum, Spectrum):
         raise ValueError(f"`spectrum` must be a Spectrum, got {type(spectrum).__name__}")

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from rotorred.elements import Bearing, Disk, IntershaftBearing, ShaftElement
+from rotorred.model.elements import Bearing, Disk, IntershaftBearing, ShaftElement
 
 
 @dataclass(frozen=True)
