@@ -1,0 +1,253 @@
+"""The one validation module: every check of an input value, and the one form of its message.
+
+Every bad input a user can give (a rotor file, a scene file, a dataclass argument, a command
+option) is refused by a function of this module, before anything is computed, with an
+:class:`InputError` whose message has one form::
+
+    <field> = <value as given>: <what is allowed> (<unit>)
+
+for example ``rub[0].clearance = -1e-06: must be >= 0 (m)`` or
+``--speeds = '0:12000': must be START:STOP:COUNT in rpm``. The field is the path of the key as
+the user wrote it (``spool[1].elements[0].D_i``, ``solver.dt``, ``--out``); a dataclass knows
+only its own attribute name, and the loader that built it prefixes the path with
+:meth:`InputError.within`. Values are shown as written, in the user's units (the loaders check
+raw file values before converting rpm or Hz to rad/s).
+
+The checks return the converted value (``float``, ``int``, ``str``, tuple), so a loader reads as
+a list of named fields.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from typing import Any, NoReturn
+
+import numpy as np
+
+__all__ = ["InputError", "MISSING", "fail", "join", "number", "positive", "non_negative", "integer", "choice",
+           "string", "boolean", "table", "sequence", "array", "node", "keys", "ranges_text", "fmt_value"]
+
+
+class _Missing:
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+#: the value of a required key that was not given
+MISSING: Any = _Missing()
+
+
+def fmt_value(value) -> str:
+    """The value as the user wrote it: ``repr`` of Python scalars (numpy scalars unwrapped)."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, np.ndarray):
+        return f"array of shape {value.shape}"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def join(prefix: str, field: str) -> str:
+    """``join("rub[0]", "clearance") == "rub[0].clearance"``; ``join("spool", "[1]") == "spool[1]"``."""
+    if not prefix:
+        return field
+    if not field:
+        return prefix
+    return prefix + field if field.startswith("[") else f"{prefix}.{field}"
+
+
+class InputError(ValueError):
+    """An input that rotorred refuses: names the field, the value and what is allowed.
+
+    Attributes
+    ----------
+    field : str
+        Path of the key or option (``rub[0].clearance``, ``--out``).
+    value : object
+        The value as given (:data:`MISSING` for a required key that was not given).
+    requirement : str
+        What is allowed, e.g. ``"must be >= 0"``.
+    unit : str
+        Unit of the value as the user gives it (``"m"``, ``"Hz"``, ``"rpm"``); empty if none.
+    source : str
+        The file or built-in the value came from, if known.
+    """
+
+    def __init__(self, field: str, value, requirement: str, unit: str = "", source: str = ""):
+        self.field = field
+        self.value = value
+        self.requirement = requirement
+        self.unit = unit
+        self.source = source
+        super().__init__(field, value, requirement, unit, source)
+
+    def __str__(self) -> str:
+        unit = f" ({self.unit})" if self.unit and self.unit != "-" else ""
+        where = f"{self.source}: " if self.source else ""
+        if self.value is MISSING:
+            return f"{where}{self.field}: missing; {self.requirement}{unit}"
+        return f"{where}{self.field} = {fmt_value(self.value)}: {self.requirement}{unit}"
+
+    def within(self, prefix: str) -> InputError:
+        """The same error with the field path prefixed (``"rub[0]"`` + ``"clearance"``)."""
+        return type(self)(join(prefix, self.field), self.value, self.requirement, self.unit, self.source)
+
+    def from_source(self, source: str) -> InputError:
+        """The same error, naming the file (or built-in) it came from."""
+        return type(self)(self.field, self.value, self.requirement, self.unit, source)
+
+
+def fail(field: str, value, requirement: str, unit: str = "") -> NoReturn:
+    """Raise the :class:`InputError` ``<field> = <value>: <requirement> (<unit>)``."""
+    raise InputError(field, value, requirement, unit)
+
+
+# --------------------------------------------------------------------------- scalars
+def _is_real(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def _bounds_text(ge, gt, le, lt) -> str:
+    lo = ge if ge is not None else gt
+    hi = le if le is not None else lt
+    if lo is not None and hi is not None:
+        return f"in {'[' if ge is not None else '('}{lo:g}, {hi:g}{']' if le is not None else ')'}"
+    if lo is not None:
+        return f">= {lo:g}" if ge is not None else f"> {lo:g}"
+    if hi is not None:
+        return f"<= {hi:g}" if le is not None else f"< {hi:g}"
+    return ""
+
+
+def number(field: str, value, unit: str = "", *, ge: float | None = None, gt: float | None = None,
+           le: float | None = None, lt: float | None = None) -> float:
+    """A finite real number, optionally bounded: ``ge`` (>=), ``gt`` (>), ``le`` (<=), ``lt`` (<).
+
+    Returns
+    -------
+    float
+    """
+    bounds = _bounds_text(ge, gt, le, lt)
+    if not _is_real(value) or not math.isfinite(value):
+        fail(field, value, "must be a finite number" + (f" {bounds}" if bounds else ""), unit)
+    v = float(value)
+    if ((ge is not None and not v >= ge) or (gt is not None and not v > gt)
+            or (le is not None and not v <= le) or (lt is not None and not v < lt)):
+        fail(field, value, f"must be {bounds}" if not bounds.startswith("in") else f"must lie {bounds}", unit)
+    return v
+
+
+def positive(field: str, value, unit: str = "") -> float:
+    """A finite number > 0."""
+    return number(field, value, unit, gt=0.0)
+
+
+def non_negative(field: str, value, unit: str = "") -> float:
+    """A finite number >= 0."""
+    return number(field, value, unit, ge=0.0)
+
+
+def integer(field: str, value, unit: str = "", *, ge: int | None = None, le: int | None = None) -> int:
+    """An integer (not a bool, not a float), optionally bounded (``ge`` <= value <= ``le``)."""
+    bounds = _bounds_text(ge, None, le, None)
+    if not isinstance(value, (int, np.integer)) or isinstance(value, (bool, np.bool_)):
+        fail(field, value, "must be an integer" + (f" {bounds}" if bounds else ""), unit)
+    v = int(value)
+    if (ge is not None and v < ge) or (le is not None and v > le):
+        fail(field, value, "must be an integer " + bounds, unit)
+    return v
+
+
+def choice(field: str, value, allowed: Iterable[str]) -> str:
+    """One of ``allowed`` (compared as given)."""
+    allowed = tuple(allowed)
+    if not isinstance(value, str) or value not in allowed:
+        fail(field, value, "must be one of " + ", ".join(repr(a) for a in allowed))
+    return value
+
+
+def string(field: str, value, *, empty: bool = True) -> str:
+    """A string (non-empty unless ``empty``)."""
+    if not isinstance(value, str) or (not empty and not value):
+        fail(field, value, "must be a string" if empty else "must be a non-empty string")
+    return value
+
+
+def boolean(field: str, value) -> bool:
+    """``true`` or ``false`` (a bool, not a number)."""
+    if not isinstance(value, (bool, np.bool_)):
+        fail(field, value, "must be true or false")
+    return bool(value)
+
+
+# --------------------------------------------------------------------------- containers
+def table(field: str, value) -> dict:
+    """A table (TOML ``[section]``, a dict)."""
+    if not isinstance(value, Mapping):
+        fail(field, value, "must be a table")
+    return dict(value)
+
+
+def sequence(field: str, value, item: Callable[[str, Any], Any] | None = None, *, min_len: int = 0,
+             max_len: int | None = None, unique: bool = False) -> tuple:
+    """A list whose entries each pass ``item(field[i], entry)``; returns the tuple of checked entries."""
+    if not isinstance(value, (list, tuple)):
+        fail(field, value, "must be a list")
+    if len(value) < min_len or (max_len is not None and len(value) > max_len):
+        count = f"{min_len}" if max_len == min_len else (
+            f"at least {min_len}" if max_len is None else f"{min_len} to {max_len}")
+        fail(field, value, f"must hold {count} entries, not {len(value)}")
+    out = tuple(item(f"{field}[{i}]", v) if item else v for i, v in enumerate(value))
+    if unique and len(set(out)) != len(out):
+        fail(field, value, "must not list an entry twice")
+    return out
+
+
+def array(field: str, value, shape: tuple[int, ...] | None = None, unit: str = "") -> np.ndarray:
+    """A finite float array, of ``shape`` if given."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        fail(field, value, "must be an array of numbers", unit)
+    if shape is not None and arr.shape != tuple(shape):
+        fail(field, arr, f"must have shape {tuple(shape)}", unit)
+    if not np.all(np.isfinite(arr)):
+        fail(field, arr, "must hold finite numbers only", unit)
+    return arr
+
+
+def ranges_text(nodes: Iterable[int]) -> str:
+    """``'1-13, 14-20'`` for node numbers (sorted, consecutive runs joined)."""
+    nodes = sorted(nodes)
+    if not nodes:
+        return "none"
+    out, start, prev = [], nodes[0], nodes[0]
+    for n in nodes[1:] + [None]:
+        if n is not None and n == prev + 1:
+            prev = n
+            continue
+        out.append(f"{start}" if start == prev else f"{start}-{prev}")
+        if n is not None:
+            start = prev = n
+    return ", ".join(out)
+
+
+def node(field: str, value, nodes: Collection[int], what: str = "a node of the rotor") -> int:
+    """An integer that is one of ``nodes``."""
+    integer(field, value)
+    if int(value) not in nodes:
+        fail(field, value, f"must be {what} ({ranges_text(nodes)})")
+    return int(value)
+
+
+def keys(field: str, data: Mapping, allowed: Iterable[str], required: Iterable[str] = ()) -> None:
+    """No key outside ``allowed`` and every key of ``required`` present in the table ``data``."""
+    allowed = set(allowed)
+    for k in data:
+        if k not in allowed:
+            fail(join(field, str(k)), data[k], "unknown key; allowed keys are " + ", ".join(sorted(allowed)))
+    for k in sorted(set(required)):
+        if k not in data:
+            raise InputError(join(field, k), MISSING, "required")
+
