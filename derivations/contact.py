@@ -5,16 +5,18 @@ Hertz contact with Hunt–Crossley damping on the local contact deformation ``de
 
     F = K_nr delta^(3/2) (1 + c rate),
 
-with ``rate`` the penetration rate (m/s) and ``c`` (s/m) the Hunt–Crossley coefficient. The
-integrator's Newton method needs dF/d(delta) and dF/d(rate). The 3/2 power is written with
-the argument ``s = sqrt(delta)`` (``delta = s^2``) so the generated code is polynomial
-(no ``sqrt``, safe at ``delta = 0`` where dF/d(delta) = 0).
+with ``rate`` the penetration rate (m/s) and ``c`` (s/m) the Hunt–Crossley coefficient.
 
 The series coupling with the plate's bending (Eqs. 4, 10-11): the penetration ``p`` is shared
 between the bending deflection ``W = lam F + w0`` and ``delta``, so the normal force solves
-``R(F) = F - K_nr (p - w0 - lam F)^(3/2) (1 + c rate) = 0``; its derivatives follow from the
-chain rule with dR/dF = 1 + lam dF/d(delta), dR/dp = -dF/d(delta), dR/d(rate) = -dF/d(rate)
-(``normal_residual`` below).
+``R(F) = F - K_nr (p - w0 - lam F)^(3/2) (1 + c rate) = 0``. The integrator's Newton method
+needs the tangent: dR/dF = 1 + lam dF/d(delta), dR/dp = -dF/d(delta), dR/d(rate) = -dF/d(rate)
+(``normal_residual`` below, the one implementation of the law: the step kernel and
+:func:`rotorred.transient.contact.normal_force` evaluate it, and the Hertz force alone is its
+value at F = 0, lam = 0). The 3/2 power is written with the argument
+``s = sqrt(p - w0 - lam F)`` so the generated code is polynomial (no ``sqrt``, safe at
+``delta = 0`` where dF/d(delta) = 0); ``s = 0`` gives the open law R = F, dR/dF = 1 (the clamp of
+:func:`rotorred.transient.contact.normal_law`).
 
 The elastic energy stored in the contact, ``U = int_0^delta K_nr d^(3/2) dd = 2/5 K_nr delta^(5/2)``,
 enters the energy balance of the tests.
@@ -26,14 +28,6 @@ import sympy as sp
 
 s, rate, K_nr, c, lam, F, p, w0 = sp.symbols("s rate K_nr c lam F p w0", real=True)
 delta = sp.Symbol("delta", positive=True)
-
-
-def hunt_crossley() -> sp.Matrix:
-    """[F, dF/d(delta), dF/d(rate)] as functions of (s = sqrt(delta), rate, K_nr, c), shape (3, 1)."""
-    force = K_nr * delta ** sp.Rational(3, 2) * (1 + c * rate)
-    out = [force, sp.diff(force, delta), sp.diff(force, rate)]
-    sq = sp.Symbol("sq", positive=True)
-    return sp.Matrix([sp.expand(e.subs(delta, sq**2)).subs(sq, s) for e in out])
 
 
 def hertz_energy() -> sp.Matrix:
@@ -48,7 +42,7 @@ def normal_residual() -> sp.Matrix:
     """[R, dR/dF, dR/dp, dR/d(rate)] of R = F - K_nr (p - w0 - lam F)^(3/2) (1 + c rate), shape (4, 1).
 
     Arguments (F, s, rate, K_nr, c, lam) with ``s = sqrt(p - w0 - lam F)`` (the deformation
-    left to Hertz contact); only valid in contact (s > 0 or s = 0 at the onset).
+    left to Hertz contact); ``s = 0`` gives the law without contact force (R = F, dR/dF = 1).
     """
     dd = sp.Symbol("dd", positive=True)
     R = F - K_nr * dd ** sp.Rational(3, 2) * (1 + c * rate)
@@ -69,15 +63,6 @@ def module_text() -> str:
     )
     fns = [
         GeneratedFunction(
-            "hunt_crossley", (s, rate, K_nr, c), hunt_crossley(),
-            "Hertz force with Hunt–Crossley damping and its tangent (Xu et al. 2016, Eq. 8).\n\n"
-            "    Parameters\n    ----------\n" + common +
-            "    rate : float\n        Penetration rate (m/s).\n"
-            "    K_nr : float\n        Hertz stiffness (N/m^1.5).\n    c : float\n        Hunt–Crossley damping (s/m).\n\n"
-            "    Returns\n    -------\n    ndarray, shape (3,)\n"
-            "        [F (N), dF/d(delta) (N/m), dF/d(rate) (N s/m)] of F = K_nr delta^1.5 (1 + c rate).\n",
-        ),
-        GeneratedFunction(
             "hertz_energy", (s, K_nr), hertz_energy(),
             "Elastic energy of the Hertz contact, 2/5 K_nr delta^2.5.\n\n"
             "    Parameters\n    ----------\n" + common +
@@ -97,6 +82,8 @@ def module_text() -> str:
     ]
     return render_module(
         "derivations/contact.py", fns,
-        "Rub-impact contact law: Hertz force with Hunt–Crossley damping and its tangent.\n\n"
+        "Rub-impact contact law: Hertz force with Hunt–Crossley damping in series with plate bending,\n"
+        "its tangent, and the Hertz energy.\n\n"
         "Derived in derivations/contact.py (Xu et al. 2016, Eqs. 8, 10-11). The 3/2 power is\n"
-        "written with s = sqrt(delta) so every expression is a polynomial.")
+        "written with s = sqrt(delta) so every expression is a polynomial; rotorred.transient.contact\n"
+        "applies the clamp (s = 0 without contact); the step kernel compiles normal_residual.")

@@ -1,1 +1,91 @@
-"""rotorred: rotordynamics of dual-rotor machines with rub-impact faults."""
+"""rotorred: rotordynamics of dual-rotor (twin-spool) machines with rub-impact faults.
+
+The user-level functions and result types, importable from ``rotorred`` directly::
+
+    import rotorred as rr
+
+    rotor = rr.load_rotor("seed-rig")
+    cd = rr.campbell(rotor, np.linspace(0, 1200, 61))       # rad/s of the reference spool
+    model = rr.reduce_rotor(rotor, extra_nodes=[18], n_modes=24)
+    res = rr.simulate(model, None, 0.5, 2e-5, rotor=rotor, unbalances=[rr.Unbalance(18, 2e-3)],
+                      plates=[rr.RubPlate.for_rotor(rotor, 18)], outputs=[(18, "y")])
+
+Layers (imports point downwards only; ``tests/test_architecture.py`` checks it):
+``checks``/``writers`` and ``_generated`` at the bottom, then ``model``, ``linear`` and
+``signals``, ``transient``, ``plots`` (the only layer besides ``cli`` that imports
+matplotlib), ``scenes``, ``cli``. The names below are loaded on first use, so
+``import rotorred`` costs little and never loads matplotlib or numba.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__version__ = "0.1.0"
+
+#: public name -> module that defines it
+_EXPORTS = {
+    # errors
+    "InputError": "rotorred.checks",
+    # model
+    "Material": "rotorred.model.elements",
+    "ShaftElement": "rotorred.model.elements",
+    "Disk": "rotorred.model.elements",
+    "Bearing": "rotorred.model.elements",
+    "IntershaftBearing": "rotorred.model.elements",
+    "Spool": "rotorred.model.rotor",
+    "Rotor": "rotorred.model.rotor",
+    "load_rotor": "rotorred.model.rotor_file",
+    "presets": "rotorred.model.rotor_file",
+    "assemble": "rotorred.model.assembly",
+    "SystemMatrices": "rotorred.model.assembly",
+    "Unbalance": "rotorred.model.loads",
+    # linear analyses
+    "campbell": "rotorred.linear.campbell",
+    "CampbellResult": "rotorred.linear.campbell",
+    "CriticalSpeed": "rotorred.linear.campbell",
+    "unbalance_response": "rotorred.linear.harmonic",
+    "UnbalanceResponse": "rotorred.linear.harmonic",
+    "frequency_response": "rotorred.linear.harmonic",
+    "FrequencyResponse": "rotorred.linear.harmonic",
+    "steady_state": "rotorred.linear.harmonic",
+    "SteadyState": "rotorred.linear.harmonic",
+    "reduce_rotor": "rotorred.linear.reduction",
+    "ReducedSystem": "rotorred.linear.reduction",
+    # transient
+    "RubPlate": "rotorred.transient.contact",
+    "NavierPlate": "rotorred.transient.plate",
+    "ClampedFreePlate": "rotorred.transient.plate",
+    "RigidPlate": "rotorred.transient.plate",
+    "simulate": "rotorred.transient.newmark",
+    "TransientResult": "rotorred.transient.newmark",
+    "SimulationDiverged": "rotorred.transient.newmark",
+    # signals
+    "amplitude_spectrum": "rotorred.signals.spectra",
+    "settled_spectrum": "rotorred.signals.spectra",
+    "Spectrum": "rotorred.signals.spectra",
+    "label_lines": "rotorred.signals.lines",
+    "SpectralLine": "rotorred.signals.lines",
+    # scenes
+    "load_scene": "rotorred.scenes.schema",
+    "builtin_scenes": "rotorred.scenes.schema",
+    "Scene": "rotorred.scenes.schema",
+    "run_scene": "rotorred.scenes.run",
+    "SceneResult": "rotorred.scenes.run",
+    "write_outputs": "rotorred.scenes.outputs",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rotorred' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -26,12 +26,16 @@ from typing import Any, NoReturn
 import numpy as np
 
 __all__ = ["InputError", "MISSING", "fail", "join", "number", "positive", "non_negative", "integer", "choice",
-           "string", "boolean", "table", "sequence", "array", "node", "keys", "ranges_text", "fmt_value"]
+           "string", "boolean", "table", "tables", "sequence", "array", "vector", "node", "keys", "ranges_text",
+           "fmt_value"]
 
 
 class _Missing:
     def __repr__(self) -> str:
         return "<missing>"
+
+    def __reduce__(self) -> str:
+        return "MISSING"  # unpickles as the module's one MISSING, so ``value is MISSING`` survives
 
 
 #: the value of a required key that was not given
@@ -189,6 +193,16 @@ def table(field: str, value) -> dict:
     return dict(value)
 
 
+def tables(field: str, value, *, min_len: int = 0) -> tuple[dict, ...]:
+    """An array of tables (TOML ``[[field]]`` or ``field = [{...}, ...]``): a list of dicts."""
+    if not isinstance(value, (list, tuple)):
+        fail(field, value, "must be an array of tables")
+    if len(value) < min_len:
+        fail(field, value, "must be a non-empty array of tables" if min_len == 1
+             else f"must be an array of at least {min_len} tables")
+    return tuple(table(f"{field}[{i}]", v) for i, v in enumerate(value))
+
+
 def sequence(field: str, value, item: Callable[[str, Any], Any] | None = None, *, min_len: int = 0,
              max_len: int | None = None, unique: bool = False) -> tuple:
     """A list whose entries each pass ``item(field[i], entry)``; returns the tuple of checked entries."""
@@ -197,7 +211,8 @@ def sequence(field: str, value, item: Callable[[str, Any], Any] | None = None, *
     if len(value) < min_len or (max_len is not None and len(value) > max_len):
         count = f"{min_len}" if max_len == min_len else (
             f"at least {min_len}" if max_len is None else f"{min_len} to {max_len}")
-        fail(field, value, f"must hold {count} entries, not {len(value)}")
+        fail(field, value, f"must hold {count} {'entry' if count.endswith(' 1') or count == '1' else 'entries'}, "
+                           f"not {len(value)}")
     out = tuple(item(f"{field}[{i}]", v) if item else v for i, v in enumerate(value))
     if unique and len(set(out)) != len(out):
         fail(field, value, "must not list an entry twice")
@@ -205,15 +220,41 @@ def sequence(field: str, value, item: Callable[[str, Any], Any] | None = None, *
 
 
 def array(field: str, value, shape: tuple[int, ...] | None = None, unit: str = "") -> np.ndarray:
-    """A finite float array, of ``shape`` if given."""
+    """A finite real float array, of ``shape`` if given."""
+    if np.iscomplexobj(value):
+        fail(field, value, "must be an array of real numbers", unit)
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         fail(field, value, "must be an array of numbers", unit)
     if shape is not None and arr.shape != tuple(shape):
-        fail(field, arr, f"must have shape {tuple(shape)}", unit)
+        fail(field, value, f"must have shape {tuple(shape)}", unit)
     if not np.all(np.isfinite(arr)):
-        fail(field, arr, "must hold finite numbers only", unit)
+        fail(field, value, "must hold finite numbers only", unit)
+    return arr
+
+
+def vector(field: str, value, unit: str = "", *, min_len: int = 1, max_len: int | None = None,
+           ge: float | None = None, gt: float | None = None, increasing: bool = False) -> np.ndarray:
+    """A finite 1-D float array of ``min_len`` to ``max_len`` entries, each ``>= ge`` / ``> gt``,
+    strictly increasing if ``increasing``.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    arr = array(field, value, unit=unit)
+    if arr.ndim != 1 or len(arr) < min_len or (max_len is not None and len(arr) > max_len):
+        count = (f"{min_len}" if max_len == min_len else f"at least {min_len}" if max_len is None
+                 else f"{min_len} to {max_len}")
+        fail(field, value, f"must be a 1-D array of {count} value{'' if count.endswith(' 1') or count == '1' else 's'}",
+             unit)
+    bounds = _bounds_text(ge, gt, None, None)
+    if (ge is not None and np.any(arr < ge)) or (gt is not None and np.any(arr <= gt)):
+        fail(field, value, f"must hold values {bounds} only", unit)
+    if increasing and np.any(np.diff(arr) <= 0):
+        i = int(np.argmax(np.diff(arr) <= 0))
+        fail(field, value, f"must be strictly increasing; entry {i} = {arr[i]:g} is followed by {arr[i + 1]:g}", unit)
     return arr
 
 

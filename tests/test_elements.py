@@ -1,11 +1,13 @@
 """Invariants of the generated Timoshenko shaft element and rigid disk."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 from rotorred._generated import timoshenko as gen
+from rotorred.checks import InputError
 from rotorred.model.elements import Disk, Material, ShaftElement, shear_coefficient
 
 STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
@@ -165,32 +167,43 @@ def test_hutchinson_against_cowper(nu, ratio):
 
 
 @pytest.mark.parametrize(
-    "kwargs, field",
+    "kwargs, message",
     [
-        (dict(L=-0.1), "`L`"),
-        (dict(L=0.0), "`L`"),
-        (dict(D_i=0.05), "`D_i`"),
-        (dict(D_i=0.06), "`D_i`"),
-        (dict(D_o=float("nan")), "`D_o`"),
-        (dict(shear="reissner"), "`shear`"),
-        (dict(right=1), "`left` and `right`"),
-        (dict(element="p5"), "`element`"),
-        (dict(element="hierarchical", shear="none"), "`element`"),
+        (dict(L=-0.1), "L = -0.1: must be > 0 (m)"),
+        (dict(L=0.0), "L = 0.0: must be > 0 (m)"),
+        (dict(D_i=0.05), "D_i = 0.05: must be < D_o = 0.05 (m)"),
+        (dict(D_i=0.06), "D_i = 0.06: must be < D_o = 0.05 (m)"),
+        (dict(D_o=float("nan")), "D_o = nan: must be a finite number > 0 (m)"),
+        (dict(shear="reissner"), "shear = 'reissner': must be one of 'cowper', 'hutchinson', 'none'"),
+        (dict(right=1), "right = 1: must differ from left = 1"),
+        (dict(element="p5"), "element = 'p5': must be one of 'nelson', 'hierarchical'"),
+        (dict(element="hierarchical", shear="none"), "element = 'hierarchical': must be 'nelson' with shear = 'none'"),
+        (dict(left=-1), "left = -1: must be an integer >= 0"),
+        (dict(material="steel"), "material = 'steel': must be a Material"),
     ],
 )
-def test_bad_shaft_element(kwargs, field):
+def test_bad_shaft_element(kwargs, message):
     base = dict(left=1, right=2, L=0.1, D_o=0.05, D_i=0.0, material=STEEL)
     base.update(kwargs)
-    with pytest.raises(ValueError, match=field):
+    with pytest.raises(InputError, match="^" + re.escape(message)):
         ShaftElement(**base)
 
 
-@pytest.mark.parametrize("kwargs, field", [(dict(rho=-1.0), "`rho`"), (dict(E=0.0), "`E`"), (dict(nu=0.6), "`nu`")])
-def test_bad_material(kwargs, field):
+@pytest.mark.parametrize("kwargs, message", [(dict(rho=-1.0), "rho = -1.0: must be > 0 (kg/m^3)"),
+                                             (dict(E=0.0), "E = 0.0: must be > 0 (Pa)"),
+                                             (dict(nu=0.6), "nu = 0.6: must lie in (-1, 0.5)")])
+def test_bad_material(kwargs, message):
     base = dict(name="s", E=2e11, rho=7800.0, nu=0.3)
     base.update(kwargs)
-    with pytest.raises(ValueError, match=field):
+    with pytest.raises(InputError, match="^" + re.escape(message) + "$"):
         Material(**base)
+
+
+def test_checked_values_are_stored_converted():
+    """Integers given for lengths are stored as floats, numpy integers for nodes as int."""
+    e = ShaftElement(np.int64(1), 2, 1, 1, 0, STEEL)
+    assert type(e.left) is int and type(e.L) is float and type(e.D_i) is float
+    assert e == ShaftElement(1, 2, 1.0, 1.0, 0.0, STEEL)
 
 
 def test_phi_definition():

@@ -1,5 +1,6 @@
 """The checked-in generated module is what `python -m derivations` writes today."""
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -56,3 +57,33 @@ def test_generated_header_is_deterministic():
     assert "_t0 = " in text  # flat cse temporaries
     for word in ("2024", "2025", "2026", "time", "date"):
         assert word not in text.split('"""')[0], f"header contains {word!r}"
+
+
+def test_header_names_sympy_major_minor():
+    """The header names sympy's major.minor ("with sympy 1.14."), not the patch level: a patch release does not
+    make the checked-in code stale."""
+    import sympy as sp
+
+    from derivations import TARGETS
+    from derivations.codegen import sympy_version
+
+    assert sympy_version("1.14.0") == "1.14" and sympy_version("1.15") == "1.15" and sympy_version("2.0.1rc1") == "2.0"
+    major_minor = ".".join(sp.__version__.split(".")[:2])
+    for relative, _ in TARGETS:
+        first = (ROOT / relative).read_text().splitlines()[0]
+        assert first.endswith(f" with sympy {major_minor}."), first
+
+
+def test_every_generated_function_is_used():
+    """No dead generated code: each generated function is referenced by a module of the package outside _generated."""
+    import ast
+
+    from derivations import TARGETS
+
+    sources = "\n".join(p.read_text() for p in (ROOT / "rotorred").rglob("*.py") if "_generated" not in p.parts)
+    for relative, _ in TARGETS:
+        tree = ast.parse((ROOT / relative).read_text())
+        names = [f.name for f in tree.body if isinstance(f, ast.FunctionDef)]
+        assert names, relative
+        unused = [n for n in names if not re.search(rf"\b_?gen\.{n}\b|\bimport [^\n]*\b{n}\b", sources)]
+        assert not unused, f"{relative}: {unused} are generated but not used"

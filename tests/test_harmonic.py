@@ -13,7 +13,9 @@ from scipy.integrate import solve_ivp
 from rotorred.model.assembly import DofMap, SystemMatrices, assemble
 from rotorred.cli import main
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.linear.harmonic import frequency_response, parse_dof, response_error, steady_state, unbalance_response
+from rotorred.checks import InputError
+from rotorred.linear.harmonic import frequency_response, response_error, steady_state, unbalance_response
+from rotorred.model.dofs import parse_dof
 from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
@@ -280,12 +282,13 @@ def test_cli_harmonic_takes_a_scene(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--unbalance", "99:1e-5"], "node 99 does not exist"),
+    (["--unbalance", "99:1e-5"], "--unbalance = 99: must be a node of the rotor (1-20)"),
     (["--unbalance", "11"], "NODE:ME"),
-    (["--unbalance", "11:-1e-5"], "`m_e` must be"),
+    (["--unbalance", "11:-1e-5"], "--unbalance = -1e-05: must be >= 0 (kg m)"),
     (["--outputs", "13:z"], "direction must be one of"),
-    (["--speeds", "0:100:-3"], "`--speeds`"),
-    (["--reduced", "--modes", "-2"], "`--modes` must be an integer >= 0, got -2"),
+    (["--speeds", "0:100:-3"], "--speeds = '0:100:-3': must be START:STOP:COUNT (COUNT >= 1) or a comma list of "
+                               "numbers (rpm)"),
+    (["--reduced", "--modes", "-2"], "--modes = -2: must be an integer >= 0"),
     (["--reduced", "--cutoff", "50"], "below the frequency band"),
     (["--ratio", "fan=2"], "unknown spool"),
 ])
@@ -299,26 +302,33 @@ def test_bad_input_is_named():
     system = assemble(rotor)
     ub = [Unbalance(2, 1e-5)]
     ok = dict(ratios={"outer": 1.2}, outputs=[(2, "x")], spool_of=rotor.spool_of)
-    with pytest.raises(ValueError, match="node 99 does not exist"):
+    nodes = r"\(1-3, 10-11\)"
+    with pytest.raises(InputError, match=rf"^unbalances\[0\]\.node = 99: must be a node of the model {nodes}$"):
         unbalance_response(system, [Unbalance(99, 1e-5)], [100.0], **ok)
-    with pytest.raises(ValueError, match="node 42 does not exist"):
+    with pytest.raises(InputError, match=rf"^outputs\[0\] = \(42, 'x'\): must name a node of the model {nodes}; "
+                                         r"node 42 is not one$"):
         unbalance_response(system, ub, [100.0], **{**ok, "outputs": [(42, "x")]})
-    with pytest.raises(ValueError, match="`speeds` must be"):
+    with pytest.raises(InputError, match=r"^speeds = \[-1\.0, 100\.0\]: must hold values >= 0 only \(rad/s\)$"):
         unbalance_response(system, ub, [-1.0, 100.0], **ok)
-    with pytest.raises(ValueError, match=r"`ratios` must give the speed ratio .* \['outer'\]"):
+    with pytest.raises(InputError, match=r"^ratios = None: must give the speed ratio \(to 'inner'\) of spool\(s\) "
+                                         r"\['outer'\]$"):
         unbalance_response(system, ub, [100.0], **{**ok, "ratios": None})
-    with pytest.raises(ValueError, match="`spool_of`"):
+    with pytest.raises(InputError, match=r"^spool_of = None: must be given \(node -> spool, e\.g\. Rotor\.spool_of\) "
+                                         r"for a model with 2 spools$"):
         unbalance_response(system, ub, [100.0], **{**ok, "spool_of": None})
-    with pytest.raises(ValueError, match="unknown spool"):
+    with pytest.raises(InputError, match=r"^ratios = \{'outer': 1\.2, 'fan': 2\.0\}: must name only spools of the "
+                                         r"model \(inner, outer\); unknown spool\(s\) \['fan'\]$"):
         unbalance_response(system, ub, [100.0], **{**ok, "ratios": {"outer": 1.2, "fan": 2.0}})
-    with pytest.raises(ValueError, match=r"`ratios\['inner'\]` must be 1"):
+    with pytest.raises(InputError, match=r"^ratios\['inner'\] = 2\.0: must be 1 \(it is the reference spool\)$"):
         unbalance_response(system, ub, [100.0], **{**ok, "ratios": {"inner": 2.0, "outer": 1.2}})
-    with pytest.raises(ValueError, match="`unbalances` must hold at least one"):
+    with pytest.raises(InputError, match=r"^unbalances = \[\]: must hold at least one Unbalance$"):
         unbalance_response(system, [], [100.0], **ok)
-    with pytest.raises(ValueError, match="direction must be one of"):
+    with pytest.raises(InputError, match=r"^inputs\[0\] = \(2, 'z'\): direction must be one of 'x', 'y', "):
         frequency_response(system, [(2, "z")], [(2, "x")], [10.0])
-    with pytest.raises(ValueError, match="NODE:DIRECTION"):
-        parse_dof("13x")
+    with pytest.raises(InputError, match=r"^--outputs = '13x': must be NODE:DIRECTION \(e\.g\. '13:x'\)"):
+        parse_dof("--outputs", "13x")
     red = reduce_rotor(rotor, n_modes=0)  # every node of this small rotor is a boundary node
-    with pytest.raises(ValueError, match="node 99 does not exist"):
+    with pytest.raises(InputError, match=rf"^unbalances\[0\]\.node = 99: must be a node of the model {nodes}$"):
         unbalance_response(red, [Unbalance(99, 1e-5)], [100.0], **ok)
+    with pytest.raises(InputError, match=r"^speeds\.inner: missing; required$"):
+        steady_state(system, ub, {"outer": 1.0}, rotor.spool_of)

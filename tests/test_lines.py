@@ -1,10 +1,12 @@
 """Line labelling: the rule reproduces the paper's Table 1, peaks are found and labelled."""
 
+import re
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
+from rotorred.checks import InputError
 from rotorred.signals.lines import (
     MINUS,
     UNKNOWN,
@@ -47,10 +49,16 @@ def test_label_text_both_minus_signs():
             for minus in (MINUS, "-"):
                 assert parse_label(combination_label(m, n, minus=minus)) == (m, n)
     for bad in ["", "2f_H+3f_H", "f_H/2", "f_L/3", "f_H-", "3 Hz"]:
-        with pytest.raises(ValueError, match="`label`"):
+        with pytest.raises(InputError, match=f"^label = {re.escape(repr(bad))}: must look like 'f_H-f_L', "):
             parse_label(bad)
-    with pytest.raises(ValueError, match="`m`"):
+    with pytest.raises(InputError, match="^label = 3: must be a string$"):
+        parse_label(3)
+    with pytest.raises(InputError, match=r"^m = 1\.5: must be an integer$"):
         combination_label(1.5, 1)
+    with pytest.raises(InputError, match=r"^n = 0\.25: must be an integer or half-integer$"):
+        combination_label(1, 0.25)
+    with pytest.raises(InputError, match=r"^n = nan: must be a finite number$"):
+        combination_label(1, float("nan"))
 
 
 def test_table1_data_is_consistent_with_70_90_hz():
@@ -95,10 +103,12 @@ def test_rule_beyond_table1():
     assert label_frequency(650.0, F_L, F_H, 0.5) == (8, -1)  # not f_H+8f_L
     assert label_frequency(333.0, F_L, F_H, 0.5) is None  # off the 10 Hz grid
     assert label_frequency(20.0, F_L, F_H, 0.5, max_m=0) is None  # bound respected
-    with pytest.raises(ValueError, match="`tol_hz`"):
+    with pytest.raises(InputError, match=r"^tol_hz = 0\.0: must be > 0 \(Hz\)$"):
         label_frequency(20.0, F_L, F_H, 0.0)
-    with pytest.raises(ValueError, match="`f_H`"):
+    with pytest.raises(InputError, match=r"^f_H = nan: must be a finite number > 0 \(Hz\)$"):
         label_frequency(20.0, F_L, float("nan"), 0.5)
+    with pytest.raises(InputError, match=r"^max_m = -1: must be an integer >= 0$"):
+        label_frequency(20.0, F_L, F_H, 0.5, max_m=-1)
 
 
 # --------------------------------------------------------------------------- synthetic
@@ -152,7 +162,7 @@ def test_threshold_and_peaks():
     a = s.amplitudes
     k_hi = find_peaks(s, threshold=0.3)
     assert set(k_hi) == {i for i in k if a[i] >= 0.3 * a[1:].max()}
-    with pytest.raises(ValueError, match="`threshold`"):
+    with pytest.raises(InputError, match=r"^threshold = 1\.5: must lie in \(0, 1\]$"):
         find_peaks(s, threshold=1.5)
 
 
@@ -190,8 +200,10 @@ def test_table_and_comparison_output():
     assert bad[1].found is None and bad[1].label_agrees is None
     table = format_comparison(bad, ascii=True)
     assert "NO" in table and "not found" in table
-    with pytest.raises(ValueError, match="`label`"):
+    with pytest.raises(InputError, match="^label = 'nonsense': must look like"):
         compare_with_expected(lines, [(20.0, "nonsense")])
+    with pytest.raises(InputError, match=r"^expected\[1\] = -5\.0: must be > 0 \(Hz\)$"):
+        compare_with_expected(lines, [20.0, -5.0])
 
 
 def test_labels_on_flattop_fallback_for_incommensurate_speeds():

@@ -1,8 +1,11 @@
 """Rotor model, DOF map and assembly invariants."""
 
+import re
+
 import numpy as np
 import pytest
 
+from rotorred.checks import InputError
 from rotorred.model.assembly import assemble
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
 from rotorred.model.rotor_file import load_rotor
@@ -110,33 +113,52 @@ def test_hierarchical_internal_dofs_come_after_nodal():
 @pytest.mark.parametrize(
     "make, message",
     [
-        (lambda: Spool("s", ()), "at least one shaft element"),
+        (lambda: Spool("s", ()), "elements = (): must hold at least 1 entry, not 0"),
         (lambda: Spool("s", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL), ShaftElement(3, 4, 0.1, 0.02, 0, STEEL))),
-         "chain"),
-        (lambda: Rotor(()), "at least one spool"),
+         "elements[1].left = 3: must be 2, the right node of elements[0]: the elements form a chain"),
+        (lambda: Spool("s", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL), ShaftElement(2, 1, 0.1, 0.02, 0, STEEL))),
+         "elements[1].right = 1: must not repeat a node of the chain"),
+        (lambda: Rotor(()), "spools = (): must hold at least one spool"),
         (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
-                       disks=(Disk(7, 1.0, 0.01, 0.02),)), "`node` 7 does not exist"),
+                       disks=(Disk(7, 1.0, 0.01, 0.02),)), "disks[0].node = 7: must be a node of the rotor (1-2)"),
         (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
-                       bearings=(Bearing(k_xx=1.0, node=9),)), "bearings\\[0\\].*`node` 9 does not exist"),
+                       bearings=(Bearing(k_xx=1.0, node=9),)),
+         "bearings[0].node = 9: must be a node of the rotor (1-2)"),
         (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),),
-                       intershaft_bearings=(IntershaftBearing(node_a=1, node_b=2),)), "two different spools"),
+                       intershaft_bearings=(IntershaftBearing(node_a=1, node_b=2),)),
+         "intershaft_bearings[0].node_b = 2: must be on another spool than node_a = 1 (both are on spool 'a'); "
+         "an inter-shaft bearing joins two different spools"),
         (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),
-                        Spool("b", (ShaftElement(2, 3, 0.1, 0.02, 0, STEEL),)))), "node 2 belongs"),
-        (lambda: Bearing(k_xx=-1.0, node=1), "`k_xx`"),
-        (lambda: Disk(1, m=-2.0, I_d=0.0, I_p=0.0), "`m`"),
-        (lambda: load_rotor("seed-rig").refined(0), "`n`"),
+                        Spool("b", (ShaftElement(2, 3, 0.1, 0.02, 0, STEEL),)))),
+         "spools[1].nodes = (2, 3): must not include node 2, which belongs to spool 'a'"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),), rayleigh=(-1.0, 0.0)),
+         "rayleigh[0] = -1.0: must be >= 0 (1/s)"),
+        (lambda: Rotor((Spool("a", (ShaftElement(1, 2, 0.1, 0.02, 0, STEEL),)),), disks=(3,)),
+         "disks[0] = 3: must be a Disk"),
+        (lambda: Bearing(k_xx=-1.0, node=1), "k_xx = -1.0: must be >= 0 (N/m)"),
+        (lambda: Bearing(k_xx=1.0), "node = -1: must be an integer >= 0"),
+        (lambda: IntershaftBearing(node_a=3, node_b=3), "node_b = 3: must differ from node_a = 3"),
+        (lambda: Disk(1, m=-2.0, I_d=0.0, I_p=0.0), "m = -2.0: must be > 0 (kg)"),
+        (lambda: load_rotor("seed-rig").refined(0), "n = 0: must be an integer >= 1"),
+        (lambda: load_rotor("seed-rig").with_speeds({"fan": 1.0}), "speeds.fan = 1.0: unknown key; allowed keys are "
+         "inner, outer"),
+        (lambda: load_rotor("seed-rig").spool("fan"), "spool = 'fan': must be one of 'inner', 'outer'"),
+        (lambda: load_rotor("seed-rig").disk_at(5), "node = 5: must carry a disk; disks are at nodes [3, 11, 16, 18]"),
     ],
 )
 def test_bad_model_input(make, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(InputError, match="^" + re.escape(message) + "$"):
         make()
 
 
 def test_dofmap_errors(rig):
     S = assemble(rig)
-    with pytest.raises(ValueError, match="node 99 does not exist"):
+    with pytest.raises(InputError, match=r"^node = 99: must be a node of the model \(1-20\)$"):
         S.dofs.index(99, "x")
-    with pytest.raises(ValueError, match="`direction`"):
+    with pytest.raises(InputError, match=r"^direction = 'z': must be one of 'x', 'y', 'theta_x' \('tx'\)"):
         S.dofs.index(18, "z")
-    with pytest.raises(ValueError, match="unknown spool"):
+    with pytest.raises(InputError, match=r"^speeds\.fan = 1\.0: unknown key; allowed keys are inner, outer$"):
         S.gyroscopic({"fan": 1.0})
+    with pytest.raises(InputError, match=r"^dof = 80: must be an integer in \[0, 79\]$"):
+        S.dofs.label(80)
+    assert S.dofs.index(18, "ty") == S.dofs.index(18, "theta_y")

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from rotorred.linear.harmonic import unbalance_response
-from rotorred.scenes.run import build_model, harmonic_outputs, run_scene, settled_state, write_outputs
+from rotorred.scenes.outputs import write_outputs
+from rotorred.scenes.run import build_model, harmonic_outputs, run_scene, settled_state
 from rotorred.scenes.schema import scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]

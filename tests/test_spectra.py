@@ -1,10 +1,12 @@
 """Amplitude spectra: exact on-bin amplitudes, stated window errors, plan reuse, record length."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
+from rotorred.checks import InputError
 from rotorred.signals import spectra
 from rotorred.signals.spectra import (
     WINDOWS,
@@ -104,19 +106,19 @@ def test_off_bin_amplitude_error_within_stated_bound(name):
 
 
 def test_bad_inputs():
-    with pytest.raises(ValueError, match="`dt`"):
+    with pytest.raises(InputError, match=r"^dt = -1\.0: must be > 0 \(s\)$"):
         amplitude_spectrum(np.ones(8), -1.0)
-    with pytest.raises(ValueError, match="`dt`"):
+    with pytest.raises(InputError, match=r"^dt = nan: must be a finite number > 0 \(s\)$"):
         amplitude_spectrum(np.ones(8), float("nan"))
-    with pytest.raises(ValueError, match="`window`"):
+    with pytest.raises(InputError, match=r"^window = 'kaiser': must be one of 'rectangular', 'hann', 'flattop'$"):
         amplitude_spectrum(np.ones(8), 1e-3, window="kaiser")
-    with pytest.raises(ValueError, match="`x` must be finite"):
+    with pytest.raises(InputError, match=r"^x = array of shape \(3,\): must hold finite numbers only$"):
         amplitude_spectrum(np.array([1.0, np.nan, 2.0]), 1e-3)
-    with pytest.raises(ValueError, match="`x` must be real"):
+    with pytest.raises(InputError, match=r"^x = array of shape \(8,\): must be an array of real numbers$"):
         amplitude_spectrum(np.ones(8) * 1j, 1e-3)
-    with pytest.raises(ValueError, match="one-dimensional"):
+    with pytest.raises(InputError, match=r"^x = array of shape \(2, 8\): must be a 1-D array of at least 2 values$"):
         amplitude_spectrum(np.ones((2, 8)), 1e-3)
-    with pytest.raises(ValueError, match="at least 2"):
+    with pytest.raises(InputError, match=r"^x = array of shape \(1,\): must be a 1-D array of at least 2 values$"):
         amplitude_spectrum(np.ones(1), 1e-3)
 
 
@@ -166,24 +168,28 @@ def test_record_length_70_90_hz():
 
 def test_record_length_bad_inputs():
     cases = [
-        (dict(f_L=70, f_H=90, dt=-1e-5), "`dt`"),
-        (dict(f_L=70, f_H=90, dt=0.0), "`dt`"),
-        (dict(f_L=float("nan"), f_H=90, dt=1e-5), "`f_L`"),
-        (dict(f_L=70, f_H=float("inf"), dt=1e-5), "`f_H`"),
-        (dict(f_L=-70, f_H=90, dt=1e-5), "`f_L`"),
-        (dict(f_L=70, f_H=90, dt=1e-5, n_available=9999), "shorter than one common period"),
-        (dict(f_L=70, f_H=90, dt=1e-5, n_available=20000, n_periods=3), "do not fit"),
-        (dict(f_L=70, f_H=90, dt=1e-5, n_periods=0), "`n_periods`"),
+        (dict(f_L=70, f_H=90, dt=-1e-5), "dt = -1e-05: must be > 0 (s)"),
+        (dict(f_L=70, f_H=90, dt=0.0), "dt = 0.0: must be > 0 (s)"),
+        (dict(f_L=float("nan"), f_H=90, dt=1e-5), "f_L = nan: must be a finite number > 0 (Hz)"),
+        (dict(f_L=70, f_H=float("inf"), dt=1e-5), "f_H = inf: must be a finite number > 0 (Hz)"),
+        (dict(f_L=-70, f_H=90, dt=1e-5), "f_L = -70: must be > 0 (Hz)"),
+        (dict(f_L=70, f_H=90, dt=1e-5, n_available=9999),
+         "n_available = 9999: must hold at least one common period T = 0.1 s = 10000 samples"),
+        (dict(f_L=70, f_H=90, dt=1e-5, n_available=20000, n_periods=3),
+         "n_periods = 3: must fit in n_available = 20000 samples: at most 2 periods of 10000 samples"),
+        (dict(f_L=70, f_H=90, dt=1e-5, n_periods=0), "n_periods = 0: must be an integer >= 1"),
+        (dict(f_L=70, f_H=90, dt=1e-5, rtol=0.5), "rtol = 0.5: must lie in (0, 0.01)"),
     ]
-    for kwargs, match in cases:
-        with pytest.raises(ValueError, match=match):
+    for kwargs, message in cases:
+        with pytest.raises(InputError, match="^" + re.escape(message) + "$"):
             commensurate_record(**kwargs)
     # Not commensurate (the paper's read-off 69.58 / 90.33 Hz) and T/dt not whole.
-    with pytest.raises(NotCommensurateError, match="not commensurate"):
+    with pytest.raises(NotCommensurateError, match=r"^f_H = 90\.33: must be commensurate with f_L = 69\.58 Hz"):
         commensurate_record(69.58, 90.33, 1e-5)
-    with pytest.raises(NotCommensurateError, match="not commensurate"):
+    with pytest.raises(NotCommensurateError, match=r"^f_H = 98\.99.*: must be commensurate with f_L = 70\.0 Hz"):
         commensurate_record(70.0, 70.0 * math.sqrt(2), 1e-5)
-    with pytest.raises(NotCommensurateError, match="not a whole number of samples"):
+    with pytest.raises(NotCommensurateError, match=r"^dt = 3e-05: must divide the common period T = 0\.1 s into a "
+                                                  r"whole number of samples \(T/dt = 3333\.3"):
         commensurate_record(70.0, 90.0, 3e-5)  # 0.1 / 3e-5 = 3333.33
 
 
@@ -205,13 +211,13 @@ def test_settled_spectrum_exact_and_fallback():
     y = 1e-6 * (3.0 * np.cos(2 * np.pi * f_L * t) + 60.0 * np.cos(2 * np.pi * f_H * t))
     s = settled_spectrum(y, dt, f_L, f_H)
     assert s.window == "flattop" and s.n_samples == t.size
-    assert "not commensurate" in s.note
+    assert "f_H = 90.33: must be commensurate with f_L = 69.58 Hz" in s.note
     for f, a in [(f_L, 3.0), (f_H, 60.0)]:
         k = int(round(f / s.df))
         peak = s.amplitudes_um[k - 1 : k + 2].max()
         # Other line (20 Hz = 50 bins away) leaks < 60 * 1.8e-5 µm into the 3 µm line.
         assert abs(20 * np.log10(peak / a)) <= 0.0045 + 20 * np.log10(1 + 60 / a * 1.8e-5)
-    with pytest.raises(ValueError, match="`f_L`"):  # bad input is not a fallback
+    with pytest.raises(InputError, match=r"^f_L = -1\.0: must be > 0 \(Hz\)$"):  # bad input is not a fallback
         settled_spectrum(y, dt, -1.0, f_H)
 
 

@@ -87,7 +87,7 @@ def test_sweep_validates_every_value_before_computing(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("computed before validating all values")
     monkeypatch.setattr(sweep_mod, "run_scene", boom)
-    with pytest.raises(ValueError, match="`rub\\[0\\].clearance` must be a finite number >= 0"):
+    with pytest.raises(ValueError, match=r"rub\[0\]\.clearance = -5e-06: must be >= 0 \(m\)"):
         sweep("paper-rub", "rub.clearance", [20e-6, -5e-6], settings=SHORT)
 
 

@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from rotorred.scenes.sweep import format_sweep, plot_sweep, sweep
+from rotorred.scenes.sweep import format_sweep, sweep
 
 #: clearances (m): from contact at rest to beyond the free orbit's reach (43 um)
 CLEARANCES = (1e-6, 4e-6, 7e-6, 10e-6, 13e-6, 16e-6, 20e-6, 25e-6, 30e-6, 35e-6, 40e-6, 42e-6, 45e-6, 50e-6, 60e-6)
@@ -61,6 +61,8 @@ def main(argv=None) -> int:
           f"clearance, up to {1e6 * np.max(total[:3]):.3g} um at the three smallest clearances "
           f"(x{growth:.1f})")
     if args.plot:
+        from rotorred.plots.sweep import plot_sweep
+
         print(f"wrote {plot_sweep(r, args.plot)}")
     print(f"{len(r.values)} runs in {time.perf_counter() - t0:.1f} s (mean {np.mean(r.wall_times):.2f} s per run)")
     return 0 if (no_lines_far and lines_near and growth > 1) else 1

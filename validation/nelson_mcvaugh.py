@@ -94,7 +94,9 @@ def main(argv=None) -> int:
     if args.plot:
         result = campbell(rotor("isotropic"), np.linspace(0, 40000, 81) * math.pi / 30, n_modes=N_MODES,
                           harmonics=(1, 2))
-        print(f"wrote {result.plot(args.plot)}")
+        from rotorred.plots.campbell import plot_campbell
+
+        print(f"wrote {plot_campbell(result, args.plot)}")
     return 0
 
 

@@ -27,9 +27,10 @@ import time
 
 import numpy as np
 
-from rotorred.signals.lines import XU2016_TABLE1, compare_with_expected, format_comparison, label_lines
-from rotorred.scenes.run import run_scene, write_outputs
+from rotorred.scenes.outputs import write_outputs
+from rotorred.scenes.run import run_scene
 from rotorred.scenes.schema import load_scene
+from rotorred.signals.lines import XU2016_TABLE1, compare_with_expected, format_comparison, label_lines
 
 #: threshold of the normal-state check (fraction of the largest line), from the issue
 NORMAL_THRESHOLD = 0.01

@@ -8,39 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
+from rotorred.cli.options import grid, number_list
+
 
 def parse_speeds(text: str) -> np.ndarray:
-    """``"0:12000:61"`` (rpm, count >= 2 points, 0 <= start < stop) -> speeds (rad/s), shape (count,)."""
-    parts = text.split(":")
-    if len(parts) != 3:
-        raise ValueError(f"--speeds must be START:STOP:COUNT in rpm (e.g. 0:12000:61), got {text!r}")
-    try:
-        start, stop = float(parts[0]), float(parts[1])
-    except ValueError:
-        raise ValueError(f"--speeds START and STOP must be numbers (rpm), got {text!r}") from None
-    try:
-        count = int(parts[2])
-    except ValueError:
-        raise ValueError(f"--speeds COUNT must be an integer >= 2, got {parts[2]!r} in {text!r}") from None
-    if not (math.isfinite(start) and math.isfinite(stop)) or start < 0:
-        raise ValueError(f"--speeds START must be a finite speed >= 0 rpm, got {text!r}")
-    if not stop > start:
-        raise ValueError(f"--speeds STOP must be greater than START, got {text!r}")
-    if count < 2:
-        raise ValueError(f"--speeds COUNT must be an integer >= 2, got {count} in {text!r}")
-    return np.linspace(start, stop, count) * math.pi / 30.0
+    """``"0:12000:61"`` or ``"0,1000,2500"`` (rpm, >= 0, increasing, at least 2) -> speeds (rad/s)."""
+    return grid("--speeds", text, "rpm", min_count=2, ge=0.0, increasing=True) * math.pi / 30.0
 
 
 def parse_harmonics(text: str) -> tuple[float, ...]:
     """``"1,2"`` -> (1.0, 2.0); each > 0."""
-    try:
-        h = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        raise ValueError(f"--harmonics must be a comma-separated list of positive numbers (e.g. 1,2), "
-                         f"got {text!r}") from None
-    if not all(math.isfinite(v) and v > 0 for v in h):
-        raise ValueError(f"--harmonics must be positive numbers, got {text!r}")
-    return h
+    return number_list("--harmonics", text, gt=0.0)
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -52,7 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "campbell.png to --out and prints the critical speeds.")
     p.add_argument("rotor", metavar="ROTOR", help="preset name (e.g. seed-rig) or rotor TOML file")
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
-                   help="reference-spool speeds in rpm, e.g. 0:12000:61")
+                   help="reference-spool speeds in rpm, e.g. 0:12000:61, or a comma list (increasing, >= 0)")
     p.add_argument("--ratio", type=float, default=None,
                    help="two spools: speed of the second spool / speed of the first (Omega_H/Omega_L for "
                         "the seed rig); default: ratio of the nominal speeds")
@@ -67,6 +45,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     from rotorred.linear.campbell import campbell
     from rotorred.model.rotor_file import load_rotor
+    from rotorred.plots.campbell import plot_campbell
 
     speeds = parse_speeds(args.speeds)
     harmonics = parse_harmonics(args.harmonics)
@@ -77,7 +56,7 @@ def run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     csv_path = result.to_csv(out / "campbell.csv")
     ref_nominal = rotor.speeds[result.reference]
-    png_path = result.plot(out / "campbell.png", operating_speed=ref_nominal if ref_nominal > 0 else None)
+    png_path = plot_campbell(result, out / "campbell.png", operating_speed=ref_nominal if ref_nominal > 0 else None)
     print(format_critical_speeds(result))
     print(f"wrote {csv_path} and {png_path}")
     return 0

@@ -12,9 +12,9 @@ Defaults (documented in ``--help``):
 
 * speeds: 0 to 1.5x the reference spool's nominal speed, 301 points;
 * ratio: from the rotor's nominal speeds (seed rig: outer/inner = 5400/4200 rpm);
-* unbalances: seed rig: 1e-5 kg m on disk 11 (inner, LP turbine) and on disk 16 (outer,
-  HP compressor), phase 0; any other rotor: 1e-5 kg m on the first disk of each spool;
-* outputs: seed rig: 13:x,13:y,14:x,14:y; otherwise x and y at each unbalance node.
+* unbalances, outputs and the reduced model's extra boundary nodes: the rotor file's
+  ``[defaults]`` table (the seed rig's: 1e-5 kg m on disks 11 and 16; outputs 13:x,13:y,14:x,14:y;
+  the rub node 18), else 1e-5 kg m on the first disk of each spool and x, y at each unbalance node.
 """
 
 from __future__ import annotations
@@ -26,12 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-#: default unbalance magnitude (kg m) when none is given
+from rotorred import checks
+from rotorred.cli.options import dof_list, grid, node_list
+
+#: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
+#: file's ``[defaults]`` gives one
 DEFAULT_M_E = 1e-5
-#: per-preset defaults: unbalance nodes, output DOFs, extra boundary nodes (the rub node)
-PRESET_DEFAULTS = {
-    "seed-rig": {"unbalance_nodes": (11, 16), "outputs": "13:x,13:y,14:x,14:y", "boundary": (18,)},
-}
 _RPM = 60.0 / (2.0 * math.pi)
 
 
@@ -53,10 +53,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="speed ratio(s) to the reference spool: a number (two-spool rotors) or "
                         "SPOOL=R,SPOOL=R (default: from the nominal speeds)")
     p.add_argument("--unbalance", action="append", default=None, metavar="NODE:ME[:PHASE]",
-                   help="unbalance at NODE, ME in kg m, PHASE in degrees (repeatable; default seed rig: "
-                        "11:1e-5 and 16:1e-5; otherwise 1e-5 kg m on the first disk of each spool)")
+                   help="unbalance at NODE, ME in kg m, PHASE in degrees (repeatable; default: the rotor file's "
+                        "[defaults] unbalances, seed rig 11:1e-5 and 16:1e-5; otherwise 1e-5 kg m on the first disk "
+                        "of each spool)")
     p.add_argument("--outputs", default=None,
-                   help="response DOFs NODE:DIR,... with DIR x, y, tx, ty (default seed rig 13:x,13:y,14:x,14:y)")
+                   help="response DOFs NODE:DIR,... with DIR x, y, tx, ty (default: the rotor file's [defaults] outputs, "
+                        "seed rig 13:x,13:y,14:x,14:y)")
     p.add_argument("--model", choices=("full", "reduced"), default=None,
                    help="full FE model or Craig-Bampton reduced model (boundary: bearings, inter-shaft "
                         "bearings, the rub node 18 of the seed rig or a scene's rub nodes, --boundary-nodes); "
@@ -74,31 +76,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def _grid(text: str, name: str, unit: str) -> np.ndarray:
-    try:
-        if ":" in text:
-            a, b, n = text.split(":")
-            n = int(n)
-            if n < 1:
-                raise ValueError
-            return np.linspace(float(a), float(b), n)
-        return np.array([float(v) for v in text.split(",") if v.strip()])
-    except ValueError:
-        raise ValueError(f"`--{name}` must be START:STOP:N (N >= 1) or a comma list of numbers in {unit}, "
-                         f"got {text!r}") from None
-
-
-def _unbalance(text: str):
+def _unbalance(text: str, nodes):
     from rotorred.model.loads import Unbalance
+
     parts = text.split(":")
     try:
         if len(parts) not in (2, 3):
             raise ValueError
         node, m_e = int(parts[0]), float(parts[1])
-        phase = math.radians(float(parts[2])) if len(parts) == 3 else 0.0
+        phase = float(parts[2]) if len(parts) == 3 else 0.0
     except ValueError:
-        raise ValueError(f"`--unbalance` must be NODE:ME[:PHASE_DEG] (e.g. 11:1e-5:90), got {text!r}") from None
-    return Unbalance(node, m_e, phase)
+        checks.fail("--unbalance", text, "must be NODE:ME[:PHASE_DEG] (e.g. 11:1e-5:90)")
+    checks.node("--unbalance", node, nodes)
+    checks.non_negative("--unbalance", m_e, "kg m")
+    return Unbalance(node, m_e, math.radians(checks.number("--unbalance", phase, "deg")))
 
 
 def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
@@ -109,34 +100,35 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
             return {s: 1.0 for s in names}
         return {s: nominal[s] / nominal[reference] for s in names}
     out = {reference: 1.0}
-    try:
-        if "=" not in text:
-            others = [s for s in names if s != reference]
-            if len(others) != 1:
-                raise ValueError(f"`--ratio` as a bare number needs a two-spool rotor; spools are {names}: "
-                                 f"write SPOOL=R,...")
-            out[others[0]] = float(text)
-        else:
-            for item in text.split(","):
-                s, r = item.split("=")
-                out[s.strip()] = float(r)
-    except ValueError as exc:
-        if "bare number" in str(exc):
-            raise
-        raise ValueError(f"`--ratio` must be a number or SPOOL=R,..., got {text!r}") from None
+    if "=" not in text:
+        others = [s for s in names if s != reference]
+        if len(others) != 1:
+            checks.fail("--ratio", text, f"a bare number needs a two-spool rotor; spools are {names}: write SPOOL=R,...")
+        out[others[0]] = checks.number("--ratio", _float("--ratio", text), gt=0.0)
+        return out
+    for item in text.split(","):
+        spool, _, r = item.partition("=")
+        if spool.strip() not in names:
+            checks.fail("--ratio", text, f"names unknown spool {spool.strip()!r}; spools are {names}")
+        out[spool.strip()] = checks.number("--ratio", _float("--ratio", r), ge=0.0)
     return out
+
+
+def _float(option: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        checks.fail(option, text, "must be a number or SPOOL=R,...")
 
 
 def _load(spec: str):
     """(rotor, scene or None) for a rotor or scene argument."""
     from rotorred.model.rotor_file import load_rotor
-    try:
-        from rotorred.scenes.schema import builtin_scenes, load_scene
-    except ImportError:  # pragma: no cover - scenes not available
-        return load_rotor(spec), None
+    from rotorred.scenes.schema import builtin_scenes, load_scene
+
     if spec in builtin_scenes() or _is_scene_file(spec):
         scene = load_scene(spec)
-        return scene.rotor, scene
+        return scene.rotor.with_speeds(scene.speeds), scene
     return load_rotor(spec), None
 
 
@@ -152,103 +144,123 @@ def _is_scene_file(spec: str) -> bool:
         return False
 
 
-def run(args) -> int:
-    from rotorred.model.assembly import assemble
-    from rotorred.linear.harmonic import frequency_response, parse_dof, unbalance_response
-    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
-    from rotorred.model.loads import Unbalance
-    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
+def _speeds(args, rotor, reference: str) -> np.ndarray:
+    """Reference-spool speeds of the sweep (rad/s)."""
+    if args.speeds is not None:
+        return grid("--speeds", args.speeds, "rpm", ge=0.0) / _RPM
+    nominal = rotor.speeds[reference]
+    if nominal <= 0:
+        checks.fail("--speeds", None, f"must be given: rotor {args.rotor!r} has no nominal speed for spool "
+                                      f"{reference!r}", "rpm")
+    return np.linspace(0.0, 1.5 * nominal, 301)
 
-    rotor, scene = _load(str(args.rotor))
-    preset = PRESET_DEFAULTS.get(str(args.rotor), {})
+
+def _unbalances(args, rotor, scene) -> list:
+    """--unbalance, else the scene's, else the rotor file's [defaults], else 1e-5 kg m on each spool's first disk."""
+    from rotorred.model.loads import Unbalance
+
+    nodes = rotor.spool_of
+    if args.unbalance:
+        return [_unbalance(u, nodes) for u in args.unbalance]
     if scene is not None:
-        rotor = rotor.with_speeds(scene.speeds)
-        preset = {"unbalance": scene.unbalances,
-                  "boundary": tuple(scene.solver.boundary_nodes) + tuple(p.node for p in scene.plates)}
-        if scene.output.nodes:
-            preset["outputs"] = ",".join(f"{n}:{d}" for n, d in scene.output.dofs)
-    model_kind = args.model or (scene.solver.model if scene is not None else "full")
+        return list(scene.unbalances)
+    if rotor.defaults.unbalances:
+        return list(rotor.defaults.unbalances)
+    out = []
+    for s in rotor.spools:
+        disks = [d for d in rotor.disks if d.node in set(s.nodes)]
+        if disks:
+            out.append(Unbalance(disks[0].node, DEFAULT_M_E))
+    if not out:
+        checks.fail("--unbalance", None, f"must be given: rotor {args.rotor!r} has no disk to put a default on")
+    return out
+
+
+def _outputs(args, rotor, scene, unbalances) -> list[tuple[int, str]]:
+    """--outputs, else the scene's output DOFs, else the rotor file's [defaults], else x, y at each unbalance."""
+    if args.outputs:
+        return dof_list("--outputs", args.outputs, rotor.spool_of)
+    if scene is not None and scene.output.nodes:
+        return list(scene.output.dofs)
+    if rotor.defaults.outputs:
+        return list(rotor.defaults.outputs)
+    return [(u.node, d) for u in unbalances for d in ("x", "y")]
+
+
+def _model(args, rotor, scene, speeds, ratios):
+    """The full model, or the Craig-Bampton model with its description."""
+    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
+    from rotorred.model.assembly import assemble
+
+    system = assemble(rotor)
+    kind = args.model or (scene.solver.model if scene is not None else "full")
+    if kind != "reduced":
+        return system, f"full model, {system.n_dof} DOFs", kind
     modes, cutoff_hz = args.modes, args.cutoff
     if scene is not None and modes is None and cutoff_hz is None:
         modes, cutoff_hz = scene.solver.modes, scene.solver.cutoff_hz
+    if modes is not None:
+        checks.integer("--modes", modes, ge=0)
+    extra = (list(scene.solver.boundary_nodes) + [p.node for p in scene.plates] if scene is not None
+             else list(rotor.defaults.boundary_nodes))
+    if args.boundary_nodes.strip():
+        extra += node_list("--boundary-nodes", args.boundary_nodes, rotor.spool_of)
+    extra = list(dict.fromkeys(extra))
+    cutoff = None if cutoff_hz is None else 2 * math.pi * checks.positive("--cutoff", cutoff_hz, "Hz")
+    # the band a cutoff must cover: every excitation frequency of the sweep
+    band = None if cutoff is None else (0.0, max(float(np.max(speeds)) * r for r in ratios.values()))
+    model = reduce_rotor(rotor, extra, n_modes=modes, cutoff=cutoff, band=band, system=system)
+    label = (f"Craig-Bampton model, {model.n_dof} DOFs ({model.n_boundary_dofs} boundary DOFs at nodes "
+             f"{list(default_boundary_nodes(rotor, extra))} + {model.n_modes} modes); {model.selection.describe()}")
+    return model, label, kind
+
+
+def _frf_pairs(text: str, nodes) -> list[tuple[tuple[int, str], tuple[int, str]]]:
+    pairs = []
+    for item in text.split(","):
+        a, sep, b = item.partition(">")
+        if not sep:
+            checks.fail("--frf", text, "pairs must be IN>OUT (e.g. 18:x>13:x)")
+        pairs.append((dof_list("--frf", a, nodes)[0], dof_list("--frf", b, nodes)[0]))
+    return pairs
+
+
+def run(args) -> int:
+    from rotorred.linear.harmonic import frequency_response, unbalance_response
+    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+
+    rotor, scene = _load(str(args.rotor))
     reference = args.reference_spool or rotor.spools[0].name
-    rotor.spool(reference)  # ValueError naming the spools if unknown
-    if args.speeds is None:
-        nominal = rotor.speeds[reference]
-        if nominal <= 0:
-            raise ValueError(f"rotor {args.rotor!r} has no nominal speed for spool {reference!r}; give `--speeds`")
-        speeds = np.linspace(0.0, 1.5 * nominal, 301)
-    else:
-        speeds = _grid(args.speeds, "speeds", "rpm") / _RPM
-    if args.unbalance:
-        unbalances = [_unbalance(u) for u in args.unbalance]
-    elif "unbalance" in preset:
-        unbalances = list(preset["unbalance"])
-    elif "unbalance_nodes" in preset:
-        unbalances = [Unbalance(n, DEFAULT_M_E) for n in preset["unbalance_nodes"]]
-    else:
-        unbalances = []
-        for s in rotor.spools:
-            disks = [d for d in rotor.disks if d.node in set(s.nodes)]
-            if disks:
-                unbalances.append(Unbalance(disks[0].node, DEFAULT_M_E))
-        if not unbalances:
-            raise ValueError(f"rotor {args.rotor!r} has no disk to put a default unbalance on; give `--unbalance`")
-    if args.outputs:
-        outputs = [parse_dof(o) for o in args.outputs.split(",") if o.strip()]
-    elif "outputs" in preset:
-        outputs = [parse_dof(o) for o in preset["outputs"].split(",")]
-    else:
-        outputs = [(u.node, d) for u in unbalances for d in ("x", "y")]
+    if reference not in rotor.speeds:
+        checks.fail("--reference-spool", reference, f"must be one of {[s.name for s in rotor.spools]}")
+    speeds = _speeds(args, rotor, reference)
+    unbalances = _unbalances(args, rotor, scene)
+    outputs = _outputs(args, rotor, scene, unbalances)
     ratios = _ratios(args.ratio, rotor, reference)
-    unknown = set(ratios) - {s.name for s in rotor.spools}
-    if unknown:
-        raise ValueError(f"`--ratio` names unknown spool(s) {sorted(unknown)}; spools are "
-                         f"{[s.name for s in rotor.spools]}")
+    frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
+    frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
 
     t0 = time.perf_counter()
-    system = assemble(rotor)
-    model, label = system, f"full model, {system.n_dof} DOFs"
-    if model_kind == "reduced":
-        extra = list(dict.fromkeys(preset.get("boundary", ())))
-        if args.boundary_nodes.strip():
-            try:
-                extra += [int(n) for n in args.boundary_nodes.split(",") if n.strip()]
-            except ValueError:
-                raise ValueError(f"`--boundary-nodes` must be a comma list of node numbers, got "
-                                 f"{args.boundary_nodes!r}") from None
-        if modes is not None and modes < 0:
-            raise ValueError(f"`--modes` must be an integer >= 0, got {modes}")
-        cutoff = None if cutoff_hz is None else 2 * math.pi * cutoff_hz
-        # the band a cutoff must cover: every excitation frequency of the sweep
-        band = None if cutoff is None else (0.0, max(float(np.max(speeds)) * r for r in ratios.values()))
-        model = reduce_rotor(rotor, extra, n_modes=modes, cutoff=cutoff, band=band, system=system)
-        label = (f"Craig-Bampton model, {model.n_dof} DOFs ({model.n_boundary_dofs} boundary DOFs at nodes "
-                 f"{list(default_boundary_nodes(rotor, extra))} + {model.n_modes} modes); "
-                 f"{model.selection.describe()}")
+    model, label, kind = _model(args, rotor, scene, speeds, ratios)
     result = unbalance_response(model, unbalances, speeds, ratios=ratios, outputs=outputs,
                                 spool_of=rotor.spool_of, reference_spool=reference)
     elapsed = time.perf_counter() - t0
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    title = f"{rotor.name or args.rotor}: unbalance response ({model_kind} model)"
+    title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
     files = [result.write_csv(out / "response.csv"), plot_bode(result, out / "bode.png", title),
              plot_polar(result, out / "polar.png", title)]
-    if args.frf:
-        pairs = []
-        for item in args.frf.split(","):
-            try:
-                a, b = item.split(">")
-            except ValueError:
-                raise ValueError(f"`--frf` pairs must be IN>OUT (e.g. 18:x>13:x), got {item!r}") from None
-            pairs.append((parse_dof(a), parse_dof(b)))
-        inputs = list(dict.fromkeys(p[0] for p in pairs))
-        frf_outputs = list(dict.fromkeys(p[1] for p in pairs))
-        freqs = 2 * math.pi * _grid(args.frequencies, "frequencies", "Hz")
-        frf = frequency_response(model, inputs, frf_outputs, freqs, speeds=rotor.speeds)
+    if frf_pairs:
+        inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
+        frf = frequency_response(model, inputs, list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs,
+                                 speeds=rotor.speeds)
         files += [frf.write_csv(out / "frf.csv"), plot_frf(frf, out / "frf.png")]
+    _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files)
+    return 0
 
+
+def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files) -> None:
     if scene is not None:
         print(f"scene {scene.name} ({scene.source})")
     print(f"rotor {rotor.name or args.rotor}: {label}")
@@ -262,4 +274,3 @@ def run(args) -> int:
               f"{speeds[k] * _RPM:.0f} rpm")
     for f in files:
         print(f"wrote {f}")
-    return 0

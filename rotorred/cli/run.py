@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import time
 
+from rotorred import checks
+
 DEFAULT_SCENE = "paper-rub"
 
 
@@ -34,7 +36,9 @@ def add_parser(subparsers):
 def run(args) -> int:
     from pathlib import Path
 
-    from rotorred.scenes.run import format_summary, run_scene, write_outputs
+    from rotorred.scenes.outputs import write_outputs
+    from rotorred.scenes.run import run_scene
+    from rotorred.scenes.summary import format_summary
     from rotorred.scenes.schema import load_scene, parse_setting
 
     t0 = time.perf_counter()
@@ -42,8 +46,7 @@ def run(args) -> int:
     for item in args.set:
         key, values = parse_setting(item)
         if len(values) != 1:
-            raise ValueError(f"`--set {key}` takes one value in `rotorred run` (use `rotorred sweep` for several), "
-                             f"got {len(values)}")
+            checks.fail("--set", item, "takes one value in `rotorred run` (use `rotorred sweep` for several)")
         settings[key] = values[0]
     scene = load_scene(args.scene, settings)
     result = run_scene(scene, compare_normal=False if args.no_normal else None, progress=None)

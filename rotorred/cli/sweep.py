@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import time
 
+from rotorred import checks
+from rotorred.model.dofs import parse_dof
+
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
@@ -35,7 +38,7 @@ def run(args) -> int:
         key, values = parse_setting(item)
         if len(values) > 1:
             if swept is not None:
-                raise ValueError(f"`--set` sweeps one key; got several values for both {swept[0]!r} and {key!r}")
+                checks.fail("--set", item, f"sweeps one key; {swept[0]!r} already has several values")
             swept = (key, values)
         else:
             fixed[key] = values[0]
@@ -45,14 +48,8 @@ def run(args) -> int:
             swept = (swept[0], [swept[1]])
             fixed = {}
         else:
-            raise ValueError("`--set` must give one key with several values, e.g. rub.clearance=10e-6,20e-6")
-    dof = None
-    if args.dof:
-        node, _, d = args.dof.partition(":")
-        try:
-            dof = (int(node), d)
-        except ValueError:
-            raise ValueError(f"`--dof` must be NODE:DIR (e.g. 14:y), got {args.dof!r}") from None
+            checks.fail("--set", args.set, "must give one key with several values, e.g. rub.clearance=10e-6,20e-6")
+    dof = parse_dof("--dof", args.dof) if args.dof else None
     key, values = swept
     print(f"sweep of {key} over {len(values)} values")
     result = sweep(args.scene, key, values, settings=fixed, dof=dof, progress=True)

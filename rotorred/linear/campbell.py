@@ -32,7 +32,6 @@ Allemang, "The modal assurance criterion - twenty years of use and abuse", Sound
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,8 +40,9 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
-from rotorred.model.assembly import SystemMatrices, assemble
+from rotorred import checks, writers
 from rotorred.linear.modal import eigen, mac
+from rotorred.model.assembly import SystemMatrices, assemble
 from rotorred.model.rotor import Rotor
 
 WHIRL_LABELS = ("forward", "backward", "mixed", "planar")
@@ -181,22 +181,19 @@ class CampbellResult:
         return tuple((s, h, h * r) for s, r in self.speed_ratios.items() if r > 0 for h in self.harmonics)
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec``."""
-        path = Path(path)
-        with path.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"])
-            for i, rpm in enumerate(self.speeds_rpm):
-                for j in range(self.n_modes):
-                    w.writerow([f"{rpm:.10g}", j, f"{self.frequencies_hz[i, j]:.9g}", self.whirl[i, j],
-                                f"{self.log_dec[i, j]:.6g}"])
-        return path
+        """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec``.
 
-    def plot(self, path: str | Path, **kwargs) -> Path:
-        """Write the Campbell diagram as a PNG; see :func:`rotorred.plots.campbell.plot_campbell`."""
-        from rotorred.plots.campbell import plot_campbell
-
-        return plot_campbell(self, path, **kwargs)
+        Speeds with 10 significant digits, frequencies with 9, log decrements with 6. The
+        diagram itself is drawn by :func:`rotorred.plots.campbell.plot_campbell`.
+        """
+        n_s, n_m = self.frequencies.shape
+        speed = np.repeat(self.speeds_rpm, n_m)
+        mode = np.tile(np.arange(n_m), n_s)
+        # mixed precision: frequency and log dec are formatted here, the speed by the writer (digits=10)
+        freq = [f"{v:.9g}" for v in self.frequencies_hz.ravel()]
+        log_dec = [f"{v:.6g}" for v in self.log_dec.ravel()]
+        return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"],
+                                 [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec], digits=10)
 
 
 def excitation_label(harmonic: float, spool: str) -> str:
@@ -293,52 +290,20 @@ def speed_ratios(rotor: Rotor, ratio: float | None = None, reference: str | None
     dict of str to float
     """
     names = [s.name for s in rotor.spools]
-    if reference is None:
-        reference = names[0]
-    if reference not in names:
-        raise ValueError(f"`reference` must be one of the spools {names}, got {reference!r}")
+    reference = checks.choice("reference", names[0] if reference is None else reference, names)
     if ratio is not None:
         if len(names) != 2:
-            raise ValueError(f"`ratio` applies to two-spool rotors only; rotor {rotor.name!r} has "
-                             f"{len(names)} spool(s) {names}; leave `ratio` unset")
-        if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not (math.isfinite(ratio) and ratio >= 0):
-            raise ValueError(f"`ratio` (Omega_{names[1]} / Omega_{names[0]}) must be a finite number >= 0, "
-                             f"got {ratio!r}")
-        absolute = {names[0]: 1.0, names[1]: float(ratio)}
+            checks.fail("ratio", ratio, f"must be left unset: it applies to two-spool rotors only, and rotor "
+                        f"{rotor.name!r} has {len(names)} spool(s) {names}")
+        absolute = {names[0]: 1.0, names[1]: checks.non_negative("ratio", ratio)}
     else:
         absolute = dict(rotor.speeds)
         if len(names) == 1:
             absolute = {names[0]: 1.0}
     if absolute[reference] <= 0:
-        raise ValueError(f"the reference spool {reference!r} has nominal speed 0, so the speed ratios are "
-                         f"undefined; give `ratio` or choose another `reference`")
+        checks.fail("reference", reference, "must be a spool with a nominal speed > 0, or ratio must be given: "
+                    f"spool {reference!r} has nominal speed 0, so the speed ratios are undefined")
     return {n: absolute[n] / absolute[reference] for n in names}
-
-
-def _check_speeds(speeds) -> np.ndarray:
-    try:
-        s = np.asarray(speeds, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"`speeds` must be a 1-D sequence of numbers (rad/s), got {speeds!r}") from None
-    if s.ndim != 1 or s.size < 2:
-        raise ValueError(f"`speeds` must be a 1-D sequence of at least 2 speeds (rad/s), got shape {s.shape}")
-    if not np.all(np.isfinite(s)) or np.any(s < 0):
-        raise ValueError(f"`speeds` must be finite and >= 0 (rad/s), got min {s.min()!r}")
-    if np.any(np.diff(s) <= 0):
-        i = int(np.argmax(np.diff(s) <= 0))
-        raise ValueError(f"`speeds` must be strictly increasing; speeds[{i}] = {s[i]!r} is followed by "
-                         f"{s[i + 1]!r}")
-    return s
-
-
-def _check_harmonics(harmonics) -> tuple[float, ...]:
-    try:
-        h = tuple(float(v) for v in harmonics)
-    except (TypeError, ValueError):
-        raise ValueError(f"`harmonics` must be a sequence of positive numbers, got {harmonics!r}") from None
-    if not h or not all(math.isfinite(v) and v > 0 for v in h):
-        raise ValueError(f"`harmonics` must be a non-empty sequence of positive numbers, got {harmonics!r}")
-    return tuple(sorted(set(h)))
 
 
 class _Solver:
@@ -422,16 +387,15 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     -------
     CampbellResult
     """
-    Omega = _check_speeds(speeds)
-    if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
-        raise ValueError(f"`n_modes` must be an integer >= 1, got {n_modes!r}")
-    h = _check_harmonics(harmonics)
+    Omega = checks.vector("speeds", speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
+    n_modes = checks.integer("n_modes", n_modes, ge=1)
+    h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
     ratios = speed_ratios(rotor, ratio, reference)
     reference = reference or rotor.spools[0].name
     sm = assemble(rotor)
     n_available = sm.n_dof  # at most one frequency per DOF
     if n_modes > n_available:
-        raise ValueError(f"`n_modes` must be <= {n_available} (the number of DOFs), got {n_modes}")
+        checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
     solver = _Solver(sm, ratios, min(n_available, 2 * n_modes + 4))
 
     n_s = len(Omega)
@@ -440,15 +404,15 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     tracking = np.ones((n_s - 1, n_modes))
     lam, modes = solver.solve(Omega[0])
     if len(lam) < n_modes:
-        raise ValueError(f"`n_modes` = {n_modes} but the rotor has only {len(lam)} oscillating modes at "
-                         f"{Omega[0]:g} rad/s")
+        checks.fail("n_modes", n_modes, f"must be <= {len(lam)}, the number of oscillating modes at "
+                    f"{Omega[0]:g} rad/s")
     lam_all[0], cur = lam[:n_modes], modes[:, :n_modes]
     shapes.append(cur)
     for i in range(1, n_s):
         lam, modes = solver.solve(Omega[i])
         if len(lam) < n_modes:
-            raise ValueError(f"only {len(lam)} oscillating modes at {Omega[i]:g} rad/s, fewer than "
-                             f"`n_modes` = {n_modes}")
+            checks.fail("n_modes", n_modes, f"must be <= {len(lam)}, the number of oscillating modes at "
+                        f"{Omega[i]:g} rad/s")
         cols, m = _assign(cur, lam_all[i - 1].imag, lam, modes)
         lam_all[i], cur = lam[cols], modes[:, cols]
         tracking[i - 1] = m

@@ -32,7 +32,6 @@ such as 70:90 Hz the signal is periodic and the true peak lies somewhat below th
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,21 +40,13 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.model.assembly import DIRECTIONS
+from rotorred import checks, writers
 from rotorred.model.loads import Unbalance
 
 Output = tuple[int, str]
+#: significant digits of the CSV files
+CSV_DIGITS = 10
 
-
-
-def _write_columns(path: Path, header: list[str], cols: list[np.ndarray]) -> Path:
-    """Write equal-length columns as CSV (10 significant digits)."""
-    with path.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for row in np.column_stack(cols):
-            w.writerow([f"{v:.10g}" for v in row])
-    return path
 
 @dataclass(frozen=True)
 class UnbalanceResponse:
@@ -139,7 +130,7 @@ class UnbalanceResponse:
                 cols += [1e6 * self.amplitude(o, s), np.degrees(self.phase(o, s))]
             header.append(f"{name} peak bound (um)")
             cols.append(1e6 * self.peak(o))
-        return _write_columns(path, header, cols)
+        return writers.write_csv(path, header, cols, digits=CSV_DIGITS)
 
 
 @dataclass(frozen=True)
@@ -178,7 +169,7 @@ class FrequencyResponse:
                 name = f"node {o[0]} {o[1]} / node {i[0]} {i[1]}"
                 header += [f"{name} |H| (m/N)", f"{name} phase (deg)"]
                 cols += [np.abs(self.h(o, i)), np.degrees(np.angle(self.h(o, i)))]
-        return _write_columns(path, header, cols)
+        return writers.write_csv(path, header, cols, digits=CSV_DIGITS)
 
 
 @dataclass(frozen=True)
@@ -228,14 +219,8 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
     SteadyState
     """
     spools = tuple(model.spools)
-    speeds = {s: float(w) for s, w in speeds.items()}
-    missing = [s for s in spools if s not in speeds]
-    unknown = set(speeds) - set(spools)
-    if missing or unknown:
-        raise ValueError(f"`speeds` must give the speed of every spool {list(spools)}, got {sorted(speeds)}")
-    for s, w in speeds.items():
-        if not (math.isfinite(w) and w >= 0):
-            raise ValueError(f"`speeds[{s!r}]` must be a finite speed >= 0 (rad/s), got {w!r}")
+    checks.keys("speeds", speeds, spools, required=spools)
+    speeds = {s: checks.non_negative(f"speeds.{s}", w, "rad/s") for s, w in speeds.items()}
     forces = _unbalance_forces(model, unbalances, spool_of)
     D = model.damping(speeds)
     phasors = {}
@@ -254,19 +239,20 @@ def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
     dofs = model.full_dofs
     if spool_of is None:
         if len(spools) != 1:
-            raise ValueError("`spool_of` (node -> spool, e.g. Rotor.spool_of) is required for a model with "
-                             f"{len(spools)} spools")
+            checks.fail("spool_of", spool_of, f"must be given (node -> spool, e.g. Rotor.spool_of) for a model with "
+                        f"{len(spools)} spools")
         spool_of = {n: spools[0] for n in dofs.nodes}
-    if not unbalances:
-        raise ValueError("`unbalances` must hold at least one Unbalance, got none")
+    if len(unbalances) == 0:
+        checks.fail("unbalances", unbalances, "must hold at least one Unbalance")
     per_spool: dict[str, np.ndarray] = {}
     for k, u in enumerate(unbalances):
         if not isinstance(u, Unbalance):
-            raise ValueError(f"`unbalances[{k}]` must be an Unbalance, got {u!r}")
-        dofs.index(u.node, "x")  # ValueError naming the node if it does not exist
+            checks.fail(f"unbalances[{k}]", u, "must be an Unbalance")
+        checks.node(f"unbalances[{k}].node", u.node, dofs.nodes, "a node of the model")
         s = spool_of.get(u.node)
         if s not in spools:
-            raise ValueError(f"`unbalances[{k}]`: node {u.node} has no spool in `spool_of` (got {s!r})")
+            checks.fail(f"unbalances[{k}].node", u.node, f"must have a spool of the model ({', '.join(spools)}) in "
+                        f"spool_of, not {s!r}")
         rows = model.output_rows([(u.node, "x"), (u.node, "y")])
         # per unit Omega²: F_x = m_e e^{i phi}, F_y = -i m_e e^{i phi}
         f = u.m_e * np.exp(1j * u.phase) * (rows[0] - 1j * rows[1])
@@ -275,10 +261,8 @@ def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
 
 
 def _check_speeds(speeds, name: str = "speeds") -> np.ndarray:
-    arr = np.atleast_1d(np.asarray(speeds, dtype=float))
-    if arr.ndim != 1 or len(arr) == 0 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
-        raise ValueError(f"`{name}` must be a non-empty 1-D sequence of finite values >= 0 (rad/s), got {speeds!r}")
-    return arr
+    """A non-empty 1-D array of speeds or frequencies >= 0 (rad/s); a single number is one point."""
+    return checks.vector(name, [speeds] if np.ndim(speeds) == 0 else speeds, "rad/s", ge=0.0)
 
 
 def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: Mapping[str, float] | None = None,
@@ -311,27 +295,10 @@ def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: M
     speeds = _check_speeds(speeds)
     outputs = model.full_dofs.checked_outputs(outputs, "outputs")
     if not outputs:
-        raise ValueError("`outputs` must name at least one (node, direction) pair, got none")
-    if reference_spool is None:
-        reference_spool = spools[0]
-    if reference_spool not in spools:
-        raise ValueError(f"`reference_spool` {reference_spool!r} does not exist; spools are {list(spools)}")
-    ratios = dict(ratios or {})
-    unknown = set(ratios) - set(spools)
-    if unknown:
-        raise ValueError(f"`ratios` names unknown spool(s) {sorted(unknown)}; spools are {list(spools)}")
-    ratios.setdefault(reference_spool, 1.0)
-    if ratios[reference_spool] != 1.0:
-        raise ValueError(f"`ratios[{reference_spool!r}]` must be 1 (it is the reference spool), "
-                         f"got {ratios[reference_spool]!r}")
-    if len(spools) == 1:
-        ratios.setdefault(spools[0], 1.0)
-    missing = [s for s in spools if s not in ratios]
-    if missing:
-        raise ValueError(f"`ratios` must give the speed ratio (to {reference_spool!r}) of spool(s) {missing}")
-    for s, r in ratios.items():
-        if not (isinstance(r, (int, float, np.floating)) and math.isfinite(r) and r >= 0):
-            raise ValueError(f"`ratios[{s!r}]` must be a finite number >= 0, got {r!r}")
+        checks.fail("outputs", outputs, "must name at least one (node, direction) pair")
+    reference_spool = checks.choice("reference_spool", spools[0] if reference_spool is None else reference_spool,
+                                    spools)
+    ratios = _ratios(ratios, spools, reference_spool)
     per_spool = _unbalance_forces(model, unbalances, spool_of)
     R = model.output_rows(outputs)
     spool_speeds = {s: ratios[s] * speeds for s in spools}
@@ -350,6 +317,24 @@ def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: M
         phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors})
 
 
+def _ratios(given, spools: tuple[str, ...], reference: str) -> dict[str, float]:
+    """Omega_spool / Omega_reference of every spool: ``given`` checked and completed."""
+    ratios = {} if given is None else dict(checks.table("ratios", given))
+    unknown = sorted(set(ratios) - set(spools))
+    if unknown:
+        checks.fail("ratios", given, f"must name only spools of the model ({', '.join(spools)}); unknown spool(s) "
+                    f"{unknown}")
+    ratios.setdefault(reference, 1.0)
+    if ratios[reference] != 1.0:
+        checks.fail(f"ratios[{reference!r}]", ratios[reference], "must be 1 (it is the reference spool)")
+    if len(spools) == 1:
+        ratios.setdefault(spools[0], 1.0)
+    missing = [s for s in spools if s not in ratios]
+    if missing:
+        checks.fail("ratios", given, f"must give the speed ratio (to {reference!r}) of spool(s) {missing}")
+    return {s: checks.non_negative(f"ratios[{s!r}]", r) for s, r in ratios.items()}
+
+
 def response_error(reference: UnbalanceResponse, other: UnbalanceResponse, floor: float = 1e-3) -> float:
     """Worst relative phasor error of ``other`` against ``reference`` over the sweep.
 
@@ -365,7 +350,9 @@ def response_error(reference: UnbalanceResponse, other: UnbalanceResponse, floor
     """
     if set(reference.phasors) != set(other.phasors) or reference.outputs != other.outputs \
             or len(reference.speeds) != len(other.speeds):
-        raise ValueError("the two responses must have the same excited spools, outputs and sweep")
+        checks.fail("other", f"{len(other.speeds)} speeds, outputs {list(other.outputs)}, spools {list(other.phasors)}",
+                    f"must have the excited spools, outputs and sweep of reference ({len(reference.speeds)} speeds, "
+                    f"outputs {list(reference.outputs)}, spools {list(reference.phasors)})")
     worst = 0.0
     for s, per_output in reference.phasors.items():
         for o, Q in per_output.items():
@@ -397,8 +384,9 @@ def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output
     """
     inputs = model.full_dofs.checked_outputs(inputs, "inputs")
     outputs = model.full_dofs.checked_outputs(outputs, "outputs")
-    if not inputs or not outputs:
-        raise ValueError("`inputs` and `outputs` must each name at least one (node, direction) pair")
+    for name, pairs in (("inputs", inputs), ("outputs", outputs)):
+        if not pairs:
+            checks.fail(name, pairs, "must name at least one (node, direction) pair")
     w_all = _check_speeds(frequencies, "frequencies")
     speeds = dict(speeds or {})
     D = model.damping(speeds)  # ValueError for unknown spools
@@ -410,16 +398,3 @@ def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output
         H[k] = R @ sla.solve(Z, B.astype(complex), check_finite=False)
     return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H)
 
-
-def parse_dof(text: str) -> Output:
-    """``"13:x"`` -> (13, "x"); directions x, y, theta_x (tx), theta_y (ty)."""
-    aliases = {"tx": "theta_x", "ty": "theta_y"}
-    try:
-        node, direction = text.strip().split(":")
-        direction = aliases.get(direction.strip(), direction.strip())
-        node = int(node)
-    except ValueError:
-        raise ValueError(f"a DOF must be written NODE:DIRECTION (e.g. 13:x), got {text!r}") from None
-    if direction not in DIRECTIONS:
-        raise ValueError(f"DOF {text!r}: direction must be one of {DIRECTIONS}, got {direction!r}")
-    return node, direction

@@ -35,9 +35,11 @@ from typing import Mapping, Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.model.assembly import DofMap, SpoolSpeedMixin, SystemMatrices, assemble
+from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import eigen
+from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, assemble
+from rotorred.model.dofs import DofMap
 from rotorred.model.rotor import Rotor
 
 #: default relative whirl-frequency error target of the automatic mode count (0.1 %)
@@ -145,8 +147,7 @@ class ResponseCheck:
         object.__setattr__(self, "unbalances", tuple(self.unbalances))
         object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
         object.__setattr__(self, "speeds", np.asarray(self.speeds, dtype=float))
-        if not (isinstance(self.target, (int, float)) and math.isfinite(self.target) and self.target > 0):
-            raise ValueError(f"`target` must be a positive relative error, got {self.target!r}")
+        object.__setattr__(self, "target", checks.positive("target", self.target))
 
     def run(self, model):
         """Unbalance response of ``model`` for this check."""
@@ -220,8 +221,8 @@ class ReducedSystem(SpoolSpeedMixin):
         """
         full = self.full_dofs.index(node, direction)
         if full not in self._bpos:
-            raise ValueError(f"node {node} is not a boundary node of the reduced model; boundary nodes are "
-                             f"{list(self.boundary_nodes)} (use output_rows to recover interior DOFs)")
+            checks.fail("node", node, f"must be a boundary node of the reduced model {list(self.boundary_nodes)}; "
+                        "output_rows recovers the DOFs of interior nodes")
         return self._bpos[full]
 
     def output_rows(self, outputs) -> np.ndarray:
@@ -251,33 +252,21 @@ class ReducedSystem(SpoolSpeedMixin):
 
 def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:
     """Bearing nodes, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF order."""
+    extra = [checks.node(f"extra_nodes[{i}]", n, rotor.spool_of) for i, n in enumerate(extra_nodes)]
     nodes = {b.node for b in rotor.bearings}
     for b in rotor.intershaft_bearings:
         nodes.update((b.node_a, b.node_b))
-    nodes.update(extra_nodes)
-    known = set(rotor.nodes)
-    for n in extra_nodes:
-        if n not in known:
-            raise ValueError(f"boundary node {n!r} does not exist; nodes are {sorted(known)}")
+    nodes.update(extra)
     return tuple(n for n in rotor.nodes if n in nodes)
-
-
-def _check_int(name: str, value, minimum: int = 0) -> int:
-    if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < minimum:
-        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
-    return int(value)
 
 
 def _boundary(system: SystemMatrices, boundary_nodes) -> tuple[tuple[int, ...], np.ndarray, np.ndarray]:
     dofs = system.dofs
     requested = list(boundary_nodes)
     if not requested:
-        raise ValueError("`boundary_nodes` must name at least one node, got none")
-    known = set(dofs.nodes)
-    for n in requested:
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n not in known:
-            raise ValueError(f"boundary node {n!r} does not exist; nodes are {sorted(known)}")
-    chosen = set(int(n) for n in requested)
+        checks.fail("boundary_nodes", boundary_nodes, "must name at least one node")
+    chosen = {checks.node(f"boundary_nodes[{i}]", n, dofs.nodes, "a node of the model")
+              for i, n in enumerate(requested)}
     nodes = tuple(n for n in dofs.nodes if n in chosen)
     b = np.concatenate([dofs.node_dofs(n) for n in nodes])
     mask = np.ones(dofs.n_dof, dtype=bool)
@@ -313,9 +302,9 @@ def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
     try:
         chol = sla.cho_factor(K_ii)
     except np.linalg.LinAlgError:
-        raise ValueError("the interior (non-boundary) part of the model is not restrained when the boundary "
-                         "nodes are fixed (K_ii is singular); add a node of each free part to "
-                         "`boundary_nodes`") from None
+        checks.fail("boundary_nodes", [system.dofs.nodes[p] for p in np.unique(b // 4)], "must restrain the "
+                    "interior part of the model when fixed: it is not restrained (K_ii is singular); add a node "
+                    "of each free part")
     Psi = -sla.cho_solve(chol, K_ib)
     lam, Phi = sla.eigh(K_ii, M_ii)
     omega = np.sqrt(np.clip(lam, 0.0, None))
@@ -435,41 +424,15 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
     R. R. Craig, M. C. C. Bampton, "Coupling of substructures for dynamic analyses",
     AIAA Journal 6(7), 1968, 1313–1319.
     """
-    if n_modes is not None and cutoff is not None:
-        raise ValueError(f"give either `n_modes` or `cutoff`, not both (got n_modes={n_modes!r}, "
-                         f"cutoff={cutoff!r})")
-    if n_modes is not None:
-        n_modes = _check_int("n_modes", n_modes)
-    if band is not None:
-        band = tuple(float(x) for x in band)
-        if len(band) != 2 or not (0 <= band[0] < band[1] and math.isfinite(band[1])):
-            raise ValueError(f"`band` must be (low, high) with 0 <= low < high (rad/s), got {band!r}")
-    if cutoff is not None:
-        if not (isinstance(cutoff, (int, float, np.floating)) and math.isfinite(cutoff) and cutoff > 0):
-            raise ValueError(f"`cutoff` must be a positive frequency (rad/s), got {cutoff!r}")
-        if band is not None and cutoff < band[1]:
-            raise ValueError(f"`cutoff` = {cutoff:.6g} rad/s ({cutoff / (2 * math.pi):.4g} Hz) lies below the "
-                             f"frequency band of interest, which ends at {band[1]:.6g} rad/s "
-                             f"({band[1] / (2 * math.pi):.4g} Hz); the cutoff must be at least the band's "
-                             f"upper end (1.5-2x is usual)")
-    if not (isinstance(target, (int, float)) and math.isfinite(target) and target > 0):
-        raise ValueError(f"`target` must be a positive relative error, got {target!r}")
-    if n_check is not None:
-        n_check = _check_int("n_check", n_check, 1)
-    if check_speeds is not None:
-        check_speeds = tuple(dict(s) for s in check_speeds)
-        for s in check_speeds:
-            unknown = set(s) - set(system.G)
-            if unknown:
-                raise ValueError(f"unknown spool(s) {sorted(unknown)} in `check_speeds`; "
-                                 f"spools are {list(system.G)}")
+    n_modes, cutoff, band, target, n_check, check_speeds = _checked_options(
+        system, n_modes, cutoff, band, target, n_check, check_speeds)
     nodes, b, i = _boundary(system, boundary_nodes)
     basis = _basis(system, b, i)
     n_i = len(i)
 
     if n_modes is not None:
         if n_modes > n_i:
-            raise ValueError(f"`n_modes` = {n_modes} exceeds the number of interior DOFs ({n_i})")
+            checks.fail("n_modes", n_modes, f"must be <= {n_i}, the number of interior DOFs")
         selection = ModeSelection("count", n_modes, n_i)
     elif cutoff is not None:
         n_modes = int(np.count_nonzero(basis.omega <= cutoff))
@@ -500,6 +463,33 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
                                   response_target=None if response is None else float(response.target),
                                   response_error=resp_err, history=tuple(history))
     return _make(system, nodes, basis, basis.T(n_modes), n_modes, selection)
+
+
+def _checked_options(system: SystemMatrices, n_modes, cutoff, band, target, n_check, check_speeds):
+    """The options of :func:`reduce`, checked: (n_modes, cutoff, band, target, n_check, check_speeds)."""
+    if n_modes is not None and cutoff is not None:
+        checks.fail("cutoff", cutoff, f"must not be given together with n_modes = {n_modes!r}: give one or the "
+                    "other", "rad/s")
+    if n_modes is not None:
+        n_modes = checks.integer("n_modes", n_modes, ge=0)
+    if band is not None:
+        band = tuple(float(x) for x in checks.vector("band", band, "rad/s", min_len=2, max_len=2, ge=0.0,
+                                                     increasing=True))
+    if cutoff is not None:
+        cutoff = checks.positive("cutoff", cutoff, "rad/s")
+        if band is not None and cutoff < band[1]:
+            checks.fail("cutoff", cutoff, f"must not lie below the frequency band of interest, which ends at "
+                        f"{band[1]:.6g} rad/s ({band[1] / (2 * math.pi):.4g} Hz; the cutoff is "
+                        f"{cutoff / (2 * math.pi):.4g} Hz): it must be at least the band's upper end, 1.5-2x is "
+                        "usual", "rad/s")
+    target = checks.positive("target", target)
+    if n_check is not None:
+        n_check = checks.integer("n_check", n_check, ge=1)
+    if check_speeds is not None:
+        check_speeds = tuple(dict(checks.table(f"check_speeds[{k}]", s)) for k, s in enumerate(check_speeds))
+        for k, s in enumerate(check_speeds):
+            checks.keys(f"check_speeds[{k}]", s, system.G)
+    return n_modes, cutoff, band, target, n_check, check_speeds
 
 
 def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
@@ -537,9 +527,7 @@ def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | N
     -------
     ReducedSystem
     """
-    factors = tuple(float(f) for f in speed_factors)
-    if not factors or not all(math.isfinite(f) and f >= 0 for f in factors):
-        raise ValueError(f"`speed_factors` must be non-empty factors >= 0, got {speed_factors!r}")
+    factors = tuple(float(f) for f in checks.vector("speed_factors", speed_factors, ge=0.0))
     boundary = default_boundary_nodes(rotor, extra_nodes)
     if system is None:
         system = assemble(rotor)

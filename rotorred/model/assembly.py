@@ -15,90 +15,17 @@ triplets in one pass.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
 from scipy.sparse import coo_matrix
 
+from rotorred import checks
+from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
 from rotorred.model.rotor import Rotor
 
-DIRECTIONS = ("x", "y", "theta_x", "theta_y")
-_DIR_ALIASES = {"x": 0, "y": 1, "theta_x": 2, "theta_y": 3, "tx": 2, "ty": 3}
-
-
-@dataclass(frozen=True)
-class DofMap:
-    """Global DOF numbering.
-
-    4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order, indices
-    ``4 * position + direction``; then the internal (bubble) DOFs of hierarchical shaft
-    elements, ``n_internal`` of them, after all nodal DOFs. Code that needs physical DOFs uses
-    :meth:`index` or :meth:`node_dofs`, never ``n_dof // 4``.
-
-    Parameters
-    ----------
-    nodes : tuple of int
-        Node numbers in DOF order.
-    n_internal : int
-        Number of internal DOFs (0 for a model of Nelson elements only).
-    """
-
-    nodes: tuple[int, ...]
-    n_internal: int = 0
-    _pos: dict = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self):
-        object.__setattr__(self, "_pos", {n: i for i, n in enumerate(self.nodes)})
-
-    @property
-    def n_dof(self) -> int:
-        """Number of DOFs."""
-        return 4 * len(self.nodes) + self.n_internal
-
-    @property
-    def nodal(self) -> np.ndarray:
-        """Indices of all nodal DOFs as an array, shape (n_nodes, 4): row k is node ``nodes[k]``."""
-        return np.arange(4 * len(self.nodes)).reshape(-1, 4)
-
-    def node_dofs(self, node: int) -> np.ndarray:
-        """Global indices of the 4 DOFs of ``node``, shape (4,)."""
-        return 4 * self._node_pos(node) + np.arange(4)
-
-    def index(self, node: int, direction: str) -> int:
-        """Global index of ``direction`` (``"x"``, ``"y"``, ``"theta_x"``, ``"theta_y"``) at ``node``."""
-        if direction not in _DIR_ALIASES:
-            raise ValueError(f"`direction` must be one of {DIRECTIONS}, got {direction!r}")
-        return 4 * self._node_pos(node) + _DIR_ALIASES[direction]
-
-    def checked_outputs(self, outputs, name: str = "outputs") -> tuple[tuple[int, str], ...]:
-        """Validate (node, direction) pairs; ValueError naming ``name``, the entry and what is allowed."""
-        out = []
-        for o in outputs:
-            try:
-                node, direction = o
-            except (TypeError, ValueError):
-                raise ValueError(f"`{name}` entries must be (node, direction) pairs, got {o!r}") from None
-            if direction not in DIRECTIONS:
-                raise ValueError(f"`{name}`: direction must be one of {DIRECTIONS}, got {direction!r} "
-                                 f"at node {node!r}")
-            self.index(node, direction)  # ValueError naming the node if it does not exist
-            out.append((int(node), str(direction)))
-        return tuple(out)
-
-    def label(self, dof: int) -> str:
-        """Human label of a global DOF, e.g. ``"node 18 y"``."""
-        if not 0 <= dof < self.n_dof:
-            raise ValueError(f"`dof` must be in [0, {self.n_dof}), got {dof}")
-        if dof >= 4 * len(self.nodes):
-            return f"internal {dof - 4 * len(self.nodes)}"
-        return f"node {self.nodes[dof // 4]} {DIRECTIONS[dof % 4]}"
-
-    def _node_pos(self, node: int) -> int:
-        try:
-            return self._pos[node]
-        except (KeyError, TypeError):
-            raise ValueError(f"node {node!r} does not exist; nodes are {sorted(self.nodes)}") from None
+__all__ = ["SystemMatrices", "SpoolSpeedMixin", "assemble", "DofMap", "DIRECTIONS"]
 
 
 class SpoolSpeedMixin:
@@ -113,9 +40,7 @@ class SpoolSpeedMixin:
 
     def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
         """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
-        unknown = set(speeds) - set(self.G)
-        if unknown:
-            raise ValueError(f"unknown spool(s) {sorted(unknown)} in `speeds`; spools are {list(self.G)}")
+        checks.keys("speeds", speeds, self.G)
         out = np.zeros_like(self.M)
         for name, Omega in speeds.items():
             if Omega:

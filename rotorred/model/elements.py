@@ -1,11 +1,14 @@
 """Model inputs: material, shaft element, rigid disk, bearing, inter-shaft bearing.
 
-Each is a frozen dataclass validated at construction; a bad value raises ``ValueError``
-naming the parameter, the value and what is allowed. Element matrices come from the
-generated module :mod:`rotorred._generated.timoshenko` (``python -m derivations``).
+Each is a frozen dataclass validated at construction (:mod:`rotorred.checks`); a bad value
+raises :class:`rotorred.checks.InputError` (a ``ValueError``) naming the attribute, the value and
+what is allowed, e.g. ``D_i = 0.06: must be < D_o = 0.05 (m)``; a file loader prefixes the
+attribute with the key path (``spool[0].elements[2].D_i``). Numbers are stored as ``float``,
+node numbers as ``int``. Element matrices come from the generated module
+:mod:`rotorred._generated.timoshenko` (``python -m derivations``).
 
-DOF order at a node: (x, y, theta_x, theta_y); z is the shaft axis. A positive theta_y turns
-z towards x, a positive theta_x turns z towards -y; a spool spins about +z.
+DOF order at a node (:mod:`rotorred.model.dofs`): (x, y, theta_x, theta_y); z is the shaft axis.
+A positive theta_y turns z towards x, a positive theta_x turns z towards -y; a spool spins about +z.
 """
 
 from __future__ import annotations
@@ -15,25 +18,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rotorred import checks
 from rotorred._generated import timoshenko as _gen
 
 SHEAR_METHODS = ("cowper", "hutchinson", "none")
 FORMULATIONS = ("nelson", "hierarchical")
 
 
-def _positive(name: str, value: float, unit: str = "") -> None:
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise ValueError(f"`{name}` must be a positive finite number{unit}, got {value!r}")
-
-
-def _non_negative(name: str, value: float, unit: str = "") -> None:
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-        raise ValueError(f"`{name}` must be a finite number >= 0{unit}, got {value!r}")
-
-
-def _finite(name: str, value: float) -> None:
-    if not (isinstance(value, (int, float)) and math.isfinite(value)):
-        raise ValueError(f"`{name}` must be a finite number, got {value!r}")
+def _set(obj, name: str, value) -> None:
+    """Store a checked (converted) value on a frozen dataclass."""
+    object.__setattr__(obj, name, value)
 
 
 @dataclass(frozen=True)
@@ -57,11 +51,10 @@ class Material:
     nu: float = 0.3
 
     def __post_init__(self):
-        _positive("E", self.E, " (Pa)")
-        _positive("rho", self.rho, " (kg/m^3)")
-        _finite("nu", self.nu)
-        if not -1.0 < self.nu < 0.5:
-            raise ValueError(f"`nu` must lie in (-1, 0.5), got {self.nu!r}")
+        _set(self, "name", checks.string("name", self.name))
+        _set(self, "E", checks.positive("E", self.E, "Pa"))
+        _set(self, "rho", checks.positive("rho", self.rho, "kg/m^3"))
+        _set(self, "nu", checks.number("nu", self.nu, "-", gt=-1.0, lt=0.5))
 
     @property
     def G_s(self) -> float:
@@ -100,7 +93,7 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
         den = (7 * a2**2 + 34 * a2 * b2 + 7 * b2**2 + nu * (12 * a2**2 + 48 * a2 * b2 + 12 * b2**2)
                + nu**2 * (4 * a2**2 + 16 * a2 * b2 + 4 * b2**2))
         return num / den
-    raise ValueError(f"`shear` must be one of {SHEAR_METHODS}, got {method!r}")
+    checks.choice("method", method, ("cowper", "hutchinson"))
 
 
 @dataclass(frozen=True)
@@ -139,24 +132,22 @@ class ShaftElement:
     element: str = "nelson"
 
     def __post_init__(self):
-        for name in ("left", "right"):
-            value = getattr(self, name)
-            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-                raise ValueError(f"`{name}` must be a node number (integer >= 0), got {value!r}")
+        _set(self, "left", checks.integer("left", self.left, ge=0))
+        _set(self, "right", checks.integer("right", self.right, ge=0))
         if self.left == self.right:
-            raise ValueError(f"`left` and `right` must be different nodes, got {self.left} for both")
-        _positive("L", self.L, " (m)")
-        _positive("D_o", self.D_o, " (m)")
-        _non_negative("D_i", self.D_i, " (m)")
+            checks.fail("right", self.right, f"must differ from left = {self.left}")
+        _set(self, "L", checks.positive("L", self.L, "m"))
+        _set(self, "D_o", checks.positive("D_o", self.D_o, "m"))
+        _set(self, "D_i", checks.non_negative("D_i", self.D_i, "m"))
         if self.D_i >= self.D_o:
-            raise ValueError(f"`D_i` must be smaller than `D_o` = {self.D_o!r} m, got {self.D_i!r} m")
-        if self.shear not in SHEAR_METHODS:
-            raise ValueError(f"`shear` must be one of {SHEAR_METHODS}, got {self.shear!r}")
-        if self.element not in FORMULATIONS:
-            raise ValueError(f"`element` must be one of {FORMULATIONS}, got {self.element!r}")
+            checks.fail("D_i", self.D_i, f"must be < D_o = {self.D_o:g}", "m")
+        if not isinstance(self.material, Material):
+            checks.fail("material", self.material, "must be a Material")
+        checks.choice("shear", self.shear, SHEAR_METHODS)
+        checks.choice("element", self.element, FORMULATIONS)
         if self.element == "hierarchical" and self.shear == "none":
-            raise ValueError('`element` "hierarchical" needs shear flexibility; use shear="cowper" or "hutchinson" '
-                             '(or element="nelson" for an Euler-Bernoulli element)')
+            checks.fail("element", self.element, "must be 'nelson' with shear = 'none' (an Euler-Bernoulli element): "
+                        "the hierarchical element needs shear = 'cowper' or 'hutchinson'")
 
     @property
     def n_internal(self) -> int:
@@ -247,12 +238,12 @@ class Disk:
     radius: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.node, int) or isinstance(self.node, bool):
-            raise ValueError(f"`node` must be an integer node number, got {self.node!r}")
-        _positive("m", self.m, " (kg)")
-        _non_negative("I_d", self.I_d, " (kg m^2)")
-        _non_negative("I_p", self.I_p, " (kg m^2)")
-        _non_negative("radius", self.radius, " (m)")
+        _set(self, "node", checks.integer("node", self.node))
+        _set(self, "m", checks.positive("m", self.m, "kg"))
+        _set(self, "I_d", checks.non_negative("I_d", self.I_d, "kg m^2"))
+        _set(self, "I_p", checks.non_negative("I_p", self.I_p, "kg m^2"))
+        _set(self, "name", checks.string("name", self.name))
+        _set(self, "radius", checks.non_negative("radius", self.radius, "m"))
 
     def M(self) -> np.ndarray:
         """Mass matrix, shape (4, 4)."""
@@ -276,10 +267,11 @@ class _Support:
     name: str = ""
 
     def _validate(self):
-        for c in ("k_xx", "k_yy", "c_xx", "c_yy"):
-            _non_negative(c, getattr(self, c), " (N/m)" if c[0] == "k" else " (N s/m)")
-        for c in ("k_xy", "k_yx", "c_xy", "c_yx"):
-            _finite(c, getattr(self, c))
+        for c in ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"):
+            unit = "N/m" if c[0] == "k" else "N s/m"
+            direct = c[-1] == c[-2]  # direct terms are >= 0, cross-coupled terms any sign
+            _set(self, c, checks.number(c, getattr(self, c), unit, ge=0.0 if direct else None))
+        _set(self, "name", checks.string("name", self.name))
 
     @property
     def K(self) -> np.ndarray:
@@ -309,8 +301,7 @@ class Bearing(_Support):
     node: int = field(default=-1, kw_only=True)
 
     def __post_init__(self):
-        if not isinstance(self.node, int) or isinstance(self.node, bool) or self.node < 0:
-            raise ValueError(f"`node` must be an integer node number, got {self.node!r}")
+        _set(self, "node", checks.integer("node", self.node, ge=0))
         self._validate()
 
 
@@ -334,10 +325,8 @@ class IntershaftBearing(_Support):
     node_b: int = field(default=-1, kw_only=True)
 
     def __post_init__(self):
-        for name in ("node_a", "node_b"):
-            value = getattr(self, name)
-            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-                raise ValueError(f"`{name}` must be an integer node number, got {value!r}")
+        _set(self, "node_a", checks.integer("node_a", self.node_a, ge=0))
+        _set(self, "node_b", checks.integer("node_b", self.node_b, ge=0))
         if self.node_a == self.node_b:
-            raise ValueError(f"`node_a` and `node_b` must differ, got {self.node_a} for both")
+            checks.fail("node_b", self.node_b, f"must differ from node_a = {self.node_a}")
         self._validate()

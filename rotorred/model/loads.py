@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
+
+from rotorred import checks
+
+#: keys of an unbalance table (a scene's ``[[unbalance]]``, a rotor file's ``[defaults]`` ``unbalance``)
+UNBALANCE_KEYS = ("node", "m_e", "phase_deg")
 
 
 @dataclass(frozen=True)
@@ -29,12 +35,23 @@ class Unbalance:
     phase: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.node, int) or isinstance(self.node, bool):
-            raise ValueError(f"`node` must be an integer node number, got {self.node!r}")
-        if not (math.isfinite(self.m_e) and self.m_e >= 0):
-            raise ValueError(f"`m_e` must be a finite number >= 0 (kg m), got {self.m_e!r}")
-        if not math.isfinite(self.phase):
-            raise ValueError(f"`phase` must be finite (rad), got {self.phase!r}")
+        object.__setattr__(self, "node", checks.integer("node", self.node))
+        object.__setattr__(self, "m_e", checks.non_negative("m_e", self.m_e, "kg m"))
+        object.__setattr__(self, "phase", checks.number("phase", self.phase, "rad"))
+
+
+def unbalance_from_table(field: str, table, nodes: Collection[int]) -> Unbalance:
+    """An :class:`Unbalance` from a file table ``{node = 11, m_e = 1e-5, phase_deg = 90.0}``.
+
+    ``m_e`` in kg m, ``phase_deg`` in degrees (default 0); ``node`` must be one of ``nodes``.
+    Values are checked as written (degrees) before the phase is converted to radians.
+    """
+    table: Mapping = checks.table(field, table)
+    checks.keys(field, table, UNBALANCE_KEYS, required=("node", "m_e"))
+    node = checks.node(f"{field}.node", table["node"], nodes)
+    m_e = checks.non_negative(f"{field}.m_e", table["m_e"], "kg m")
+    phase_deg = checks.number(f"{field}.phase_deg", table.get("phase_deg", 0.0), "deg")
+    return Unbalance(node, m_e, math.radians(phase_deg))
 
 
 def gravity_force(model, g: float) -> np.ndarray:
@@ -54,11 +71,12 @@ def gravity_force(model, g: float) -> np.ndarray:
     -------
     ndarray, shape (n,)
     """
+    g = checks.number("g", g, "m/s^2")
     pairs = [(node, d) for node in model.full_dofs.nodes for d in ("x", "y", "theta_x", "theta_y")]
     R = model.output_rows(pairs)
     target = np.array([1.0 if d == "y" else 0.0 for _, d in pairs])
     e, *_ = np.linalg.lstsq(R, target, rcond=None)
     if np.max(np.abs(R @ e - target)) > 1e-8:
-        raise ValueError("`gravity`: a rigid translation is not representable in this model's coordinates "
-                         "(a reduced model must keep every bearing node on its boundary)")
+        checks.fail("g", g, "needs a model that represents a rigid translation: a reduced model must keep every "
+                    "bearing node on its boundary", "m/s^2")
     return -g * (model.M @ e)

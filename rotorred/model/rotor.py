@@ -3,16 +3,85 @@
 A :class:`Rotor` holds one or more :class:`Spool` s. Each spool is a chain of shaft
 elements on user-visible node numbers and spins at its own speed; the gyroscopic term of
 the assembled system is ``sum_s Omega_s G_s`` (Xu et al. 2016, Eq. 13, with one G per spool).
+A rotor also carries its :class:`AnalysisDefaults` (a rotor file's ``[defaults]`` table): the
+unbalances, output DOFs and extra reduction boundary nodes an analysis uses when none are given.
+
+Validation (:mod:`rotorred.checks`) names attributes (``disks[0].node``); the rotor-file loader
+renames them to the file's keys (``disk[0].node``).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
-from dataclasses import dataclass
+from collections.abc import Collection
+from dataclasses import dataclass, field
 from typing import Mapping
 
+from rotorred import checks
+from rotorred.model.dofs import checked_dof
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, ShaftElement
+from rotorred.model.loads import Unbalance
+
+
+@dataclass(frozen=True)
+class AnalysisDefaults:
+    """What an analysis of a rotor uses when the user gives nothing else (a rotor file's ``[defaults]``).
+
+    Parameters
+    ----------
+    unbalances : tuple of Unbalance
+        Default unbalances (e.g. of ``rotorred harmonic``).
+    outputs : tuple of (int, str)
+        Default response DOFs (node, direction).
+    boundary_nodes : tuple of int
+        Extra boundary nodes of a Craig-Bampton reduced model (e.g. the rub node).
+
+    All are empty by default; :class:`Rotor` checks that their nodes exist.
+    """
+
+    unbalances: tuple[Unbalance, ...] = ()
+    outputs: tuple[tuple[int, str], ...] = ()
+    boundary_nodes: tuple[int, ...] = ()
+
+    def __post_init__(self):
+        unbalances = checks.sequence("unbalances", _tuple(self.unbalances), _unbalance)
+        outputs = checks.sequence("outputs", _tuple(self.outputs), checked_dof, unique=True)
+        boundary = checks.sequence("boundary_nodes", _tuple(self.boundary_nodes), _node_number, unique=True)
+        object.__setattr__(self, "unbalances", unbalances)
+        object.__setattr__(self, "outputs", outputs)
+        object.__setattr__(self, "boundary_nodes", boundary)
+
+    def check_nodes(self, nodes: Collection[int]) -> None:
+        """InputError naming the entry if a node is not one of ``nodes``."""
+        for i, u in enumerate(self.unbalances):
+            checks.node(f"unbalances[{i}].node", u.node, nodes)
+        for i, o in enumerate(self.outputs):
+            checked_dof(f"outputs[{i}]", o, nodes)
+        for i, n in enumerate(self.boundary_nodes):
+            checks.node(f"boundary_nodes[{i}]", n, nodes)
+
+    def restricted(self, nodes: Collection[int]) -> AnalysisDefaults:
+        """The defaults whose nodes are among ``nodes`` (e.g. of one spool)."""
+        return AnalysisDefaults(tuple(u for u in self.unbalances if u.node in nodes),
+                                tuple(o for o in self.outputs if o[0] in nodes),
+                                tuple(n for n in self.boundary_nodes if n in nodes))
+
+
+def _tuple(value):
+    """``tuple(value)`` for a list, generator or other non-string iterable; anything else as is (for the check)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        return value
+    return tuple(value)
+
+
+def _unbalance(field_: str, value) -> Unbalance:
+    if not isinstance(value, Unbalance):
+        checks.fail(field_, value, "must be an Unbalance")
+    return value
+
+
+def _node_number(field_: str, value) -> int:
+    return checks.integer(field_, value, ge=0)
 
 
 @dataclass(frozen=True)
@@ -37,23 +106,20 @@ class Spool:
     z0: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"spool `name` must be a non-empty string, got {self.name!r}")
-        object.__setattr__(self, "elements", tuple(self.elements))
-        if not self.elements:
-            raise ValueError(f"spool {self.name!r}: `elements` must hold at least one shaft element, got none")
-        for i, (a, b) in enumerate(zip(self.elements[:-1], self.elements[1:])):
+        checks.string("name", self.name, empty=False)
+        elements = checks.sequence("elements", _tuple(self.elements), _shaft_element, min_len=1)
+        object.__setattr__(self, "elements", elements)
+        for i, (a, b) in enumerate(zip(elements[:-1], elements[1:])):
             if a.right != b.left:
-                raise ValueError(
-                    f"spool {self.name!r}: elements must form a chain; element {i} ends at node {a.right} "
-                    f"but element {i + 1} starts at node {b.left}")
-        nodes = self.nodes
-        if len(set(nodes)) != len(nodes):
-            raise ValueError(f"spool {self.name!r}: a node appears twice in the chain {nodes}")
-        if not (math.isfinite(self.speed) and self.speed >= 0):
-            raise ValueError(f"spool {self.name!r}: `speed` must be >= 0 rad/s, got {self.speed!r}")
-        if not math.isfinite(self.z0):
-            raise ValueError(f"spool {self.name!r}: `z0` must be finite, got {self.z0!r}")
+                checks.fail(f"elements[{i + 1}].left", b.left,
+                            f"must be {a.right}, the right node of elements[{i}]: the elements form a chain")
+        seen = {elements[0].left}
+        for i, e in enumerate(elements):
+            if e.right in seen:
+                checks.fail(f"elements[{i}].right", e.right, "must not repeat a node of the chain")
+            seen.add(e.right)
+        object.__setattr__(self, "speed", checks.non_negative("speed", self.speed, "rad/s"))
+        object.__setattr__(self, "z0", checks.number("z0", self.z0, "m"))
 
     @property
     def nodes(self) -> tuple[int, ...]:
@@ -85,6 +151,9 @@ class Rotor:
         (alpha (1/s), beta (s)) of the shafts' Rayleigh damping C = alpha M_shaft + beta K_shaft;
         disks and bearings are not included.
     name : str
+    defaults : AnalysisDefaults
+        Default unbalances, outputs and extra boundary nodes of analyses (empty by default);
+        kept by :meth:`refined`, :meth:`with_speeds` and the other copies.
     """
 
     spools: tuple[Spool, ...]
@@ -93,41 +162,48 @@ class Rotor:
     intershaft_bearings: tuple[IntershaftBearing, ...] = ()
     rayleigh: tuple[float, float] = (0.0, 0.0)
     name: str = ""
+    defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
 
     def __post_init__(self):
-        for f in ("spools", "disks", "bearings", "intershaft_bearings", "rayleigh"):
-            object.__setattr__(self, f, tuple(getattr(self, f)))
+        for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", Bearing),
+                          ("intershaft_bearings", IntershaftBearing)):
+            object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
-            raise ValueError("`spools` must hold at least one spool, got none")
-        names = [s.name for s in self.spools]
-        if len(set(names)) != len(names):
-            raise ValueError(f"spool names must be unique, got {names}")
+            checks.fail("spools", self.spools, "must hold at least one spool")
+        rayleigh = checks.sequence("rayleigh", _tuple(self.rayleigh), min_len=2, max_len=2)
+        object.__setattr__(self, "rayleigh", (checks.non_negative("rayleigh[0]", rayleigh[0], "1/s"),
+                                              checks.non_negative("rayleigh[1]", rayleigh[1], "s")))
+        checks.string("name", self.name)
+        if not isinstance(self.defaults, AnalysisDefaults):
+            checks.fail("defaults", self.defaults, "must be an AnalysisDefaults")
+        self._check_topology()
+
+    def _check_topology(self) -> None:
+        """Spool names unique, no node on two spools, every referenced node exists."""
         owner: dict[int, str] = {}
-        for s in self.spools:
+        for i, s in enumerate(self.spools):
+            if s.name in [t.name for t in self.spools[:i]]:
+                checks.fail(f"spools[{i}].name", s.name, "must differ from the names of the other spools")
             for n in s.nodes:
                 if n in owner:
-                    raise ValueError(f"node {n} belongs to spool {owner[n]!r} and to spool {s.name!r}")
+                    checks.fail(f"spools[{i}].nodes", s.nodes, f"must not include node {n}, which belongs to "
+                                f"spool {owner[n]!r}")
                 owner[n] = s.name
-        known = sorted(owner)
         for i, d in enumerate(self.disks):
-            if d.node not in owner:
-                raise ValueError(f"disks[{i}] ({d.name or 'unnamed'}): `node` {d.node} does not exist; "
-                                 f"nodes are {_ranges(known)}")
+            checks.node(f"disks[{i}].node", d.node, owner)
         for i, b in enumerate(self.bearings):
-            if b.node not in owner:
-                raise ValueError(f"bearings[{i}] ({b.name or 'unnamed'}): `node` {b.node} does not exist; "
-                                 f"nodes are {_ranges(known)}")
+            checks.node(f"bearings[{i}].node", b.node, owner)
         for i, b in enumerate(self.intershaft_bearings):
-            for attr in ("node_a", "node_b"):
-                n = getattr(b, attr)
-                if n not in owner:
-                    raise ValueError(f"intershaft_bearings[{i}] ({b.name or 'unnamed'}): `{attr}` {n} does not "
-                                     f"exist; nodes are {_ranges(known)}")
+            checks.node(f"intershaft_bearings[{i}].node_a", b.node_a, owner)
+            checks.node(f"intershaft_bearings[{i}].node_b", b.node_b, owner)
             if owner[b.node_a] == owner[b.node_b]:
-                raise ValueError(f"intershaft_bearings[{i}]: nodes {b.node_a} and {b.node_b} are both on spool "
-                                 f"{owner[b.node_a]!r}; an inter-shaft bearing joins two different spools")
-        if len(self.rayleigh) != 2 or not all(math.isfinite(v) and v >= 0 for v in self.rayleigh):
-            raise ValueError(f"`rayleigh` must be (alpha >= 0, beta >= 0), got {self.rayleigh!r}")
+                checks.fail(f"intershaft_bearings[{i}].node_b", b.node_b,
+                            f"must be on another spool than node_a = {b.node_a} (both are on spool "
+                            f"{owner[b.node_a]!r}); an inter-shaft bearing joins two different spools")
+        try:
+            self.defaults.check_nodes(owner)
+        except checks.InputError as exc:
+            raise exc.within("defaults") from None
 
     # --- topology -----------------------------------------------------------------
     @property
@@ -155,17 +231,15 @@ class Rotor:
 
     def spool(self, name: str) -> Spool:
         """The spool called ``name``."""
-        for s in self.spools:
-            if s.name == name:
-                return s
-        raise ValueError(f"spool {name!r} does not exist; spools are {[s.name for s in self.spools]}")
+        checks.choice("spool", name, [s.name for s in self.spools])
+        return next(s for s in self.spools if s.name == name)
 
     def disk_at(self, node: int) -> Disk:
         """The disk at ``node``."""
         for d in self.disks:
             if d.node == node:
                 return d
-        raise ValueError(f"there is no disk at node {node}; disks are at {[d.node for d in self.disks]}")
+        checks.fail("node", node, f"must carry a disk; disks are at nodes {[d.node for d in self.disks]}")
 
     @property
     def mass(self) -> float:
@@ -179,8 +253,7 @@ class Rotor:
         The original nodes keep their numbers; new nodes are numbered from
         ``max(nodes) + 1`` on, element by element along each spool.
         """
-        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-            raise ValueError(f"`n` must be an integer >= 1, got {n!r}")
+        n = checks.integer("n", n, ge=1)
         if n == 1:
             return self
         next_node = max(self.nodes) + 1
@@ -196,9 +269,7 @@ class Rotor:
 
     def with_speeds(self, speeds: Mapping[str, float]) -> Rotor:
         """Return a copy whose spools have the nominal speeds ``speeds`` (rad/s)."""
-        unknown = set(speeds) - {s.name for s in self.spools}
-        if unknown:
-            raise ValueError(f"unknown spool(s) {sorted(unknown)}; spools are {[s.name for s in self.spools]}")
+        checks.keys("speeds", speeds, [s.name for s in self.spools])
         spools = tuple(dataclasses.replace(s, speed=float(speeds.get(s.name, s.speed))) for s in self.spools)
         return dataclasses.replace(self, spools=spools)
 
@@ -213,19 +284,18 @@ class Rotor:
         return dataclasses.replace(
             self, spools=(s,), disks=tuple(d for d in self.disks if d.node in nodes),
             bearings=tuple(b for b in self.bearings if b.node in nodes), intershaft_bearings=(),
-            name=f"{self.name} [{name}]")
+            name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes))
 
 
-def _ranges(nodes: list[int]) -> str:
-    """'1-13, 14-20' for a sorted list of node numbers."""
-    if not nodes:
-        return "none"
-    out, start, prev = [], nodes[0], nodes[0]
-    for n in nodes[1:] + [None]:
-        if n is not None and n == prev + 1:
-            prev = n
-            continue
-        out.append(f"{start}" if start == prev else f"{start}-{prev}")
-        if n is not None:
-            start = prev = n
-    return ", ".join(out)
+
+def _instance(cls):
+    """Item check of :func:`rotorred.checks.sequence`: an instance of ``cls``."""
+    def check(field_: str, value):
+        if not isinstance(value, cls):
+            checks.fail(field_, value, f"must be a {cls.__name__}")
+        return value
+    return check
+
+
+def _shaft_element(field_: str, value) -> ShaftElement:
+    return _instance(ShaftElement)(field_, value)

@@ -17,34 +17,55 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     node_a = 20; node_b = 9; k = 1e7; c = 300.0
     [damping]
     rayleigh_alpha = 0.0; rayleigh_beta = 0.0
+    [defaults]                         # what analyses use when nothing else is given (all optional)
+    unbalance = [ { node = 11, m_e = 1e-5, phase_deg = 0.0 } ]   # kg m, deg
+    outputs = ["13:x", "13:y"]         # NODE:DIRECTION, DIRECTION x, y, theta_x (tx), theta_y (ty)
+    boundary_nodes = [18]              # extra boundary nodes of a reduced model
+
+Every value is checked as written, in the file's units (speeds in rpm), before it is converted;
+an error is a :class:`RotorFileError` (a :class:`rotorred.checks.InputError`) naming the file, the
+key path, the value and what is allowed, e.g.
+``rig.toml: spool[0].elements[1].D_i = 0.03: must be < D_o = 0.02 (m)``.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
-from rotorred.model.rotor import Rotor, Spool
+from rotorred import checks
+from rotorred.checks import InputError
+from rotorred.model.dofs import parse_dof
+from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, Disk, IntershaftBearing, Material,
+                                     ShaftElement)
+from rotorred.model.loads import unbalance_from_table
+from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 
 try:  # Python >= 3.11
     import tomllib
 except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
-_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping"}
+__all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_from_dict", "read_toml"]
+
+_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping",
+             "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "elements"}
 _ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
+_DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
+#: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
+_FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing"}
 
 
-class RotorFileError(ValueError):
-    """A rotor file that does not describe a valid rotor."""
+class RotorFileError(InputError):
+    """A rotor file that does not describe a valid rotor (an :class:`rotorred.checks.InputError`)."""
 
 
 def presets() -> list[str]:
@@ -63,6 +84,13 @@ def load_rotor(spec: str | Path) -> Rotor:
     Returns
     -------
     Rotor
+
+    Raises
+    ------
+    RotorFileError
+        For a file that does not describe a valid rotor, naming the file and the key.
+    FileNotFoundError
+        If ``spec`` is neither a preset nor an existing file.
     """
     spec_str = str(spec)
     if spec_str in presets():
@@ -74,190 +102,183 @@ def load_rotor(spec: str | Path) -> Rotor:
     return rotor_from_toml(path.read_text(), source=str(path))
 
 
-def rotor_from_toml(text: str, source: str = "<string>") -> Rotor:
-    """Parse and validate a rotor TOML document; see the module docstring for the format."""
+def read_toml(text: str, error: type[InputError] = InputError) -> dict[str, Any]:
+    """Parse a TOML document; a syntax error is an ``error`` naming the line, its text and the reason."""
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise RotorFileError(f"{source}: not valid TOML: {exc}") from None
+        reason = str(exc)
+        at = re.search(r"\s*\(at line (\d+), column (\d+)\)$", reason)
+        if at is None:
+            raise error("TOML", text, f"must be valid TOML: {reason}") from None
+        line, column = int(at.group(1)), int(at.group(2))
+        lines = text.splitlines()
+        value = lines[line - 1] if 0 < line <= len(lines) else ""
+        raise error(f"line {line}", value, f"must be valid TOML: {reason[:at.start()]} at column {column}") from None
+
+
+def rotor_from_toml(text: str, source: str = "<string>") -> Rotor:
+    """Parse and validate a rotor TOML document; see the module docstring for the format.
+
+    Raises
+    ------
+    RotorFileError
+        Naming ``source``, the key path, the value and what is allowed.
+    """
     try:
-        return rotor_from_dict(data)
-    except (ValueError, TypeError) as exc:
-        raise RotorFileError(f"{source}: {exc}") from None
+        return rotor_from_dict(read_toml(text, RotorFileError))
+    except RotorFileError as exc:
+        raise exc.from_source(source) from None
 
 
 def rotor_from_dict(data: dict[str, Any]) -> Rotor:
-    """Build a :class:`Rotor` from the parsed TOML tables."""
-    _check_keys("rotor file", data, _TOP_KEYS)
-    materials: dict[str, Material] = {}
-    for i, m in enumerate(_list_of_tables(data, "material")):
-        where = f"material[{i}]"
-        _check_keys(where, m, _MATERIAL_KEYS, required={"name", "E", "rho"})
-        name = _string(where, m, "name")
-        if name in materials:
-            raise ValueError(f"{where}: material `name` {name!r} is defined twice")
-        materials[name] = _build(where, Material, name=name, E=_number(where, m, "E"), rho=_number(where, m, "rho"),
-                                 nu=_number(where, m, "nu", 0.3))
-    spools = []
-    tables = _list_of_tables(data, "spool")
-    if not tables:
-        raise ValueError("at least one [[spool]] table is required, got none")
-    for i, s in enumerate(tables):
-        where = f"spool[{i}]"
-        _check_keys(where, s, _SPOOL_KEYS, required={"name", "first_node", "elements"})
-        name = _string(where, s, "name")
-        where = f"spool[{i}] ({name!r})"
-        node = _integer(where, s, "first_node")
-        if node < 0:
-            raise ValueError(f"{where}: `first_node` must be >= 0, got {node}")
-        default_shear = s.get("shear", "cowper")
-        default_element = s.get("element", "nelson")
-        elements = []
-        rows = s["elements"]
-        if not isinstance(rows, list) or not rows:
-            raise ValueError(f"{where}: `elements` must be a non-empty list of tables, got {rows!r}")
-        for j, e in enumerate(rows):
-            ew = f"{where}.elements[{j}]"
-            if not isinstance(e, dict):
-                raise ValueError(f"{ew}: must be a table {{L = ..., D_o = ..., ...}}, got {e!r}")
-            _check_keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o", "material"})
-            mat = _material(ew, e, materials)
-            repeat = _integer(ew, e, "repeat", 1)
-            if repeat < 1:
-                raise ValueError(f"{ew}: `repeat` must be >= 1, got {repeat}")
-            for _ in range(repeat):
-                elements.append(_build(ew, ShaftElement, left=node, right=node + 1, L=_number(ew, e, "L"),
-                                       D_o=_number(ew, e, "D_o"), D_i=_number(ew, e, "D_i", 0.0), material=mat,
-                                       shear=e.get("shear", default_shear),
-                                       element=e.get("element", default_element)))
-                node += 1
-        speed_rpm = _number(where, s, "speed_rpm", 0.0)
-        if speed_rpm < 0:
-            raise ValueError(f"{where}: `speed_rpm` must be >= 0, got {speed_rpm}")
-        spools.append(_build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0,
-                             z0=_number(where, s, "z0", 0.0)))
-    disks = []
-    for i, d in enumerate(_list_of_tables(data, "disk")):
-        where = f"disk[{i}]"
-        _check_keys(where, d, _DISK_KEYS, required={"node"})
-        disks.append(_disk(where, d, materials))
-    bearings = []
-    for i, b in enumerate(_list_of_tables(data, "bearing")):
-        where = f"bearing[{i}]"
-        _check_keys(where, b, _SUPPORT_KEYS | {"node"}, required={"node"})
-        bearings.append(_build(where, Bearing, node=_integer(where, b, "node"), **_coefficients(where, b)))
-    inter = []
-    for i, b in enumerate(_list_of_tables(data, "intershaft_bearing")):
-        where = f"intershaft_bearing[{i}]"
-        _check_keys(where, b, _SUPPORT_KEYS | {"node_a", "node_b"}, required={"node_a", "node_b"})
-        inter.append(_build(where, IntershaftBearing, node_a=_integer(where, b, "node_a"),
-                            node_b=_integer(where, b, "node_b"), **_coefficients(where, b)))
-    damping = data.get("damping", {})
-    if not isinstance(damping, dict):
-        raise ValueError(f"`damping` must be a table, got {damping!r}")
-    _check_keys("damping", damping, _DAMPING_KEYS)
-    rayleigh = (_number("damping", damping, "rayleigh_alpha", 0.0), _number("damping", damping, "rayleigh_beta", 0.0))
-    name = data.get("name", "")
-    if not isinstance(name, str):
-        raise ValueError(f"`name` must be a string, got {name!r}")
-    return Rotor(spools=tuple(spools), disks=tuple(disks), bearings=tuple(bearings),
-                 intershaft_bearings=tuple(inter), rayleigh=rayleigh, name=name)
+    """Build a :class:`Rotor` from the parsed TOML tables; :class:`RotorFileError` naming the key."""
+    try:
+        return _rotor(checks.table("rotor file", data))
+    except InputError as exc:
+        raise RotorFileError(exc.field, exc.value, exc.requirement, exc.unit, exc.source) from None
 
 
-# --- helpers ------------------------------------------------------------------------
+# --- the tables, one step each --------------------------------------------------------------
+def _rotor(data: dict) -> Rotor:
+    checks.keys("", data, _TOP_KEYS)
+    name = checks.string("name", data.get("name", ""))
+    checks.string("description", data.get("description", ""))
+    materials = _materials(data.get("material", []))
+    spools = _spools(data.get("spool", checks.MISSING), materials)
+    nodes = {n for s in spools for n in s.nodes}
+    disks = tuple(_disk(f"disk[{i}]", d, materials)
+                  for i, d in enumerate(checks.tables("disk", data.get("disk", []))))
+    bearings = tuple(_bearing(f"bearing[{i}]", b)
+                     for i, b in enumerate(checks.tables("bearing", data.get("bearing", []))))
+    inter = tuple(_intershaft_bearing(f"intershaft_bearing[{i}]", b)
+                  for i, b in enumerate(checks.tables("intershaft_bearing", data.get("intershaft_bearing", []))))
+    rayleigh = _damping(data.get("damping", {}))
+    defaults = _defaults(data.get("defaults", {}), nodes)
+    try:
+        return Rotor(spools=spools, disks=disks, bearings=bearings, intershaft_bearings=inter, rayleigh=rayleigh,
+                     name=name, defaults=defaults)
+    except InputError as exc:  # Rotor names its attributes (disks[0].node); the file's keys are disk[0].node
+        head, _, rest = exc.field.partition("[")
+        field = f"{_FILE_KEYS[head]}[{rest}" if head in _FILE_KEYS and rest else exc.field
+        raise InputError(field, exc.value, exc.requirement, exc.unit) from None
+
+
 def _build(where: str, cls, **kwargs):
+    """``cls(**kwargs)``, its InputError prefixed with the key path ``where``."""
     try:
         return cls(**kwargs)
-    except ValueError as exc:
-        raise ValueError(f"{where}: {exc}") from None
+    except InputError as exc:
+        raise exc.within(where) from None
 
 
-def _check_keys(where: str, table: dict, allowed: set[str], required: set[str] = frozenset()) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"{where}: unknown key(s) {unknown}; allowed keys are {sorted(allowed)}")
-    missing = sorted(required - set(table))
-    if missing:
-        raise ValueError(f"{where}: missing required key(s) {missing}")
+def _materials(value) -> dict[str, Material]:
+    materials: dict[str, Material] = {}
+    for i, m in enumerate(checks.tables("material", value)):
+        where = f"material[{i}]"
+        checks.keys(where, m, _MATERIAL_KEYS, required={"name", "E", "rho"})
+        name = checks.string(f"{where}.name", m["name"], empty=False)
+        if name in materials:
+            checks.fail(f"{where}.name", name, "must differ from the names of the other [[material]] tables")
+        materials[name] = _build(where, Material, name=name, E=m["E"], rho=m["rho"], nu=m.get("nu", 0.3))
+    return materials
 
 
-def _list_of_tables(data: dict, key: str) -> list[dict]:
-    value = data.get(key, [])
-    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-        raise ValueError(f"`{key}` must be an array of tables ([[{key}]]), got {value!r}")
-    return value
+def _material(field: str, name, materials: dict[str, Material]) -> Material:
+    if not materials:
+        checks.fail(field, name, "must name a [[material]] table; there is none")
+    return materials[checks.choice(field, name, sorted(materials))]
 
 
-def _number(where: str, table: dict, key: str, default: float | None = None) -> float:
-    if key not in table:
-        if default is None:
-            raise ValueError(f"{where}: missing required key `{key}`")
-        return default
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{where}: `{key}` must be a finite number, got {value!r}")
-    return float(value)
+def _spools(value, materials: dict[str, Material]) -> tuple[Spool, ...]:
+    if value is checks.MISSING:
+        raise InputError("spool", checks.MISSING, "required: at least one [[spool]] table")
+    return tuple(_spool(f"spool[{i}]", s, materials) for i, s in enumerate(checks.tables("spool", value, min_len=1)))
 
 
-def _integer(where: str, table: dict, key: str, default: int | None = None) -> int:
-    if key not in table:
-        if default is None:
-            raise ValueError(f"{where}: missing required key `{key}`")
-        return default
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"{where}: `{key}` must be an integer, got {value!r}")
-    return value
-
-
-def _string(where: str, table: dict, key: str) -> str:
-    value = table.get(key)
-    if not isinstance(value, str) or not value:
-        raise ValueError(f"{where}: `{key}` must be a non-empty string, got {value!r}")
-    return value
-
-
-def _material(where: str, table: dict, materials: dict[str, Material]) -> Material:
-    name = table["material"]
-    if name not in materials:
-        raise ValueError(f"{where}: `material` {name!r} is not defined; defined materials are {sorted(materials)}")
-    return materials[name]
+def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
+    checks.keys(where, s, _SPOOL_KEYS, required={"name", "first_node", "elements"})
+    name = checks.string(f"{where}.name", s["name"], empty=False)
+    node = checks.integer(f"{where}.first_node", s["first_node"], ge=0)
+    shear = checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS)
+    element = checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS)
+    elements = []
+    for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
+        ew = f"{where}.elements[{j}]"
+        checks.keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o", "material"})
+        mat = _material(f"{ew}.material", e["material"], materials)
+        for _ in range(checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1)):
+            elements.append(_build(ew, ShaftElement, left=node, right=node + 1, L=e["L"], D_o=e["D_o"],
+                                   D_i=e.get("D_i", 0.0), material=mat, shear=e.get("shear", shear),
+                                   element=e.get("element", element)))
+            node += 1
+    speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0,
+                  z0=s.get("z0", 0.0))
 
 
 def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
-    node = _integer(where, d, "node")
-    name = d.get("name", "")
-    explicit = {"m", "I_d", "I_p"} & set(d)
-    geometric = {"D_o", "thickness", "material"} & set(d)
+    checks.keys(where, d, _DISK_KEYS, required={"node"})
+    explicit = [k for k in ("m", "I_d", "I_p") if k in d]
+    geometric = [k for k in ("D_o", "thickness", "material") if k in d]
     if explicit and geometric:
-        raise ValueError(f"{where}: give either (m, I_d, I_p) or (D_o, D_i, thickness, material), not both")
-    if geometric:
-        _check_keys(where, d, _DISK_KEYS, required={"node", "D_o", "thickness", "material"})
-        mat = _material(where, d, materials)
-        D_o, D_i, h = _number(where, d, "D_o"), _number(where, d, "D_i", 0.0), _number(where, d, "thickness")
-        if not (D_o > 0 and h > 0 and 0 <= D_i < D_o):
-            raise ValueError(f"{where}: need D_o > 0, thickness > 0 and 0 <= D_i < D_o, got D_o={D_o}, D_i={D_i}, "
-                             f"thickness={h} (m)")
-        ro2, ri2 = (D_o / 2) ** 2, (D_i / 2) ** 2
-        m = mat.rho * math.pi * (ro2 - ri2) * h
-        # Thin annular disk: I_p = m (ro^2 + ri^2) / 2, I_d = m (3 (ro^2 + ri^2) + h^2) / 12.
-        return _build(where, Disk, node=node, m=m, I_d=m * (3 * (ro2 + ri2) + h**2) / 12, I_p=m * (ro2 + ri2) / 2,
-                      name=name, radius=_number(where, d, "radius", D_o / 2))
-    _check_keys(where, d, _DISK_KEYS, required={"node", "m", "I_d", "I_p"})
-    return _build(where, Disk, node=node, m=_number(where, d, "m"), I_d=_number(where, d, "I_d"),
-                  I_p=_number(where, d, "I_p"), name=name, radius=_number(where, d, "radius", 0.0))
+        checks.fail(f"{where}.{explicit[0]}", d[explicit[0]], f"must not be given with {', '.join(geometric)}: "
+                    "give either (m, I_d, I_p) or (D_o, D_i, thickness, material)")
+    if not geometric:
+        checks.keys(where, d, _DISK_KEYS, required={"node", "m", "I_d", "I_p"})
+        return _build(where, Disk, node=d["node"], m=d["m"], I_d=d["I_d"], I_p=d["I_p"], name=d.get("name", ""),
+                      radius=d.get("radius", 0.0))
+    checks.keys(where, d, _DISK_KEYS, required={"node", "D_o", "thickness", "material"})
+    mat = _material(f"{where}.material", d["material"], materials)
+    D_o = checks.positive(f"{where}.D_o", d["D_o"], "m")
+    D_i = checks.non_negative(f"{where}.D_i", d.get("D_i", 0.0), "m")
+    if D_i >= D_o:
+        checks.fail(f"{where}.D_i", d["D_i"], f"must be < D_o = {D_o:g}", "m")
+    h = checks.positive(f"{where}.thickness", d["thickness"], "m")
+    ro2, ri2 = (D_o / 2) ** 2, (D_i / 2) ** 2
+    m = mat.rho * math.pi * (ro2 - ri2) * h
+    # Thin annular disk: I_p = m (ro^2 + ri^2) / 2, I_d = m (3 (ro^2 + ri^2) + h^2) / 12.
+    return _build(where, Disk, node=d["node"], m=m, I_d=m * (3 * (ro2 + ri2) + h**2) / 12, I_p=m * (ro2 + ri2) / 2,
+                  name=d.get("name", ""), radius=d.get("radius", D_o / 2))
+
+
+def _bearing(where: str, b: dict) -> Bearing:
+    checks.keys(where, b, _SUPPORT_KEYS | {"node"}, required={"node"})
+    return _build(where, Bearing, node=b["node"], **_coefficients(where, b))
+
+
+def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing:
+    checks.keys(where, b, _SUPPORT_KEYS | {"node_a", "node_b"}, required={"node_a", "node_b"})
+    return _build(where, IntershaftBearing, node_a=b["node_a"], node_b=b["node_b"], **_coefficients(where, b))
 
 
 def _coefficients(where: str, b: dict) -> dict[str, Any]:
-    out: dict[str, Any] = {"name": b.get("name", "")}
-    for kind in ("k", "c"):
+    """The support coefficients as given; ``k`` / ``c`` (isotropic) set both direct terms."""
+    out: dict[str, Any] = {k: v for k, v in b.items() if k in _SUPPORT_KEYS - {"k", "c"}}
+    for kind, unit in (("k", "N/m"), ("c", "N s/m")):
         if kind in b:
             for direct in (f"{kind}_xx", f"{kind}_yy"):
                 if direct in b:
-                    raise ValueError(f"{where}: give `{kind}` (isotropic) or `{direct}`, not both")
-            out[f"{kind}_xx"] = out[f"{kind}_yy"] = _number(where, b, kind)
-        for suffix in ("xx", "yy", "xy", "yx"):
-            key = f"{kind}_{suffix}"
-            if key in b:
-                out[key] = _number(where, b, key)
+                    checks.fail(f"{where}.{direct}", b[direct], f"must not be given with {kind}: "
+                                f"give {kind} (isotropic) or {kind}_xx, {kind}_yy")
+            out[f"{kind}_xx"] = out[f"{kind}_yy"] = checks.non_negative(f"{where}.{kind}", b[kind], unit)
     return out
+
+
+def _damping(value) -> tuple[float, float]:
+    table = checks.table("damping", value)
+    checks.keys("damping", table, _DAMPING_KEYS)
+    return (checks.non_negative("damping.rayleigh_alpha", table.get("rayleigh_alpha", 0.0), "1/s"),
+            checks.non_negative("damping.rayleigh_beta", table.get("rayleigh_beta", 0.0), "s"))
+
+
+def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
+    table = checks.table("defaults", value)
+    checks.keys("defaults", table, _DEFAULTS_KEYS)
+    unbalances = tuple(unbalance_from_table(f"defaults.unbalance[{i}]", u, nodes)
+                       for i, u in enumerate(checks.tables("defaults.unbalance", table.get("unbalance", []))))
+    outputs = checks.sequence("defaults.outputs", table.get("outputs", []), lambda f, v: parse_dof(f, v, nodes),
+                              unique=True)
+    boundary = checks.sequence("defaults.boundary_nodes", table.get("boundary_nodes", []),
+                               lambda f, v: checks.node(f, v, nodes), unique=True)
+    return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary)

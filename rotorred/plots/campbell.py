@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from rotorred.linear.campbell import CampbellResult, excitation_label
 
@@ -37,18 +38,31 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
     -------
     Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     path = Path(path)
-    rpm = result.speeds_rpm
-    f_hz = result.frequencies_hz
-    fig, ax = plt.subplots(figsize=(11, 6), dpi=120)
+    fig = Figure(figsize=(11, 6), dpi=120)
+    ax = fig.subplots()
+    top = max_frequency_hz or 1.1 * float(result.frequencies_hz.max())
+    _whirl_curves(ax, result, max_frequency_hz)
+    ax.set_xlim(float(result.speeds_rpm[0]), float(result.speeds_rpm[-1]))
+    ax.set_ylim(0, top)
+    _excitation_lines(ax, result, top)
+    if result.critical_speeds:
+        ax.plot([c.speed_rpm for c in result.critical_speeds], [c.frequency_hz for c in result.critical_speeds],
+                "o", mfc="none", mec="black", ms=8, mew=1.5, label="critical speed", zorder=5)
+    if operating_speed is not None:
+        op = operating_speed * 30 / np.pi
+        ax.axvline(op, color="tab:green", lw=1.2, label=f"operating point {op:.0f} rpm")
+    _axes_and_legend(ax, result, title)
+    fig.tight_layout()
+    fig.savefig(path)
+    return path
+
+
+def _whirl_curves(ax, result: CampbellResult, max_frequency_hz: float | None) -> None:
+    """One line per run of equal whirl direction of each mode; consecutive runs share their end point."""
+    rpm, f_hz = result.speeds_rpm, result.frequencies_hz
     seen = set()
     for j in range(result.n_modes):
-        # one line per run of equal whirl direction; consecutive runs share their end point
         w = result.whirl[:, j]
         start = 0
         for i in range(1, len(rpm) + 1):
@@ -62,18 +76,19 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
         if f_hz[-1, j] <= (max_frequency_hz or np.inf):
             ax.annotate(f"{j}", (rpm[-1], f_hz[-1, j]), xytext=(3, 0), textcoords="offset points", fontsize=8,
                         va="center", color="0.3", annotation_clip=False)
-    top = max_frequency_hz or 1.1 * float(f_hz.max())
+
+
+def _excitation_lines(ax, result: CampbellResult, top: float) -> None:
+    """The excitation lines, each labelled inline where it is farthest from the curves and other labels."""
+    rpm, f_hz = result.speeds_rpm, result.frequencies_hz
     x_max = float(rpm[-1])
-    ax.set_xlim(float(rpm[0]), x_max)
-    ax.set_ylim(0, top)
     placed: list[tuple[float, float]] = []
     dashes = [(0, (6, 2)), (0, (1, 1.5)), (0, (6, 2, 1, 2)), (0, (3, 3)), (0, (8, 2, 1, 2, 1, 2))]
     for k, (spool, h, slope) in enumerate(result.excitation_lines):
         label = excitation_label(h, spool)
-        y = slope * result.speeds / (2 * np.pi)
-        ax.plot(rpm, y, color="0.2", lw=1.0, linestyle=dashes[k % len(dashes)], label=label)
-        # inline label on the visible part of the line, where it is farthest from the whirl curves and
-        # from the labels already placed (distances in axes fractions)
+        ax.plot(rpm, slope * result.speeds / (2 * np.pi), color="0.2", lw=1.0, linestyle=dashes[k % len(dashes)],
+                label=label)
+        # distances in axes fractions
         hz_per_rpm = slope * np.pi / 30 / (2 * np.pi)
         x_end = min(x_max, top / hz_per_rpm) if hz_per_rpm > 0 else x_max
         best, x = -1.0, 0.5 * (float(rpm[0]) + x_end)
@@ -90,12 +105,10 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
         ax.text(x, hz_per_rpm * x, label, rotation=angle, rotation_mode="anchor", ha="center", va="center",
                 fontsize=8.5, color="0.1", bbox=dict(boxstyle="round,pad=0.12", fc="white", ec="none", alpha=0.85),
                 zorder=4)
-    if result.critical_speeds:
-        ax.plot([c.speed_rpm for c in result.critical_speeds], [c.frequency_hz for c in result.critical_speeds],
-                "o", mfc="none", mec="black", ms=8, mew=1.5, label="critical speed", zorder=5)
-    if operating_speed is not None:
-        op = operating_speed * 30 / np.pi
-        ax.axvline(op, color="tab:green", lw=1.2, label=f"operating point {op:.0f} rpm")
+
+
+def _axes_and_legend(ax, result: CampbellResult, title: str | None) -> None:
+    """Axis labels (rpm, Hz), the other spool's speed on top, title with the speed ratios, legend."""
     ax.set_xlabel(f"speed of the {result.reference} spool (rpm)")
     ax.set_ylabel("whirl frequency (Hz)")
     others = {s: r for s, r in result.speed_ratios.items() if s != result.reference}
@@ -114,7 +127,3 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
     pairs = sorted(zip(handles, labels), key=lambda hl: key[hl[1]])
     ax.legend([h for h, _ in pairs], [lab for _, lab in pairs], loc="upper left", bbox_to_anchor=(1.03, 1.0),
               fontsize=9, title="curves (mode no. at right end)", title_fontsize=8.5)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path

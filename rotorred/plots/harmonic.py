@@ -9,17 +9,11 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from rotorred.linear.harmonic import FrequencyResponse, UnbalanceResponse
 
 _RPM = 60.0 / (2.0 * math.pi)
-
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 def plot_bode(result: UnbalanceResponse, path: str | Path, title: str = "") -> Path:
@@ -28,10 +22,10 @@ def plot_bode(result: UnbalanceResponse, path: str | Path, title: str = "") -> P
     One line per excited spool (at that spool's own frequency) and, with more than one
     excited spool, the peak bound (sum of magnitudes) dashed.
     """
-    plt = _pyplot()
     path = Path(path)
     n_out = len(result.outputs)
-    fig, axes = plt.subplots(2, n_out, figsize=(4.2 * n_out + 1, 6.2), sharex=True, squeeze=False)
+    fig = Figure(figsize=(4.2 * n_out + 1, 6.2))
+    axes = fig.subplots(2, n_out, sharex=True, squeeze=False)
     rpm = result.speeds * _RPM
     for j, o in enumerate(result.outputs):
         ax_a, ax_p = axes[0, j], axes[1, j]
@@ -54,7 +48,6 @@ def plot_bode(result: UnbalanceResponse, path: str | Path, title: str = "") -> P
     fig.suptitle(title or "Unbalance response (Bode)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -65,10 +58,10 @@ def plot_polar(result: UnbalanceResponse, path: str | Path, title: str = "") -> 
     frequencies); the largest-amplitude point and the sweep's end are labelled with the
     reference spool speed (rpm).
     """
-    plt = _pyplot()
     path = Path(path)
     n_out = len(result.outputs)
-    fig, axes = plt.subplots(1, n_out, figsize=(4.6 * n_out + 0.5, 4.8), squeeze=False)
+    fig = Figure(figsize=(4.6 * n_out + 0.5, 4.8))
+    axes = fig.subplots(1, n_out, squeeze=False)
     rpm = result.speeds * _RPM
     for j, o in enumerate(result.outputs):
         ax = axes[0, j]
@@ -91,15 +84,14 @@ def plot_polar(result: UnbalanceResponse, path: str | Path, title: str = "") -> 
     fig.suptitle((title or "Unbalance response (polar)") + f"; points labelled with the {result.reference_spool} speed")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
 def plot_frf(frf: FrequencyResponse, path: str | Path, title: str = "") -> Path:
     """Bode plot of every FRF pair: |H| (m/N, log) and phase (deg) against frequency (Hz)."""
-    plt = _pyplot()
     path = Path(path)
-    fig, (ax_a, ax_p) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    fig = Figure(figsize=(7, 6))
+    (ax_a, ax_p) = fig.subplots(2, 1, sharex=True)
     f = frf.frequencies / (2 * math.pi)
     for o in frf.outputs:
         for i in frf.inputs:
@@ -118,5 +110,4 @@ def plot_frf(frf: FrequencyResponse, path: str | Path, title: str = "") -> Path:
     fig.suptitle(title or f"Receptance FRF ({speeds})")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path

@@ -22,51 +22,45 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from rotorred import checks
+from rotorred.model.dofs import direction_name
 from rotorred.signals.lines import SpectralLine
 from rotorred.signals.spectra import Spectrum
 
-__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits"]
+__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_scene"]
 
 
 # --------------------------------------------------------------------------- helpers
 def _panels(data, what: str) -> dict[str, dict[str, object]]:
     """Normalise one-panel or multi-panel mappings to {panel title: {label: item}}."""
     if not isinstance(data, Mapping) or not data:
-        raise ValueError(f"`{what}` must be a non-empty mapping label -> data, got {data!r:.80}")
+        checks.fail(what, data, "must be a non-empty mapping label -> data")
     nested = [isinstance(v, Mapping) for v in data.values()]
     if all(nested):
         out = {}
         for title, series in data.items():
             if not series:
-                raise ValueError(f"`{what}` panel {title!r} is empty")
+                checks.fail(f"{what}[{title!r}]", series, "must not be empty")
             out[str(title)] = dict(series)
         return out
     if any(nested):
-        raise ValueError(f"`{what}` mixes panels (mappings) and series; use one form")
+        checks.fail(what, data, "mixes panels (mappings) and series; use one form")
     return {"": dict(data)}
-
-
-def _check_scale(scale) -> float:
-    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
-        raise ValueError(f"`scale` must be a positive finite number, got {scale!r}")
-    if not (math.isfinite(scale) and scale > 0):
-        raise ValueError(f"`scale` must be a positive finite number, got {scale!r}")
-    return float(scale)
 
 
 def _vector(name: str, y, n: int | None = None) -> np.ndarray:
     y = np.asarray(y, dtype=float)
     if y.ndim != 1 or y.size < 2:
-        raise ValueError(f"`{name}` must be a 1-D array of at least 2 samples, got shape {y.shape}")
+        checks.fail(name, y, "must be a 1-D array of at least 2 samples")
     if n is not None and y.size != n:
-        raise ValueError(f"`{name}` has {y.size} samples, expected {n} (the length of `t`)")
+        checks.fail(name, y, f"must have {n} samples (the length of t), not {y.size}")
     return y
 
 
 def _path(path) -> Path:
     p = Path(path)
     if not p.suffix:
-        raise ValueError(f"`path` must have a file extension (e.g. .png), got {str(path)!r}")
+        checks.fail("path", str(path), "must have a file extension (e.g. .png)")
     p.parent.mkdir(parents=True, exist_ok=True)
     return p
 
@@ -114,15 +108,16 @@ def plot_waveforms(
     Path
     """
     t = _vector("t", t)
-    scale = _check_scale(scale)
+    scale = checks.positive("scale", scale)
     panels = _panels(signals, "signals")
     if t_window is not None:
-        lo, hi = (float(v) for v in t_window)
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            raise ValueError(f"`t_window` must be (start, end) with start < end (s), got {t_window!r}")
+        lo, hi = checks.sequence("t_window", list(t_window), lambda f, v: checks.number(f, v, "s"), min_len=2,
+                                 max_len=2)
+        if not lo < hi:
+            checks.fail("t_window", t_window, "must be (start, end) with start < end", "s")
         keep = (t >= lo) & (t <= hi)
         if keep.sum() < 2:
-            raise ValueError(f"`t_window`={t_window!r} holds fewer than 2 samples of `t`")
+            checks.fail("t_window", t_window, "must hold at least 2 samples of t", "s")
     else:
         keep = np.ones(t.size, dtype=bool)
     path = _path(path)
@@ -150,10 +145,7 @@ def _spectrum_arrays(name: str, item) -> tuple[np.ndarray, np.ndarray]:
         f = _vector(f"{name} frequencies", item[0])
         a = _vector(f"{name} amplitudes", item[1], f.size)
         return f, a
-    raise ValueError(
-        f"`spectra[{name!r}]` must be a Spectrum or (frequencies Hz, amplitudes), "
-        f"got {type(item).__name__}"
-    )
+    checks.fail(f"spectra[{name!r}]", type(item).__name__, "must be a Spectrum or (frequencies Hz, amplitudes)")
 
 
 def plot_spectra(
@@ -195,20 +187,19 @@ def plot_spectra(
     -------
     Path
     """
-    scale = _check_scale(scale)
+    scale = checks.positive("scale", scale)
     panels = _panels(spectra, "spectra")
     lines = {} if lines is None else dict(lines)
-    if not (math.isfinite(dynamic_range) and dynamic_range > 1):
-        raise ValueError(f"`dynamic_range` must be a finite number > 1, got {dynamic_range!r}")
+    checks.number("dynamic_range", dynamic_range, gt=1.0)
     all_labels = {str(k) for series in panels.values() for k in series}
     for key in lines:
         if str(key) not in all_labels:
-            raise ValueError(f"`lines` key {key!r} is not a series of `spectra` ({sorted(all_labels)})")
+            checks.fail(f"lines[{key!r}]", key, f"lines key must be a series of spectra ({sorted(all_labels)})")
     if f_max is None:
         known = [ln.frequency_hz for seq in lines.values() for ln in seq if ln.known]
         f_max = 1.1 * max(known) if known else None
-    elif not (math.isfinite(f_max) and f_max > 0):
-        raise ValueError(f"`f_max` must be a positive finite frequency (Hz), got {f_max!r}")
+    else:
+        checks.positive("f_max", f_max, "Hz")
     path = _path(path)
     fig = Figure(figsize=(10, 3.4 * len(panels) + 0.8), layout="constrained")
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
@@ -278,22 +269,19 @@ def plot_orbits(
     -------
     Path
     """
-    scale = _check_scale(scale)
+    scale = checks.positive("scale", scale)
     panels = _panels(orbits, "orbits")
     if clearance is None:
         clearances = {}
     elif isinstance(clearance, Mapping):
         unknown = set(map(str, clearance)) - set(panels)
         if unknown:
-            raise ValueError(f"`clearance` keys {sorted(unknown)} are not panels of `orbits`")
+            checks.fail("clearance", sorted(unknown), "keys must be panels of orbits; these are not panels")
         clearances = {str(k): v for k, v in clearance.items()}
     else:
         clearances = {panel: clearance for panel in panels}
     for panel, radius in clearances.items():
-        if isinstance(radius, bool) or not isinstance(radius, (int, float, np.floating)) or not (
-            math.isfinite(radius) and radius > 0
-        ):
-            raise ValueError(f"`clearance` must be a positive finite radius (m), got {radius!r}")
+        checks.positive("clearance", radius, "m")
     path = _path(path)
     n = len(panels)
     fig = Figure(figsize=(4.6 * n + 0.4, 5.0), layout="constrained")
@@ -301,7 +289,7 @@ def plot_orbits(
     for ax, (panel, series) in zip(axes, panels.items()):
         for label, xy in series.items():
             if not (isinstance(xy, Sequence) and len(xy) == 2):
-                raise ValueError(f"`orbits[{label!r}]` must be a pair (x, y), got {type(xy).__name__}")
+                checks.fail(f"orbits[{label!r}]", type(xy).__name__, "must be a pair (x, y)")
             x = _vector(f"orbits[{label!r}] x", xy[0])
             y = _vector(f"orbits[{label!r}] y", xy[1], x.size)
             ax.plot(scale * x, scale * y, lw=0.9, label=str(label))
@@ -321,3 +309,63 @@ def plot_orbits(
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
     return _save(fig, path, title)
+
+
+# --------------------------------------------------------------------------- a scene's figures
+def plot_scene(result, out: str | Path) -> list[Path]:
+    """The figures a scene's ``output.plots`` asks for, written into ``out``: waveforms, spectra, orbits.
+
+    Parameters
+    ----------
+    result : rotorred.scenes.run.SceneResult
+        The result, with its ``normal`` (no-rub) companion overlaid when present.
+    out : str or Path
+        Output folder.
+
+    Returns
+    -------
+    list of Path
+    """
+    out = Path(out)
+    sc = result.scene
+    plots = sc.output.plots
+    case = "rub" if sc.plates else "response"
+    pairs = [("normal", result.normal), (case, result)] if result.normal is not None else [(case, result)]
+    files = []
+    rub_text = "; ".join(f"rub at node {p.node} ({math.degrees(p.theta):g} deg, clearance {1e6 * p.clearance:.3g} um)"
+                         for p in sc.plates) or "no rub"
+    speeds = ", ".join(f"{w / (2 * math.pi):.4g} Hz" for w in sc.speeds.values())
+    translational = [d for d in sc.output.directions if d in ("x", "y")]
+    if "waveforms" in plots:
+        window = sc.output.plot_window or (result.t[0], min(result.t[-1], result.t[0] + 0.14))
+        signals = {f"node {n} {direction_name(d)}": {label: r.outputs[(n, d)] for label, r in pairs}
+                   for n in sc.output.nodes for d in sc.output.directions}
+        files.append(plot_waveforms(result.t, signals, out / "waveforms.png", t_window=window,
+                                    title=f"{sc.name}: time waveforms ({speeds}; {rub_text})",
+                                    unit="µm" if translational else "µrad"))
+    if "spectra" in plots:
+        f_max = sc.output.f_max_hz
+        for n in sc.output.nodes:
+            spectra, lines = {}, {}
+            for d in sc.output.directions:
+                panel = f"node {n} {direction_name(d)}"
+                spectra[panel] = {f"{label} {direction_name(d)}": r.spectra[(n, d)] for label, r in pairs}
+                lines[f"{case} {direction_name(d)}"] = result.lines[(n, d)]
+            if f_max is None:
+                known = [ln.frequency_hz for ls in lines.values() for ln in ls if ln.known]
+                f_max_n = max(1.1 * max(known, default=0.0), 3.0 * result.f_H)
+            else:
+                f_max_n = f_max
+            files.append(plot_spectra(spectra, out / f"spectra_node{n}.png", lines=lines, f_max=f_max_n,
+                                      title=f"{sc.name}: amplitude spectra at node {n} ({rub_text})"))
+    if "orbits" in plots and {"x", "y"} <= set(sc.output.directions):
+        orbits = {}
+        for n in sc.output.nodes:
+            title = f"node {n} ({sc.rotor.spool_of[n]})"
+            for p in sc.plates:
+                if p.node == n:
+                    title += f", plate at {math.degrees(p.theta):g} deg"
+            orbits[title] = {label: (r.outputs[(n, "x")], r.outputs[(n, "y")]) for label, r in pairs}
+        files.append(plot_orbits(orbits, out / "orbits.png",
+                                 title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
+    return files

@@ -1,8 +1,9 @@
 """Scenes: a complete simulation described in one TOML file (rotor, speeds, loads, rubs, solver, outputs).
 
 A scene is loaded and validated in full before anything is computed: every key is checked
-(unknown keys, types, ranges, node numbers against the rotor), and an error names the key,
-the value and what is allowed. The format, with every key's unit and default, is documented
+(unknown keys, types, ranges, node numbers against the rotor) by :mod:`rotorred.checks`, as
+written (speeds in Hz, angles in degrees) before it is converted, and an error (:class:`SceneError`)
+names the file, the key, the value and what is allowed. The format, with every key's unit and default, is documented
 in ``docs/scenes.md``; in short::
 
     name = "paper-rub"
@@ -41,21 +42,18 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from rotorred.transient.contact import RubPlate
-from rotorred.model.rotor_file import load_rotor, presets
-from rotorred.model.loads import Unbalance
+from rotorred import checks
+from rotorred.checks import InputError, fail
+from rotorred.model.dofs import DIRECTIONS, parse_dof
+from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.rotor import Rotor
+from rotorred.model.rotor_file import load_rotor, presets, read_toml
+from rotorred.transient.contact import RubPlate
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
-
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover
-    import tomli as tomllib
 
 __all__ = ["Scene", "SolverSpec", "OutputSpec", "SceneError", "load_scene", "scene_from_toml", "scene_from_dict",
            "builtin_scenes", "apply_settings", "parse_setting", "DIRECTIONS", "PLOTS", "FORMATS"]
 
-DIRECTIONS = ("x", "y", "theta_x", "theta_y")
 PLOTS = ("waveforms", "spectra", "orbits")
 FORMATS = ("npz", "csv", "mat")
 MODELS = ("reduced", "full")
@@ -65,7 +63,7 @@ BENDING = ("navier", "clamped-free", "rigid")
 
 _TOP_KEYS = {"name", "description", "rotor", "speeds", "unbalance", "rub", "solver", "output"}
 _ROTOR_KEYS = {"preset", "file", "rayleigh_alpha", "rayleigh_beta"}
-_UNBALANCE_KEYS = {"node", "m_e", "phase_deg"}
+_UNBALANCE_KEYS = {"node", "m_e", "phase_deg"}  # rotorred.model.loads.UNBALANCE_KEYS
 _RUB_NUMBERS = {"clearance": ("m", 0.0, False), "K_nr": ("N/m^1.5", 0.0, True), "c": ("s/m", 0.0, False),
                 "mu_s": ("-", 0.0, False), "mu_d": ("-", 0.0, False), "m_p": ("kg", 0.0, True),
                 "k_n": ("N/m", 0.0, False), "k_t": ("N/m", 0.0, False), "c_n": ("N s/m", 0.0, False),
@@ -85,8 +83,13 @@ _RTOL = 1e-9
 NAVIER_TOL = 1e-6
 
 
-class SceneError(ValueError):
-    """A scene file that does not describe a valid simulation."""
+class SceneError(InputError):
+    """A scene file that does not describe a valid simulation (an :class:`rotorred.checks.InputError`).
+
+    Its message names the file, the key path, the value as written and what is allowed, e.g.
+    ``paper-rub.toml: rub[0].clearance = -5e-06: must be >= 0 (m)``. An error in the scene's rotor
+    file names that file.
+    """
 
 
 @dataclass(frozen=True)
@@ -243,9 +246,9 @@ def _read(spec: str | Path) -> tuple[dict, str, Path | None]:
                                     f"({', '.join(builtin_scenes())}) nor an existing file")
         text, source, base = path.read_text(), str(path), path.parent
     try:
-        return tomllib.loads(text), source, base
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source}: not valid TOML: {exc}") from None
+        return read_toml(text, SceneError), source, base
+    except SceneError as exc:
+        raise exc.from_source(source) from None
 
 
 def load_scene(spec: str | Path, settings: dict[str, Any] | None = None) -> Scene:
@@ -261,6 +264,13 @@ def load_scene(spec: str | Path, settings: dict[str, Any] | None = None) -> Scen
     Returns
     -------
     Scene
+
+    Raises
+    ------
+    SceneError
+        For a scene (or its rotor file) that is not valid, naming the file and the key.
+    FileNotFoundError
+        If ``spec`` is neither a built-in scene nor an existing file.
     """
     data, source, base = _read(spec)
     if settings:
@@ -271,46 +281,46 @@ def load_scene(spec: str | Path, settings: dict[str, Any] | None = None) -> Scen
 def scene_from_toml(text: str, source: str = "<string>", base: Path | None = None) -> Scene:
     """Parse and validate a scene TOML document."""
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source}: not valid TOML: {exc}") from None
+        data = read_toml(text, SceneError)
+    except SceneError as exc:
+        raise exc.from_source(source) from None
     return scene_from_dict(data, source=source, base=base)
 
 
 def scene_from_dict(data: dict, source: str = "<string>", base: Path | None = None) -> Scene:
-    """Build a :class:`Scene` from parsed TOML tables; raises :class:`SceneError` naming the key."""
+    """Build a :class:`Scene` from parsed TOML tables; raises :class:`SceneError` naming the key.
+
+    An error in the scene's rotor file keeps that file as its source.
+    """
     try:
-        return _build(copy.deepcopy(data), source, base)
-    except SceneError:
-        raise
-    except FileNotFoundError as exc:
-        raise SceneError(f"{source}: {exc}") from None
-    except (ValueError, TypeError) as exc:
-        raise SceneError(f"{source}: {exc}") from None
+        return _build(copy.deepcopy(checks.table("scene", data)), source, base)
+    except InputError as exc:
+        raise SceneError(exc.field, exc.value, exc.requirement, exc.unit, exc.source or source) from None
 
 
 # --------------------------------------------------------------------------- settings (--set)
+_SET_FORM = "must be KEY=VALUES (e.g. rub.clearance=10e-6,20e-6) or KEY=START:STOP:N"
+
+
 def parse_setting(text: str) -> tuple[str, list]:
     """Parse ``"section.key=v1,v2,..."`` or ``"section.key=start:stop:n"`` into (key, values).
 
     Values are TOML values (numbers, strings, booleans); a bare word is a string.
     ``start:stop:n`` gives ``n`` evenly spaced numbers (n >= 2).
     """
-    if "=" not in text:
-        raise ValueError(f"`--set` must be KEY=VALUES (e.g. rub.clearance=10e-6,20e-6), got {text!r}")
+    checks.string("--set", text)
     key, _, rhs = text.partition("=")
     key, rhs = key.strip(), rhs.strip()
-    if not key or not rhs:
-        raise ValueError(f"`--set` must be KEY=VALUES (e.g. rub.clearance=10e-6,20e-6), got {text!r}")
+    if "=" not in text or not key or not rhs:
+        fail("--set", text, _SET_FORM)
     if rhs.count(":") == 2 and "," not in rhs:
         a, b, n = rhs.split(":")
         try:
             a, b, n = float(a), float(b), int(n)
         except ValueError:
-            raise ValueError(f"`--set {key}`: a range must be START:STOP:N with numbers and an integer N, "
-                             f"got {rhs!r}") from None
-        if n < 2:
-            raise ValueError(f"`--set {key}`: a range needs N >= 2 points, got {n}")
+            n = None
+        if n is None or n < 2:
+            fail(f"--set {key}", rhs, "must be START:STOP:N with numbers START, STOP and an integer N >= 2")
         return key, [a + (b - a) * i / (n - 1) for i in range(n)]
     return key, [_toml_value(v.strip(), key) for v in _split_top(rhs) if v.strip()]
 
@@ -336,11 +346,11 @@ def _split_top(text: str) -> list[str]:
 
 def _toml_value(text: str, key: str):
     try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+        return read_toml(f"v = {text}")["v"]
+    except InputError:
         if text and all(ch.isalnum() or ch in "_-:.+" for ch in text):
             return text  # a bare word, e.g. full or 14:y
-        raise ValueError(f"`--set {key}`: cannot read the value {text!r}") from None
+        fail(f"--set {key}", text, "must be a TOML value (number, string, boolean, array) or a bare word")
 
 
 def apply_settings(data: dict, settings: dict[str, Any]) -> dict:
@@ -357,7 +367,7 @@ def apply_settings(data: dict, settings: dict[str, Any]) -> dict:
             data[key] = value
             continue
         if len(parts) != 2:
-            raise ValueError(f"setting {key!r} must be KEY or SECTION.KEY (e.g. rub.clearance)")
+            fail("--set", key, "must be KEY or SECTION.KEY (e.g. rub.clearance)")
         section, name = parts
         index = None
         if section.endswith("]") and "[" in section:
@@ -365,231 +375,196 @@ def apply_settings(data: dict, settings: dict[str, Any]) -> dict:
             try:
                 index = int(idx)
             except ValueError:
-                raise ValueError(f"setting {key!r}: the index in [] must be an integer") from None
+                fail("--set", key, "must index an entry with an integer, e.g. rub[1].clearance")
         target = data.get(section)
         if isinstance(target, list):
-            entries = target if index is None else [target[index]] if 0 <= index < len(target) else None
-            if entries is None:
-                raise ValueError(f"setting {key!r}: the scene has {len(target)} [[{section}]] entries")
-            for entry in entries:
+            if index is not None and not 0 <= index < len(target):
+                fail("--set", key, f"must index an existing entry: the scene has {len(target)} [[{section}]] entries")
+            for entry in target if index is None else [target[index]]:
                 entry[name] = value
         elif index is not None:
-            raise ValueError(f"setting {key!r}: [{section}] is not an array of tables")
+            fail("--set", key, f"must index an array of tables; [{section}] is not one")
         elif target is None:
             if section in ("rub", "unbalance"):
-                raise ValueError(f"setting {key!r}: the scene has no [[{section}]] entry to set")
+                fail("--set", key, f"must set a key of an existing entry: the scene has no [[{section}]] entry")
             data[section] = {name: value}
         elif isinstance(target, dict):
             target[name] = value
         else:
-            raise ValueError(f"setting {key!r}: {section!r} is not a table")
+            fail("--set", key, f"must set a key of a table; {section!r} is not a table")
     return data
 
 
 # --------------------------------------------------------------------------- checks
-def _keys(where: str, table, allowed: set[str], required: set[str] = frozenset()) -> None:
-    if not isinstance(table, dict):
-        raise SceneError(f"`{where}` must be a table, got {table!r}")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise SceneError(f"unknown key(s) {', '.join(f'`{where}.{k}`' if where else f'`{k}`' for k in unknown)}; "
-                         f"allowed: {', '.join(sorted(allowed))}")
-    missing = sorted(required - set(table))
-    if missing:
-        raise SceneError(f"missing key(s) {', '.join(f'`{where}.{k}`' for k in missing)}")
+def _bounded(field: str, value, unit: str, low: float | None, strict: bool) -> float:
+    """A finite number, > ``low`` if ``strict`` else >= ``low`` (no bound for ``low`` None)."""
+    if low is None:
+        return checks.number(field, value, unit)
+    return checks.number(field, value, unit, gt=low) if strict else checks.number(field, value, unit, ge=low)
 
 
-def _number(where: str, value, unit: str, minimum: float | None = None, strict: bool = False) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    if ok and minimum is not None:
-        ok = value > minimum if strict else value >= minimum
-    if not ok:
-        rel = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
-        raise SceneError(f"`{where}` must be a finite number{rel} ({unit}), got {value!r}")
-    return float(value)
-
-
-def _integer(where: str, value, minimum: int | None = None) -> int:
-    if not isinstance(value, int) or isinstance(value, bool) or (minimum is not None and value < minimum):
-        rel = "" if minimum is None else f" >= {minimum}"
-        raise SceneError(f"`{where}` must be an integer{rel}, got {value!r}")
-    return value
-
-
-def _choice(where: str, value, allowed: tuple[str, ...]) -> str:
-    if value not in allowed:
-        raise SceneError(f"`{where}` must be one of {', '.join(repr(a) for a in allowed)}, got {value!r}")
-    return value
-
-
-def _string(where: str, value) -> str:
-    if not isinstance(value, str):
-        raise SceneError(f"`{where}` must be a string, got {value!r}")
-    return value
-
-
-def _node(where: str, value, rotor: Rotor) -> int:
-    _integer(where, value)
-    if value not in rotor.spool_of:
-        raise SceneError(f"`{where}` = {value} is not a node of the rotor; nodes are "
-                         f"{min(rotor.nodes)}-{max(rotor.nodes)} ({sorted(rotor.nodes)})")
-    return value
-
-
-def _list(where: str, value, item_check) -> tuple:
-    if not isinstance(value, list):
-        raise SceneError(f"`{where}` must be a list, got {value!r}")
-    return tuple(item_check(f"{where}[{i}]", v) for i, v in enumerate(value))
+def _node_of(rotor: Rotor):
+    """Item check of :func:`rotorred.checks.sequence`: a node of ``rotor``."""
+    return lambda field, value: checks.node(field, value, rotor.spool_of)
 
 
 # --------------------------------------------------------------------------- build
-def _rotor(table, base: Path | None) -> tuple[Rotor, str]:
-    _keys("rotor", table, _ROTOR_KEYS)
+def _rotor(value, base: Path | None) -> tuple[Rotor, str]:
+    table = checks.table("rotor", value)
+    checks.keys("rotor", table, _ROTOR_KEYS)
     if ("preset" in table) == ("file" in table):
-        raise SceneError(f"`rotor` must give exactly one of `rotor.preset` ({', '.join(presets())}) or `rotor.file` "
-                         f"(a rotor TOML path), got {sorted(k for k in table if k in ('preset', 'file')) or 'neither'}")
+        fail("rotor", table, f"must hold exactly one of preset ({', '.join(presets())}) or file (a rotor TOML path)")
     if "preset" in table:
-        name = _string("rotor.preset", table["preset"])
-        if name not in presets():
-            raise SceneError(f"`rotor.preset` must be one of {', '.join(repr(p) for p in presets())}, got {name!r}")
+        name = checks.choice("rotor.preset", table["preset"], presets())
         rotor, source = load_rotor(name), name
     else:
-        path = Path(_string("rotor.file", table["file"]))
+        path = Path(checks.string("rotor.file", table["file"], empty=False))
         if not path.is_absolute() and base is not None:
             path = base / path
         if not path.is_file():
-            raise SceneError(f"`rotor.file` {str(path)!r} does not exist")
+            fail("rotor.file", table["file"], f"must be an existing rotor TOML file ({str(path)!r} is not)")
         rotor, source = load_rotor(path), str(path)
     alpha, beta = rotor.rayleigh
     if "rayleigh_alpha" in table:
-        alpha = _number("rotor.rayleigh_alpha", table["rayleigh_alpha"], "1/s", 0.0)
+        alpha = checks.non_negative("rotor.rayleigh_alpha", table["rayleigh_alpha"], "1/s")
     if "rayleigh_beta" in table:
-        beta = _number("rotor.rayleigh_beta", table["rayleigh_beta"], "s", 0.0)
+        beta = checks.non_negative("rotor.rayleigh_beta", table["rayleigh_beta"], "s")
     if (alpha, beta) != tuple(rotor.rayleigh):
         rotor = dataclasses.replace(rotor, rayleigh=(alpha, beta))
     return rotor, source
 
 
-def _speeds(table, rotor: Rotor) -> dict[str, float]:
-    names = [s.name for s in rotor.spools]
+def _speeds(value, rotor: Rotor) -> dict[str, float]:
+    """Spool speeds (rad/s): the rotor's nominal speeds, overridden by ``[speeds]`` (Hz); one must be > 0."""
     speeds = dict(rotor.speeds)
-    if table is None:
-        return speeds
-    _keys("speeds", table, set(names))
-    for s, v in table.items():
-        speeds[s] = 2 * math.pi * _number(f"speeds.{s}", v, "Hz", 0.0)
+    if value is not None:
+        table = checks.table("speeds", value)
+        checks.keys("speeds", table, [s.name for s in rotor.spools])
+        for s, v in table.items():
+            speeds[s] = 2 * math.pi * checks.non_negative(f"speeds.{s}", v, "Hz")
+    if not any(w > 0 for w in speeds.values()):
+        given = {s: w / (2 * math.pi) for s, w in speeds.items()} if value is None else value
+        fail("speeds", given, f"must give at least one spool of {', '.join(speeds)} a speed > 0"
+             + ("; the rotor's nominal speeds are all 0" if value is None else ""), "Hz")
     return speeds
 
 
-def _check_turning(speeds: dict[str, float], table) -> None:
-    if not any(w > 0 for w in speeds.values()):
-        raise SceneError(f"every spool speed is 0 (the rotor's nominal speeds{' and `speeds`' if table else ''}); "
-                         f"give `speeds.<spool>` in Hz (> 0) for at least one of {sorted(speeds)}")
-
-
 def _unbalances(entries, rotor: Rotor) -> tuple[Unbalance, ...]:
-    if not isinstance(entries, list):
-        raise SceneError(f"`unbalance` must be an array of tables ([[unbalance]]), got {entries!r}")
-    out = []
-    for i, u in enumerate(entries):
-        where = f"unbalance[{i}]"
-        _keys(where, u, _UNBALANCE_KEYS, required={"node", "m_e"})
-        node = _node(f"{where}.node", u["node"], rotor)
-        m_e = _number(f"{where}.m_e", u["m_e"], "kg m", 0.0)
-        phase = math.radians(_number(f"{where}.phase_deg", u.get("phase_deg", 0.0), "deg"))
-        out.append(Unbalance(node, m_e, phase))
-    return tuple(out)
+    return tuple(unbalance_from_table(f"unbalance[{i}]", u, rotor.spool_of)
+                 for i, u in enumerate(checks.tables("unbalance", entries)))
 
 
 def _bending(where: str, r: dict):
-    kind = _choice(f"{where}.bending", r.get("bending", "navier"), BENDING)
+    kind = checks.choice(f"{where}.bending", r.get("bending", "navier"), BENDING)
     allowed = {"navier": {"plate_a", "plate_b", "plate_h", "plate_E", "plate_nu", "plate_xi", "plate_eta"},
                "clamped-free": {"a0", "b0"}, "rigid": set()}[kind]
     stray = sorted(k for k in _PLATE_NUMBERS if k in r and k not in allowed)
     if stray:
-        raise SceneError(f"`{where}.{stray[0]}` does not apply to `{where}.bending` = {kind!r}; "
-                         f"its keys are {', '.join(sorted(allowed)) or 'none'}")
-    vals = {}
-    for k in allowed:
-        if k in r:
-            unit, lo, strict = _PLATE_NUMBERS[k]
-            vals[k] = _number(f"{where}.{k}", r[k], unit, lo, strict)
+        fail(f"{where}.{stray[0]}", r[stray[0]], f"must not be given with {where}.bending = {kind!r}, whose keys "
+             f"are {', '.join(sorted(allowed)) or 'none'}")
+    vals = {k: _bounded(f"{where}.{k}", r[k], *_PLATE_NUMBERS[k]) for k in sorted(allowed) if k in r}
+    if "plate_nu" in vals:
+        checks.number(f"{where}.plate_nu", r["plate_nu"], "-", gt=-1.0, lt=0.5)
     if kind == "rigid":
         return RigidPlate()
-    if kind == "clamped-free":
-        return ClampedFreePlate(**vals)
-    kw = {k[len("plate_"):]: v for k, v in vals.items()}
-    if "nu" in kw and not -1.0 < kw["nu"] < 0.5:
-        raise SceneError(f"`{where}.plate_nu` must lie in (-1, 0.5), got {kw['nu']!r}")
+    cls, prefix = (ClampedFreePlate, "") if kind == "clamped-free" else (NavierPlate, "plate_")
+    kw = {k[len(prefix):]: v for k, v in vals.items()}
+    if cls is NavierPlate:
+        kw["tol"] = NAVIER_TOL
     try:
-        return NavierPlate(tol=NAVIER_TOL, **kw)
+        return cls(**kw)
+    except InputError as exc:  # the plate names its attributes (xi); the scene's keys are rub[0].plate_xi
+        raise InputError(f"{where}.{prefix}{exc.field}", exc.value, exc.requirement, exc.unit) from None
     except ValueError as exc:
-        raise SceneError(f"`{where}`: {exc}".replace("`xi`", f"`{where}.plate_xi`")
-                         .replace("`eta`", f"`{where}.plate_eta`")) from None
+        fail(f"{where}.bending", kind, f"must describe a valid plate: {exc}")
 
 
 def _plates(entries, rotor: Rotor) -> tuple[RubPlate, ...]:
-    if not isinstance(entries, list):
-        raise SceneError(f"`rub` must be an array of tables ([[rub]]), got {entries!r}")
-    out = []
-    for i, r in enumerate(entries):
-        where = f"rub[{i}]"
-        _keys(where, r, _RUB_KEYS, required={"node", "clearance"})
-        node = _node(f"{where}.node", r["node"], rotor)
-        kw = {}
-        for k, (unit, lo, strict) in _RUB_NUMBERS.items():
-            if k in r:
-                kw[k] = _number(f"{where}.{k}", r[k], unit, lo, strict)
-        if "mu_s" in kw or "mu_d" in kw:
-            mu_s = kw.get("mu_s", RubPlate.mu_s)
-            mu_d = kw.get("mu_d", RubPlate.mu_d)
-            if mu_d > mu_s:
-                raise SceneError(f"`{where}.mu_d` = {mu_d:g} must not exceed `{where}.mu_s` = {mu_s:g}")
-        theta = math.radians(_number(f"{where}.theta_deg", r.get("theta_deg", 90.0), "deg"))
-        if "disk_radius" not in kw:
-            disk = next((d for d in rotor.disks if d.node == node), None)
-            if disk is None or disk.radius <= 0:
-                raise SceneError(f"`{where}.node` = {node} carries no disk with a radius; rub plates face a disk "
-                                 f"(disks with a radius at nodes "
-                                 f"{[d.node for d in rotor.disks if d.radius > 0]}) or give `{where}.disk_radius`")
-            kw["disk_radius"] = disk.radius
-        name = _string(f"{where}.name", r.get("name", f"rub plate at node {node}"))
-        out.append(RubPlate(node=node, theta=theta, bending=_bending(where, r), name=name, **kw))
-    return tuple(out)
+    return tuple(_plate(f"rub[{i}]", r, rotor) for i, r in enumerate(checks.tables("rub", entries)))
 
 
-def _solver(table, rotor: Rotor, speeds: dict[str, float]) -> SolverSpec:
-    table = {} if table is None else table
-    _keys("solver", table, _SOLVER_KEYS)
+def _plate(where: str, r: dict, rotor: Rotor) -> RubPlate:
+    checks.keys(where, r, _RUB_KEYS, required={"node", "clearance"})
+    node = checks.node(f"{where}.node", r["node"], rotor.spool_of)
+    kw = {k: _bounded(f"{where}.{k}", r[k], *_RUB_NUMBERS[k]) for k in _RUB_NUMBERS if k in r}
+    if "mu_s" in kw or "mu_d" in kw:
+        mu_s, mu_d = kw.get("mu_s", RubPlate.mu_s), kw.get("mu_d", RubPlate.mu_d)
+        if mu_d > mu_s:
+            fail(f"{where}.mu_d", r.get("mu_d", mu_d), f"must not exceed {where}.mu_s = {mu_s:g}")
+    theta = math.radians(checks.number(f"{where}.theta_deg", r.get("theta_deg", 90.0), "deg"))
+    if "disk_radius" not in kw:
+        disk = next((d for d in rotor.disks if d.node == node), None)
+        if disk is None or disk.radius <= 0:
+            fail(f"{where}.node", r["node"], f"must carry a disk with a radius (rub plates face a disk: disks with "
+                 f"a radius are at nodes {[d.node for d in rotor.disks if d.radius > 0]}), or give "
+                 f"{where}.disk_radius")
+        kw["disk_radius"] = disk.radius
+    name = checks.string(f"{where}.name", r.get("name", f"rub plate at node {node}"))
+    bending = _bending(where, r)
+    try:
+        return RubPlate(node=node, theta=theta, bending=bending, name=name, **kw)
+    except InputError as exc:
+        raise exc.within(where) from None
+
+
+def _solver(value, rotor: Rotor, speeds: dict[str, float]) -> SolverSpec:
+    table = checks.table("solver", {} if value is None else value)
+    checks.keys("solver", table, _SOLVER_KEYS)
     d = SolverSpec()
-    model = _choice("solver.model", table.get("model", d.model), MODELS)
-    modes = table.get("modes", None)
+    model = checks.choice("solver.model", table.get("model", d.model), MODELS)
+    modes, cutoff, boundary = _solver_reduction(table, rotor)
+    dt, duration, record_start = _solver_times(table, d, speeds)
+    start = checks.choice("solver.start", table.get("start", d.start), STARTS)
+    method = checks.choice("solver.method", table.get("method", d.method), METHODS)
+    alpha = table.get("alpha")
+    if alpha is not None:
+        if method != "hht":
+            fail("solver.alpha", alpha, 'must not be given unless solver.method = "hht"')
+        alpha = checks.number("solver.alpha", alpha, "-", ge=-1 / 3, le=0.0)
+    gravity = checks.number("solver.gravity", table.get("gravity", d.gravity), "m/s^2")
+    return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
+                      record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity)
+
+
+def _solver_reduction(table: dict, rotor: Rotor) -> tuple[int | None, float | None, tuple[int, ...]]:
+    """``solver.modes``, ``solver.cutoff_hz`` and ``solver.boundary_nodes``.
+
+    They are validated but unused with model = "full", so that ``--set solver.model=full``
+    switches a reduced scene to the full model.
+    """
+    modes = table.get("modes")
     if modes == "auto":
         modes = None
     if modes is not None:
-        if not isinstance(modes, int) or isinstance(modes, bool) or modes < 0:
-            raise SceneError(f"`solver.modes` must be \"auto\" or an integer >= 0, got {modes!r}")
+        try:
+            modes = checks.integer("solver.modes", modes, ge=0)
+        except InputError:
+            fail("solver.modes", modes, 'must be "auto" or an integer >= 0')
     cutoff = table.get("cutoff_hz")
     if cutoff is not None:
-        cutoff = _number("solver.cutoff_hz", cutoff, "Hz", 0.0, strict=True)
+        cutoff = checks.positive("solver.cutoff_hz", cutoff, "Hz")
         if modes is not None:
-            raise SceneError(f"give `solver.modes` or `solver.cutoff_hz`, not both (got {modes!r} and {cutoff!r})")
-    # modes, cutoff_hz and boundary_nodes are validated but unused with model = "full", so that
-    # `--set solver.model=full` switches a reduced scene to the full model
-    boundary = _list("solver.boundary_nodes", table.get("boundary_nodes", []), lambda w, v: _node(w, v, rotor))
-    dt = _number("solver.dt", table.get("dt", d.dt), "s", 0.0, strict=True)
-    duration = _number("solver.duration", table.get("duration", d.duration), "s", 0.0, strict=True)
-    record_start = _number("solver.record_start", table.get("record_start", d.record_start), "s", 0.0)
+            fail("solver.cutoff_hz", table["cutoff_hz"], f"must not be given together with solver.modes = {modes!r}: "
+                 "give one or the other", "Hz")
+    boundary = checks.sequence("solver.boundary_nodes", table.get("boundary_nodes", []), _node_of(rotor))
+    return modes, cutoff, boundary
+
+
+def _solver_times(table: dict, d: SolverSpec, speeds: dict[str, float]) -> tuple[float, float, float]:
+    """``solver.dt``, ``solver.duration`` and ``solver.record_start`` (s), consistent with each other."""
+    dt = checks.positive("solver.dt", table.get("dt", d.dt), "s")
+    duration = checks.positive("solver.duration", table.get("duration", d.duration), "s")
+    record_start = checks.non_negative("solver.record_start", table.get("record_start", d.record_start), "s")
     if dt >= duration:
-        raise SceneError(f"`solver.dt` = {dt:g} s must be smaller than `solver.duration` = {duration:g} s")
+        fail("solver.dt", dt, f"must be < solver.duration = {duration:g}", "s")
     if record_start >= duration:
-        raise SceneError(f"`solver.duration` = {duration:g} s must exceed `solver.record_start` = {record_start:g} s "
-                         f"(the recorded window is record_start..duration)")
+        fail("solver.duration", duration, f"must exceed solver.record_start = {record_start:g}, the start of the "
+             "recorded window record_start..duration", "s")
     for name, value in (("duration", duration), ("record_start", record_start)):
         steps = value / dt
         if abs(steps - round(steps)) > _RTOL * max(steps, 1.0):
-            raise SceneError(f"`solver.{name}` = {value:g} s must be a whole number of steps `solver.dt` = {dt:g} s "
-                             f"(got {steps:.6g} steps)")
+            fail(f"solver.{name}", value, f"must be a whole number of steps of solver.dt = {dt:g}; it is "
+                 f"{steps:.6g} steps", "s")
     # The spectrum needs two common periods of the spools (lines 1/T apart must be resolved).
     f = sorted(w / (2 * math.pi) for w in speeds.values() if w > 0)
     if len(f) >= 2:
@@ -598,92 +573,69 @@ def _solver(table, rotor: Rotor, speeds: dict[str, float]) -> SolverSpec:
         if abs(f[-1] / f[0] - float(ratio)) <= _RTOL * f[-1] / f[0]:
             period = ratio.denominator / f[0]
             if duration - record_start < 2 * period * (1 - _RTOL):
-                raise SceneError(f"the recorded window `solver.duration` - `solver.record_start` = "
-                                 f"{duration - record_start:g} s is shorter than two common periods of the spools "
-                                 f"(2 x {period:g} s), too short to resolve their combination lines")
-    start = _choice("solver.start", table.get("start", d.start), STARTS)
-    method = _choice("solver.method", table.get("method", d.method), METHODS)
-    alpha = table.get("alpha")
-    if alpha is not None:
-        if method != "hht":
-            raise SceneError("`solver.alpha` applies to `solver.method` = \"hht\" only")
-        alpha = _number("solver.alpha", alpha, "-")
-        if not -1 / 3 <= alpha <= 0:
-            raise SceneError(f"`solver.alpha` must lie in [-1/3, 0], got {alpha!r}")
-    gravity = _number("solver.gravity", table.get("gravity", d.gravity), "m/s^2")
-    return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
-                      record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity)
+                fail("solver.record_start", record_start, f"must leave a recorded window solver.duration - "
+                     f"solver.record_start of at least two common periods of the spools, 2 x {period:g}, to "
+                     f"resolve their combination lines; it leaves {duration - record_start:g}", "s")
+    return dt, duration, record_start
 
 
-def _dof_text(where: str, value, rotor: Rotor) -> tuple[int, str]:
-    text = _string(where, value)
-    node, _, direction = text.partition(":")
-    try:
-        node = int(node)
-    except ValueError:
-        raise SceneError(f"`{where}` must be NODE:DIR (e.g. \"14:y\"), got {value!r}") from None
-    _node(where, node, rotor)
-    _choice(where + " direction", direction, DIRECTIONS)
-    return node, direction
-
-
-def _output(table, rotor: Rotor, solver: SolverSpec, plates) -> OutputSpec:
-    table = {} if table is None else table
-    _keys("output", table, _OUTPUT_KEYS)
+def _output(value, rotor: Rotor, solver: SolverSpec, plates) -> OutputSpec:
+    table = checks.table("output", {} if value is None else value)
+    checks.keys("output", table, _OUTPUT_KEYS)
     d = OutputSpec()
-    default_nodes = [min(rotor.nodes)] if not plates else [plates[0].node]
-    nodes = _list("output.nodes", table.get("nodes", default_nodes), lambda w, v: _node(w, v, rotor))
-    if not nodes:
-        raise SceneError("`output.nodes` must name at least one node")
-    if len(set(nodes)) != len(nodes):
-        raise SceneError(f"`output.nodes` lists a node twice: {list(nodes)}")
-    directions = _list("output.directions", table.get("directions", list(d.directions)),
-                       lambda w, v: _choice(w, v, DIRECTIONS))
-    if not directions or len(set(directions)) != len(directions):
-        raise SceneError(f"`output.directions` must list distinct directions of {DIRECTIONS}, got {list(directions)}")
-    plots = _list("output.plots", table.get("plots", list(d.plots)), lambda w, v: _choice(w, v, PLOTS))
-    formats = _list("output.formats", table.get("formats", list(d.formats)), lambda w, v: _choice(w, v, FORMATS))
+    nodes, directions, table_dof = _output_dofs(table, rotor, plates)
+    plots = checks.sequence("output.plots", table.get("plots", list(d.plots)), lambda f, v: checks.choice(f, v, PLOTS))
+    formats = checks.sequence("output.formats", table.get("formats", list(d.formats)),
+                              lambda f, v: checks.choice(f, v, FORMATS))
     if "orbits" in plots and not {"x", "y"} <= set(directions):
-        raise SceneError("`output.plots` asks for \"orbits\", which need both \"x\" and \"y\" in `output.directions`")
+        fail("output.plots", table.get("plots", list(d.plots)), 'must not ask for "orbits" unless '
+             'output.directions holds both "x" and "y"')
     window = table.get("plot_window")
-    lo, hi = solver.record_start, solver.duration
     if window is not None:
-        window = _list("output.plot_window", window, lambda w, v: _number(w, v, "s"))
-        if len(window) != 2 or not lo - 1e-12 <= window[0] < window[1] <= hi + 1e-12:
-            raise SceneError(f"`output.plot_window` must be [start, end] inside the recorded window "
-                             f"[{lo:g}, {hi:g}] s with start < end, got {list(window)}")
-    table_dof = table.get("table")
-    if table_dof is not None:
-        table_dof = _dof_text("output.table", table_dof, rotor)
-        if table_dof not in set((n, dd) for n in nodes for dd in directions):
-            raise SceneError(f"`output.table` = {table.get('table')!r} is not a recorded DOF (`output.nodes` x "
-                             f"`output.directions`)")
-    threshold = _number("output.line_threshold", table.get("line_threshold", d.line_threshold), "-", 0.0, True)
-    if threshold > 1:
-        raise SceneError(f"`output.line_threshold` must lie in (0, 1], got {threshold!r}")
+        lo, hi = solver.record_start, solver.duration
+        start, end = checks.sequence("output.plot_window", window, lambda f, v: checks.number(f, v, "s"),
+                                     min_len=2, max_len=2)
+        if not lo - 1e-12 <= start < end <= hi + 1e-12:
+            fail("output.plot_window", window, f"must be [start, end] inside the recorded window [{lo:g}, {hi:g}] "
+                 "with start < end", "s")
+        window = (start, end)
+    threshold = checks.number("output.line_threshold", table.get("line_threshold", d.line_threshold), "-",
+                              gt=0.0, le=1.0)
     f_max = table.get("f_max_hz")
     if f_max is not None:
-        f_max = _number("output.f_max_hz", f_max, "Hz", 0.0, strict=True)
-    compare = table.get("compare_normal", d.compare_normal)
-    if not isinstance(compare, bool):
-        raise SceneError(f"`output.compare_normal` must be true or false, got {compare!r}")
-    return OutputSpec(nodes=nodes, directions=directions, plots=plots, formats=formats,
-                      plot_window=None if window is None else (window[0], window[1]), table=table_dof,
-                      line_threshold=threshold, f_max_hz=f_max, compare_normal=compare)
+        f_max = checks.positive("output.f_max_hz", f_max, "Hz")
+    compare = checks.boolean("output.compare_normal", table.get("compare_normal", d.compare_normal))
+    return OutputSpec(nodes=nodes, directions=directions, plots=plots, formats=formats, plot_window=window,
+                      table=table_dof, line_threshold=threshold, f_max_hz=f_max, compare_normal=compare)
+
+
+def _output_dofs(table: dict, rotor: Rotor, plates) -> tuple[tuple[int, ...], tuple[str, ...], tuple | None]:
+    """``output.nodes``, ``output.directions`` and ``output.table`` (a recorded DOF)."""
+    default_nodes = [min(rotor.nodes)] if not plates else [plates[0].node]
+    nodes = checks.sequence("output.nodes", table.get("nodes", default_nodes), _node_of(rotor), min_len=1,
+                            unique=True)
+    directions = checks.sequence("output.directions", table.get("directions", list(OutputSpec.directions)),
+                                 lambda f, v: checks.choice(f, v, DIRECTIONS), min_len=1, unique=True)
+    table_dof = table.get("table")
+    if table_dof is not None:
+        table_dof = parse_dof("output.table", table_dof, rotor.spool_of)
+        if table_dof not in {(n, dd) for n in nodes for dd in directions}:
+            fail("output.table", table["table"], "must be a recorded DOF (one of output.nodes x output.directions)")
+    return nodes, directions, table_dof
 
 
 def _build(data: dict, source: str, base: Path | None) -> Scene:
-    _keys("", data, _TOP_KEYS, required={"rotor"})
-    name = _string("name", data.get("name", Path(source).stem if base is not None else source))
-    description = _string("description", data.get("description", ""))
+    checks.keys("", data, _TOP_KEYS, required={"rotor"})
+    name = checks.string("name", data.get("name", Path(source).stem if base is not None else source))
+    description = checks.string("description", data.get("description", ""))
     rotor, rotor_source = _rotor(data["rotor"], base)
     speeds = _speeds(data.get("speeds"), rotor)
-    _check_turning(speeds, data.get("speeds"))
     unbalances = _unbalances(data.get("unbalance", []), rotor)
     plates = _plates(data.get("rub", []), rotor)
     solver = _solver(data.get("solver"), rotor, speeds)
     output = _output(data.get("output"), rotor, solver, plates)
     if not unbalances and solver.gravity == 0:
-        raise SceneError("the scene has no load: give at least one `[[unbalance]]` (or `solver.gravity`)")
+        fail("unbalance", data.get("unbalance", []), "must hold at least one entry unless solver.gravity is given: "
+             "the scene has no load")
     return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source, speeds=speeds,
                  unbalances=unbalances, plates=plates, solver=solver, output=output, source=source, data=data)

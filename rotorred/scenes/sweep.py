@@ -4,14 +4,13 @@
 one structural model for every run when the key does not change it, and collects per value:
 the amplitudes of f_L, f_H and every combination line at one DOF, the number of combination
 lines, the peak displacement, the contact fraction and the number of impacts of the first
-plate. :func:`plot_sweep` draws them against the swept value; for a clearance sweep it marks
-the free (no-rub) orbit's reach towards the plate at the rub node, beyond which no contact
-and so no combination line can occur.
+plate. :func:`rotorred.plots.sweep.plot_sweep` draws them against the swept value; for a
+clearance sweep it marks the free (no-rub) orbit's reach towards the plate at the rub node,
+beyond which no contact and so no combination line can occur.
 """
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass
@@ -21,11 +20,12 @@ from typing import Sequence
 
 import numpy as np
 
-from rotorred.model.loads import gravity_force
-from rotorred.scenes.run import _model_key, _steady, build_model, run_scene, table_dof
+from rotorred.scenes.run import SceneModel, build_model, model_key, run_scene, settled_response
 from rotorred.scenes.schema import Scene, load_scene
+from rotorred.scenes.summary import table_dof
+from rotorred.writers import render_table, write_csv, write_text
 
-__all__ = ["SweepResult", "sweep", "free_reach", "plot_sweep", "write_sweep", "format_sweep"]
+__all__ = ["SweepResult", "sweep", "free_reach", "write_sweep", "format_sweep", "axis_of"]
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,10 @@ class SweepResult:
         plate (m); a clearance above it cannot be touched. None without plates.
     wall_times : ndarray, shape (n,)
         Wall time per run (s).
+    axis_scale : float
+        Factor from the swept value (SI) to the unit of ``axis_label`` (1e6 for a clearance in µm).
+    axis_label : str
+        Name and unit of the swept key for plots and tables, e.g. "Rub clearance (µm)".
     """
 
     scene_name: str
@@ -74,6 +78,8 @@ class SweepResult:
     n_impacts: np.ndarray
     free_reach: float | None
     wall_times: np.ndarray
+    axis_scale: float = 1.0
+    axis_label: str = ""
 
     def combinations(self) -> list[str]:
         """Combination-line labels, strongest (largest amplitude over the sweep) first."""
@@ -96,7 +102,6 @@ def free_reach(scene: Scene, model=None) -> float | None:
     """
     if not scene.plates:
         return None
-    from rotorred.scenes.run import SceneModel
     if model is None:
         model = build_model(scene)
     m = model.model if isinstance(model, SceneModel) else model
@@ -106,13 +111,7 @@ def free_reach(scene: Scene, model=None) -> float | None:
     ratio = Fraction(max(f) / min(f)).limit_denominator(100)
     period = ratio.denominator / min(f)
     t = np.arange(0.0, period, min(scene.solver.dt, period / 2000))
-    xy = np.zeros((2, len(t)))
-    steady = _steady(scene, m)
-    for s, P in (steady.phasors.items() if steady is not None else ()):
-        xy += np.real((rows @ P)[:, None] * np.exp(1j * steady.speeds[s] * t)[None, :])
-    if scene.solver.gravity:
-        xy += (rows @ np.linalg.solve(m.K, gravity_force(m, scene.solver.gravity)))[:, None]
-    return float(np.max(plate.normal @ xy))
+    return float(np.max(plate.normal @ settled_response(scene, m, rows, t)))
 
 
 def sweep(spec, key: str, values: Sequence, settings: dict | None = None, dof: tuple | None = None,
@@ -152,7 +151,7 @@ def sweep(spec, key: str, values: Sequence, settings: dict | None = None, dof: t
     reach = None
     for i, sc in enumerate(scenes):
         t0 = time.perf_counter()
-        mk = _model_key(sc)
+        mk = model_key(sc)
         if mk not in model_cache:
             model_cache[mk] = build_model(sc)
         model = model_cache[mk]
@@ -178,13 +177,15 @@ def sweep(spec, key: str, values: Sequence, settings: dict | None = None, dof: t
                   f"lines, peak {1e6 * peak[i]:.4g} um ({wall[i]:.2f} s)", flush=True)
     vals = np.array([float(v) for v in values]) if all(isinstance(v, (int, float)) for v in values) \
         else np.arange(n, dtype=float)
+    scale, label = axis_of(key)
     return SweepResult(scene_name=scenes[0].name, key=key, values=vals, dof=dof0, f_L=f_L, f_H=f_H,
                        amplitudes={k: np.array(v) for k, v in amps.items()}, n_combinations=n_comb, peak=peak,
-                       contact_fraction=cf, n_impacts=imp, free_reach=reach, wall_times=wall)
+                       contact_fraction=cf, n_impacts=imp, free_reach=reach, wall_times=wall, axis_scale=scale,
+                       axis_label=label)
 
 
-def _axis(key: str) -> tuple[float, str]:
-    """Plot scale and axis label of a swept key."""
+def axis_of(key: str) -> tuple[float, str]:
+    """Plot scale and axis label of a swept scene key: ``"rub.clearance"`` -> (1e6, "Rub clearance (µm)")."""
     name = key.split(".")[-1]
     if name == "clearance":
         return 1e6, "Rub clearance (µm)"
@@ -194,86 +195,35 @@ def _axis(key: str) -> tuple[float, str]:
     return scale, f"{key} ({unit})"
 
 
-def plot_sweep(result: SweepResult, path, n_lines: int = 4) -> Path:
-    """Line amplitudes (f_L, f_H, the ``n_lines`` strongest combinations) and contact fraction against the value."""
-    from matplotlib.figure import Figure
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    scale, xlabel = _axis(result.key)
-    x = scale * result.values
-    fig = Figure(figsize=(9, 7.5), layout="constrained")
-    ax1, ax2 = fig.subplots(2, 1, sharex=True)
-    node, d = result.dof
-    labels = [k for k in ("f_L", "f_H") if k in result.amplitudes] + result.combinations()[:n_lines]
-    for k in labels:
-        style = "-o" if k in ("f_L", "f_H") else "--s"
-        mathlabel = "$" + k.replace("f_L", "f_L").replace("f_H", "f_H") + "$"
-        ax1.plot(x, 1e6 * result.amplitudes[k], style, ms=4, label=f"{mathlabel} ({_line_hz(k, result):.0f} Hz)")
-    ax1.plot(x, 1e6 * result.combination_total(), ":", color="k", label="sum of all combination lines")
-    ax1.set_ylabel(f"Line amplitude at node {node} {d.upper()} (µm)")
-    ax1.set_title(f"Spectral lines at node {node} {d.upper()}")
-    ax1.grid(True, alpha=0.3)
-    ax2.plot(x, 100 * result.contact_fraction, "-o", ms=4, color="C3", label="contact fraction")
-    ax2.set_ylabel("Contact fraction of the window (%)")
-    ax2.set_xlabel(xlabel)
-    ax2.set_title("Rub contact")
-    ax2.grid(True, alpha=0.3)
-    ax3 = ax2.twinx()
-    ax3.plot(x, result.n_combinations, "-^", ms=4, color="C4", label="number of combination lines")
-    ax3.set_ylabel("Combination lines above threshold")
-    if result.free_reach is not None and result.key.endswith("clearance"):
-        for ax in (ax1, ax2):
-            ax.axvline(scale * result.free_reach, color="0.4", ls="--", lw=1.0,
-                       label=f"free orbit reach {scale * result.free_reach:.3g} µm")
-    h2, l2 = ax2.get_legend_handles_labels()
-    h3, l3 = ax3.get_legend_handles_labels()
-    ax2.legend(h2 + h3, l2 + l3, loc="upper right", fontsize=8)
-    ax1.legend(loc="upper right", fontsize=8)
-    fig.suptitle(f"{result.scene_name}: sweep of {result.key} (f_L = {result.f_L:.4g} Hz, f_H = {result.f_H:.4g} Hz)")
-    fig.savefig(path, dpi=120)
-    return path
-
-
-def _line_hz(label: str, result: SweepResult) -> float:
-    from rotorred.signals.lines import parse_label
-    m, n = parse_label(label)
-    return m * result.f_H + float(n) * result.f_L
+def _reported_lines(result: SweepResult, n_lines: int | None) -> list[str]:
+    """f_L, f_H, then the combination lines, strongest first (the first ``n_lines`` of them)."""
+    combos = result.combinations()
+    return [k for k in ("f_L", "f_H") if k in result.amplitudes] + (combos if n_lines is None else combos[:n_lines])
 
 
 def format_sweep(result: SweepResult, n_lines: int = 4) -> str:
     """Table: value, contact fraction, impacts, number of combination lines, amplitudes (µm)."""
-    scale, xlabel = _axis(result.key)
-    labels = [k for k in ("f_L", "f_H") if k in result.amplitudes] + result.combinations()[:n_lines]
-    header = [xlabel, "contact (%)", "impacts", "comb. lines", "peak (um)"] + [f"{k} (um)" for k in labels]
-    rows = []
-    for i, v in enumerate(result.values):
-        rows.append([f"{scale * v:.4g}", f"{100 * result.contact_fraction[i]:.2f}", str(result.n_impacts[i]),
-                     str(result.n_combinations[i]), f"{1e6 * result.peak[i]:.4g}"]
-                    + [f"{1e6 * result.amplitudes[k][i]:.4g}" for k in labels])
-    widths = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(header)]
-    out = [" | ".join(h.ljust(w) for h, w in zip(header, widths)), "-|-".join("-" * w for w in widths)]
-    out += [" | ".join(c.ljust(w) for c, w in zip(r, widths)) for r in rows]
+    labels = _reported_lines(result, n_lines)
+    header = [result.axis_label, "contact (%)", "impacts", "comb. lines", "peak (um)"] + [f"{k} (um)" for k in labels]
+    rows = [[f"{result.axis_scale * v:.4g}", f"{100 * result.contact_fraction[i]:.2f}", str(result.n_impacts[i]),
+             str(result.n_combinations[i]), f"{1e6 * result.peak[i]:.4g}"]
+            + [f"{1e6 * result.amplitudes[k][i]:.4g}" for k in labels] for i, v in enumerate(result.values)]
+    out = render_table(header, rows)
     if result.free_reach is not None:
-        out.append(f"free (no-rub) orbit reach towards the plate at the rub node: {1e6 * result.free_reach:.4g} um")
-    return "\n".join(out)
+        out += f"\nfree (no-rub) orbit reach towards the plate at the rub node: {1e6 * result.free_reach:.4g} um"
+    return out
 
 
 def write_sweep(result: SweepResult, out) -> list[Path]:
     """Write ``sweep.png``, ``sweep.csv`` (all lines, amplitudes in µm) and ``sweep.txt``."""
+    from rotorred.plots.sweep import plot_sweep  # matplotlib only when figures are written
+
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    files = [plot_sweep(result, out / "sweep.png")]
-    labels = [k for k in ("f_L", "f_H") if k in result.amplitudes] + result.combinations()
-    with open(out / "sweep.csv", "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow([f"{result.key} (SI)", "contact fraction", "impacts", "combination lines", "peak (um)"]
-                   + [f"{k} (um)" for k in labels])
-        for i, v in enumerate(result.values):
-            w.writerow([f"{v:.9g}", f"{result.contact_fraction[i]:.6g}", result.n_impacts[i],
-                        result.n_combinations[i], f"{1e6 * result.peak[i]:.6g}"]
-                       + [f"{1e6 * result.amplitudes[k][i]:.6g}" for k in labels])
-    files.append(out / "sweep.csv")
-    (out / "sweep.txt").write_text(format_sweep(result) + "\n")
-    files.append(out / "sweep.txt")
-    return files
+    labels = _reported_lines(result, None)
+    header = [f"{result.key} (SI)", "contact fraction", "impacts", "combination lines", "peak (um)"] + [
+        f"{k} (um)" for k in labels]
+    cols = [result.values, result.contact_fraction, result.n_impacts, result.n_combinations, 1e6 * result.peak]
+    cols += [1e6 * result.amplitudes[k] for k in labels]
+    return [plot_sweep(result, out / "sweep.png"), write_csv(out / "sweep.csv", header, cols),
+            write_text(out / "sweep.txt", format_sweep(result) + "\n")]

@@ -57,6 +57,8 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from rotorred import checks
+from rotorred.writers import render_table
 from rotorred.signals.spectra import Spectrum
 
 __all__ = [
@@ -113,17 +115,11 @@ XU2016_TABLE1: tuple[tuple[float, str], ...] = (
 
 # --------------------------------------------------------------------------- labels
 def _as_n(n) -> Fraction:
-    if isinstance(n, bool):
-        raise ValueError(f"`n` must be an integer or half-integer, got {n!r}")
-    if isinstance(n, (float, np.floating)):
-        if not math.isfinite(n):
-            raise ValueError(f"`n` must be an integer or half-integer, got {n!r}")
-    try:
-        f = Fraction(n)
-    except (TypeError, ValueError):
-        raise ValueError(f"`n` must be an integer or half-integer, got {n!r}") from None
-    if f.denominator not in (1, 2):
-        raise ValueError(f"`n` must be an integer or half-integer, got {n!r}")
+    if not isinstance(n, Fraction):
+        checks.number("n", n)  # a finite real number (not a bool) ...
+    f = Fraction(n) if not isinstance(n, np.generic) else Fraction(n.item())
+    if f.denominator not in (1, 2):  # ... that is a multiple of 1/2
+        checks.fail("n", n, "must be an integer or half-integer")
     return f
 
 
@@ -162,8 +158,7 @@ def combination_label(m: int, n, minus: str = MINUS, math_text: bool = False) ->
     >>> combination_label(1, 1.5, minus="-")
     'f_H+3f_L/2'
     """
-    if isinstance(m, bool) or not isinstance(m, (int, np.integer)):
-        raise ValueError(f"`m` must be an integer, got {m!r}")
+    checks.integer("m", m)
     nf = _as_n(n)
     mf = Fraction(int(m))
     terms = [(c, s) for c, s in ((mf, "f_H"), (nf, "f_L")) if c != 0]
@@ -192,8 +187,7 @@ def parse_label(label: str) -> tuple[int, Fraction]:
     m : int
     n : Fraction
     """
-    if not isinstance(label, str):
-        raise ValueError(f"`label` must be a string, got {label!r}")
+    checks.string("label", label)
     text = label.replace(MINUS, "-").replace(" ", "").strip("$")
     m, n = Fraction(0), Fraction(0)
     pos = 0
@@ -213,29 +207,12 @@ def parse_label(label: str) -> tuple[int, Fraction]:
             n = sign * coef
         pos = match.end()
     if pos != len(text) or pos == 0 or m.denominator != 1 or n.denominator not in (1, 2):
-        raise ValueError(
-            f"`label` must look like 'f_H-f_L', '2f_H+f_L', 'f_H+3f_L/2' (integer m, integer "
-            f"or half-integer n), got {label!r}"
-        )
+        checks.fail("label", label, "must look like 'f_H-f_L', '2f_H+f_L', 'f_H+3f_L/2' (integer m, integer or "
+                    "half-integer n)")
     return int(m), n
 
 
 # --------------------------------------------------------------------------- matching
-def _check_positive(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"`{name}` must be a positive finite number, got {value!r}")
-    value = float(value)
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"`{name}` must be a positive finite number, got {value!r}")
-    return value
-
-
-def _check_bound(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"`{name}` must be an integer >= 0, got {value!r}")
-    return int(value)
-
-
 def _rule_key(mn: tuple[int, Fraction]) -> tuple:
     m, n = mn
     return (abs(m) + abs(n), abs(n), -m)
@@ -272,12 +249,12 @@ def combinations_near(
         Sorted by the labelling rule (``(|m| + |n|, |n|, -m)``, see the module docstring);
         only combinations with positive frequency.
     """
-    f = _check_positive("frequency_hz", frequency_hz)
-    f_L = _check_positive("f_L", f_L)
-    f_H = _check_positive("f_H", f_H)
-    tol = _check_positive("tol_hz", tol_hz)
-    max_m = _check_bound("max_m", max_m)
-    max_n = _check_bound("max_n", max_n)
+    f = checks.positive("frequency_hz", frequency_hz, "Hz")
+    f_L = checks.positive("f_L", f_L, "Hz")
+    f_H = checks.positive("f_H", f_H, "Hz")
+    tol = checks.positive("tol_hz", tol_hz, "Hz")
+    max_m = checks.integer("max_m", max_m, ge=0)
+    max_n = checks.integer("max_n", max_n, ge=0)
     step = 2 if half_integer else 1
     out = []
     for k in range(-max_n * step, max_n * step + 1):
@@ -380,10 +357,8 @@ def find_peaks(spectrum: Spectrum, threshold: float = 0.005) -> np.ndarray:
     :func:`rotorred.signals.spectra.settled_spectrum` takes as many periods as fit.
     """
     if not isinstance(spectrum, Spectrum):
-        raise ValueError(f"`spectrum` must be a Spectrum, got {type(spectrum).__name__}")
-    threshold = _check_positive("threshold", threshold)
-    if threshold > 1:
-        raise ValueError(f"`threshold` must be in (0, 1], got {threshold!r}")
+        checks.fail("spectrum", spectrum, "must be a Spectrum")
+    threshold = checks.number("threshold", threshold, gt=0.0, le=1.0)
     a = np.asarray(spectrum.amplitudes, dtype=float)
     if a.size < 2:
         return np.zeros(0, dtype=int)
@@ -482,21 +457,12 @@ def format_table(
         rows.append(row)
     if amplitude_scale is not None:
         header.append(f"Amplitude ({amplitude_unit})")
-    return _render(header, rows)
+    return render_table(header, rows)
 
 
 def print_table(lines: Iterable[SpectralLine], **kwargs) -> None:
     """Print :func:`format_table` (same keyword arguments)."""
     print(format_table(lines, **kwargs))
-
-
-def _render(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    widths = [max([len(h)] + [len(r[i]) for r in rows]) for i, h in enumerate(header)]
-    out = [" | ".join(h.ljust(w) for h, w in zip(header, widths)).rstrip()]
-    out.append("-|-".join("-" * w for w in widths))
-    for r in rows:
-        out.append(" | ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
-    return "\n".join(out)
 
 
 @dataclass(frozen=True)
@@ -558,20 +524,20 @@ def compare_with_expected(
     list of LineMatch
         In the order of ``expected``.
     """
-    tol_hz = _check_positive("tol_hz", tol_hz)
+    tol_hz = checks.positive("tol_hz", tol_hz, "Hz")
     lines = list(lines)
     freqs = np.array([line.frequency_hz for line in lines], dtype=float)
     out = []
-    for item in expected:
+    for i, item in enumerate(expected):
         if isinstance(item, tuple):
             if len(item) != 2 or not isinstance(item[1], str):
-                raise ValueError(f"`expected` items must be float or (float, str), got {item!r}")
+                checks.fail(f"expected[{i}]", item, "must be a frequency (Hz) or a (frequency, label) pair")
             f, label = item
             parse_label(label)  # validates the label
             label = label.replace(MINUS, "-").replace(" ", "")
         else:
             f, label = item, None
-        f = _check_positive("expected frequency", f)
+        f = checks.positive(f"expected[{i}]", f, "Hz")
         found = None
         if freqs.size:
             i = int(np.argmin(np.abs(freqs - f)))
@@ -599,4 +565,4 @@ def format_comparison(matches: Iterable[LineMatch], *, ascii: bool = False) -> s
             our_label = mt.found.label_ascii if ascii else mt.found.label
         agrees = {None: "", True: "yes", False: "NO"}[mt.label_agrees]
         rows.append([f"{mt.expected_hz:.2f}", exp_label, ours, diff, our_label, agrees])
-    return _render(header, rows)
+    return render_table(header, rows)

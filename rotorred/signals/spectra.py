@@ -56,6 +56,8 @@ import numpy as np
 import pyfftw
 import pyfftw.builders
 
+from rotorred import checks
+
 __all__ = [
     "WINDOWS",
     "WindowInfo",
@@ -138,8 +140,7 @@ def window_values(name: str, n: int) -> np.ndarray:
     ndarray, shape (n,)
     """
     info = _window_info(name)
-    if not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"`n` must be an integer >= 1, got {n!r}")
+    n = checks.integer("n", n, ge=1)
     z = 2.0 * np.pi * np.arange(n) / n
     w = np.zeros(n)
     for k, c in enumerate(info.cosine_coefficients):
@@ -148,9 +149,7 @@ def window_values(name: str, n: int) -> np.ndarray:
 
 
 def _window_info(name: str) -> WindowInfo:
-    if name not in WINDOWS:
-        raise ValueError(f"`window` must be one of {sorted(WINDOWS)}, got {name!r}")
-    return WINDOWS[name]
+    return WINDOWS[checks.choice("window", name, WINDOWS)]
 
 
 # --------------------------------------------------------------------------- FFT plans
@@ -190,11 +189,9 @@ def rfft_plan(n: int, dtype=np.float64) -> pyfftw.FFTW:
 
 
 def _plan_entry(n: int, dtype) -> tuple[pyfftw.FFTW, threading.Lock]:
+    checks.choice("dtype", np.dtype(dtype).name, ("float64", "float32"))
     dtype = np.dtype(dtype)
-    if dtype not in (np.dtype(np.float64), np.dtype(np.float32)):
-        raise ValueError(f"`dtype` must be float64 or float32, got {dtype}")
-    if not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"`n` must be an integer >= 1, got {n!r}")
+    checks.integer("n", n, ge=1)
     key = (int(n), dtype.str)
     with _PLAN_LOCK:
         entry = _PLANS.get(key)
@@ -283,36 +280,15 @@ class Spectrum:
 
     def amplitude_at(self, frequency_hz: float) -> float:
         """Amplitude at the bin nearest to ``frequency_hz`` (signal units)."""
-        if not (math.isfinite(frequency_hz) and 0 <= frequency_hz <= self.frequencies[-1]):
-            raise ValueError(
-                f"`frequency_hz` must be finite in [0, {self.frequencies[-1]}] Hz, "
-                f"got {frequency_hz!r}"
-            )
+        frequency_hz = checks.number("frequency_hz", frequency_hz, "Hz", ge=0.0, le=float(self.frequencies[-1]))
         return float(self.amplitudes[int(round(frequency_hz / self.df))])
 
 
-def _check_dt(dt) -> float:
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer)):
-        raise ValueError(f"`dt` must be a positive finite number (s), got {dt!r}")
-    dt = float(dt)
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"`dt` must be a positive finite number (s), got {dt!r}")
-    return dt
-
-
 def _check_signal(x) -> np.ndarray:
+    """A finite real 1-D record of at least 2 samples, as float64 (float32 records stay float32)."""
     x = np.asarray(x)
-    if x.ndim != 1:
-        raise ValueError(f"`x` must be one-dimensional, got shape {x.shape}")
-    if x.size < 2:
-        raise ValueError(f"`x` must have at least 2 samples, got {x.size}")
-    if np.iscomplexobj(x) or not np.issubdtype(x.dtype, np.number):
-        raise ValueError(f"`x` must be real, got dtype {x.dtype}")
-    if x.dtype != np.float32:
-        x = x.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(x)):
-        raise ValueError("`x` must be finite; it contains NaN or inf")
-    return x
+    checked = checks.vector("x", x, min_len=2)
+    return x if x.dtype == np.float32 else checked
 
 
 def amplitude_spectrum(x, dt: float, window: str = "rectangular") -> Spectrum:
@@ -338,7 +314,7 @@ def amplitude_spectrum(x, dt: float, window: str = "rectangular") -> Spectrum:
     Nyquist bin, where ``c_k = 1``. The mean is not removed: a constant offset reads at 0 Hz.
     """
     info = _window_info(window)
-    dt = _check_dt(dt)
+    dt = checks.positive("dt", dt, "s")
     x = _check_signal(x)
     n = x.size
     w = window_values(window, n)
@@ -361,8 +337,9 @@ def amplitude_spectrum(x, dt: float, window: str = "rectangular") -> Spectrum:
 
 
 # --------------------------------------------------------------------------- record length
-class NotCommensurateError(ValueError):
-    """The spool frequencies have no common period that is a whole number of samples."""
+class NotCommensurateError(checks.InputError):
+    """The spool frequencies have no common period that is a whole number of samples
+    (an :class:`rotorred.checks.InputError`, so a ``ValueError``)."""
 
 
 @dataclass(frozen=True)
@@ -396,15 +373,6 @@ class CommensurateRecord:
     def df(self) -> float:
         """Bin width of the record ``1 / (n_periods T)`` (Hz)."""
         return self.fundamental_hz / self.n_periods
-
-
-def _check_frequency(name: str, f) -> float:
-    if isinstance(f, bool) or not isinstance(f, (int, float, np.floating, np.integer)):
-        raise ValueError(f"`{name}` must be a positive finite frequency (Hz), got {f!r}")
-    f = float(f)
-    if not (math.isfinite(f) and f > 0):
-        raise ValueError(f"`{name}` must be a positive finite frequency (Hz), got {f!r}")
-    return f
 
 
 def commensurate_record(
@@ -457,55 +425,45 @@ def commensurate_record(
     ValueError
         For bad inputs, or a record that does not fit in ``n_available``.
     """
-    f_L = _check_frequency("f_L", f_L)
-    f_H = _check_frequency("f_H", f_H)
-    dt = _check_dt(dt)
-    if not (isinstance(max_denominator, (int, np.integer)) and max_denominator >= 1):
-        raise ValueError(f"`max_denominator` must be an integer >= 1, got {max_denominator!r}")
-    if not (math.isfinite(rtol) and 0 < rtol < 1e-2):
-        raise ValueError(f"`rtol` must be in (0, 1e-2), got {rtol!r}")
-    if n_available is not None and not (
-        isinstance(n_available, (int, np.integer)) and n_available >= 1
-    ):
-        raise ValueError(f"`n_available` must be an integer >= 1, got {n_available!r}")
-    if n_periods is not None and not (isinstance(n_periods, (int, np.integer)) and n_periods >= 1):
-        raise ValueError(f"`n_periods` must be an integer >= 1, got {n_periods!r}")
+    f_L = checks.positive("f_L", f_L, "Hz")
+    f_H = checks.positive("f_H", f_H, "Hz")
+    dt = checks.positive("dt", dt, "s")
+    max_denominator = checks.integer("max_denominator", max_denominator, ge=1)
+    rtol = checks.number("rtol", rtol, gt=0.0, lt=1e-2)
+    if n_available is not None:
+        n_available = checks.integer("n_available", n_available, ge=1)
+    if n_periods is not None:
+        n_periods = checks.integer("n_periods", n_periods, ge=1)
 
     r = f_H / f_L
     frac = Fraction(r).limit_denominator(max_denominator)
     p, q = frac.numerator, frac.denominator
     if abs(r - p / q) > rtol * r:
         raise NotCommensurateError(
-            f"`f_L`={f_L!r} Hz and `f_H`={f_H!r} Hz are not commensurate: f_H/f_L={r!r} is "
-            f"not a ratio p/q with q <= max_denominator={max_denominator} within rtol={rtol} "
-            f"(nearest {p}/{q}); use a window (e.g. window='flattop') instead"
-        )
+            "f_H", f_H, f"must be commensurate with f_L = {f_L!r} Hz: f_H/f_L = {r!r} is not a ratio p/q with "
+            f"q <= max_denominator = {max_denominator} within rtol = {rtol} (nearest {p}/{q}); use a window "
+            "(e.g. window='flattop') instead", "Hz")
     f0 = f_L / q
     period = 1.0 / f0
     spp_float = period / dt
     spp = int(round(spp_float))
     if spp < 1 or abs(spp_float - spp) > rtol * spp_float:
         raise NotCommensurateError(
-            f"the common period T = {period!r} s is not a whole number of samples of "
-            f"`dt`={dt!r} s (T/dt = {spp_float!r}, tolerance rtol={rtol}); choose dt = T/N "
-            f"or use a window (e.g. window='flattop')"
-        )
+            "dt", dt, f"must divide the common period T = {period!r} s into a whole number of samples "
+            f"(T/dt = {spp_float!r}, tolerance rtol = {rtol}); choose dt = T/N or use a window "
+            "(e.g. window='flattop')", "s")
     if n_available is None:
         k = 1 if n_periods is None else int(n_periods)
     else:
         k_max = int(n_available) // spp
         if k_max < 1:
-            raise ValueError(
-                f"`n_available`={n_available} samples is shorter than one common period "
-                f"T = {period!r} s = {spp} samples"
-            )
+            checks.fail("n_available", n_available, f"must hold at least one common period T = {period!r} s = "
+                        f"{spp} samples")
         if n_periods is None:
             k = k_max
         elif n_periods > k_max:
-            raise ValueError(
-                f"`n_periods`={n_periods} periods of {spp} samples do not fit in "
-                f"`n_available`={n_available} samples (at most {k_max})"
-            )
+            checks.fail("n_periods", n_periods, f"must fit in n_available = {n_available} samples: at most {k_max} "
+                        f"periods of {spp} samples")
         else:
             k = int(n_periods)
     return CommensurateRecord(

@@ -15,7 +15,9 @@ project's single definition)
 * The penetration is shared between plate bending and local contact deformation
   (Eq. 4): ``p = W + delta``, with ``W = lam P + w0`` from the plate model
   (:mod:`rotorred.transient.plate`, Eqs. 10-11) and ``delta`` the Hertz deformation.
-* Normal force (Eq. 8, Hunt–Crossley reading of the "nonlinear spring damping model"):
+* Normal force (Eq. 8, Hunt–Crossley reading of the "nonlinear spring damping model";
+  :func:`normal_law`, the one implementation, evaluates the residual generated from
+  ``derivations/contact.py``, and the step kernel compiles it):
   ``P = K_nr delta^1.5 max(0, 1 + c p')`` for ``delta > 0``, else 0. The rate is the
   approach rate ``p' = -g'`` of the disk towards the plate (the bending deflection is treated
   as quasi-static, so ``delta'`` is replaced by ``p'``; this keeps the law algebraic in each
@@ -28,7 +30,7 @@ project's single definition)
   the plate's tangential velocity. Slip: ``T = -mu_d P sign(v_rel)``. Stick: ``v_rel = 0`` with
   ``|T| <= mu_s P``. The integrator treats stick exactly as a constraint (no regularisation);
   see :mod:`rotorred.transient.newmark`.
-* Forces: on the disk ``-P n + T t``; on the plate ``+P n - T t``. In the paper's Eq. 12,
+* Forces: on the disk ``-P n + T t`` (:func:`disk_force`); on the plate ``+P n - T t``. In the paper's Eq. 12,
   ``F_x = F_n cos theta + F_t sin theta``, ``F_y = F_n sin theta - F_t cos theta`` with
   ``F_n = -P`` and ``F_t = -T`` (the paper's t axis is ``-t`` here).
 """
@@ -41,6 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rotorred import checks
 from rotorred._generated import contact as _gen
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
@@ -50,15 +53,9 @@ PlateBending = NavierPlate | ClampedFreePlate | RigidPlate
 OPEN, SLIP, STICK = 0, 1, 2
 STATE_NAMES = {OPEN: "open", SLIP: "slip", STICK: "stick"}
 
-
-def _check(name: str, value, *, minimum: float | None = None, strict: bool = False, unit: str = "") -> float:
-    ok = isinstance(value, (int, float, np.floating)) and not isinstance(value, bool) and math.isfinite(value)
-    if ok and minimum is not None:
-        ok = value > minimum if strict else value >= minimum
-    if not ok:
-        rel = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
-        raise ValueError(f"`{name}` must be a finite number{rel} ({unit}), got {value!r}")
-    return float(value)
+#: the generated residual of the normal law (derivations/contact.py); the kernel compiles
+#: :func:`normal_law` with this name bound to the njit wrap of the same function
+_normal_residual = _gen.normal_residual
 
 
 @dataclass(frozen=True)
@@ -119,30 +116,29 @@ class RubPlate:
     name: str = ""
 
     def __post_init__(self):
-        if not isinstance(self.node, int) or isinstance(self.node, bool):
-            raise ValueError(f"`node` must be an integer node number, got {self.node!r}")
-        _check("theta", self.theta, unit="rad")
-        _check("clearance", self.clearance, unit="m")
-        _check("K_nr", self.K_nr, minimum=0.0, strict=True, unit="N/m^1.5")
-        _check("c", self.c, minimum=0.0, unit="s/m")
-        _check("mu_s", self.mu_s, minimum=0.0, unit="-")
-        _check("mu_d", self.mu_d, minimum=0.0, unit="-")
+        checks.integer("node", self.node)
+        checks.number("theta", self.theta, "rad")
+        checks.number("clearance", self.clearance, "m")
+        checks.positive("K_nr", self.K_nr, "N/m^1.5")
+        checks.non_negative("c", self.c, "s/m")
+        checks.non_negative("mu_s", self.mu_s)
+        checks.non_negative("mu_d", self.mu_d)
         if self.mu_d > self.mu_s:
-            raise ValueError(f"`mu_d` = {self.mu_d!r} must not exceed `mu_s` = {self.mu_s!r}")
-        _check("m_p", self.m_p, minimum=0.0, strict=True, unit="kg")
-        for f in ("k_n", "k_t", "c_n", "c_t"):
-            _check(f, getattr(self, f), minimum=0.0, unit="N/m" if f[0] == "k" else "N s/m")
+            checks.fail("mu_d", self.mu_d, f"must not exceed mu_s = {self.mu_s!r}")
+        checks.positive("m_p", self.m_p, "kg")
+        for name, unit in (("k_n", "N/m"), ("k_t", "N/m"), ("c_n", "N s/m"), ("c_t", "N s/m")):
+            checks.non_negative(name, getattr(self, name), unit)
         if not isinstance(self.bending, (NavierPlate, ClampedFreePlate, RigidPlate)):
-            raise ValueError(f"`bending` must be a NavierPlate, ClampedFreePlate or RigidPlate, got {self.bending!r}")
+            checks.fail("bending", self.bending, "must be a NavierPlate, ClampedFreePlate or RigidPlate")
         if self.disk_radius is not None:
-            _check("disk_radius", self.disk_radius, minimum=0.0, unit="m")
+            checks.non_negative("disk_radius", self.disk_radius, "m")
 
     @classmethod
     def for_rotor(cls, rotor, node: int = 18, **kwargs) -> RubPlate:
         """A plate at ``node`` of ``rotor`` with ``disk_radius`` taken from the rotor's disk there."""
         disk = rotor.disk_at(node)
         if disk.radius <= 0:
-            raise ValueError(f"the disk at node {node} has no `radius`; give `disk_radius` explicitly")
+            checks.fail("node", node, "must carry a disk with a radius > 0; else give disk_radius")
         return cls(node=node, disk_radius=disk.radius, **kwargs)
 
     def with_(self, **changes) -> RubPlate:
@@ -175,8 +171,44 @@ def gap(plate: RubPlate, x: float, y: float, u_n: float = 0.0) -> float:
     return plate.clearance + u_n - (x * math.cos(plate.theta) + y * math.sin(plate.theta))
 
 
+def normal_law(F, delta, rate, K_nr, c, lam):
+    """The normal contact law in residual form and its tangent, clamped (Eqs. 8, 10-11).
+
+    ``R(F) = F - K_nr delta^1.5 max(0, 1 + c rate)`` for ``delta > 0``, else ``R = F``: the
+    generated :func:`rotorred._generated.contact.normal_residual` evaluated at
+    ``s = sqrt(delta)``, or at ``s = 0`` (no force) when ``delta <= 0`` or ``1 + c rate <= 0``,
+    which gives ``R = F``, ``dR/dF = 1`` and zero other derivatives. Plain Python on floats; the
+    kernel compiles this same function (:mod:`rotorred.transient.kernel`), and so evaluates the
+    same generated code.
+
+    Parameters
+    ----------
+    F : float
+        Normal force (N).
+    delta : float
+        Local (Hertz) contact deformation ``p - w0 - lam F`` (m).
+    rate : float
+        Penetration rate (m/s).
+    K_nr : float
+        Hertz stiffness (N/m^1.5).
+    c : float
+        Hunt–Crossley coefficient (s/m).
+    lam : float
+        Plate bending compliance (m/N).
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)], ``p`` the penetration.
+    """
+    s = math.sqrt(delta) if delta > 0.0 and 1.0 + c * rate > 0.0 else 0.0
+    return _normal_residual(F, s, rate, K_nr, c, lam)
+
+
 def hunt_crossley(delta: float, rate: float, K_nr: float, c: float) -> tuple[float, float, float]:
     """Hertz force with Hunt–Crossley damping, clamped at zero, and its tangent.
+
+    The law of :func:`normal_law` for a rigid plate at zero force: ``F = -R(0)`` with ``lam = 0``.
 
     Parameters
     ----------
@@ -194,17 +226,15 @@ def hunt_crossley(delta: float, rate: float, K_nr: float, c: float) -> tuple[flo
     force, stiffness, damping : float
         F (N), dF/d(delta) (N/m), dF/d(rate) (N s/m).
     """
-    if delta <= 0.0 or 1.0 + c * rate <= 0.0:
-        return 0.0, 0.0, 0.0
-    F, k, d = _gen.hunt_crossley(math.sqrt(delta), rate, K_nr, c)
-    return float(F), float(k), float(d)
+    R, _, dR_dp, dR_drate = normal_law(0.0, delta, rate, K_nr, c, 0.0)
+    return 0.0 - float(R), 0.0 - float(dR_dp), 0.0 - float(dR_drate)
 
 
 def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 1e-14) -> tuple[float, float]:
     """Normal contact force P of the plate's series law: P = K_nr (p - w0 - lam P)^1.5 max(0, 1 + c rate).
 
-    Solved by Newton from P = 0 (the residual is increasing and concave in P for fixed
-    ``rate``, so the iterates increase monotonically to the root).
+    The root of :func:`normal_law`'s residual by Newton from P = 0 (the residual is increasing and
+    concave in P for fixed ``rate``, so the iterates increase monotonically to the root).
 
     Parameters
     ----------
@@ -224,16 +254,13 @@ def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 
     lam, w0 = plate.compliance, plate.offset
     P = 0.0
     for _ in range(200):
-        delta = penetration - w0 - lam * P
-        F, k, _d = hunt_crossley(delta, rate, plate.K_nr, plate.c)
-        R, dR = P - F, 1.0 + lam * k
-        step = R / dR
+        R, dR_dF, _, _ = normal_law(P, penetration - w0 - lam * P, rate, plate.K_nr, plate.c, lam)
+        step = R / dR_dF
         P -= step
         if abs(step) <= tol * max(abs(P), 1e-300):
             break
-    delta = penetration - w0 - lam * P
-    _, k, _ = hunt_crossley(delta, rate, plate.K_nr, plate.c)
-    return max(P, 0.0), k / (1.0 + lam * k)
+    _, dR_dF, dR_dp, _ = normal_law(P, penetration - w0 - lam * P, rate, plate.K_nr, plate.c, lam)
+    return max(float(P), 0.0), float(-dR_dp / dR_dF)
 
 
 def contact_energy(P: float, plate: RubPlate) -> float:
@@ -253,7 +280,28 @@ def sliding_velocity(plate: RubPlate, Omega: float, radius: float, vx: float, vy
     return Omega * radius + (-vx * math.sin(plate.theta) + vy * math.cos(plate.theta)) - v_t
 
 
+def disk_force(P, T, cos_theta, sin_theta):
+    """Force (F_x, F_y) on the disk of normal force ``P`` and friction ``T`` (N) (Eq. 12): ``-P n + T t``.
+
+    ``F_x = -P cos(theta) - T sin(theta)``, ``F_y = -P sin(theta) + T cos(theta)``. Plain arithmetic:
+    works on floats and on numpy arrays of any (broadcastable) shape; the kernel compiles this
+    same function.
+
+    Parameters
+    ----------
+    P, T : float or ndarray
+        Normal and friction force (N).
+    cos_theta, sin_theta : float or ndarray
+        Components of the plate normal n (-).
+
+    Returns
+    -------
+    F_x, F_y : float or ndarray
+        (N), the broadcast shape of the arguments.
+    """
+    return -P * cos_theta - T * sin_theta, -P * sin_theta + T * cos_theta
+
+
 def rotor_force(plate: RubPlate, P: float, T: float) -> tuple[float, float]:
     """Force (F_x, F_y) (N) on the rotor node for normal force ``P`` and friction ``T`` (Eq. 12)."""
-    c, s = math.cos(plate.theta), math.sin(plate.theta)
-    return -P * c - T * s, -P * s + T * c
+    return disk_force(P, T, math.cos(plate.theta), math.sin(plate.theta))

@@ -2,12 +2,21 @@
 
 Everything here is ``numba.njit(cache=True)``; no Python runs per step. The Python side
 (:mod:`rotorred.transient.newmark`) builds the constant step matrices once per step size ("level":
-``dt / 2**level``, used when a step must be halved) and calls :func:`run_steps` in chunks.
+``dt / 2**level``, used when a step must be halved) and calls :func:`run_steps` in chunks with a
+few typed containers (namedtuples of arrays; the loop reads them as borrowed views, :func:`_borrowed`):
 
-One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Newmark):
+* :class:`Levels` -- the step matrices of every level;
+* :class:`Forcing` -- the time functions of the external forces;
+* :class:`Plates` -- the plates' parameters and the contact DOFs' selection;
+* :class:`State` -- the state (rotor, contact DOFs, plates, contact forces), updated in place,
+  with a spare set of the same buffers and the :class:`Work` arrays;
+* :class:`Record` -- the record buffers and their plan;
+* :class:`Settings` and :class:`Diagnostics` -- the solver's settings, its counters and the failure report.
 
-1. Linear predictor ``q_lin``: the step with the new contact force set to zero,
-   ``q_new = q_lin + (1+alpha) S f_new`` with ``A = c0 M + (1+alpha)(c3 D + K)`` and
+One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Newmark), :func:`_substep`:
+
+1. Linear predictor ``q_lin`` (:func:`_linear_predictor`): the step with the new contact force
+   set to zero. ``q_new = q_lin + (1+alpha) S f_new`` with ``A = c0 M + (1+alpha)(c3 D + K)`` and
    ``S = A^-1 B`` (B: the columns of the contact DOFs) is then the exact implicit step for any
    contact force ``f_new``. For Newmark (alpha = 0) the equation of motion holds at every step,
    ``M a = F + B f - D v - K q``, so ``a`` is eliminated from the predictor and
@@ -16,286 +25,278 @@ One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Ne
    with ``-alpha A^-1``. The external forces are constants or sinusoids, so their values at ``ta``
    are a rotation of those at ``tb`` by the fixed step: both terms are folded into one set of
    vectors ``UF`` (per step size), evaluated with cos and sin at ``tb`` only.
-2. Condensation: the disk displacements at the contact nodes, the plates' rigid DOFs and their
-   velocities are affine in the unknown forces ``z = (P_0, T_0, P_1, T_1, ...)``:
-   ``p = p_lin + Jp z`` (penetration), ``p' = p'_lin + c3 Jp z``, ``v_rel = v_lin + c3 Jv z``.
-3. Newton on the contact residual (:func:`contact_residual`) with the analytic tangent of the
-   law (generated from ``derivations/contact.py``), with an active set for Coulomb friction:
-   slip rows ``T + mu_d s P = 0``, stick rows ``v_rel = 0``; a slip whose ``v_rel`` reverses
-   within the step becomes stick, a stick needing ``|T| > mu_s P`` becomes slip. The first guess
-   extrapolates the forces of the last two steps. Every plate open at ``z = 0`` (the common
-   case) skips Newton.
-4. Newmark update of q, v, a and of the plates; finiteness check. For alpha = 0 the stick forces
-   are then corrected to zero relative acceleration (:func:`_stick_acceleration_reset`).
+2. Contact condensation (:func:`_condense_contact`): the disk displacements at the contact nodes,
+   the plates' rigid DOFs and their velocities are affine in the unknown forces
+   ``z = (P_0, T_0, P_1, T_1, ...)``: ``p = p_lin + Jp z`` (penetration), ``p' = p'_lin + c3 Jp z``,
+   ``v_rel = v_lin + c3 Jv z`` (:class:`Condensed`).
+3. Contact solve (:func:`_solve_contact_forces`): Newton on the contact residual
+   (:func:`contact_residual`) with the analytic tangent of the law (the generated
+   ``normal_residual`` through :func:`rotorred.transient.contact.normal_law`), with an active set
+   for Coulomb friction: slip rows ``T + mu_d s P = 0``, stick rows ``v_rel = 0``; a slip whose
+   ``v_rel`` reverses within the step becomes stick, a stick needing ``|T| > mu_s P`` becomes
+   slip. The first guess extrapolates the forces of the last two steps. Every plate open at
+   ``z = 0`` (the common case) skips Newton.
+4. Newmark update (:func:`_update_contact`, :func:`_newmark_update`) of the contact DOFs, the
+   plates and q, v, a; finiteness check.
+5. Stick reset (:func:`_stick_reset`): for alpha = 0 the stick forces are corrected to zero
+   relative acceleration.
 
-If Newton fails or a value is not finite, the step is retried as two half steps, recursively
-(up to ``L - 1`` halvings), and then the main step size is resumed.
+After each main step the state is recorded (:func:`_record_step`). If the contact solve fails or
+a value is not finite, the step is retried as two half steps, recursively (up to ``L - 1``
+halvings), and then the main step size is resumed.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numba import types as nbtypes
+from numba.core import cgutils
+from numba.extending import intrinsic
 
-from rotorred._generated import contact as _gen
+from rotorred.transient import contact, numba_cache
+from rotorred.transient.contact_solve import (  # noqa: F401 - re-exported: the kernel's constants and contact solve
+    C_ACTIVESET, C_CONTACT, C_MAXNEWTON, C_NEWTON, C_STEPS, C_SUBSTEPS, N_COUNTERS, N_PLATE_PAR, P_C, P_CLEAR,
+    P_COS, P_K, P_LAM, P_MP, P_MUD, P_MUS, P_SIN, P_V, P_W0, Condensed, _kinematics, _normal_law,
+    _normal_residual, _open_plates, _solve_small, contact_residual, solve_contact)
 
-_hunt_crossley = njit(cache=True)(_gen.hunt_crossley)
+numba_cache.register()
+
+
+_disk_force = njit(cache=True)(contact.disk_force)
+
+
+def _borrow_codegen(context, builder, ty, value):
+    """LLVM value of ``value`` (numba type ``ty``) with the meminfo and parent of every array in it set to NULL."""
+    if isinstance(ty, nbtypes.Array):
+        ary = context.make_array(ty)(context, builder, value=value)
+        ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
+        ary.parent = cgutils.get_null_value(ary.parent.type)
+        return ary._getvalue()
+    if isinstance(ty, nbtypes.BaseTuple):
+        for i, member in enumerate(ty):
+            value = builder.insert_value(value, _borrow_codegen(context, builder, member,
+                                                                builder.extract_value(value, i)), i)
+    return value
+
+
+@intrinsic
+def _borrowed(typingctx, container):
+    """``container`` (a namedtuple of arrays and scalars) with its arrays as borrowed views.
+
+    numba counts the references to every array a compiled function binds (an atomic add and
+    subtract on the array's meminfo), and in the inlined step functions of the loop it cannot
+    prove most of those counts redundant: they would cost more than the step's arithmetic. Every
+    array the loop touches is owned by the Python caller of :func:`run_steps` for the whole call,
+    so the loop works on views without a meminfo (same data, shape and strides), which numba's
+    reference counting skips. Nothing keeps such a view beyond the call.
+    """
+    if not isinstance(container, nbtypes.BaseTuple):
+        return None
+
+    def codegen(context, builder, sig, args):
+        return _borrow_codegen(context, builder, container, args[0])
+
+    return container(container), codegen
+
 
 # status codes
 RUNNING, DONE, NONFINITE, NEWTON_FAILED, LIMIT = 0, 1, 2, 3, 4
 # steps between exact re-evaluations of the forcing's cos/sin in the rotation recurrence
 RESYNC = 1024
 
-# columns of the per-plate parameter array
-P_COS, P_SIN, P_CLEAR, P_W0, P_LAM, P_K, P_C, P_MUS, P_MUD, P_V, P_MP = range(11)
-N_PLATE_PAR = 11
-# columns of the per-plate record
+# columns of Record.plate
 R_P, R_T, R_UN, R_UT, R_VREL, R_GAP = range(6)
 N_PLATE_REC = 6
-# counters
-C_STEPS, C_NEWTON, C_SUBSTEPS, C_CONTACT, C_MAXNEWTON, C_ACTIVESET = range(6)
+# Diagnostics.err: time of the failing step (s), DOF (or -1 - contact DOF), plate, status
+E_TIME, E_DOF, E_PLATE, E_STATUS = range(4)
 
 
-@njit(cache=True)
-def _solve_small(J, R, out, A):
-    """Solve J out = -R (Gaussian elimination with partial pivoting, A a work array); False if singular."""
-    m = R.shape[0]
-    for i in range(m):
-        for j in range(m):
-            A[i, j] = J[i, j]
-    b = out
-    for i in range(m):
-        b[i] = -R[i]
-    for col in range(m):
-        piv = col
-        big = abs(A[col, col])
-        for r in range(col + 1, m):
-            if abs(A[r, col]) > big:
-                big = abs(A[r, col])
-                piv = r
-        if big == 0.0 or not math.isfinite(big):
-            return False
-        if piv != col:
-            for c in range(m):
-                tmp = A[col, c]
-                A[col, c] = A[piv, c]
-                A[piv, c] = tmp
-            tmp = b[col]
-            b[col] = b[piv]
-            b[piv] = tmp
-        for r in range(col + 1, m):
-            f = A[r, col] / A[col, col]
-            if f != 0.0:
-                for c in range(col, m):
-                    A[r, c] -= f * A[col, c]
-                b[r] -= f * b[col]
-    for r in range(m - 1, -1, -1):
-        s = b[r]
-        for c in range(r + 1, m):
-            s -= A[r, c] * b[c]
-        b[r] = s / A[r, r]
-    return True
+class Levels(NamedTuple):
+    """Constant step matrices, one per step size ``h = dt / 2**level`` (leading axis: level, L of them).
 
-
-@njit(cache=True)
-def contact_residual(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, R, J):
-    """Residual and Jacobian of the condensed contact equations of one step.
-
-    Parameters
+    Attributes
     ----------
-    z : ndarray, shape (2 n_p,)
-        Unknown forces (P_0, T_0, P_1, T_1, ...) (N): P the normal force pressing the disk
-        away from plate k, T the friction force on the disk along plate k's tangent.
-    p_lin, pd_lin, v_lin : ndarray, shape (n_p,)
-        Effective penetration p - w0 (m), its rate (m/s) and the sliding velocity (m/s) at z = 0.
-    Jp, Jv : ndarray, shape (n_p, 2 n_p)
-        d(penetration)/dz and d(v_rel)/dz / c3 (m/N).
-    c3 : float
-        Newmark velocity factor gamma / (beta h) (1/s).
-    pp : ndarray, shape (n_p, 10)
-        Plate parameters (cos, sin, clearance, w0, lam, K_nr, c, mu_s, mu_d, Omega r).
-    mode : ndarray of int, shape (n_p,)
-        1 = slip, 2 = stick.
+    H : ndarray, shape (L, n, n_hist)
+        History map of the linear predictor: ``[P_q, P_v]`` on (q, v) for Newmark (n_hist = 2 n),
+        ``[Hq, Hv, Ha]`` on (q, v, a) for HHT-α (n_hist = 3 n).
+    UF : ndarray, shape (L, nf, n)
+        Forcing vectors folded onto the end of the step: ``q_lin += sum_j w_j(tb) UF[j]`` (m per N).
+    ST : ndarray, shape (L, m, n)
+        ``(A^-1 B)^T``: displacement per unit new contact force (m/N), m = 2 n_p.
+    S0T : ndarray, shape (L, m, n)
+        The same for the previous step's contact force (``(Ha M^-1 B)^T`` or ``-alpha (A^-1 B)^T``) (m/N).
+    W : ndarray, shape (L, m, m)
+        ``(1 + alpha) B^T A^-1 B``: contact-DOF displacement per unit contact force (m/N).
+    Jp, Jv : ndarray, shape (L, n_p, m)
+        The condensed contact operator: d(penetration)/dz and d(v_rel)/dz / c3 (m/N).
+    plate : ndarray, shape (L, n_p, 2, 4)
+        Per plate, (normal, tangential) x (hq, hv, ha, 1/A) of its scalar Newmark step.
+    coef : ndarray, shape (L, 8)
+        Newmark constants c0 ... c5, alpha, h.
+    """
+
+    H: np.ndarray
+    UF: np.ndarray
+    ST: np.ndarray
+    S0T: np.ndarray
+    W: np.ndarray
+    Jp: np.ndarray
+    Jv: np.ndarray
+    plate: np.ndarray
+    coef: np.ndarray
+
+
+class Forcing(NamedTuple):
+    """Time functions of the external force columns.
+
+    Attributes
+    ----------
+    kind : ndarray of int64, shape (nf,)
+        0 constant, 1 cos(omega t), 2 sin(omega t).
+    omega : ndarray, shape (nf,)
+        Angular frequency (rad/s).
+    """
+
+    kind: np.ndarray
+    omega: np.ndarray
+
+
+class Plates(NamedTuple):
+    """The plates' parameters and the contact DOFs (x, y of each plate's node).
+
+    Attributes
+    ----------
+    par : ndarray, shape (n_p, N_PLATE_PAR)
+        Columns P_COS, P_SIN (normal n, -), P_CLEAR (m), P_W0 (m), P_LAM (m/N), P_K (N/m^1.5),
+        P_C (s/m), P_MUS, P_MUD (-), P_V (disk surface speed Omega r, m/s), P_MP (kg).
+    atol : ndarray, shape (n_p,)
+        Absolute force tolerance of the contact Newton iteration (N).
+    BT : ndarray, shape (m, n)
+        ``B^T``: the contact DOFs as rows on q.
+    MBT : ndarray, shape (m, n)
+        ``(M^-1 B)^T`` (1/kg).
+    G : ndarray, shape (m, m)
+        ``B^T M^-1 B`` (1/kg).
+    """
+
+    par: np.ndarray
+    atol: np.ndarray
+    BT: np.ndarray
+    MBT: np.ndarray
+    G: np.ndarray
+
+
+class State(NamedTuple):
+    """The state after a step.
+
+    Attributes
+    ----------
+    x : ndarray, shape (3 n,)
+        q, v, a (model coordinates).
+    xc : ndarray, shape (m, 3)
+        Contact DOFs (x, y of each plate's node): displacement (m), velocity, acceleration.
+    ps : ndarray, shape (n_p, 2, 3)
+        Plates' rigid DOFs (normal, tangential) x (u (m), u' (m/s), u'' (m/s^2)).
+    z : ndarray, shape (m,)
+        Contact forces (P_0, T_0, P_1, ...) (N).
+    mode : ndarray of int64, shape (n_p,)
+        1 slip, 2 stick.
     sgn : ndarray, shape (n_p,)
-        Slip direction sign(v_rel) of slipping plates.
-    R : ndarray, shape (2 n_p,)
-        Output residual (N).
-    J : ndarray, shape (2 n_p, 2 n_p)
-        Output Jacobian dR/dz.
+        Slip direction, sign(v_rel).
+    pinfo : ndarray, shape (n_p, 3)
+        v_rel (m/s), gap (m), contact state (0 open, 1 slip, 2 stick).
     """
-    n_p = pp.shape[0]
-    m = 2 * n_p
-    for k in range(n_p):
-        p = p_lin[k]
-        pd = pd_lin[k]
-        vr = v_lin[k]
-        for j in range(m):
-            p += Jp[k, j] * z[j]
-            pd += c3 * Jp[k, j] * z[j]
-            vr += c3 * Jv[k, j] * z[j]
-        P = z[2 * k]
-        T = z[2 * k + 1]
-        lam = pp[k, P_LAM]
-        delta = p - lam * P
-        F = 0.0
-        Fd = 0.0
-        Fr = 0.0
-        if delta > 0.0 and 1.0 + pp[k, P_C] * pd > 0.0:
-            out = _hunt_crossley(math.sqrt(delta), pd, pp[k, P_K], pp[k, P_C])
-            F = out[0]
-            Fd = out[1]
-            Fr = out[2]
-        R[2 * k] = P - F
-        g = Fd + c3 * Fr
-        for j in range(m):
-            J[2 * k, j] = -g * Jp[k, j]
-        J[2 * k, 2 * k] += 1.0 + Fd * lam
-        if mode[k] == 2:
-            zeta = 1.0 / (c3 * Jv[k, 2 * k + 1])
-            R[2 * k + 1] = zeta * vr
-            for j in range(m):
-                J[2 * k + 1, j] = Jv[k, j] / Jv[k, 2 * k + 1]
-        else:
-            mu = pp[k, P_MUD]
-            R[2 * k + 1] = T + mu * sgn[k] * P
-            for j in range(m):
-                J[2 * k + 1, j] = 0.0
-            J[2 * k + 1, 2 * k + 1] = 1.0
-            J[2 * k + 1, 2 * k] = mu * sgn[k]
+
+    x: np.ndarray
+    xc: np.ndarray
+    ps: np.ndarray
+    z: np.ndarray
+    mode: np.ndarray
+    sgn: np.ndarray
+    pinfo: np.ndarray
 
 
-@njit(cache=True)
-def _kinematics(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, k):
-    p = p_lin[k]
-    pd = pd_lin[k]
-    vr = v_lin[k]
-    for j in range(z.shape[0]):
-        p += Jp[k, j] * z[j]
-        pd += c3 * Jp[k, j] * z[j]
-        vr += c3 * Jv[k, j] * z[j]
-    return p, pd, vr
+class Record(NamedTuple):
+    """Record buffers: the state at step indices ``j >= start`` with ``(j - start) % every == 0``.
 
-
-@njit(cache=True)
-def _newton(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, tol, atol, maxiter, counters, wv, wm):
-    """Newton with backtracking on the contact residual; returns True on convergence.
-
-    ``wv`` (4, m) and ``wm`` (3, m, m) are work arrays.
+    Attributes
+    ----------
+    rows : ndarray, shape (n_out, n)
+        Output rows on q.
+    start, every : int
+        First recorded step index and decimation.
+    t : ndarray, shape (n_rec,)
+        Times (s).
+    y : ndarray, shape (n_rec, n_out)
+        Outputs (m or rad).
+    plate : ndarray, shape (n_rec, n_p, N_PLATE_REC)
+        Columns R_P, R_T (N), R_UN, R_UT (m), R_VREL (m/s), R_GAP (m).
+    state : ndarray of int8, shape (n_rec, n_p)
+        Contact state (0 open, 1 slip, 2 stick).
+    count : ndarray of int64, shape (1,)
+        Records written.
     """
-    m = z.shape[0]
-    R = wv[0]
-    dz = wv[1]
-    zt = wv[2]
-    Rt = wv[3]
-    J = wm[0]
-    Jt = wm[1]
-    contact_residual(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, R, J)
-    merit = 0.0
-    for i in range(m):
-        merit += R[i] * R[i]
-    for it in range(maxiter):
-        counters[C_NEWTON] += 1
-        if not _solve_small(J, R, dz, wm[2]):
-            return False
-        small = True
-        for k in range(m // 2):
-            scale = tol * (abs(z[2 * k]) + abs(z[2 * k + 1])) + atol[k]
-            if abs(dz[2 * k]) > scale or abs(dz[2 * k + 1]) > scale:
-                small = False
-        if small:  # quadratic convergence: the update is below tolerance, accept it as is
-            for i in range(m):
-                z[i] += dz[i]
-            for k in range(m // 2):
-                if z[2 * k] < 0.0:
-                    z[2 * k] = 0.0
-            if it + 1 > counters[C_MAXNEWTON]:
-                counters[C_MAXNEWTON] = it + 1
-            return True
-        lam = 1.0
-        for ls in range(12):
-            for i in range(m):
-                zt[i] = z[i] + lam * dz[i]
-            for k in range(m // 2):
-                if zt[2 * k] < 0.0:
-                    zt[2 * k] = 0.0
-            contact_residual(zt, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, Rt, Jt)
-            mt = 0.0
-            for i in range(m):
-                mt += Rt[i] * Rt[i]
-            if mt <= merit or small or not math.isfinite(merit):
-                break
-            lam *= 0.5
-        if not math.isfinite(mt):
-            return False
-        for i in range(m):
-            z[i] = zt[i]
-            R[i] = Rt[i]
-            for j in range(m):
-                J[i, j] = Jt[i, j]
-        merit = mt
-        if small:
-            if it + 1 > counters[C_MAXNEWTON]:
-                counters[C_MAXNEWTON] = it + 1
-            return True
-    return False
+
+    rows: np.ndarray
+    start: int
+    every: int
+    t: np.ndarray
+    y: np.ndarray
+    plate: np.ndarray
+    state: np.ndarray
+    count: np.ndarray
 
 
-@njit(cache=True)
-def solve_contact(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, tol, atol, maxiter, counters, wv, wm):
-    """Solve the condensed contact problem of one step with the Coulomb active set.
+class Settings(NamedTuple):
+    """Solver settings: start time t0 (s), main step dt (s), allowed halvings, Newton's relative tolerance
+    and iteration budget, contact-DOF displacement limit (m)."""
 
-    ``z``, ``mode`` and ``sgn`` hold the previous step's forces and states on entry (warm
-    start) and the solution on exit. Returns True on success.
-    """
-    n_p = pp.shape[0]
-    # fast path: no plate touches when every force is zero
-    any_contact = False
-    for k in range(n_p):
-        if p_lin[k] > 0.0:
-            any_contact = True
-    if not any_contact:
-        for k in range(n_p):
-            z[2 * k] = 0.0
-            z[2 * k + 1] = 0.0
-            mode[k] = 1
-            sgn[k] = 1.0 if v_lin[k] >= 0.0 else -1.0
-        return True
-    counters[C_CONTACT] += 1
-    for k in range(n_p):
-        if z[2 * k] == 0.0:  # was open: start sliding in the predicted direction
-            if v_lin[k] > 0.0:
-                mode[k] = 1
-                sgn[k] = 1.0
-            elif v_lin[k] < 0.0:
-                mode[k] = 1
-                sgn[k] = -1.0
-            else:
-                mode[k] = 2
-    for sweep in range(8):
-        counters[C_ACTIVESET] += 1
-        if not _newton(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, pp, mode, sgn, tol, atol, maxiter, counters, wv, wm):
-            return False
-        consistent = True
-        for k in range(n_p):
-            P = z[2 * k]
-            T = z[2 * k + 1]
-            p, pd, vr = _kinematics(z, p_lin, pd_lin, v_lin, Jp, Jv, c3, k)
-            if mode[k] == 2:
-                if abs(T) > pp[k, P_MUS] * P * (1.0 + 1e-12) + atol[k]:
-                    mode[k] = 1
-                    sgn[k] = -1.0 if T > 0.0 else 1.0
-                    consistent = False
-            else:
-                if P > 0.0 and sgn[k] * vr < 0.0:
-                    mode[k] = 2
-                    consistent = False
-        if consistent:
-            return True
-    return False
+    t0: float
+    dt: float
+    n_halvings: int
+    newton_tol: float
+    max_newton: int
+    limit: float
 
 
+class Diagnostics(NamedTuple):
+    """Counters (int64, shape (N_COUNTERS,), C_*) and the failure report (shape (4,), E_*)."""
+
+    counters: np.ndarray
+    err: np.ndarray
+
+
+class Work(NamedTuple):
+    """Work arrays of :func:`run_steps` (n DOFs, n_p plates, m = 2 n_p, nf force columns)."""
+
+    qn: np.ndarray      # (n,) the step's displacement
+    frot: np.ndarray    # (m,) contact forces on the disks (F_x, F_y per plate)
+    rlin: np.ndarray    # (m,) contact-DOF displacement at z = 0
+    rdlin: np.ndarray   # (m,) and velocity
+    p_lin: np.ndarray   # (n_p,) Condensed.p
+    pd_lin: np.ndarray  # (n_p,) Condensed.pd
+    v_lin: np.ndarray   # (n_p,) Condensed.v
+    ulin: np.ndarray    # (n_p, 2) plate displacement at z = 0
+    udlin: np.ndarray   # (n_p, 2) and velocity
+    wv: np.ndarray      # (4, m) Newton vectors
+    wm: np.ndarray      # (3, m, m) Newton matrices
+    stuck: np.ndarray   # (n_p,) int64, sticking plates
+    Hs: np.ndarray      # (n_p, n_p) stick reset matrix
+    rs: np.ndarray      # (n_p,) its right-hand side
+    dT: np.ndarray      # (n_p,) its solution
+    Ws: np.ndarray      # (n_p, n_p) its work array
+    fcos: np.ndarray    # (nf,) cos(omega t) at the end of the main step
+    fsin: np.ndarray    # (nf,) sin(omega t)
+    rot_c: np.ndarray   # (nf,) cos(omega dt)
+    rot_s: np.ndarray   # (nf,) sin(omega dt)
+    fval: np.ndarray    # (nf,) time functions at the end of the main step
+
+
+# ----------------------------------------------------------------------------------- linear algebra
 @njit(cache=True, fastmath={"reassoc", "contract"})
 def _matvec(H, x, out):
     """out = H x for H (n, k) C-contiguous; four rows at a time (the step's only O(n^2) work)."""
@@ -325,6 +326,26 @@ def _matvec(H, x, out):
         i += 1
 
 
+@njit(cache=True, inline="always")
+def _add_columns(qn, f, cols, scale):
+    """qn += scale f_j cols[j] for every non-zero f_j (cols: (m, n))."""
+    for j in range(f.shape[0]):
+        fj = scale * f[j]
+        if fj != 0.0:
+            for ii in range(qn.shape[0]):
+                qn[ii] += fj * cols[j, ii]
+
+
+@njit(cache=True, inline="always")
+def _disk_forces(z, par, out):
+    """out[2k], out[2k+1] = (F_x, F_y) on the disk of plate k (Eq. 12) for the forces z = (P_k, T_k)."""
+    for k in range(par.shape[0]):
+        fx, fy = _disk_force(z[2 * k], z[2 * k + 1], par[k, P_COS], par[k, P_SIN])
+        out[2 * k] = fx
+        out[2 * k + 1] = fy
+
+
+# ----------------------------------------------------------------------------------- forcing
 @njit(cache=True)
 def _forcing_value(kind, omega, t):
     if kind == 0:
@@ -334,8 +355,190 @@ def _forcing_value(kind, omega, t):
     return math.sin(omega * t)
 
 
-@njit(cache=True)
-def _stick_acceleration_reset(x_new, xc_new, ps_new, z_new, mode_new, pp, MBT, Gm, n, stuck, Hs, rs, dT, Ws):
+# The step functions below are inlined into run_steps (numba inline="always"): a call would pass
+# every array of its containers (a few hundred machine words) per step.
+@njit(cache=True, inline="always")
+def _start_forcing(forcing, dt, w):
+    """The rotation of each sinusoid over one main step: cos and sin of omega dt."""
+    for j in range(forcing.omega.shape[0]):
+        w.rot_c[j] = math.cos(forcing.omega[j] * dt)
+        w.rot_s[j] = math.sin(forcing.omega[j] * dt)
+
+
+@njit(cache=True, inline="always")
+def _forcing_at_step_end(k, t_end, forcing, w):
+    """``w.fval``: the time functions at the end ``t_end`` (s) of the chunk's ``k``-th main step.
+
+    By an exact rotation recurrence (cos and sin of omega dt), re-synchronised with cos/sin every
+    RESYNC steps (the recurrence's round-off grows like the number of steps, ~1e-13 over RESYNC).
+    """
+    if k % RESYNC == 0:
+        for j in range(forcing.kind.shape[0]):
+            w.fcos[j] = math.cos(forcing.omega[j] * t_end)
+            w.fsin[j] = math.sin(forcing.omega[j] * t_end)
+    else:
+        for j in range(forcing.kind.shape[0]):
+            c_old = w.fcos[j]
+            w.fcos[j] = c_old * w.rot_c[j] - w.fsin[j] * w.rot_s[j]
+            w.fsin[j] = w.fsin[j] * w.rot_c[j] + c_old * w.rot_s[j]
+    for j in range(forcing.kind.shape[0]):
+        kind = forcing.kind[j]
+        w.fval[j] = 1.0 if kind == 0 else (w.fcos[j] if kind == 1 else w.fsin[j])
+
+
+# ----------------------------------------------------------------------------------- the step
+@njit(cache=True, inline="always")
+def _linear_predictor(level, tb, cur, levels, forcing, plates, w):
+    """``w.qn = H x + sum_j w_j(tb) UF_j + S0^T f_old``: the step's q at zero new contact force.
+
+    A full main step (level 0) takes the time functions of ``w.fval``; a halved one evaluates them at ``tb``.
+    """
+    _matvec(levels.H[level], cur.x, w.qn)
+    for j in range(forcing.kind.shape[0]):
+        w1 = w.fval[j] if level == 0 else _forcing_value(forcing.kind[j], forcing.omega[j], tb)
+        for ii in range(w.qn.shape[0]):
+            w.qn[ii] += w1 * levels.UF[level, j, ii]
+    if plates.par.shape[0] > 0:
+        _disk_forces(cur.z, plates.par, w.frot)
+        _add_columns(w.qn, w.frot, levels.S0T[level], 1.0)
+
+
+@njit(cache=True, inline="always")
+def _condense_contact(l, cur, levels, plates, w):
+    """Contact kinematics at zero new contact force (:class:`Condensed` p, pd, v in ``w``); True if any plate touches.
+
+    Fills ``w.rlin``/``w.rdlin`` (contact-DOF displacement and velocity) and ``w.ulin``/``w.udlin``
+    (plate displacement and velocity), then the penetration, its rate and v_rel of each plate.
+    """
+    c3, c4, c5, alpha = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5], levels.coef[l, 6]
+    for j in range(cur.xc.shape[0]):
+        s = 0.0
+        for ii in range(w.qn.shape[0]):
+            s += plates.BT[j, ii] * w.qn[ii]
+        w.rlin[j] = s
+        w.rdlin[j] = c3 * (s - cur.xc[j, 0]) + c4 * cur.xc[j, 1] + c5 * cur.xc[j, 2]
+    touching = False
+    for k in range(plates.par.shape[0]):
+        cs = plates.par[k, P_COS]
+        sn = plates.par[k, P_SIN]
+        for d in range(2):
+            f0 = cur.z[2 * k] if d == 0 else -cur.z[2 * k + 1]
+            u0 = cur.ps[k, d, 0]
+            v0 = cur.ps[k, d, 1]
+            a0 = cur.ps[k, d, 2]
+            ul = (levels.plate[l, k, d, 0] * u0 + levels.plate[l, k, d, 1] * v0 + levels.plate[l, k, d, 2] * a0
+                  - alpha * levels.plate[l, k, d, 3] * f0)
+            w.ulin[k, d] = ul
+            w.udlin[k, d] = c3 * (ul - u0) + c4 * v0 + c5 * a0
+        dl = w.rlin[2 * k] * cs + w.rlin[2 * k + 1] * sn
+        ddl = w.rdlin[2 * k] * cs + w.rdlin[2 * k + 1] * sn
+        edl = -w.rdlin[2 * k] * sn + w.rdlin[2 * k + 1] * cs
+        w.p_lin[k] = dl - plates.par[k, P_CLEAR] - w.ulin[k, 0] - plates.par[k, P_W0]
+        w.pd_lin[k] = ddl - w.udlin[k, 0]
+        w.v_lin[k] = plates.par[k, P_V] + edl - w.udlin[k, 1]
+        if w.p_lin[k] > 0.0:
+            touching = True
+    return touching
+
+
+@njit(cache=True, inline="always")
+def _first_guess(extrapolate, cur, new):
+    """Newton's start in ``new.z``: the linear extrapolation of the last two steps' forces (``new.z``
+    holds the older one after the buffer swap) where both were in contact, else the last forces."""
+    for k in range(cur.z.shape[0] // 2):
+        for d in range(2):
+            j = 2 * k + d
+            g = 2.0 * cur.z[j] - new.z[j]
+            if cur.z[2 * k] > 0.0 and new.z[2 * k] > 0.0 and extrapolate and math.isfinite(g):
+                new.z[j] = g
+            else:
+                new.z[j] = cur.z[j]
+        if new.z[2 * k] < 0.0:
+            new.z[2 * k] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
+    """The step's contact forces and states into ``new.z``, ``new.mode``, ``new.sgn``; False if Newton failed."""
+    if not touching:  # every plate open: no contact force, no Newton
+        _open_plates(cond, new.z, new.mode, new.sgn)
+        return True
+    _first_guess(extrapolate, cur, new)
+    for k in range(cur.mode.shape[0]):
+        new.mode[k] = cur.mode[k]
+        new.sgn[k] = cur.sgn[k]
+    return solve_contact(new.z, cond, plates.par, new.mode, new.sgn, settings.newton_tol, plates.atol,
+                         settings.max_newton, diag.counters, w.wv, w.wm)
+
+
+@njit(cache=True, inline="always")
+def _update_contact(l, touching, cond, cur, new, levels, plates, w):
+    """The new contact forces' share of the step, and the Newmark update of the contact DOFs and plates.
+
+    ``w.qn += (1 + alpha) S f``; ``new.xc`` (contact DOFs), ``new.ps`` (plates), ``new.pinfo``
+    (v_rel, gap, state); the friction force of an open plate is set to zero.
+    """
+    c0, c1, c2 = levels.coef[l, 0], levels.coef[l, 1], levels.coef[l, 2]
+    c3, c4, c5, alpha = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5], levels.coef[l, 6]
+    _disk_forces(new.z, plates.par, w.frot)
+    _add_columns(w.qn, w.frot, levels.ST[l], 1.0 + alpha)
+    for j in range(cur.xc.shape[0]):
+        r = w.rlin[j]
+        if touching:
+            for jj in range(cur.xc.shape[0]):
+                r += levels.W[l, j, jj] * w.frot[jj]
+        dr = r - cur.xc[j, 0]
+        new.xc[j, 0] = r
+        new.xc[j, 1] = c3 * dr + c4 * cur.xc[j, 1] + c5 * cur.xc[j, 2]
+        new.xc[j, 2] = c0 * dr - c1 * cur.xc[j, 1] - c2 * cur.xc[j, 2]
+    for k in range(plates.par.shape[0]):
+        for d in range(2):
+            f1 = new.z[2 * k] if d == 0 else -new.z[2 * k + 1]
+            u = w.ulin[k, d] + (1.0 + alpha) * levels.plate[l, k, d, 3] * f1
+            du = u - cur.ps[k, d, 0]
+            new.ps[k, d, 0] = u
+            new.ps[k, d, 1] = c3 * du + c4 * cur.ps[k, d, 1] + c5 * cur.ps[k, d, 2]
+            new.ps[k, d, 2] = c0 * du - c1 * cur.ps[k, d, 1] - c2 * cur.ps[k, d, 2]
+        if touching:
+            p, pd, vr = _kinematics(new.z, cond, k)
+        else:
+            p = w.p_lin[k]
+            vr = w.v_lin[k]
+        new.pinfo[k, 0] = vr
+        new.pinfo[k, 1] = -(p + plates.par[k, P_W0])  # gap
+        if new.z[2 * k] == 0.0:
+            new.z[2 * k + 1] = 0.0
+            new.pinfo[k, 2] = 0.0
+        else:
+            new.pinfo[k, 2] = 2.0 if new.mode[k] == 2 else 1.0
+
+
+@njit(cache=True, inline="always")
+def _newmark_update(l, cur, new, levels, diag, w):
+    """``new.x`` = (q, v, a) from ``q = w.qn``; NONFINITE (with the DOF in ``diag.err``) if not finite."""
+    c0, c1, c2 = levels.coef[l, 0], levels.coef[l, 1], levels.coef[l, 2]
+    c3, c4, c5 = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5]
+    n = w.qn.shape[0]
+    total = 0.0
+    for ii in range(n):
+        dq = w.qn[ii] - cur.x[ii]
+        vi = c3 * dq + c4 * cur.x[n + ii] + c5 * cur.x[2 * n + ii]
+        ai = c0 * dq - c1 * cur.x[n + ii] - c2 * cur.x[2 * n + ii]
+        new.x[ii] = w.qn[ii]
+        new.x[n + ii] = vi
+        new.x[2 * n + ii] = ai
+        total += w.qn[ii] + vi
+    if math.isfinite(total):
+        return RUNNING
+    for ii in range(3 * n):
+        if not math.isfinite(new.x[ii]):
+            diag.err[E_DOF] = ii % n
+            break
+    return NONFINITE
+
+
+@njit(cache=True, inline="always")
+def _stick_reset(new, plates, w):
     """Make the relative tangential acceleration of sticking plates zero (Newmark, alpha = 0).
 
     The average-acceleration rule with the velocity constraint v_rel = 0 gives
@@ -347,344 +550,200 @@ def _stick_acceleration_reset(x_new, xc_new, ps_new, z_new, mode_new, pp, MBT, G
     (``a += M^-1 B dF``; equilibrium at t_{n+1} still holds). Once a_rel = 0 the constraint
     keeps it zero, so this changes only the step where stick begins (and round-off).
     """
-    n_p = pp.shape[0]
     ns = 0
-    for k in range(n_p):
-        if mode_new[k] == 2 and z_new[2 * k] > 0.0:
-            stuck[ns] = k
+    for k in range(plates.par.shape[0]):
+        if new.mode[k] == 2 and new.z[2 * k] > 0.0:
+            w.stuck[ns] = k
             ns += 1
     if ns == 0:
         return
     for a in range(ns):
-        k = stuck[a]
-        tx = -pp[k, P_SIN]
-        ty = pp[k, P_COS]
-        rs[a] = xc_new[2 * k, 2] * tx + xc_new[2 * k + 1, 2] * ty - ps_new[k, 1, 2]
+        k = w.stuck[a]
+        tx = -plates.par[k, P_SIN]
+        ty = plates.par[k, P_COS]
+        w.rs[a] = new.xc[2 * k, 2] * tx + new.xc[2 * k + 1, 2] * ty - new.ps[k, 1, 2]
         for b in range(ns):
-            j = stuck[b]
-            sx = -pp[j, P_SIN]
-            sy = pp[j, P_COS]
-            Hs[a, b] = (tx * (Gm[2 * k, 2 * j] * sx + Gm[2 * k, 2 * j + 1] * sy)
-                        + ty * (Gm[2 * k + 1, 2 * j] * sx + Gm[2 * k + 1, 2 * j + 1] * sy))
-        Hs[a, a] += 1.0 / pp[k, P_MP]
-    if not _solve_small(Hs[:ns, :ns], rs[:ns], dT[:ns], Ws[:ns, :ns]):
+            j = w.stuck[b]
+            sx = -plates.par[j, P_SIN]
+            sy = plates.par[j, P_COS]
+            w.Hs[a, b] = (tx * (plates.G[2 * k, 2 * j] * sx + plates.G[2 * k, 2 * j + 1] * sy)
+                          + ty * (plates.G[2 * k + 1, 2 * j] * sx + plates.G[2 * k + 1, 2 * j + 1] * sy))
+        w.Hs[a, a] += 1.0 / plates.par[k, P_MP]
+    if not _solve_small(w.Hs[:ns, :ns], w.rs[:ns], w.dT[:ns], w.Ws[:ns, :ns]):
         return
+    n = plates.MBT.shape[1]
     for b in range(ns):
-        j = stuck[b]
-        d = dT[b]
-        z_new[2 * j + 1] += d
-        fx = -pp[j, P_SIN] * d
-        fy = pp[j, P_COS] * d
+        j = w.stuck[b]
+        d = w.dT[b]
+        new.z[2 * j + 1] += d
+        fx, fy = _disk_force(0.0, d, plates.par[j, P_COS], plates.par[j, P_SIN])  # friction increment on the disk
         for i in range(n):
-            x_new[2 * n + i] += MBT[2 * j, i] * fx + MBT[2 * j + 1, i] * fy
-        for i in range(xc_new.shape[0]):
-            xc_new[i, 2] += Gm[i, 2 * j] * fx + Gm[i, 2 * j + 1] * fy
-        ps_new[j, 1, 2] -= d / pp[j, P_MP]
+            new.x[2 * n + i] += plates.MBT[2 * j, i] * fx + plates.MBT[2 * j + 1, i] * fy
+        for i in range(new.xc.shape[0]):
+            new.xc[i, 2] += plates.G[i, 2 * j] * fx + plates.G[i, 2 * j + 1] * fy
+        new.ps[j, 1, 2] -= d / plates.par[j, P_MP]
 
 
+@njit(cache=True, inline="always")
+def _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w):
+    """One (sub)step at ``level`` ending at ``tb`` (s), from ``cur`` into ``new``; returns RUNNING or a failure."""
+    _linear_predictor(level, tb, cur, levels, forcing, plates, w)
+    if plates.par.shape[0] > 0:
+        touching = _condense_contact(level, cur, levels, plates, w)
+        cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[level], levels.Jv[level], levels.coef[level, 3])
+        if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
+            for k in range(w.p_lin.shape[0]):
+                if w.p_lin[k] > 0.0:
+                    diag.err[E_PLATE] = k
+                    break
+            return NEWTON_FAILED
+        _update_contact(level, touching, cond, cur, new, levels, plates, w)
+    status = _newmark_update(level, cur, new, levels, diag, w)
+    if status == RUNNING and levels.coef[level, 6] == 0.0:
+        _stick_reset(new, plates, w)
+    return status
+
+
+@njit(cache=True, inline="always")
+def _beyond_limit(xc, limit):
+    """Index of the first contact DOF displaced beyond ``limit`` (m), or -1."""
+    for j in range(xc.shape[0]):
+        if abs(xc[j, 0]) > limit:
+            return j
+    return -1
+
+
+# ----------------------------------------------------------------------------------- records, buffers
+@njit(cache=True, inline="always")
+def _record(idx, t, s, record):
+    """Write the state ``s`` at time ``t`` (s) into record row ``idx``."""
+    record.t[idx] = t
+    for r in range(record.rows.shape[0]):
+        acc = 0.0
+        for i in range(record.rows.shape[1]):
+            acc += record.rows[r, i] * s.x[i]
+        record.y[idx, r] = acc
+    for k in range(s.ps.shape[0]):
+        record.plate[idx, k, R_P] = s.z[2 * k]
+        record.plate[idx, k, R_T] = s.z[2 * k + 1]
+        record.plate[idx, k, R_UN] = s.ps[k, 0, 0]
+        record.plate[idx, k, R_UT] = s.ps[k, 1, 0]
+        record.plate[idx, k, R_VREL] = s.pinfo[k, 0]
+        record.plate[idx, k, R_GAP] = s.pinfo[k, 1]
+        record.state[idx, k] = np.int8(s.pinfo[k, 2])
+
+
+@njit(cache=True, inline="always")
+def _record_step(j, t, s, record):
+    """Record the state after step index ``j`` (time ``t``) if the plan asks for it and there is room."""
+    if j >= record.start and (j - record.start) % record.every == 0:
+        idx = record.count[0]
+        if idx < record.t.shape[0]:
+            _record(idx, t, s, record)
+            record.count[0] = idx + 1
+
+
+@njit(cache=True, inline="always")
+def _write_state(src, dst):
+    dst.x[:] = src.x
+    dst.xc[:] = src.xc
+    dst.ps[:] = src.ps
+    dst.z[:] = src.z
+    dst.mode[:] = src.mode
+    dst.sgn[:] = src.sgn
+    dst.pinfo[:] = src.pinfo
+
+
+def work_arrays(n: int, n_p: int, nf: int) -> Work:
+    """Empty work arrays of :func:`run_steps` for n DOFs, n_p plates and nf force columns (Python side)."""
+    m = 2 * n_p
+    return Work(qn=np.empty(n), frot=np.empty(m), rlin=np.empty(m), rdlin=np.empty(m), p_lin=np.empty(n_p),
+                pd_lin=np.empty(n_p), v_lin=np.empty(n_p), ulin=np.empty((n_p, 2)), udlin=np.empty((n_p, 2)),
+                wv=np.empty((4, m)), wm=np.empty((3, m, m)), stuck=np.empty(n_p, dtype=np.int64),
+                Hs=np.empty((n_p, n_p)), rs=np.empty(n_p), dT=np.empty(n_p), Ws=np.empty((n_p, n_p)),
+                fcos=np.empty(nf), fsin=np.empty(nf), rot_c=np.empty(nf), rot_s=np.empty(nf), fval=np.empty(nf))
+
+
+def spare_state(state: State) -> State:
+    """A second set of state buffers (a copy of ``state``): :func:`run_steps` writes each step into one from the other."""
+    return State(*(a.copy() for a in state))
+
+
+# ----------------------------------------------------------------------------------- the loop
 @njit(cache=True)
-def _record(idx, t, x, rows, ps, z, pinfo, out_t, out_y, out_plate, out_state):
-    n = rows.shape[1]
-    out_t[idx] = t
-    for r in range(rows.shape[0]):
-        s = 0.0
-        for i in range(n):
-            s += rows[r, i] * x[i]
-        out_y[idx, r] = s
-    for k in range(ps.shape[0]):
-        out_plate[idx, k, R_P] = z[2 * k]
-        out_plate[idx, k, R_T] = z[2 * k + 1]
-        out_plate[idx, k, R_UN] = ps[k, 0, 0]
-        out_plate[idx, k, R_UT] = ps[k, 1, 0]
-        out_plate[idx, k, R_VREL] = pinfo[k, 0]
-        out_plate[idx, k, R_GAP] = pinfo[k, 1]
-        out_state[idx, k] = np.int8(pinfo[k, 2])
-
-
-@njit(cache=True)
-def _write_back(x, xc, ps, z, mode, sgn, pinfo, x_io, xc_io, ps_io, z_io, mode_io, sgn_io, pinfo_io):
-    x_io[:] = x
-    xc_io[:] = xc
-    ps_io[:] = ps
-    z_io[:] = z
-    mode_io[:] = mode
-    sgn_io[:] = sgn
-    pinfo_io[:] = pinfo
-
-
-@njit(cache=True)
-def run_steps(i_begin, i_end, t0, dt, n_levels_max,
-              H, UF, f_kind, f_omega, ST, S0T, BT, Wm, Jp, Jv, pp, plvl, coef, MBT, Gm,
-              x_io, xc_io, ps_io, z_io, mode_io, sgn_io, pinfo_io,
-              rows, rec_start, rec_every, out_t, out_y, out_plate, out_state, rec_count,
-              newton_tol, atol, maxiter, limit, counters, err):
+def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` (time ``t0 + i dt`` to ``t0 + (i+1) dt``).
 
-    The state arrays (x = [q, v, a], xc, ps, z, mode, sgn, pinfo) are updated in place.
-    Records are written for step indices ``j >= rec_start`` with ``(j - rec_start) % rec_every == 0``
-    (index j = state at time t0 + j dt). ``err`` receives (time, dof, plate, status) on failure.
+    Parameters
+    ----------
+    i_begin, i_end : int
+        Main step indices of this chunk.
+    levels : Levels
+    forcing : Forcing
+    plates : Plates
+    state : State
+        Updated in place to the state after the last completed step.
+    spare : State
+        Second state buffers (:func:`spare_state`): each step is written from one set into the other.
+    work : Work
+        Work arrays (:func:`work_arrays`).
+    record : Record
+        Records are written for step indices ``j >= record.start`` with
+        ``(j - record.start) % record.every == 0`` (index j = state at time t0 + j dt).
+    settings : Settings
+    diag : Diagnostics
+        Counters are incremented; ``diag.err`` receives (time, dof, plate, status) on failure.
 
-    Returns a status code: RUNNING when the chunk completed, else the failure code.
+    Returns
+    -------
+    int
+        RUNNING when the chunk completed, else the failure code.
     """
-    # work on local copies and swap current/new buffers each step; written back on return
-    x = x_io.copy()
-    xc = xc_io.copy()
-    ps = ps_io.copy()
-    z = z_io.copy()
-    mode = mode_io.copy()
-    sgn = sgn_io.copy()
-    pinfo = pinfo_io.copy()
-    n3 = x.shape[0]
-    n = n3 // 3
-    n_p = pp.shape[0]
-    m = 2 * n_p
-    nf = f_kind.shape[0]
-    qn = np.empty(n)
-    x_new = np.empty_like(x)
-    xc_new = np.empty_like(xc)
-    ps_new = np.empty_like(ps)
-    z_new = np.empty_like(z)
-    mode_new = np.empty_like(mode)
-    sgn_new = np.empty_like(sgn)
-    pinfo_new = np.empty_like(pinfo)
-    frot = np.empty(m)
-    rlin = np.empty(m)
-    rdlin = np.empty(m)
-    p_lin = np.empty(n_p)
-    pd_lin = np.empty(n_p)
-    v_lin = np.empty(n_p)
-    ulin = np.empty((n_p, 2))
-    udlin = np.empty((n_p, 2))
-    wv = np.empty((4, m))
-    wm = np.empty((3, m, m))
-    stuck = np.empty(n_p, dtype=np.int64)
-    Hs = np.empty((n_p, n_p))
-    rs = np.empty(n_p)
-    dT = np.empty(n_p)
-    Ws = np.empty((n_p, n_p))
-    if i_begin == 0 and rec_start == 0 and rec_count[0] == 0:
-        _record(0, t0, x, rows, ps, z, pinfo, out_t, out_y, out_plate, out_state)
-        rec_count[0] = 1
-    units_total = 1 << n_levels_max
-    extrapolate = False  # z_new holds the previous step's forces only after a committed step
-    # Sinusoidal forcing at the end of each full main step, t = t0 + (i+1) dt, by an exact rotation
-    # recurrence (cos and sin of omega dt), re-synchronised with cos/sin every RESYNC steps (the
-    # recurrence's round-off grows like the number of steps, ~1e-13 over RESYNC); halved substeps
-    # evaluate cos/sin directly.
-    fcos = np.empty(nf)
-    fsin = np.empty(nf)
-    rot_c = np.empty(nf)
-    rot_s = np.empty(nf)
-    fval = np.empty(nf)
-    for j in range(nf):
-        rot_c[j] = math.cos(f_omega[j] * dt)
-        rot_s[j] = math.sin(f_omega[j] * dt)
+    # borrowed views of the caller's arrays; the current and new state swap buffers each step
+    levels, forcing, plates, record, diag = (_borrowed(levels), _borrowed(forcing), _borrowed(plates),
+                                             _borrowed(record), _borrowed(diag))
+    cur, new, w = _borrowed(state), _borrowed(spare), _borrowed(work)
+    t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
+    if i_begin == 0 and record.start == 0 and record.count[0] == 0:
+        _record(0, t0, cur, record)
+        record.count[0] = 1
+    units_total = 1 << n_halvings
+    extrapolate = False  # new.z holds the previous step's forces only after a committed step
+    _start_forcing(forcing, dt, w)
     for i in range(i_begin, i_end):
         t_main = t0 + i * dt
-        if (i - i_begin) % RESYNC == 0:
-            t_end_main = t0 + (i + 1) * dt
-            for j in range(nf):
-                fcos[j] = math.cos(f_omega[j] * t_end_main)
-                fsin[j] = math.sin(f_omega[j] * t_end_main)
-        else:
-            for j in range(nf):
-                c_old = fcos[j]
-                fcos[j] = c_old * rot_c[j] - fsin[j] * rot_s[j]
-                fsin[j] = fsin[j] * rot_c[j] + c_old * rot_s[j]
-        for j in range(nf):
-            kind = f_kind[j]
-            fval[j] = 1.0 if kind == 0 else (fcos[j] if kind == 1 else fsin[j])
+        _forcing_at_step_end(i - i_begin, t0 + (i + 1) * dt, forcing, w)
         level = 0
         progress = 0
         while progress < units_total:
-            h_units = 1 << (n_levels_max - level)
+            h_units = 1 << (n_halvings - level)
             ta = t_main + progress * (dt / units_total)
             tb = ta + h_units * (dt / units_total)
             if progress + h_units == units_total:
                 tb = t0 + (i + 1) * dt
-            # ---------------- one (sub)step at level `level` from ta to tb ----------------
-            l = level
-            status = RUNNING
-            c0 = coef[l, 0]
-            c1 = coef[l, 1]
-            c2 = coef[l, 2]
-            c3 = coef[l, 3]
-            c4 = coef[l, 4]
-            c5 = coef[l, 5]
-            alpha = coef[l, 6]
-            _matvec(H[l], x, qn)
-            for j in range(nf):
-                w1 = fval[j] if level == 0 else _forcing_value(f_kind[j], f_omega[j], tb)
-                for ii in range(n):
-                    qn[ii] += w1 * UF[l, j, ii]
-            if n_p > 0:
-                for k in range(n_p):
-                    P = z[2 * k]
-                    T = z[2 * k + 1]
-                    frot[2 * k] = -P * pp[k, P_COS] - T * pp[k, P_SIN]
-                    frot[2 * k + 1] = -P * pp[k, P_SIN] + T * pp[k, P_COS]
-                for j in range(m):
-                    f = frot[j]
-                    if f != 0.0:
-                        for ii in range(n):
-                            qn[ii] += f * S0T[l, j, ii]
-                for j in range(m):
-                    s = 0.0
-                    for ii in range(n):
-                        s += BT[j, ii] * qn[ii]
-                    rlin[j] = s
-                    rdlin[j] = c3 * (s - xc[j, 0]) + c4 * xc[j, 1] + c5 * xc[j, 2]
-                for k in range(n_p):
-                    cs = pp[k, P_COS]
-                    sn = pp[k, P_SIN]
-                    for d in range(2):
-                        f0 = z[2 * k] if d == 0 else -z[2 * k + 1]
-                        u0 = ps[k, d, 0]
-                        v0 = ps[k, d, 1]
-                        a0 = ps[k, d, 2]
-                        ul = plvl[l, k, d, 0] * u0 + plvl[l, k, d, 1] * v0 + plvl[l, k, d, 2] * a0 \
-                            - alpha * plvl[l, k, d, 3] * f0
-                        ulin[k, d] = ul
-                        udlin[k, d] = c3 * (ul - u0) + c4 * v0 + c5 * a0
-                    dl = rlin[2 * k] * cs + rlin[2 * k + 1] * sn
-                    ddl = rdlin[2 * k] * cs + rdlin[2 * k + 1] * sn
-                    edl = -rdlin[2 * k] * sn + rdlin[2 * k + 1] * cs
-                    p_lin[k] = dl - pp[k, P_CLEAR] - ulin[k, 0] - pp[k, P_W0]
-                    pd_lin[k] = ddl - udlin[k, 0]
-                    v_lin[k] = pp[k, P_V] + edl - udlin[k, 1]
-                touching = False
-                for k in range(n_p):
-                    if p_lin[k] > 0.0:
-                        touching = True
-                ok = True
-                if touching:
-                    # initial guess: linear extrapolation of the last two forces (z_new still holds the
-                    # previous step's forces after the buffer swap) where both were in contact
-                    for k in range(n_p):
-                        for d in range(2):
-                            j = 2 * k + d
-                            g = 2.0 * z[j] - z_new[j]
-                            if z[2 * k] > 0.0 and z_new[2 * k] > 0.0 and extrapolate and math.isfinite(g):
-                                z_new[j] = g
-                            else:
-                                z_new[j] = z[j]
-                        if z_new[2 * k] < 0.0:
-                            z_new[2 * k] = 0.0
-                    for k in range(n_p):
-                        mode_new[k] = mode[k]
-                        sgn_new[k] = sgn[k]
-                    ok = solve_contact(z_new, p_lin, pd_lin, v_lin, Jp[l], Jv[l], c3, pp, mode_new, sgn_new,
-                                       newton_tol, atol, maxiter, counters, wv, wm)
-                else:  # every plate open: no contact force, no Newton
-                    for k in range(n_p):
-                        z_new[2 * k] = 0.0
-                        z_new[2 * k + 1] = 0.0
-                        mode_new[k] = 1
-                        sgn_new[k] = 1.0 if v_lin[k] >= 0.0 else -1.0
-                if not ok:
-                    for k in range(n_p):
-                        if p_lin[k] > 0.0:
-                            err[2] = k
-                            break
-                    status = NEWTON_FAILED
-                else:
-                    for k in range(n_p):
-                        P = z_new[2 * k]
-                        T = z_new[2 * k + 1]
-                        frot[2 * k] = -P * pp[k, P_COS] - T * pp[k, P_SIN]
-                        frot[2 * k + 1] = -P * pp[k, P_SIN] + T * pp[k, P_COS]
-                    for j in range(m):
-                        f = (1.0 + alpha) * frot[j]
-                        if f != 0.0:
-                            for ii in range(n):
-                                qn[ii] += f * ST[l, j, ii]
-                    for j in range(m):
-                        r = rlin[j]
-                        if touching:
-                            for jj in range(m):
-                                r += Wm[l, j, jj] * frot[jj]
-                        dr = r - xc[j, 0]
-                        xc_new[j, 0] = r
-                        xc_new[j, 1] = c3 * dr + c4 * xc[j, 1] + c5 * xc[j, 2]
-                        xc_new[j, 2] = c0 * dr - c1 * xc[j, 1] - c2 * xc[j, 2]
-                    for k in range(n_p):
-                        for d in range(2):
-                            f1 = z_new[2 * k] if d == 0 else -z_new[2 * k + 1]
-                            u = ulin[k, d] + (1.0 + alpha) * plvl[l, k, d, 3] * f1
-                            du = u - ps[k, d, 0]
-                            ps_new[k, d, 0] = u
-                            ps_new[k, d, 1] = c3 * du + c4 * ps[k, d, 1] + c5 * ps[k, d, 2]
-                            ps_new[k, d, 2] = c0 * du - c1 * ps[k, d, 1] - c2 * ps[k, d, 2]
-                        if touching:
-                            p, pd, vr = _kinematics(z_new, p_lin, pd_lin, v_lin, Jp[l], Jv[l], c3, k)
-                        else:
-                            p = p_lin[k]
-                            vr = v_lin[k]
-                        pinfo_new[k, 0] = vr
-                        pinfo_new[k, 1] = -(p + pp[k, P_W0])  # gap
-                        if z_new[2 * k] == 0.0:
-                            z_new[2 * k + 1] = 0.0
-                            pinfo_new[k, 2] = 0.0
-                        else:
-                            pinfo_new[k, 2] = 2.0 if mode_new[k] == 2 else 1.0
+            status = _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w)
             if status == RUNNING:
-                total = 0.0
-                for ii in range(n):
-                    dq = qn[ii] - x[ii]
-                    vi = c3 * dq + c4 * x[n + ii] + c5 * x[2 * n + ii]
-                    ai = c0 * dq - c1 * x[n + ii] - c2 * x[2 * n + ii]
-                    x_new[ii] = qn[ii]
-                    x_new[n + ii] = vi
-                    x_new[2 * n + ii] = ai
-                    total += qn[ii] + vi
-                if not math.isfinite(total):
-                    for ii in range(n3):
-                        if not math.isfinite(x_new[ii]):
-                            err[1] = ii % n
-                            break
-                    status = NONFINITE
-            any_stick = False
-            for k in range(n_p):
-                if mode_new[k] == 2 and z_new[2 * k] > 0.0:
-                    any_stick = True
-            if status == RUNNING and alpha == 0.0 and any_stick:
-                _stick_acceleration_reset(x_new, xc_new, ps_new, z_new, mode_new, pp, MBT, Gm, n,
-                                          stuck, Hs, rs, dT, Ws)
-            # ------------------------------------------------------------------------------
-            if status == RUNNING:
-                for j in range(m):
-                    if abs(xc_new[j, 0]) > limit:
-                        err[0] = tb
-                        err[1] = -1 - j
-                        err[3] = LIMIT
-                        _write_back(x, xc, ps, z, mode, sgn, pinfo, x_io, xc_io, ps_io, z_io, mode_io, sgn_io, pinfo_io)
-                        return LIMIT
-                x, x_new = x_new, x
+                j = _beyond_limit(new.xc, settings.limit)
+                if j >= 0:
+                    diag.err[E_TIME] = tb
+                    diag.err[E_DOF] = -1 - j
+                    diag.err[E_STATUS] = LIMIT
+                    _write_state(cur, state)
+                    return LIMIT
+                cur, new = new, cur
                 extrapolate = True
-                if n_p > 0:
-                    xc, xc_new = xc_new, xc
-                    ps, ps_new = ps_new, ps
-                    z, z_new = z_new, z
-                    mode, mode_new = mode_new, mode
-                    sgn, sgn_new = sgn_new, sgn
-                    pinfo, pinfo_new = pinfo_new, pinfo
                 progress += h_units
                 if level > 0:
-                    counters[C_SUBSTEPS] += 1
+                    diag.counters[C_SUBSTEPS] += 1
             else:
                 extrapolate = False
                 level += 1
-                if level > n_levels_max:
-                    err[0] = tb
-                    err[3] = status
-                    _write_back(x, xc, ps, z, mode, sgn, pinfo, x_io, xc_io, ps_io, z_io, mode_io, sgn_io, pinfo_io)
+                if level > n_halvings:
+                    diag.err[E_TIME] = tb
+                    diag.err[E_STATUS] = status
+                    _write_state(cur, state)
                     return status
-        counters[C_STEPS] += 1
-        j = i + 1
-        if j >= rec_start and (j - rec_start) % rec_every == 0:
-            idx = rec_count[0]
-            if idx < out_t.shape[0]:
-                _record(idx, t0 + j * dt, x, rows, ps, z, pinfo, out_t, out_y, out_plate, out_state)
-                rec_count[0] = idx + 1
-    _write_back(x, xc, ps, z, mode, sgn, pinfo, x_io, xc_io, ps_io, z_io, mode_io, sgn_io, pinfo_io)
+        diag.counters[C_STEPS] += 1
+        _record_step(i + 1, t0 + (i + 1) * dt, cur, record)
+    _write_state(cur, state)
     return RUNNING

@@ -25,7 +25,7 @@ terms is ``O(N^-2)``: the error at ``2N`` is about one third of the change betwe
 ``2N``. The sum is evaluated for ``N = 16, 32, 64, ...`` until that estimate is at most ``tol``
 (default 1e-10), then the extrapolated value ``S_2N + (S_2N - S_N) / 3`` is used
 (Richardson). ``N`` is capped at 2^22; a plate that does not converge by then raises
-``ValueError`` naming the tolerance. (Summing the double series directly converges too
+:class:`rotorred.checks.InputError` naming ``tol``. (Summing the double series directly converges too
 slowly: 4096 x 4096 terms leave a relative error of 5e-8 at the plate centre.)
 """
 
@@ -37,13 +37,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rotorred import checks
+
 _N_START = 16
 _N_MAX = 1 << 22
-
-
-def _positive(name: str, value, unit: str) -> None:
-    if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value) and value > 0):
-        raise ValueError(f"`{name}` must be a positive finite number ({unit}), got {value!r}")
 
 
 def _inner_sums(beta: np.ndarray, x: float) -> np.ndarray:
@@ -97,8 +94,8 @@ def navier_series(a: float, b: float, xi: float, eta: float, tol: float = 1e-10)
         if err <= tol:
             return s + (s - s_prev) / 3.0, N2, err
         if N2 >= _N_MAX:
-            raise ValueError(f"the Navier series (Eq. 10) did not reach `tol` = {tol:g} with {N2} terms "
-                             f"(estimated error {err:.3g}); loosen `tol`")
+            checks.fail("tol", tol, f"not reached by the Navier series (Eq. 10) with {N2} terms "
+                        f"(estimated error {err:.3g}); must be larger")
         N, s_prev = N2, s
 
 
@@ -148,15 +145,10 @@ class NavierPlate:
 
     def __post_init__(self):
         for name, unit in (("a", "m"), ("b", "m"), ("h", "m"), ("E", "Pa"), ("tol", "-")):
-            _positive(name, getattr(self, name), unit)
-        if not (isinstance(self.nu, (int, float)) and -1.0 < self.nu < 0.5):
-            raise ValueError(f"`nu` must lie in (-1, 0.5), got {self.nu!r}")
-        xi = self.a / 2 if self.xi is None else self.xi
-        eta = self.b / 2 if self.eta is None else self.eta
-        if not (isinstance(xi, (int, float)) and 0.0 < xi < self.a):
-            raise ValueError(f"`xi` must lie strictly inside (0, a) = (0, {self.a}) m, got {self.xi!r}")
-        if not (isinstance(eta, (int, float)) and 0.0 < eta < self.b):
-            raise ValueError(f"`eta` must lie strictly inside (0, b) = (0, {self.b}) m, got {self.eta!r}")
+            checks.positive(name, getattr(self, name), unit)
+        checks.number("nu", self.nu, gt=-1.0, lt=0.5)
+        xi = self.a / 2 if self.xi is None else checks.number("xi", self.xi, "m", gt=0.0, lt=self.a)
+        eta = self.b / 2 if self.eta is None else checks.number("eta", self.eta, "m", gt=0.0, lt=self.b)
         object.__setattr__(self, "xi", float(xi))
         object.__setattr__(self, "eta", float(eta))
         D = self.E * self.h**3 / (12.0 * (1.0 - self.nu**2))
@@ -202,10 +194,10 @@ class ClampedFreePlate:
     offset: float = field(init=False)
 
     def __post_init__(self):
-        _positive("a0", self.a0, "N/m")
-        if not (isinstance(self.b0, (int, float)) and math.isfinite(self.b0) and self.b0 >= 0):
-            raise ValueError(f"`b0` must be a finite number >= 0 (N), got {self.b0!r}; a negative intercept "
-                             "of F = a0 W - b0 would push the disk before contact")
+        checks.positive("a0", self.a0, "N/m")
+        if checks.number("b0", self.b0, "N") < 0.0:
+            checks.fail("b0", self.b0, "must be >= 0 (a negative intercept of F = a0 W - b0 would push the disk "
+                        "before contact)", "N")
         object.__setattr__(self, "compliance", 1.0 / self.a0)
         object.__setattr__(self, "offset", self.b0 / self.a0)
 

@@ -1,0 +1,91 @@
+"""Parsers of command-line option values, each refusing bad text with the one message form of
+:mod:`rotorred.checks` (``--speeds = '0:12000': must be START:STOP:COUNT or a comma list (rpm)``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.model.dofs import parse_dof
+
+__all__ = ["grid", "number_list", "dof_list", "node_list"]
+
+
+def grid(option: str, text: str, unit: str, *, min_count: int = 1, ge: float | None = None,
+         increasing: bool = False) -> np.ndarray:
+    """``"START:STOP:COUNT"`` (evenly spaced, both ends included) or ``"v1,v2,..."``, in ``unit``.
+
+    Parameters
+    ----------
+    option : str
+        The option's name, e.g. ``"--speeds"``.
+    text : str
+        The option's value as typed.
+    unit : str
+        Unit of the values as typed (``"rpm"``, ``"Hz"``).
+    min_count : int
+        Fewest values allowed.
+    ge : float, optional
+        Smallest value allowed.
+    increasing : bool
+        Values must increase strictly.
+
+    Returns
+    -------
+    ndarray, shape (count,)
+        The values, in ``unit``.
+    """
+    form = f"must be START:STOP:COUNT (COUNT >= {min_count}) or a comma list of numbers"
+    try:
+        if ":" in text:
+            a, b, n = text.split(":")
+            count = int(n)
+            values = np.linspace(float(a), float(b), count) if count >= 1 else np.zeros(0)
+            if count < min_count:
+                raise ValueError
+        else:
+            values = np.array([float(v) for v in text.split(",") if v.strip()])
+    except ValueError:
+        checks.fail(option, text, form, unit)
+    if len(values) < min_count or not np.all(np.isfinite(values)):
+        checks.fail(option, text, form + (f", at least {min_count}" if len(values) < min_count else ", finite"),
+                    unit)
+    if ge is not None and np.any(values < ge):
+        checks.fail(option, text, f"must hold values >= {ge:g}", unit)
+    if increasing and np.any(np.diff(values) <= 0):
+        checks.fail(option, text, "must hold strictly increasing values", unit)
+    return values
+
+
+def number_list(option: str, text: str, unit: str = "", *, gt: float | None = None) -> tuple[float, ...]:
+    """``"1,2"`` -> (1.0, 2.0): finite numbers, each > ``gt`` if given."""
+    requirement = "must be a comma list of numbers" + (f" > {gt:g}" if gt is not None else "")
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        checks.fail(option, text, requirement, unit)
+    if not all(math.isfinite(v) and (gt is None or v > gt) for v in values):
+        checks.fail(option, text, requirement, unit)
+    return values
+
+
+def dof_list(option: str, text: str, nodes=None) -> list[tuple[int, str]]:
+    """``"13:x,14:ty"`` -> [(13, "x"), (14, "theta_y")] (:func:`rotorred.model.dofs.parse_dof`)."""
+    items = [item for item in text.split(",") if item.strip()]
+    if not items:
+        checks.fail(option, text, "must be NODE:DIR,... with DIR x, y, tx, ty")
+    return [parse_dof(option, item, nodes) for item in items]
+
+
+def node_list(option: str, text: str, nodes=None) -> list[int]:
+    """``"11,16"`` -> [11, 16]: node numbers, each a node of the rotor if ``nodes`` is given."""
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        checks.fail(option, text, "must be a comma list of node numbers")
+    if nodes is not None:
+        for v in values:
+            checks.node(option, v, nodes)
+    return values

@@ -1,0 +1,109 @@
+"""The files of a scene's result: figures (PNG), data (NPZ, CSV, MATLAB .mat) and ``summary.txt``.
+
+Keys, columns and variables are documented in ``docs/scenes.md``. Every file goes through the
+one writer of its format (:mod:`rotorred.writers`); figures come from
+:func:`rotorred.plots.scene.plot_scene`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rotorred.scenes.run import SceneResult
+from rotorred.scenes.summary import format_summary
+from rotorred.writers import write_csv, write_mat, write_npz, write_text
+
+__all__ = ["data_arrays", "write_data", "write_outputs"]
+
+
+def _key(case: str, d) -> str:
+    return f"{case}_{d[0]}_{d[1]}"
+
+
+def _cases(result: SceneResult) -> list[tuple[SceneResult, str]]:
+    """(result, name) of the run and of its no-rub companion: ("rub" or "response", "normal")."""
+    case = "rub" if result.scene.plates else "response"
+    return [(r, c) for r, c in ((result, case), (result.normal, "normal")) if r is not None]
+
+
+def _unit(d) -> str:
+    return "urad" if d[1].startswith("theta") else "um"
+
+
+def data_arrays(result: SceneResult) -> dict[str, np.ndarray]:
+    """The arrays written to NPZ and .mat (keys documented in ``docs/scenes.md``)."""
+    arrays = {"t": result.t, "f_L": np.array(result.f_L), "f_H": np.array(result.f_H)}
+    arrays["frequency"] = next(iter(result.spectra.values())).frequencies
+    for r, c in _cases(result):
+        for d in r.scene.output.dofs:
+            arrays[_key(c, d)] = r.outputs[d]
+            arrays[_key(f"{c}_amp", d)] = r.spectra[d].amplitudes
+    for k, ch in enumerate(result.contacts):
+        arrays[f"plate{k}_normal_force"] = ch.normal_force
+        arrays[f"plate{k}_friction_force"] = ch.friction_force
+        arrays[f"plate{k}_state"] = ch.state.astype(np.int8)
+        arrays[f"plate{k}_gap"] = ch.gap
+    return arrays
+
+
+def _timeseries_csv(result: SceneResult, path: Path) -> Path:
+    header, cols = ["t (s)"], [result.t]
+    for r, c in _cases(result):
+        for d in result.scene.output.dofs:
+            header.append(f"{c} node {d[0]} {d[1]} ({_unit(d)})")
+            cols.append(1e6 * r.outputs[d])
+    for k, ch in enumerate(result.contacts):
+        header += [f"plate {k} normal force (N)", f"plate {k} friction force (N)", f"plate {k} state",
+                   f"plate {k} gap (um)"]
+        cols += [ch.normal_force, ch.friction_force, ch.state.astype(int), 1e6 * ch.gap]
+    return write_csv(path, header, cols)
+
+
+def _spectra_csv(result: SceneResult, path: Path) -> Path:
+    dofs = result.scene.output.dofs
+    header, cols = ["frequency (Hz)"], [result.spectra[dofs[0]].frequencies]
+    for r, c in _cases(result):
+        for d in dofs:
+            header.append(f"{c} node {d[0]} {d[1]} amplitude ({_unit(d)})")
+            cols.append(1e6 * r.spectra[d].amplitudes)
+    return write_csv(path, header, cols)
+
+
+def _lines_csv(result: SceneResult, path: Path) -> Path:
+    rows = [[d[0], d[1], ln.frequency_hz, 1e6 * ln.amplitude, "" if ln.m is None else ln.m,
+             "" if ln.n is None else str(ln.n), ln.label_ascii]
+            for d in result.scene.output.dofs for ln in result.lines[d]]
+    header = ["node", "direction", "frequency (Hz)", "amplitude (um or urad)", "m (multiple of f_H)",
+              "n (multiple of f_L)", "label"]
+    return write_csv(path, header, list(zip(*rows)) if rows else [[]] * len(header))
+
+
+def write_data(result: SceneResult, out: str | Path) -> list[Path]:
+    """Write the data files the scene's ``output.formats`` asks for; returns their paths."""
+    out = Path(out)
+    formats = result.scene.output.formats
+    files = []
+    if "npz" in formats:
+        files.append(write_npz(out / "result.npz", data_arrays(result)))
+    if "mat" in formats:
+        files.append(write_mat(out / "result.mat", data_arrays(result)))
+    if "csv" in formats:
+        files += [_timeseries_csv(result, out / "timeseries.csv"), _spectra_csv(result, out / "spectra.csv"),
+                  _lines_csv(result, out / "lines.csv")]
+    return files
+
+
+def write_outputs(result: SceneResult, out: str | Path) -> list[Path]:
+    """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written."""
+    from rotorred.plots.scene import plot_scene  # matplotlib only when figures are written
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = plot_scene(result, out) if result.scene.output.plots else []
+    files += write_data(result, out)
+    summary = out / "summary.txt"
+    files.append(summary)
+    write_text(summary, format_summary(result, files) + "\n")
+    return files

@@ -1,0 +1,106 @@
+"""The text summary of a scene's result: set-up, peaks, rub contact and the labelled lines (Table 1 form)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from rotorred.model.dofs import direction_name
+from rotorred.scenes.run import SceneResult
+from rotorred.signals.lines import format_table
+from rotorred.signals.spectra import WINDOWS
+from rotorred.writers import render_table
+
+__all__ = ["format_summary", "table_dof"]
+
+_RPM = 60.0 / (2.0 * math.pi)
+
+
+def table_dof(result: SceneResult) -> tuple[int, str]:
+    """The DOF whose lines are tabulated: ``output.table``, else the last node's y (or first direction)."""
+    out = result.scene.output
+    if out.table is not None:
+        return out.table
+    node = out.nodes[-1] if not result.scene.plates else next(
+        (n for n in reversed(out.nodes) if n != result.scene.plates[0].node), out.nodes[-1])
+    return (node, "y" if "y" in out.directions else out.directions[0])
+
+
+def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
+    """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form)."""
+    parts = [_setup(result), _peaks(result), _contacts(result), _lines(result)]
+    if files:
+        parts.append("\n".join(f"wrote {f}" for f in files))
+    return "\n\n".join(p for p in parts if p)
+
+
+def _setup(result: SceneResult) -> str:
+    sc, s = result.scene, result.scene.solver
+    spools = ", ".join(f"{name} {w / (2 * math.pi):.6g} Hz ({w * _RPM:.0f} rpm)" for name, w in sc.speeds.items())
+    lines = [f"scene {sc.name} ({sc.source}){': ' + sc.description if sc.description else ''}",
+             f"rotor {sc.rotor_source}; Rayleigh damping alpha = {sc.rotor.rayleigh[0]:g} 1/s, "
+             f"beta = {sc.rotor.rayleigh[1]:g} s; speeds {spools}",
+             "unbalances: " + (", ".join(f"node {u.node} {u.m_e:g} kg m at {math.degrees(u.phase):g} deg"
+                                         for u in sc.unbalances) or "none"),
+             f"model: {result.model_label}; built in {result.build_time:.2f} s"]
+    if result.method == "harmonic":
+        lines.append(f"response: harmonic steady state (linear scene, settled start), {len(result.t)} samples "
+                     f"of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
+    else:
+        c = result.counters
+        origin = "the settled linear state" if s.start == "settled" else "rest"
+        lines.append(f"response: {s.method} time stepping from {origin}, {result.n_steps} steps of {s.dt:g} s to "
+                     f"{s.duration:g} s ({c.get('us_per_step', 0):.2f} us/step, "
+                     f"{c.get('n_contact_steps', 0)} contact steps, {c.get('n_substeps', 0)} half steps), recorded "
+                     f"{s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
+    return "\n".join(lines)
+
+
+def _peaks(result: SceneResult) -> str:
+    sc, normal = result.scene, result.normal
+    header = ["DOF", "peak (um)"] + (["normal peak (um)", "change (%)"] if normal else [])
+    rows = []
+    for d in sc.output.dofs:
+        row = [f"node {d[0]} {direction_name(d[1])}", f"{1e6 * result.peak(d):.4g}"]
+        if normal:
+            pn = normal.peak(d)
+            row += [f"{1e6 * pn:.4g}", f"{100 * (result.peak(d) - pn) / pn:+.1f}" if pn > 0 else "-"]
+        rows.append(row)
+    rotations = any(d[1].startswith("theta") for d in sc.output.dofs)
+    title = "Peak amplitudes in the recorded window" + (" (rotations in urad)" if rotations else "")
+    return title + "\n" + render_table(header, rows)
+
+
+def _contacts(result: SceneResult) -> str:
+    duration = result.t[-1] - result.t[0] if len(result.t) > 1 else 0.0
+    lines = []
+    for k, (p, ch) in enumerate(zip(result.scene.plates, result.contacts)):
+        impacts = result.n_impacts(k)
+        lines.append(f"rub plate {k} at node {p.node} (normal at {math.degrees(p.theta):g} deg, clearance "
+                     f"{1e6 * p.clearance:.4g} um): contact {100 * result.contact_fraction(k):.2f} % of the window "
+                     f"(slip {100 * ch.fraction('slip'):.2f} %, stick {100 * ch.fraction('stick'):.2f} %), "
+                     f"{impacts} impacts ({impacts / duration if duration else 0:.1f}/s), "
+                     f"max normal force {ch.normal_force.max(initial=0.0):.4g} N")
+    return "\n".join(lines)
+
+
+def _lines(result: SceneResult) -> str:
+    sc = result.scene
+    d = table_dof(result)
+    spec, found = result.spectra[d], result.lines[d]
+    exact = spec.window == "rectangular" and "on bins" in spec.note
+    error = "0 on-bin" if exact else f"<= {WINDOWS[spec.window].max_scalloping_db:.3g} dB"
+    known = [ln for ln in found if ln.known]
+    combos = [ln for ln in known if ln.m not in (0, 1) or ln.n not in (0, 1) or (ln.m == 1 and ln.n == 1)]
+    lines = [f"Spectral lines of node {d[0]} {direction_name(d[1])} above {100 * sc.output.line_threshold:g} % of "
+             f"the largest (f_L = {result.f_L:.6g} Hz, f_H = {result.f_H:.6g} Hz; bin {spec.df:.4g} Hz, labels "
+             f"m f_H + n f_L matched within half a bin; {spec.window} window, amplitude error {error}):",
+             format_table(found, ascii=True, amplitude_scale=1e6, amplitude_unit="um"),
+             f"{len(found)} lines, {len(known)} labelled, {len(combos)} besides f_L and f_H; spectrum: {spec.note}"]
+    others = [x for x in sc.output.dofs if x != d]
+    if others:
+        lines.append("other DOFs: " + "; ".join(
+            f"node {x[0]} {direction_name(x[1])}: {len(result.lines[x])} lines "
+            f"({', '.join(ln.label_ascii for ln in result.lines[x][:6])}{', ...' if len(result.lines[x]) > 6 else ''})"
+            for x in others))
+    return "\n".join(lines)

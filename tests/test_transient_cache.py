@@ -1,0 +1,90 @@
+"""numba's on-disk cache of rotorred's compiled functions follows the generated code and the kernel's sources
+(rotorred.transient.numba_cache), and still works when the package folder is not writable.
+
+Each check runs a copy of the package in fresh subprocesses and calls one small compiled function,
+``kernel._normal_law`` (defined in transient/contact.py), which compiles in the generated
+``normal_residual`` of _generated/contact.py: numba's own cache key (the stamp of contact.py) would not see
+a change of the generated file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rotorred.transient import numba_cache
+
+PACKAGE = Path(__file__).resolve().parents[1] / "rotorred"
+
+SNIPPET = """
+import json
+from rotorred.transient import kernel
+r = kernel._normal_law(10.0, 2e-6, 0.01, 5e9, 1.0, 1e-8)
+st = kernel._normal_law.stats
+print(json.dumps({"R": float(r[0]), "hits": sum(st.cache_hits.values()), "misses": sum(st.cache_misses.values()),
+                  "path": st.cache_path}))
+"""
+
+
+@pytest.fixture()
+def package_copy(tmp_path):
+    """A copy of the rotorred package (without caches) importable from ``tmp_path / "pkg"``."""
+    shutil.copytree(PACKAGE, tmp_path / "pkg" / "rotorred", ignore=shutil.ignore_patterns("__pycache__"))
+    return tmp_path / "pkg"
+
+
+def run(root: Path, **env_changes) -> dict:
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "NUMBA_DISABLE_JIT")}
+    env.update(PYTHONPATH=str(root), **env_changes)
+    out = subprocess.run([sys.executable, "-c", SNIPPET], cwd=root, env=env, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_cache_is_reused_and_recompiled_when_the_generated_law_changes(package_copy):
+    first = run(package_copy)
+    again = run(package_copy)
+    assert first["misses"] == 1 and first["hits"] == 0  # compiled into an empty cache
+    assert again["hits"] == 1 and again["misses"] == 0 and again["R"] == first["R"]  # unchanged: loaded
+    assert Path(again["path"]).is_relative_to(package_copy / "rotorred")  # the in-tree __pycache__
+    generated = package_copy / "rotorred" / "_generated" / "contact.py"
+    text = generated.read_text()
+    hertz = "    _t0 = K_nr*s**3.0\n"
+    assert text.count(hertz) == 1
+    generated.write_text(text.replace(hertz, "    _t0 = 2.0*K_nr*s**3.0\n"))  # twice the Hertz force
+    changed = run(package_copy)
+    assert changed["misses"] == 1 and changed["hits"] == 0  # recompiled, not loaded stale
+    # R = F - K s^3 (1 + c rate): doubling the Hertz term gives 2 R - F (round-off of 1e-14 N at F = 10 N)
+    assert changed["R"] == pytest.approx(2 * first["R"] - 10.0, abs=1e-12) and changed["R"] != first["R"]
+
+
+def test_cache_falls_back_when_the_package_is_not_writable(package_copy, tmp_path):
+    """With the package's __pycache__ unusable (a file of that name: even root cannot create the folder) the cache
+    goes to numba's user-wide directory; with that unusable too, under the temporary directory; each is reused."""
+    for sub in ("transient", "_generated"):
+        (package_copy / "rotorred" / sub / "__pycache__").write_text("not a folder")
+    user = run(package_copy, XDG_CACHE_HOME=str(tmp_path / "xdg"))
+    user_again = run(package_copy, XDG_CACHE_HOME=str(tmp_path / "xdg"))
+    assert Path(user["path"]).is_relative_to(tmp_path / "xdg") and user["misses"] == 1
+    assert user_again["hits"] == 1 and user_again["misses"] == 0
+    (tmp_path / "no-xdg").write_text("not a folder")
+    (tmp_path / "tmp").mkdir()
+    env = dict(XDG_CACHE_HOME=str(tmp_path / "no-xdg"), TMPDIR=str(tmp_path / "tmp"))
+    temp, temp_again = run(package_copy, **env), run(package_copy, **env)
+    assert Path(temp["path"]).is_relative_to(tmp_path / "tmp") and temp["misses"] == 1
+    assert temp_again["hits"] == 1 and temp_again["misses"] == 0 and temp_again["R"] == user["R"]
+
+
+def test_digest_covers_every_module_with_compiled_code():
+    """Every rotorred module that defines or wraps an njit function is part of the cache's digest."""
+    digest = {p.resolve() for p in numba_cache.source_files()}
+    compiled = {p.resolve() for p in PACKAGE.rglob("*.py") if re.search(r"\bnjit\(", p.read_text())}
+    compiled.discard((PACKAGE / "transient" / "numba_cache.py").resolve())  # describes njit, compiles nothing
+    assert compiled and compiled <= digest, sorted(map(str, compiled - digest))
+    assert set((PACKAGE / "_generated").glob("*.py")) <= {p for p in numba_cache.source_files()}
