@@ -19,7 +19,9 @@ value at F = 0, lam = 0). The 3/2 power is written with the argument
 :func:`rotorred.transient.contact.normal_law`).
 
 The elastic energy stored in the contact, ``U = int_0^delta K_nr d^(3/2) dd = 2/5 K_nr delta^(5/2)``,
-enters the energy balance of the tests.
+enters the energy balance of the tests. ``rate`` is the total approach rate p' (not the rate
+``delta' = p' - lam F'`` of Eq. 8, which would make the law differential in F): the law then
+dissipates ``F p' - d/dt(U + lam F^2 / 2) = c K_nr delta^(3/2) p' delta'`` (docs/model.md §4).
 """
 
 from __future__ import annotations

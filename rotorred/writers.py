@@ -20,7 +20,17 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "write_npz", "write_mat", "write_text", "atomic_path", "render_table"]
+__all__ = ["write_csv", "write_npz", "write_mat", "write_text", "atomic_path", "render_table", "OutputFolder",
+           "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _umask()
 
 
 @contextmanager
@@ -29,6 +39,7 @@ def atomic_path(path: str | Path, suffix: str = ""):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{suffix}", dir=path.parent)
+    os.fchmod(fd, 0o666 & ~_UMASK)  # mkstemp's 0600 -> what open() would give
     os.close(fd)
     try:
         yield Path(tmp)
@@ -108,3 +119,141 @@ def render_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     out = [" | ".join(h.ljust(w) for h, w in zip(header, widths)).rstrip(), "-|-".join("-" * w for w in widths)]
     out += [" | ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
     return "\n".join(out)
+
+
+# --------------------------------------------------------------------------- output folders
+#: marker file of a folder whose result is incomplete (a diverged run, or a commit cut by a hard kill)
+INCOMPLETE = "INCOMPLETE"
+#: the names of the files of the folder's last committed result, one a line (hidden)
+MANIFEST = ".rotorred-files"
+#: the lock held by the run writing into the folder (hidden; removed when the run ends)
+LOCK = ".rotorred.lock"
+
+
+class FolderBusy(OSError):
+    """Another rotorred run holds the lock of the output folder."""
+
+
+def _acquire_lock(folder: Path):
+    """An open file holding an exclusive ``flock`` on ``folder/.rotorred.lock`` (FolderBusy if taken)."""
+    import fcntl
+
+    path = folder / LOCK
+    while True:
+        handle = open(path, "a+")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            owner = handle.read().strip()
+            handle.close()
+            raise FolderBusy(f"--out = {str(folder)!r}: another rotorred run ({owner or 'unknown'}) is writing into "
+                             f"this folder; wait for it to end or choose another --out") from None
+        try:
+            same = os.fstat(handle.fileno()).st_ino == os.stat(path).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:  # not unlinked by the run that released it meanwhile
+            handle.seek(0)
+            handle.truncate()
+            handle.write(f"pid {os.getpid()}\n")
+            handle.flush()
+            return handle
+        handle.close()
+
+
+@contextmanager
+def _signals_blocked():
+    """SIGINT and SIGTERM held back (delivered on exit) so that a commit is not cut in half."""
+    import signal
+
+    held = {signal.SIGINT, signal.SIGTERM}
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, ValueError):
+        old = None
+    try:
+        yield
+    finally:
+        if old is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+class OutputFolder:
+    """One result written into ``--out`` as a whole: locked, staged, then committed.
+
+    Files are written into a hidden staging folder inside ``folder`` (:attr:`staging`); :meth:`commit`
+    moves them into place with signals held back, removes the files of the earlier result that the
+    new one does not have (listed in the hidden manifest), and writes the new manifest. An
+    interrupt before the commit leaves the earlier result as it was; a hard kill during it leaves
+    the :data:`INCOMPLETE` marker. Files in the folder that rotorred did not write are left alone.
+
+    Use as a context manager: the lock is taken on entry (:class:`FolderBusy` if another run holds
+    it), and on exit the staging folder and the lock are removed, and the folder too if this run
+    created it and committed nothing.
+    """
+
+    def __init__(self, folder: str | Path):
+        self.folder = Path(folder)
+        self.staging: Path | None = None
+        self._created = False
+        self._lock = None
+        self.committed = False
+
+    def __enter__(self) -> OutputFolder:
+        self._created = not self.folder.exists()
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self._lock = _acquire_lock(self.folder)
+        self.staging = Path(tempfile.mkdtemp(prefix=".rotorred-staging-", dir=self.folder))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        import shutil
+
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+        if self._lock is not None:
+            (self.folder / LOCK).unlink(missing_ok=True)
+            self._lock.close()
+        if self._created and not self.committed:
+            try:
+                self.folder.rmdir()
+            except OSError:
+                pass
+
+    def staged(self, path: Path) -> Path:
+        """Where a file of the result goes before the commit (its name in the staging folder)."""
+        return self.staging / Path(path).name
+
+    def commit(self, incomplete: str | None = None) -> list[Path]:
+        """Move the staged files into the folder; ``incomplete``: the reason written to :data:`INCOMPLETE`.
+
+        Returns
+        -------
+        list of Path
+            The files of the result in the folder.
+        """
+        with _signals_blocked():
+            marker = self.folder / INCOMPLETE
+            write_text(marker, (incomplete or "a rotorred run was writing this folder and did not finish") + "\n")
+            new = sorted(p.name for p in self.staging.iterdir() if not p.name.startswith("."))
+            for name in _manifest(self.folder):
+                if name not in new and name != INCOMPLETE:
+                    (self.folder / name).unlink(missing_ok=True)
+            for name in new:
+                os.replace(self.staging / name, self.folder / name)
+            names = new + ([INCOMPLETE] if incomplete else [])
+            write_text(self.folder / MANIFEST, "".join(f"{n}\n" for n in names))
+            if not incomplete:
+                marker.unlink()
+            self.committed = True
+        return [self.folder / n for n in names]
+
+
+def _manifest(folder: Path) -> list[str]:
+    """The file names of the folder's last committed result."""
+    try:
+        return [n for n in (folder / MANIFEST).read_text(encoding="utf-8").splitlines()
+                if n and "/" not in n and not n.startswith(".")]
+    except (OSError, UnicodeDecodeError):
+        return []

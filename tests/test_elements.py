@@ -206,8 +206,27 @@ def test_checked_values_are_stored_converted():
     assert e == ShaftElement(1, 2, 1.0, 1.0, 0.0, STEEL)
 
 
-def test_phi_definition():
-    e = ShaftElement(1, 2, 0.1, 0.05, 0.01, STEEL)
-    assert e.phi == pytest.approx(12 * STEEL.E * e.I / (e.kappa * STEEL.G_s * e.A * e.L**2), rel=1e-15)
-    assert ShaftElement(1, 2, 0.1, 0.05, 0.01, STEEL, shear="none").phi == 0.0
+@pytest.mark.parametrize("shear", ["cowper", "none"])
+@pytest.mark.parametrize("n", [1, 3])
+def test_timoshenko_cantilever_tip_deflection(shear, n):
+    """A stubby cantilever (L = 0.1 m, D = 50/10 mm) of n assembled elements under a tip load: the tip deflects
+    P L^3 / 3EI + P L / (kappa G A) (bending plus shear; the shear part is 13.6 % here, so a wrong phi fails).
+    Nelson's interdependent element is exact for a static end load at any n. Replaces a test that restated
+    the code's formula for phi."""
+    from rotorred.model.assembly import assemble
+    from rotorred.model.rotor import Rotor, Spool
+
+    L, P = 0.1, 1000.0
+    els = tuple(ShaftElement(i, i + 1, L / n, 0.05, 0.01, STEEL, shear=shear) for i in range(1, n + 1))
+    K = assemble(Rotor(spools=(Spool("s", els),))).K
+    K = np.asarray(K.toarray() if hasattr(K, "toarray") else K)
+    free = np.arange(4, K.shape[0])  # node 1 clamped
+    f = np.zeros(len(free))
+    f[-4] = P  # x of the tip node
+    tip = np.linalg.solve(K[np.ix_(free, free)], f)[-4]
+    e = els[0]
+    ref = P * L**3 / (3 * STEEL.E * e.I) + (P * L / (e.kappa * STEEL.G_s * e.A) if shear != "none" else 0.0)
+    assert (e.phi == 0.0) == (shear == "none")
+    # measured within 4e-15 relative (round-off of the solve)
+    assert tip == pytest.approx(ref, rel=5e-14)
     assert math.isclose(e.A, math.pi * (0.05**2 - 0.01**2) / 4)

@@ -78,7 +78,9 @@ def test_write_sweep(result, tmp_path):
     assert sorted(f.name for f in files) == ["sweep.csv", "sweep.png", "sweep.txt"]
     header = (tmp_path / "sweep.csv").read_text().splitlines()[0].split(",")
     assert header[:5] == ["rub.clearance (SI)", "contact fraction", "impacts", "combination lines", "peak (um)"]
-    data = np.loadtxt(tmp_path / "sweep.csv", delimiter=",", skiprows=1)
+    assert header[-1] == "status"  # "ok", or "failed: <why>" for a diverged value (tests/test_cli_failures.py)
+    assert [row.rsplit(",", 1)[1] for row in (tmp_path / "sweep.csv").read_text().splitlines()[1:]] == ["ok"] * 3
+    data = np.loadtxt(tmp_path / "sweep.csv", delimiter=",", skiprows=1, usecols=range(len(header) - 1))
     np.testing.assert_allclose(data[:, 0], res.values, rtol=1e-8)
     np.testing.assert_allclose(data[:, header.index("f_H (um)")], 1e6 * res.amplitudes["f_H"], rtol=1e-5)
 
@@ -102,7 +104,7 @@ def test_cli_sweep(tmp_path, capsys):
     # two swept keys are refused
     assert main(["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.dt=1e-5,2e-5",
                  "--out", str(tmp_path)]) == 2
-    assert "sweeps one key" in capsys.readouterr().err
+    assert "sweep one key" in capsys.readouterr().err
 
 
 def test_no_plate_no_reach():

@@ -94,12 +94,12 @@ def scene():
     return rig, model, critical_speeds(rig, system)
 
 
-def run_one(rig, model, speeds, dt, K_nr, clearance, mu) -> SweepRow:
+def run_one(rig, model, speeds, dt, K_nr, clearance, mu, t_end: float = T_END) -> SweepRow:
     plate = RubPlate.for_rotor(rig, 18, K_nr=K_nr, clearance=clearance, mu_s=mu, mu_d=mu)
     outputs = [(18, "x"), (18, "y")]
     t0 = time.perf_counter()
     try:
-        res = simulate(model, speeds, T_END, dt, rotor=rig, unbalances=UNBALANCES, plates=[plate],
+        res = simulate(model, speeds, t_end, dt, rotor=rig, unbalances=UNBALANCES, plates=[plate],
                        outputs=outputs, decimate=max(1, round(1e-5 / dt)), progress=False)
         outcome, message = "bounded", res.message
     except SimulationDiverged as exc:

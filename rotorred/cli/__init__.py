@@ -2,13 +2,24 @@
 
 Each command lives in its own module ``rotorred/cli/<command>.py`` exposing
 ``add_parser(subparsers)`` (registering the sub-parser) and ``run(args) -> int``.
+
+:func:`main` is the one error path: every error reaches the user as one message on stderr
+(``rotorred <command>: error: ...``), without a traceback, and the exit status says which kind
+it was (:data:`EXIT_STATUSES`, also printed by ``rotorred --help``). An unexpected error
+("internal error") has its traceback written to a log file in the output folder (or the
+temporary folder when ``--out`` is unusable), and the message says where.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import tempfile
+import traceback
+from pathlib import Path
 
 #: command modules, in the order ``rotorred --help`` lists them
 COMMANDS = [
@@ -18,30 +29,168 @@ COMMANDS = [
     "sweep",
 ]
 
+EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_DIVERGED, EXIT_ENVIRONMENT = 0, 1, 2, 3, 4
+EXIT_SIGINT, EXIT_SIGTERM = 130, 143
+
+#: exit status -> what it means (the table of ``rotorred --help`` and the README)
+EXIT_STATUSES = {
+    EXIT_OK: "success: every result written",
+    EXIT_INTERNAL: "internal error (a bug): the traceback is in rotorred-error.log in --out (or the temp folder)",
+    EXIT_INPUT: "bad input (a file, a key, an option, --out, a size beyond the limits): nothing computed, "
+                "nothing written",
+    EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `sweep` keeps the other "
+                   "points and names the failed ones in sweep.csv and sweep.txt",
+    EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
+                      "an optional library is missing (the message gives its install command)",
+    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result",
+    EXIT_SIGTERM: "terminated (SIGTERM): --out keeps its earlier result",
+}
+
+#: optional libraries a command may need -> their install command
+INSTALL = {
+    "pyfftw": "pip install pyFFTW",
+    "matplotlib": "pip install matplotlib",
+    "numba": "pip install numba",
+    "scipy": "pip install scipy",
+    "sympy": "pip install sympy",
+}
+
+LOG_NAME = "rotorred-error.log"
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived (raised in the main thread like ``KeyboardInterrupt`` for SIGINT)."""
+
+
+def _epilog() -> str:
+    return "exit status:\n" + "\n".join(f"  {code:>3}  {text}" for code, text in EXIT_STATUSES.items())
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="rotorred",
-        description="Rotordynamics of dual-rotor machines with rub-impact faults.")
+        prog="rotorred", description="Rotordynamics of dual-rotor machines with rub-impact faults.",
+        epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         module = importlib.import_module(f"rotorred.cli.{name}")
         p = module.add_parser(sub)
+        p.epilog = _epilog()
+        p.formatter_class = argparse.RawDescriptionHelpFormatter
         p.set_defaults(_run=module.run)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit status (:data:`EXIT_STATUSES`)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "_run", None):
         parser.print_help()
-        return 2
+        return EXIT_INPUT
+    with _sigterm_raises():
+        try:
+            return int(args._run(args) or 0)
+        except BaseException as exc:  # noqa: BLE001 -- the one place every error is turned into a message
+            return _report(args, exc)
+
+
+@contextlib.contextmanager
+def _sigterm_raises():
+    """Within the block, SIGTERM raises :class:`Terminated` (main thread only; restored afterwards)."""
+    def handler(signum, frame):
+        raise Terminated()
     try:
-        return int(args._run(args) or 0)
-    except (ValueError, FileNotFoundError) as exc:
-        print(f"rotorred {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        old = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread
+        old = None
+    try:
+        yield
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _error(args, text: str) -> None:
+    print(f"rotorred {args.command}: error: {text}", file=sys.stderr)
+
+
+def _report(args, exc: BaseException) -> int:
+    """One message for ``exc`` on stderr; returns the exit status."""
+    from rotorred.checks import InputError
+    from rotorred.writers import FolderBusy
+
+    if isinstance(exc, KeyboardInterrupt):
+        _error(args, "interrupted (SIGINT); the output folder keeps its earlier result")
+        return EXIT_SIGINT
+    if isinstance(exc, Terminated):
+        _error(args, "terminated (SIGTERM); the output folder keeps its earlier result")
+        return EXIT_SIGTERM
+    if isinstance(exc, SystemExit):
+        raise exc
+    if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] in INSTALL:
+        name = exc.name.split(".")[0]
+        _error(args, f"the optional library {name!r} is needed here and is not installed: {INSTALL[name]}")
+        return EXIT_ENVIRONMENT
+    if isinstance(exc, (InputError, ValueError, FileNotFoundError)) and not _is_internal(exc):
+        _error(args, str(exc))
+        return EXIT_INPUT
+    if _is_diverged(exc):
+        _error(args, str(exc))
+        return EXIT_DIVERGED
+    if isinstance(exc, FolderBusy):
+        _error(args, str(exc))
+        return EXIT_ENVIRONMENT
+    if isinstance(exc, OSError):
+        where = f" {exc.filename!r}" if exc.filename else ""
+        _error(args, f"could not write or read{where}: {exc.strerror or exc}")
+        return EXIT_ENVIRONMENT
+    return _internal(args, exc)
+
+
+def _is_internal(exc: BaseException) -> bool:
+    """A ValueError from a library deep in a computation, not from an input check (e.g. numpy's)."""
+    from rotorred.checks import InputError
+
+    if isinstance(exc, (InputError, FileNotFoundError)):
+        return False
+    tb = exc.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    return tb is not None and not str(tb.tb_frame.f_globals.get("__name__", "")).startswith("rotorred")
+
+
+def _is_diverged(exc: BaseException) -> bool:
+    module = sys.modules.get("rotorred.transient.results")
+    return module is not None and isinstance(exc, module.SimulationDiverged)
+
+
+def _internal(args, exc: BaseException) -> int:
+    """Say "internal error", write the traceback to a log file and say where."""
+    text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+    log = None
+    for folder in (_usable_out(args), Path(tempfile.gettempdir())):
+        if folder is None:
+            continue
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            log = folder / LOG_NAME
+            log.write_text(f"rotorred {' '.join(sys.argv[1:])}\n\n{text}", encoding="utf-8")
+            break
+        except OSError:
+            log = None
+    where = f"the traceback is in {log}" if log else "the traceback could not be written:\n" + text
+    _error(args, f"internal error ({type(exc).__name__}: {exc}); {where}; please report it")
+    return EXIT_INTERNAL
+
+
+def _usable_out(args) -> Path | None:
+    from rotorred.checks import InputError
+    from rotorred.cli.options import out_dir
+
+    try:
+        return out_dir("--out", getattr(args, "out", None))
+    except InputError:
+        return None
 
 
 if __name__ == "__main__":

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 
 import numpy as np
 
-from rotorred.cli.options import grid, number_list
+from rotorred import checks
+from rotorred.cli.options import grid, number_list, out_dir
+from rotorred.writers import OutputFolder
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -39,6 +40,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--harmonics", default="1", metavar="H1,H2",
                    help="multiples of each spool's speed used as excitation lines (default 1)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
+    p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
 
 
@@ -47,19 +49,36 @@ def run(args) -> int:
     from rotorred.model.rotor_file import load_rotor
     from rotorred.plots.campbell import plot_campbell
 
+    out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
     harmonics = parse_harmonics(args.harmonics)
+    checks.integer("--modes", args.modes, ge=1)
+    if args.ratio is not None:
+        checks.number("--ratio", args.ratio, ge=0.0)
     rotor = load_rotor(args.rotor)
-    result = campbell(rotor, speeds, ratio=args.ratio, reference=args.reference, n_modes=args.modes,
-                      harmonics=harmonics)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    csv_path = result.to_csv(out / "campbell.csv")
-    ref_nominal = rotor.speeds[result.reference]
-    png_path = plot_campbell(result, out / "campbell.png", operating_speed=ref_nominal if ref_nominal > 0 else None)
+    check_model_size(rotor, args.force)
+    if args.reference is not None and args.reference not in rotor.speeds:
+        checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
+    with OutputFolder(out) as folder:
+        result = campbell(rotor, speeds, ratio=args.ratio, reference=args.reference, n_modes=args.modes,
+                          harmonics=harmonics)
+        result.to_csv(folder.staged("campbell.csv"))
+        ref_nominal = rotor.speeds[result.reference]
+        plot_campbell(result, folder.staged("campbell.png"), operating_speed=ref_nominal if ref_nominal > 0 else None)
+        folder.commit()
     print(format_critical_speeds(result))
-    print(f"wrote {csv_path} and {png_path}")
+    print(f"wrote {out / 'campbell.csv'} and {out / 'campbell.png'}")
     return 0
+
+
+def check_model_size(rotor, force: bool) -> None:
+    """Refuse a rotor whose model is beyond the size limits of :mod:`rotorred.scenes.budget` (unless ``force``)."""
+    from rotorred.scenes import budget
+
+    n_dof, model_bytes = budget.model_estimate(rotor)
+    name = rotor.name or "the rotor"
+    budget.check(budget.Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}),
+                 force=force)
 
 
 def format_critical_speeds(result) -> str:

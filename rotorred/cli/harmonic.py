@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from rotorred import checks
-from rotorred.cli.options import dof_list, grid, node_list
+from rotorred.cli.options import dof_list, grid, node_list, out_dir
+from rotorred.writers import OutputFolder
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
 #: file's ``[defaults]`` gives one
@@ -73,6 +74,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="FRF pairs IN>OUT,... e.g. 18:x>13:x, at the nominal speeds (writes frf.csv, frf.png)")
     p.add_argument("--frequencies", default="0:500:1001", help="FRF frequencies in Hz START:STOP:N (default 0:500:1001)")
     p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
 
 
@@ -226,10 +228,13 @@ def _frf_pairs(text: str, nodes) -> list[tuple[tuple[int, str], tuple[int, str]]
 
 
 def run(args) -> int:
-    from rotorred.linear.harmonic import frequency_response, unbalance_response
-    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+    """Check every option and ``--out``, then solve and write into a locked, staged ``--out``."""
+    from rotorred.cli.campbell import check_model_size
+    from rotorred.linear.harmonic import unbalance_response
 
+    out = out_dir("--out", args.out)
     rotor, scene = _load(str(args.rotor))
+    check_model_size(rotor, args.force)
     reference = args.reference_spool or rotor.spools[0].name
     if reference not in rotor.speeds:
         checks.fail("--reference-spool", reference, f"must be one of {[s.name for s in rotor.spools]}")
@@ -239,25 +244,47 @@ def run(args) -> int:
     ratios = _ratios(args.ratio, rotor, reference)
     frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
     frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
+    _check_model_options(args)
 
-    t0 = time.perf_counter()
-    model, label, kind = _model(args, rotor, scene, speeds, ratios)
-    result = unbalance_response(model, unbalances, speeds, ratios=ratios, outputs=outputs,
-                                spool_of=rotor.spool_of, reference_spool=reference)
-    elapsed = time.perf_counter() - t0
+    with OutputFolder(out) as folder:
+        t0 = time.perf_counter()
+        model, label, kind = _model(args, rotor, scene, speeds, ratios)
+        result = unbalance_response(model, unbalances, speeds, ratios=ratios, outputs=outputs,
+                                    spool_of=rotor.spool_of, reference_spool=reference)
+        elapsed = time.perf_counter() - t0
+        title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
+        names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
+        folder.commit()
+    _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result,
+            [out / n for n in names])
+    return 0
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
-    files = [result.write_csv(out / "response.csv"), plot_bode(result, out / "bode.png", title),
-             plot_polar(result, out / "polar.png", title)]
+
+def _check_model_options(args) -> None:
+    """--modes and --cutoff, in the units the user typed, before any model is built."""
+    if args.modes is not None:
+        checks.integer("--modes", args.modes, ge=0)
+    if args.cutoff is not None:
+        checks.positive("--cutoff", args.cutoff, "Hz")
+
+
+def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[str]:
+    """Stage response.csv, bode.png, polar.png (and frf.csv, frf.png); returns their names."""
+    from rotorred.linear.harmonic import frequency_response
+    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+
+    result.write_csv(folder.staged("response.csv"))
+    plot_bode(result, folder.staged("bode.png"), title)
+    plot_polar(result, folder.staged("polar.png"), title)
+    names = ["response.csv", "bode.png", "polar.png"]
     if frf_pairs:
         inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
         frf = frequency_response(model, inputs, list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs,
                                  speeds=rotor.speeds)
-        files += [frf.write_csv(out / "frf.csv"), plot_frf(frf, out / "frf.png")]
-    _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files)
-    return 0
+        frf.write_csv(folder.staged("frf.csv"))
+        plot_frf(frf, folder.staged("frf.png"))
+        names += ["frf.csv", "frf.png"]
+    return names
 
 
 def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files) -> None:

@@ -4,13 +4,18 @@
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 
 from rotorred import checks
 from rotorred.model.dofs import parse_dof
 
-__all__ = ["grid", "number_list", "dof_list", "node_list"]
+__all__ = ["grid", "number_list", "dof_list", "node_list", "out_dir", "MAX_COUNT"]
+
+#: most values a START:STOP:COUNT grid may hold (each value is a solve)
+MAX_COUNT = 100_000
 
 
 def grid(option: str, text: str, unit: str, *, min_count: int = 1, ge: float | None = None,
@@ -42,6 +47,8 @@ def grid(option: str, text: str, unit: str, *, min_count: int = 1, ge: float | N
         if ":" in text:
             a, b, n = text.split(":")
             count = int(n)
+            if count > MAX_COUNT:
+                checks.fail(option, text, f"must have COUNT <= {MAX_COUNT} (each value is a solve)", unit)
             values = np.linspace(float(a), float(b), count) if count >= 1 else np.zeros(0)
             if count < min_count:
                 raise ValueError
@@ -89,3 +96,39 @@ def node_list(option: str, text: str, nodes=None) -> list[int]:
         for v in values:
             checks.node(option, v, nodes)
     return values
+
+
+def out_dir(option: str, text: str | None) -> Path:
+    """The output folder ``text``, refused before anything is computed if it cannot be one.
+
+    Refused: an empty string, an existing file, a path below a file, a folder (or its nearest
+    existing parent) that is not writable.
+
+    Returns
+    -------
+    Path
+    """
+    if text is None or not str(text).strip():
+        checks.fail(option, text, "must be a folder path, not empty (an unset shell variable?)")
+    path = Path(text).expanduser()
+    if path.exists() and not path.is_dir():
+        checks.fail(option, text, "must be a folder; this is an existing file")
+    existing = path
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        checks.fail(option, text, f"must be a folder path; {str(existing)!r} on it is a file, not a folder")
+    if not _writable(existing):
+        checks.fail(option, text, f"must be writable; {str(existing)!r} is not writable")
+    return path
+
+
+def _writable(folder: Path) -> bool:
+    """A file can be created in ``folder`` (permissions, and a read-only file system)."""
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return False
+    try:
+        st = os.statvfs(folder)
+    except OSError:
+        return True
+    return not st.f_flag & os.ST_RDONLY

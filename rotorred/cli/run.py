@@ -4,13 +4,21 @@ With no scene it runs the built-in ``paper-rub`` (Xu et al. 2016: rub at node 18
 Writes ``waveforms.png``, ``spectra_node<N>.png``, ``orbits.png``, ``result.npz``,
 ``result.mat``, ``timeseries.csv``, ``spectra.csv``, ``lines.csv`` and ``summary.txt``
 (as the scene's ``[output]`` asks), and prints the summary.
+
+Everything is checked before computing (the scene, ``--out``, the size estimate of
+:mod:`rotorred.scenes.budget`); the files are staged and moved into ``--out`` when complete
+(:class:`rotorred.writers.OutputFolder`). A diverged transient writes its partial record marked
+``INCOMPLETE`` and exits with status 3.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 
 from rotorred import checks
+from rotorred.cli.options import out_dir
+from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
 
@@ -25,33 +33,64 @@ def add_parser(subparsers):
                     "Table 1). Scene keys: docs/scenes.md.")
     p.add_argument("scene", nargs="?", default=DEFAULT_SCENE, metavar="SCENE",
                    help=f"built-in scene ({', '.join(builtin_scenes())}) or scene TOML file (default {DEFAULT_SCENE})")
-    p.add_argument("--out", default=None, help="output directory (default ./rotorred-<scene name>)")
+    p.add_argument("--out", default=None, help="output directory (default ./rotorred-<scene name>); locked while "
+                                               "a run writes it, its files replaced as a whole when the run ends")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene key before validation, e.g. rub.clearance=20e-6 or solver.model=full "
                         "(repeatable)")
     p.add_argument("--no-normal", action="store_true", help="do not compute the scene without rub for comparison")
+    p.add_argument("--force", action="store_true",
+                   help="go on with a run beyond the size limits (steps, memory, model size; see the message)")
     return p
 
 
 def run(args) -> int:
-    from pathlib import Path
-
-    from rotorred.scenes.outputs import write_outputs
-    from rotorred.scenes.run import run_scene
-    from rotorred.scenes.summary import format_summary
-    from rotorred.scenes.schema import load_scene, parse_setting
+    """Check everything, then compute into a locked, staged ``--out`` (exit statuses: :mod:`rotorred.cli`)."""
+    from rotorred.scenes import budget
+    from rotorred.scenes.schema import load_scene
 
     t0 = time.perf_counter()
+    if args.out is not None:
+        out_dir("--out", args.out)
+    scene = load_scene(args.scene, _settings(args.set))
+    out = out_dir("--out", args.out if args.out is not None else f"rotorred-{scene.name}")
+    budget.check(budget.scene_estimate(scene), force=args.force)
+    with OutputFolder(out) as folder:
+        status = _compute_and_write(scene, args, folder, out)
+    print(f"wall time {time.perf_counter() - t0:.2f} s")
+    return status
+
+
+def _settings(items: list[str]) -> dict:
+    """The ``--set KEY=VALUE`` overrides (one value each)."""
+    from rotorred.scenes.schema import parse_setting
+
     settings = {}
-    for item in args.set:
+    for item in items:
         key, values = parse_setting(item)
         if len(values) != 1:
-            checks.fail("--set", item, "takes one value in `rotorred run` (use `rotorred sweep` for several)")
+            checks.fail("--set", item, "must have one value in `rotorred run` (use `rotorred sweep` for several)")
         settings[key] = values[0]
-    scene = load_scene(args.scene, settings)
-    result = run_scene(scene, compare_normal=False if args.no_normal else None, progress=None)
-    out = Path(args.out) if args.out else Path(f"rotorred-{scene.name}")
-    files = write_outputs(result, out)
+    return settings
+
+
+def _compute_and_write(scene, args, folder, out) -> int:
+    """Run the scene, stage its files and commit them; a diverged run commits its partial record (exit 3)."""
+    from rotorred.cli import EXIT_DIVERGED
+    from rotorred.scenes.outputs import write_outputs
+    from rotorred.scenes.run import SceneDiverged, run_scene
+    from rotorred.scenes.summary import format_summary
+
+    try:
+        result = run_scene(scene, compare_normal=False if args.no_normal else None, progress=None)
+    except SceneDiverged as exc:
+        write_outputs(exc.partial, folder.staging, shown=out)
+        files = folder.commit(incomplete=str(exc))
+        print(format_summary(exc.partial, files))
+        print(f"rotorred run: error: {exc}; partial results written to {out} (marked {INCOMPLETE})",
+              file=sys.stderr)
+        return EXIT_DIVERGED
+    files = write_outputs(result, folder.staging, shown=out)
+    folder.commit()
     print(format_summary(result, files))
-    print(f"wall time {time.perf_counter() - t0:.2f} s")
     return 0

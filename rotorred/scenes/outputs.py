@@ -35,11 +35,13 @@ def _unit(d) -> str:
 def data_arrays(result: SceneResult) -> dict[str, np.ndarray]:
     """The arrays written to NPZ and .mat (keys documented in ``docs/scenes.md``)."""
     arrays = {"t": result.t, "f_L": np.array(result.f_L), "f_H": np.array(result.f_H)}
-    arrays["frequency"] = next(iter(result.spectra.values())).frequencies
+    if result.spectra:
+        arrays["frequency"] = next(iter(result.spectra.values())).frequencies
     for r, c in _cases(result):
         for d in r.scene.output.dofs:
             arrays[_key(c, d)] = r.outputs[d]
-            arrays[_key(f"{c}_amp", d)] = r.spectra[d].amplitudes
+            if d in r.spectra:
+                arrays[_key(f"{c}_amp", d)] = r.spectra[d].amplitudes
     for k, ch in enumerate(result.contacts):
         arrays[f"plate{k}_normal_force"] = ch.normal_force
         arrays[f"plate{k}_friction_force"] = ch.friction_force
@@ -90,20 +92,36 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
     if "mat" in formats:
         files.append(write_mat(out / "result.mat", data_arrays(result)))
     if "csv" in formats:
-        files += [_timeseries_csv(result, out / "timeseries.csv"), _spectra_csv(result, out / "spectra.csv"),
-                  _lines_csv(result, out / "lines.csv")]
+        files.append(_timeseries_csv(result, out / "timeseries.csv"))
+        if result.spectra:
+            files += [_spectra_csv(result, out / "spectra.csv"), _lines_csv(result, out / "lines.csv")]
     return files
 
 
-def write_outputs(result: SceneResult, out: str | Path) -> list[Path]:
-    """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written."""
+def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None) -> list[Path]:
+    """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written.
+
+    An incomplete result (a diverged transient, ``result.incomplete``) gets its data files and
+    the summary, which says why it stops; no figures or spectra (the record is not settled).
+
+    Parameters
+    ----------
+    result : SceneResult
+    out : str or Path
+        Folder the files are written to (created if missing).
+    shown : str or Path, optional
+        Folder the summary names the files in (the final folder when ``out`` is a staging folder,
+        :class:`rotorred.writers.OutputFolder`); default ``out``.
+    """
     from rotorred.plots.scene import plot_scene  # matplotlib only when figures are written
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    files = plot_scene(result, out) if result.scene.output.plots else []
+    plots = result.scene.output.plots and not result.incomplete
+    files = plot_scene(result, out) if plots else []
     files += write_data(result, out)
     summary = out / "summary.txt"
     files.append(summary)
-    write_text(summary, format_summary(result, files) + "\n")
-    return files
+    named = [Path(shown) / f.name for f in files] if shown is not None else files
+    write_text(summary, format_summary(result, named) + "\n")
+    return named

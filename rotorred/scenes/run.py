@@ -41,7 +41,7 @@ from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
 from rotorred.signals.spectra import WINDOWS, settled_spectrum
 
-__all__ = ["SceneModel", "SceneResult", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
+__all__ = ["SceneModel", "SceneResult", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
            "harmonic_outputs", "spool_frequencies"]
 
 
@@ -96,6 +96,9 @@ class SceneResult:
         The same scene without rub plates, when ``output.compare_normal``.
     counters : dict
         Integrator counters (Newton iterations, contact steps, µs per step).
+    incomplete : str or None
+        Why the record stops early (a diverged transient, :class:`SceneDiverged`); None when complete.
+        An incomplete result has no spectra, lines or normal comparison.
     """
 
     scene: Scene
@@ -113,10 +116,11 @@ class SceneResult:
     solve_time: float
     normal: SceneResult | None = None
     counters: dict = field(default_factory=dict)
+    incomplete: str | None = None
 
     def peak(self, dof) -> float:
-        """Largest |displacement| of ``dof`` in the window (m)."""
-        return float(np.max(np.abs(self.outputs[tuple(dof)])))
+        """Largest |displacement| of ``dof`` in the window (m); 0 for an empty (diverged) record."""
+        return float(np.max(np.abs(self.outputs[tuple(dof)]), initial=0.0))
 
     def contact_fraction(self, plate: int = 0) -> float:
         """Fraction of the recorded samples in which plate ``plate`` touches (slip or stick)."""
@@ -268,7 +272,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     if scene.is_linear and scene.solver.start == "settled":
         response = _harmonic_response(scene, model.model)
     else:
-        response = _transient_response(scene, model.model, progress)
+        response = _transient_response(scene, model, progress, f_L, f_H)
     spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
     if compare_normal is None:
@@ -302,19 +306,90 @@ def _harmonic_response(scene: Scene, model) -> _Response:
     return _Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
 
 
-def _transient_response(scene: Scene, model, progress: bool | None) -> _Response:
-    """Time stepping from the settled linear state or from rest (:func:`rotorred.transient.newmark.simulate`)."""
-    from rotorred.transient.newmark import simulate  # loads numba only when a scene needs it
+def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,
+                        f_H: float) -> _Response:
+    """Time stepping from the settled linear state or from rest (:func:`rotorred.transient.newmark.simulate`).
 
-    s = scene.solver
+    Raises :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
+    """
+    from rotorred.transient.newmark import simulate  # loads numba only when a scene needs it
+    from rotorred.transient.results import SimulationDiverged
+
+    s, model = scene.solver, scene_model.model
     q0, v0 = settled_state(scene, model) if s.start == "settled" else (None, None)
     kw = {"alpha": s.alpha} if s.method == "hht" else {}
-    res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
-                   rotor=scene.rotor, outputs=scene.output.dofs, record_start=s.record_start, method=s.method,
-                   gravity=s.gravity or None, q0=q0, v0=v0, progress=progress, **kw)
-    counters = {"n_newton": res.n_newton, "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
-                "us_per_step": res.us_per_step}
-    return _Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, counters)
+    try:
+        res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
+                       rotor=scene.rotor, outputs=scene.output.dofs, record_start=s.record_start, method=s.method,
+                       gravity=s.gravity or None, q0=q0, v0=v0, progress=progress, **kw)
+    except SimulationDiverged as exc:
+        raise SceneDiverged.of(scene, scene_model, exc, f_L, f_H) from None
+    return _Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res))
+
+
+def _counters(res) -> dict:
+    return {"n_newton": res.n_newton, "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
+            "us_per_step": res.us_per_step}
+
+
+# --------------------------------------------------------------------------- divergence
+def explain_divergence(scene: Scene, exc) -> str:
+    """When, where and why a scene's transient diverged, in the scene's key names.
+
+    Parameters
+    ----------
+    exc : rotorred.transient.results.SimulationDiverged
+    """
+    import re
+
+    from rotorred.transient import kernel
+
+    status, t_done = exc.result.status, exc.result.final.t
+    where, why = exc.dof, exc.cause
+    m = re.match(r"plate (\d+)(?: at)? node (\d+) ?([xy]?)", exc.dof)
+    if m:
+        k = int(m.group(1))
+        where = f"rub[{k}] (node {m.group(2)}{', ' + m.group(3) if m.group(3) else ''})"
+    if status == kernel.LIMIT:
+        why = ("the disk's displacement exceeded 1 m, the transient's divergence limit: the response left the "
+               "model (lower unbalance[].m_e, or move speeds away from a critical speed)")
+    elif status == kernel.NEWTON_FAILED:
+        why = "the contact iteration did not converge (rub[].K_nr, rub[].c, solver.dt)"
+    elif status == kernel.NONFINITE:
+        why = "a displacement became infinite or NaN (solver.dt, rub[].K_nr)"
+    return (f"the transient diverged at t = {exc.time:.6g} s at {where}: {why}; halving solver.dt = "
+            f"{scene.solver.dt:g} s did not cure it; the record up to t = {t_done:.6g} s is kept")
+
+
+class SceneDiverged(RuntimeError):
+    """A scene's transient diverged; :attr:`partial` holds the record up to then.
+
+    Attributes
+    ----------
+    partial : SceneResult
+        The result up to the failing step (``incomplete`` set; no spectra, lines or normal comparison).
+    time : float
+        Time of the failing step (s).
+    dof : str
+        Where the failure was detected (the kernel's label).
+    cause : str
+        The kernel's cause.
+    """
+
+    def __init__(self, message: str, partial: SceneResult, time: float, dof: str, cause: str):
+        super().__init__(message)
+        self.partial, self.time, self.dof, self.cause = partial, time, dof, cause
+
+    @classmethod
+    def of(cls, scene: Scene, scene_model: SceneModel, exc, f_L: float, f_H: float) -> SceneDiverged:
+        """The scene-level error of the transient's ``SimulationDiverged`` ``exc``."""
+        message = explain_divergence(scene, exc)
+        res = exc.result
+        partial = SceneResult(scene=scene, t=res.t, outputs=res.outputs, contacts=res.contacts, spectra={},
+                              lines={}, f_L=f_L, f_H=f_H, method="transient", model_label=scene_model.label,
+                              n_steps=res.n_steps, build_time=scene_model.build_time, solve_time=res.run_time,
+                              counters=_counters(res), incomplete=message)
+        return cls(message, partial, exc.time, exc.dof, exc.cause)
 
 
 def _spectra_and_lines(scene: Scene, outputs: dict, f_L: float, f_H: float) -> tuple[dict, dict]:

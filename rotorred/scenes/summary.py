@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 from rotorred.model.dofs import direction_name
 from rotorred.scenes.run import SceneResult
 from rotorred.signals.lines import format_table
@@ -16,22 +18,65 @@ __all__ = ["format_summary", "table_dof"]
 _RPM = 60.0 / (2.0 * math.pi)
 
 
-def table_dof(result: SceneResult) -> tuple[int, str]:
-    """The DOF whose lines are tabulated: ``output.table``, else the last node's y (or first direction)."""
-    out = result.scene.output
+def table_dof(result) -> tuple[int, str]:
+    """The DOF whose lines are tabulated: ``output.table``, else the last node's y (or first direction).
+
+    ``result`` is a :class:`SceneResult` or a :class:`rotorred.scenes.schema.Scene`.
+    """
+    scene = getattr(result, "scene", result)
+    out = scene.output
     if out.table is not None:
         return out.table
-    node = out.nodes[-1] if not result.scene.plates else next(
-        (n for n in reversed(out.nodes) if n != result.scene.plates[0].node), out.nodes[-1])
+    node = out.nodes[-1] if not scene.plates else next(
+        (n for n in reversed(out.nodes) if n != scene.plates[0].node), out.nodes[-1])
     return (node, "y" if "y" in out.directions else out.directions[0])
 
 
 def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
     """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form)."""
-    parts = [_setup(result), _peaks(result), _contacts(result), _lines(result)]
+    parts = [_incomplete(result), _setup(result), _peaks(result), _range_warnings(result), _contacts(result),
+             _lines(result) if result.spectra else ""]
     if files:
         parts.append("\n".join(f"wrote {f}" for f in files))
     return "\n\n".join(p for p in parts if p)
+
+
+#: the small-displacement range of the model: a translation beyond this fraction of the largest disk
+#: radius of the rotor (1.25 mm for the seed rig's 0.125 m disks) leaves the linear beam model
+SMALL_DISPLACEMENT_FRACTION = 0.01
+#: the radius used when the rotor's disks give none (m)
+DEFAULT_RADIUS = 0.1
+
+
+def _incomplete(result: SceneResult) -> str:
+    if not result.incomplete:
+        return ""
+    return (f"INCOMPLETE: {result.incomplete}. The record below ends there: peaks and contact over the partial "
+            f"record; no figures, spectra or lines.")
+
+
+def small_displacement_limit(scene) -> float:
+    """Largest translation (m) inside the model's small-displacement range (:data:`SMALL_DISPLACEMENT_FRACTION`)."""
+    radii = [d.radius for d in scene.rotor.disks if getattr(d, "radius", 0.0) > 0]
+    return SMALL_DISPLACEMENT_FRACTION * (max(radii) if radii else DEFAULT_RADIUS)
+
+
+def _range_warnings(result: SceneResult) -> str:
+    """A warning per node whose orbit (or translation) leaves the small-displacement range."""
+    limit = small_displacement_limit(result.scene)
+    lines = []
+    for node in dict.fromkeys(d[0] for d in result.scene.output.dofs):
+        x, y = result.outputs.get((node, "x")), result.outputs.get((node, "y"))
+        parts = [v for v in (x, y) if v is not None and len(v)]
+        if not parts:
+            continue
+        reach = float(np.max(np.hypot(x, y))) if x is not None and y is not None and len(x) else max(
+            float(np.max(np.abs(v))) for v in parts)
+        if reach > limit:
+            lines.append(f"WARNING: node {node} orbits {1e3 * reach:.4g} mm from the axis, beyond the model's "
+                         f"small-displacement range of {1e3 * limit:.4g} mm ({100 * SMALL_DISPLACEMENT_FRACTION:g} % "
+                         f"of the largest disk radius): a linear beam model does not hold there")
+    return "\n".join(lines)
 
 
 def _setup(result: SceneResult) -> str:

@@ -13,14 +13,16 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
-from rotorred.scenes.run import SceneModel, build_model, model_key, run_scene, settled_response
+from rotorred import checks
+from rotorred.scenes.run import (SceneDiverged, SceneModel, build_model, model_key, run_scene, settled_response,
+                                 spool_frequencies)
 from rotorred.scenes.schema import Scene, load_scene
 from rotorred.scenes.summary import table_dof
 from rotorred.writers import render_table, write_csv, write_text
@@ -63,6 +65,9 @@ class SweepResult:
         Factor from the swept value (SI) to the unit of ``axis_label`` (1e6 for a clearance in µm).
     axis_label : str
         Name and unit of the swept key for plots and tables, e.g. "Rub clearance (µm)".
+    failures : dict of int to str
+        Index of each value whose run failed (a diverged transient) -> why; its amplitudes, peak,
+        contact fraction are NaN and its impacts -1.
     """
 
     scene_name: str
@@ -80,11 +85,16 @@ class SweepResult:
     wall_times: np.ndarray
     axis_scale: float = 1.0
     axis_label: str = ""
+    failures: dict = field(default_factory=dict)
+
+    def status(self, i: int) -> str:
+        """``"ok"`` or ``"failed: <why>"`` for value ``i``."""
+        return f"failed: {self.failures[i]}" if i in self.failures else "ok"
 
     def combinations(self) -> list[str]:
         """Combination-line labels, strongest (largest amplitude over the sweep) first."""
         combos = [k for k in self.amplitudes if k not in ("f_L", "f_H")]
-        return sorted(combos, key=lambda k: -float(np.max(self.amplitudes[k])))
+        return sorted(combos, key=lambda k: -float(np.nanmax(self.amplitudes[k], initial=0.0)))
 
     def combination_total(self) -> np.ndarray:
         """Sum of the combination-line amplitudes per value (m), shape (n,)."""
@@ -141,47 +151,84 @@ def sweep(spec, key: str, values: Sequence, settings: dict | None = None, dof: t
     if not values:
         raise ValueError(f"`values` of the sweep of {key!r} must not be empty")
     settings = dict(settings or {})
-    # validate every scene before computing anything
+    # validate every scene, and the DOF, before computing anything
     scenes = [load_scene(spec, {**settings, key: v}) for v in values]
-    model_cache = {}
-    amps: dict[str, list] = {}
-    n = len(scenes)
-    n_comb = np.zeros(n, dtype=int)
-    peak, cf, imp, wall = np.zeros(n), np.zeros(n), np.zeros(n, dtype=int), np.zeros(n)
-    reach = None
+    d = check_dof(scenes[0], dof)
+    points = _Points(len(scenes))
+    model_cache, reach = {}, None
     for i, sc in enumerate(scenes):
         t0 = time.perf_counter()
         mk = model_key(sc)
         if mk not in model_cache:
             model_cache[mk] = build_model(sc)
-        model = model_cache[mk]
-        res = run_scene(sc, model, compare_normal=False)
-        d = tuple(dof) if dof is not None else table_dof(res)
-        if d not in res.outputs:
-            raise ValueError(f"`dof` {d} is not recorded by the scene (outputs {list(res.outputs)})")
+        if i == 0:
+            reach = free_reach(sc, model_cache[mk])
+        try:
+            points.add(i, run_scene(sc, model_cache[mk], compare_normal=False), d)
+        except SceneDiverged as exc:
+            points.fail(i, str(exc))
+        points.wall[i] = time.perf_counter() - t0
+        if progress:
+            print(f"  {key} = {values[i]!r}: {points.describe(i)} ({points.wall[i]:.2f} s)", flush=True)
+    vals = np.array([float(v) for v in values]) if all(isinstance(v, (int, float)) for v in values) \
+        else np.arange(len(values), dtype=float)
+    scale, label = axis_of(key)
+    f_L, f_H = spool_frequencies(scenes[0])
+    return SweepResult(scene_name=scenes[0].name, key=key, values=vals, dof=d, f_L=f_L, f_H=f_H,
+                       amplitudes={k: np.array(v) for k, v in points.amps.items()}, n_combinations=points.n_comb,
+                       peak=points.peak, contact_fraction=points.cf, n_impacts=points.imp, free_reach=reach,
+                       wall_times=points.wall, axis_scale=scale, axis_label=label, failures=points.failures)
+
+
+def check_dof(scene: Scene, dof: tuple | None, option: str = "--dof", text: str | None = None) -> tuple:
+    """The DOF whose lines a sweep collects: ``dof`` if the scene records it, else its table DOF.
+
+    ``option`` and ``text`` (the DOF as the user typed it) name it in the message of a refusal.
+    """
+    if dof is None:
+        return table_dof(scene)
+    d = tuple(dof)
+    if d not in scene.output.dofs:
+        checks.fail(option, text or f"{d[0]}:{d[1]}", "must be a DOF the scene records (output.nodes x output.directions: "
+                                              + ", ".join(f"{n}:{x}" for n, x in scene.output.dofs) + ")")
+    return d
+
+
+class _Points:
+    """The per-value quantities of a sweep, filled run by run (NaN for a failed run)."""
+
+    def __init__(self, n: int):
+        self.n = n
+        self.amps: dict[str, list] = {}
+        self.n_comb = np.zeros(n, dtype=int)
+        self.peak, self.cf, self.wall = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.imp = np.zeros(n, dtype=int)
+        self.failures: dict[int, str] = {}
+
+    def add(self, i: int, res, d: tuple) -> None:
         for ln in res.lines[d]:
             if not ln.known:
                 continue
-            amps.setdefault(ln.label_ascii, [0.0] * n)[i] = ln.amplitude
+            self.amps.setdefault(ln.label_ascii, [math.nan if j in self.failures else 0.0
+                                                  for j in range(self.n)])[i] = ln.amplitude
             if ln.label_ascii not in ("f_L", "f_H"):
-                n_comb[i] += 1
-        peak[i] = res.peak(d)
-        cf[i] = res.contact_fraction(0)
-        imp[i] = res.n_impacts(0)
-        if i == 0:
-            reach = free_reach(sc, model)
-            f_L, f_H, dof0 = res.f_L, res.f_H, d
-        wall[i] = time.perf_counter() - t0
-        if progress:
-            print(f"  {key} = {values[i]!r}: contact {100 * cf[i]:.2f} %, {imp[i]} impacts, {n_comb[i]} combination "
-                  f"lines, peak {1e6 * peak[i]:.4g} um ({wall[i]:.2f} s)", flush=True)
-    vals = np.array([float(v) for v in values]) if all(isinstance(v, (int, float)) for v in values) \
-        else np.arange(n, dtype=float)
-    scale, label = axis_of(key)
-    return SweepResult(scene_name=scenes[0].name, key=key, values=vals, dof=dof0, f_L=f_L, f_H=f_H,
-                       amplitudes={k: np.array(v) for k, v in amps.items()}, n_combinations=n_comb, peak=peak,
-                       contact_fraction=cf, n_impacts=imp, free_reach=reach, wall_times=wall, axis_scale=scale,
-                       axis_label=label)
+                self.n_comb[i] += 1
+        self.peak[i] = res.peak(d)
+        self.cf[i] = res.contact_fraction(0)
+        self.imp[i] = res.n_impacts(0)
+
+    def fail(self, i: int, why: str) -> None:
+        self.failures[i] = why
+        for v in self.amps.values():
+            v[i] = math.nan
+        self.peak[i] = self.cf[i] = math.nan
+        self.imp[i] = self.n_comb[i] = -1
+
+    def describe(self, i: int) -> str:
+        if i in self.failures:
+            return f"FAILED: {self.failures[i]}"
+        return (f"contact {100 * self.cf[i]:.2f} %, {self.imp[i]} impacts, {self.n_comb[i]} combination lines, "
+                f"peak {1e6 * self.peak[i]:.4g} um")
 
 
 def axis_of(key: str) -> tuple[float, str]:
@@ -207,15 +254,21 @@ def format_sweep(result: SweepResult, n_lines: int = 4) -> str:
     header = [result.axis_label, "contact (%)", "impacts", "comb. lines", "peak (um)"] + [f"{k} (um)" for k in labels]
     rows = [[f"{result.axis_scale * v:.4g}", f"{100 * result.contact_fraction[i]:.2f}", str(result.n_impacts[i]),
              str(result.n_combinations[i]), f"{1e6 * result.peak[i]:.4g}"]
-            + [f"{1e6 * result.amplitudes[k][i]:.4g}" for k in labels] for i, v in enumerate(result.values)]
-    out = render_table(header, rows)
+            + [f"{1e6 * result.amplitudes[k][i]:.4g}" for k in labels] + [result.status(i)[:6]]
+            for i, v in enumerate(result.values)]
+    out = render_table(header + ["status"], rows)
+    for i, why in sorted(result.failures.items()):
+        out += f"\n{result.key} = {result.values[i]:.6g}: FAILED: {why}"
     if result.free_reach is not None:
         out += f"\nfree (no-rub) orbit reach towards the plate at the rub node: {1e6 * result.free_reach:.4g} um"
     return out
 
 
 def write_sweep(result: SweepResult, out) -> list[Path]:
-    """Write ``sweep.png``, ``sweep.csv`` (all lines, amplitudes in µm) and ``sweep.txt``."""
+    """Write ``sweep.png``, ``sweep.csv`` (all lines, amplitudes in µm, a status per value) and ``sweep.txt``.
+
+    A failed value has NaN amplitudes and its reason in the ``status`` column; no figure when every value failed.
+    """
     from rotorred.plots.sweep import plot_sweep  # matplotlib only when figures are written
 
     out = Path(out)
@@ -225,5 +278,8 @@ def write_sweep(result: SweepResult, out) -> list[Path]:
         f"{k} (um)" for k in labels]
     cols = [result.values, result.contact_fraction, result.n_impacts, result.n_combinations, 1e6 * result.peak]
     cols += [1e6 * result.amplitudes[k] for k in labels]
-    return [plot_sweep(result, out / "sweep.png"), write_csv(out / "sweep.csv", header, cols),
-            write_text(out / "sweep.txt", format_sweep(result) + "\n")]
+    header.append("status")
+    cols.append([result.status(i) for i in range(len(result.values))])
+    ok = len(result.failures) < len(result.values)
+    return ([plot_sweep(result, out / "sweep.png")] if ok else []) + [
+        write_csv(out / "sweep.csv", header, cols), write_text(out / "sweep.txt", format_sweep(result) + "\n")]

@@ -33,11 +33,11 @@ Every rule works on the settled part of the record (from the settling time of
    of its energy (issue 19), the ones that do not describe it at most 84 %.
 4. **quasi-periodic**: the lines explain at least ``explained_min`` and span a two-dimensional
    lattice (two incommensurate base frequencies ``f_H/k``, ``f_L/j``), confirmed on the Poincare
-   section: the samples taken once per revolution of f_H (r = 0, 1, ...), ordered by the phase
-   ``theta = 2 pi (f_L/j) t`` of the other base, lie on k closed curves (one per ``r mod k``;
-   one curve for k = 1): Fourier series in theta with as many harmonics as the lines need (H,
+   section: the samples taken once per period of ``f_H/k`` (every k revolutions of the outer
+   spool), ordered by the phase ``theta = 2 pi (f_L/j) t`` of the other base, lie on one closed
+   curve: Fourier series in theta with as many harmonics as the lines need (H,
    the largest multiple of ``f_L/j`` among them) explain at least ``explained_min`` of their
-   variance. With fewer than ``4 (2H + 1)`` samples per curve the curves cannot be tested and
+   variance. With fewer than ``4 (2H + 1)`` samples the curve cannot be tested and
    the line fit alone decides.
 5. **unexplained**: none of the above. The lines explain too little and the residual is not
    chaotic by rules 2b-2c (e.g. a torus of higher order, or three frequencies): the response is
@@ -45,9 +45,12 @@ Every rule works on the settled part of the record (from the settling time of
 
 Poincare samples
     The state is sampled once per period of the section frequency: ``g = gcd(f_L, f_H)`` for
-    commensurate speeds (a period-k response shows k points), else ``f_H``, once per revolution
-    of the outer spool (the section of the anchors; a 2-torus with sub-harmonic order k shows k
-    closed curves). Sample times are whole multiples of the period
+    commensurate speeds (a period-k response shows k points), else ``f_H / k``, once per k
+    revolutions of the outer spool, k the torus's sub-harmonic order of f_H (the section of the
+    anchors, once per revolution, when k = 1). Once per revolution, a 2-torus with k = 3 would
+    show three interleaved closed curves, and the 0-1 test reads their interleaving as
+    irregular (measured K = 0.86 on the rig at outer 88.8 Hz, 8 s); once per k revolutions the
+    samples lie on one closed curve. Sample times are whole multiples of the period
     in the record's own time, so the section is at phase 0 of that base. x (and y) are
     interpolated by a not-a-knot cubic spline and the velocity is its derivative. For the
     complete cubic spline the error is at most ``5/384 h^4 max|x''''|``, and
@@ -237,9 +240,9 @@ def _lattice(orders: list[tuple[Fraction, Fraction]], f_L: float, f_H: float):
 
 
 def _section_frequency(torus: Torus) -> float:
-    """gcd(f_L, f_H) when commensurate, else f_H: once per revolution of the outer spool (Hz)."""
+    """gcd(f_L, f_H) when commensurate, else f_H / k: once per period of the torus's f_H base (Hz)."""
     ratio = torus.ratio
-    return torus.f_L / ratio.denominator if ratio is not None else torus.f_H
+    return torus.f_L / ratio.denominator if ratio is not None else torus.f_H / torus.k
 
 
 def _curve_share(samples: PoincareSamples, torus: Torus, orders) -> float | None:
@@ -248,16 +251,18 @@ def _curve_share(samples: PoincareSamples, torus: Torus, orders) -> float | None
     Sampled once per revolution of f_H, a line ``(m'/k) f_H + (n'/j) f_L`` reads
     ``exp(2 pi i m' r / k) exp(i n' theta)`` at revolution number r, ``theta = 2 pi (f_L/j) t``:
     the samples of each residue ``r mod k`` lie on one closed curve, a Fourier series in theta
-    with H harmonics (H the largest ``|n'|``). None when a curve has fewer than ``4 (2H + 1)``
-    samples.
+    with H harmonics (H the largest ``|n'|``); sampled once per k revolutions (the section of
+    :func:`classify`, at f_H / k), every sample lies on one curve. None when a curve has fewer than
+    ``4 (2H + 1)`` samples.
     """
     H = max((abs(int(n * torus.j)) for _, n in orders), default=0)
+    n_curves = max(1, round(torus.k * samples.frequency_hz / torus.f_H))  # k at f_H, 1 at f_H / k
     revolution = np.rint(samples.times * samples.frequency_hz).astype(int)
     theta = 2.0 * np.pi * (torus.f_L / torus.j) * samples.times
     h = np.arange(1, H + 1)
     rss, var = 0.0, float(np.sum((samples.x - samples.x.mean()) ** 2))
-    for r in range(torus.k):
-        group = revolution % torus.k == r
+    for r in range(n_curves):
+        group = revolution % n_curves == r
         if group.sum() < 4 * (2 * H + 1):
             return None
         A = np.hstack([np.ones((group.sum(), 1)), np.cos(np.outer(theta[group], h)), np.sin(np.outer(theta[group], h))])

@@ -114,7 +114,16 @@ XU2016_TABLE1: tuple[tuple[float, str], ...] = (
 
 
 # --------------------------------------------------------------------------- labels
+def _as_m(m) -> Fraction:
+    """m as a Fraction: any ``fractions.Fraction`` (an exact sub-harmonic order, f_H/3), else an integer."""
+    if isinstance(m, Fraction):
+        return m
+    return Fraction(checks.integer("m", m))
+
+
 def _as_n(n) -> Fraction:
+    if isinstance(n, Fraction):  # an exact order: any denominator (f_L/3)
+        return n
     if not isinstance(n, Fraction):
         checks.number("n", n)  # a finite real number (not a bool) ...
     f = Fraction(n) if not isinstance(n, np.generic) else Fraction(n.item())
@@ -131,15 +140,16 @@ def _term(coefficient: Fraction, symbol: str) -> str:
     return f"{num}{symbol}{den}"
 
 
-def combination_label(m: int, n, minus: str = MINUS, math_text: bool = False) -> str:
+def combination_label(m, n, minus: str = MINUS, math_text: bool = False) -> str:
     """Label of ``m f_H + n f_L`` in the paper's Table 1 style.
 
     Parameters
     ----------
-    m : int
-        Multiple of f_H.
+    m : int or Fraction
+        Multiple of f_H: an integer, or a ``fractions.Fraction`` of any denominator
+        (``Fraction(2, 3)``: ``2f_H/3``, a sub-harmonic order, :mod:`rotorred.signals.linefit`).
     n : int or Fraction or float
-        Multiple of f_L, integer or half-integer.
+        Multiple of f_L: a ``Fraction`` of any denominator, or an integer or half-integer number.
     minus : str
         Minus sign: ``MINUS`` (U+2212, default) or ``"-"``.
     math_text : bool
@@ -157,10 +167,11 @@ def combination_label(m: int, n, minus: str = MINUS, math_text: bool = False) ->
     '3f_H-2f_L'
     >>> combination_label(1, 1.5, minus="-")
     'f_H+3f_L/2'
+    >>> combination_label(Fraction(2, 3), Fraction(-1, 3), minus="-")
+    '2f_H/3-f_L/3'
     """
-    checks.integer("m", m)
+    mf = _as_m(m)
     nf = _as_n(n)
-    mf = Fraction(int(m))
     terms = [(c, s) for c, s in ((mf, "f_H"), (nf, "f_L")) if c != 0]
     if not terms:
         return "$0$" if math_text else "0"

@@ -1,4 +1,4 @@
-"""Single-sided amplitude spectra of response signals, computed with pyFFTW.
+"""Single-sided amplitude spectra of response signals, computed with pyFFTW (or numpy.fft without it).
 
 The spectrum of a real record ``x[j] = x(j dt)``, ``j = 0 .. N-1``, windowed by ``w``, is
 read as an amplitude spectrum: a sinusoid ``a cos(2 pi f t + phase)`` whose frequency ``f``
@@ -30,7 +30,9 @@ between bins), and says so in :attr:`Spectrum.note`.
 FFT plans are built once per ``(length, dtype)`` with :func:`pyfftw.builders.rfft` and kept
 in an explicit cache (:func:`rfft_plan`, :func:`plan_cache_info`). The pyFFTW
 ``interfaces`` cache is not used: the builders objects are kept here directly, so plan
-reuse is an identity that can be checked (``rfft_plan(n) is rfft_plan(n)``).
+reuse is an identity that can be checked (``rfft_plan(n) is rfft_plan(n)``). Without pyFFTW
+the plans are :class:`NumpyPlan` objects over :func:`numpy.fft.rfft`, with a one-line note on
+stderr (:data:`NO_PYFFTW_NOTE`, once per process).
 
 References
 ----------
@@ -52,11 +54,22 @@ import threading
 from dataclasses import dataclass, replace
 from fractions import Fraction
 
+import sys
+
 import numpy as np
-import pyfftw
-import pyfftw.builders
 
 from rotorred import checks
+
+try:  # optional: the spectra fall back to numpy.fft (same values, slower for long records)
+    import pyfftw
+    import pyfftw.builders
+except ImportError:
+    pyfftw = None
+
+#: the one-line note printed (once per process) when pyFFTW is missing
+NO_PYFFTW_NOTE = ("rotorred: pyFFTW is not installed; spectra use numpy.fft "
+                  "(same results; `pip install pyfftw` for the faster FFT)")
+_NOTED = []
 
 __all__ = [
     "WINDOWS",
@@ -153,8 +166,34 @@ def _window_info(name: str) -> WindowInfo:
 
 
 # --------------------------------------------------------------------------- FFT plans
+class NumpyPlan:
+    """The interface of a ``pyfftw.FFTW`` rfft plan (``input_array``, ``output_array``, ``execute()``)
+    computed with :func:`numpy.fft.rfft`: used when pyFFTW is not installed."""
+
+    def __init__(self, n: int, dtype):
+        self.input_array = np.zeros(n, dtype=dtype)
+        ctype = np.complex64 if np.dtype(dtype) == np.float32 else np.complex128
+        self.output_array = np.zeros(n // 2 + 1, dtype=ctype)
+
+    def execute(self):
+        self.output_array[:] = np.fft.rfft(self.input_array)
+
+    __call__ = execute
+
+
+def _new_plan(n: int, dtype):
+    """A pyFFTW plan, or a :class:`NumpyPlan` with a one-line note on stderr (once) when pyFFTW is missing."""
+    if pyfftw is None:
+        if not _NOTED:
+            _NOTED.append(True)
+            print(NO_PYFFTW_NOTE, file=sys.stderr)
+        return NumpyPlan(n, dtype)
+    a = pyfftw.empty_aligned(int(n), dtype=dtype)
+    return pyfftw.builders.rfft(a, planner_effort="FFTW_ESTIMATE", threads=1, avoid_copy=False)
+
+
 _PLAN_LOCK = threading.Lock()
-_PLANS: dict[tuple[int, str], tuple[pyfftw.FFTW, threading.Lock]] = {}
+_PLANS: dict[tuple[int, str], tuple[object, threading.Lock]] = {}
 _PLAN_STATS = {"hits": 0, "misses": 0}
 
 
@@ -167,7 +206,7 @@ class PlanCacheInfo:
     size: int
 
 
-def rfft_plan(n: int, dtype=np.float64) -> pyfftw.FFTW:
+def rfft_plan(n: int, dtype=np.float64):
     """The cached pyFFTW real-to-complex plan for records of length ``n`` and ``dtype``.
 
     The first call for a ``(n, dtype)`` pair builds the plan (``FFTW_ESTIMATE``, one thread,
@@ -181,14 +220,14 @@ def rfft_plan(n: int, dtype=np.float64) -> pyfftw.FFTW:
 
     Returns
     -------
-    pyfftw.FFTW
+    pyfftw.FFTW (or NumpyPlan without pyFFTW)
         Fill ``plan.input_array``, call ``plan.execute()`` and copy ``plan.output_array``,
         shape (n // 2 + 1,), complex (as :func:`amplitude_spectrum` does).
     """
     return _plan_entry(n, dtype)[0]
 
 
-def _plan_entry(n: int, dtype) -> tuple[pyfftw.FFTW, threading.Lock]:
+def _plan_entry(n: int, dtype) -> tuple[object, threading.Lock]:
     checks.choice("dtype", np.dtype(dtype).name, ("float64", "float32"))
     dtype = np.dtype(dtype)
     checks.integer("n", n, ge=1)
@@ -199,11 +238,7 @@ def _plan_entry(n: int, dtype) -> tuple[pyfftw.FFTW, threading.Lock]:
             _PLAN_STATS["hits"] += 1
             return entry
         _PLAN_STATS["misses"] += 1
-        a = pyfftw.empty_aligned(int(n), dtype=dtype)
-        plan = pyfftw.builders.rfft(
-            a, planner_effort="FFTW_ESTIMATE", threads=1, avoid_copy=False
-        )
-        entry = (plan, threading.Lock())
+        entry = (_new_plan(int(n), dtype), threading.Lock())
         _PLANS[key] = entry
         return entry
 

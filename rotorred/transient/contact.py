@@ -18,11 +18,17 @@ project's single definition)
 * Normal force (Eq. 8, Hunt–Crossley reading of the "nonlinear spring damping model";
   :func:`normal_law`, the one implementation, evaluates the residual generated from
   ``derivations/contact.py``, and the step kernel compiles it):
-  ``P = K_nr delta^1.5 max(0, 1 + c p')`` for ``delta > 0``, else 0. The rate is the
-  approach rate ``p' = -g'`` of the disk towards the plate (the bending deflection is treated
-  as quasi-static, so ``delta'`` is replaced by ``p'``; this keeps the law algebraic in each
-  step). The damping term dissipates ``int K_nr delta^1.5 c p'^2 dt >= 0``; the clamp at 0
-  stops the law from pulling the disk back (no adhesion).
+  ``P = K_nr delta^1.5 max(0, 1 + c p')`` for ``delta > 0``, else 0. The rate is the total
+  approach rate ``p' = -g'`` of the disk towards the plate, not the rate ``delta' = p' - lam P'``
+  of the Hertz deformation printed in Eq. 8 (which would make the law a differential equation
+  for P; this keeps it algebraic in each step). The clamp at 0 stops the law from pulling the
+  disk back (no adhesion).
+* Energy: the contact force's power is ``P p'``; bending stores ``lam P^2 / 2`` and the Hertz
+  contact ``2/5 K_nr delta^2.5`` (:func:`contact_energy`), so the law dissipates
+  ``P p' - d/dt(2/5 K_nr delta^2.5 + lam P^2 / 2) = c K_nr delta^1.5 p' delta'`` (not
+  ``c K_nr delta^1.5 p'^2``, which overstates it by 42 % on 0-0.3 s of ``paper-rub``; locally
+  negative near the turn-round when the plate bends). tests/test_energy.py closes the discrete
+  energy balance of a rub run with it.
 * Friction (Eq. 8, Coulomb with static and dynamic coefficients). The relative tangential
   velocity of the disk's contact point against the plate is
   ``v_rel = Omega r + (x', y') . t - u_t'``: the disk's surface speed (spin about +z,
@@ -266,8 +272,10 @@ def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 
 def contact_energy(P: float, plate: RubPlate) -> float:
     """Elastic energy stored in bending and Hertz contact at the normal force ``P`` (J).
 
-    ``lam P^2 / 2`` (plate bending, linear part of Eqs. 10-11) plus ``2/5 K_nr delta^2.5`` with
-    ``delta = (P / K_nr)^(2/3)`` (the Hertz potential; exact for c = 0).
+    ``lam P^2 / 2`` (plate bending, linear part of Eqs. 10-11; the offset w0 shifts the penetration
+    and stores nothing) plus ``2/5 K_nr delta^2.5`` with ``delta = (P / K_nr)^(2/3)`` (the Hertz
+    potential at the static deformation; with c > 0 the deformation is ``p - w0 - lam P`` instead, see
+    the module docstring for the energy balance).
     """
     if P <= 0.0:
         return 0.0

@@ -21,7 +21,8 @@ One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Ne
    contact force ``f_new``. For Newmark (alpha = 0) the equation of motion holds at every step,
    ``M a = F + B f - D v - K q``, so ``a`` is eliminated from the predictor and
    ``q_lin = P_q q + P_v v + A^-1 F(tb) + Ha M^-1 (F(ta) + B f_old)`` costs two n x n products
-   (``H = [P_q, P_v]``); for HHT-α ``H = [Hq, Hv, Ha]`` acts on (q, v, a) and the old forces enter
+   (``H = [P_q, P_v]``; for average acceleration ``Ha M^-1 = A^-1`` and ``H = [I - 2 A^-1 K, (4/h) A^-1 M]``,
+   formed without ``M^-1``: :func:`rotorred.transient.matrices.level_matrices`); for HHT-α ``H = [Hq, Hv, Ha]`` acts on (q, v, a) and the old forces enter
    with ``-alpha A^-1``. The external forces are constants or sinusoids, so their values at ``ta``
    are a rotation of those at ``tb`` by the fixed step: both terms are folded into one set of
    vectors ``UF`` (per step size), evaluated with cos and sin at ``tb`` only.
@@ -128,7 +129,8 @@ class Levels(NamedTuple):
     ST : ndarray, shape (L, m, n)
         ``(A^-1 B)^T``: displacement per unit new contact force (m/N), m = 2 n_p.
     S0T : ndarray, shape (L, m, n)
-        The same for the previous step's contact force (``(Ha M^-1 B)^T`` or ``-alpha (A^-1 B)^T``) (m/N).
+        The same for the previous step's contact force (``(Ha M^-1 B)^T``, which is ``(A^-1 B)^T`` for average
+        acceleration, or ``-alpha (A^-1 B)^T``) (m/N).
     W : ndarray, shape (L, m, m)
         ``(1 + alpha) B^T A^-1 B``: contact-DOF displacement per unit contact force (m/N).
     Jp, Jv : ndarray, shape (L, n_p, m)

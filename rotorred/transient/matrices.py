@@ -251,11 +251,38 @@ def level_matrices(M, D, K, B, forces: ForceColumns, h: float, gamma: float, bet
     """Step matrices of the rotor for one step size ``h`` (the arrays of :class:`~rotorred.transient.kernel.Levels`
     without the plates' ones): ``H``, ``UF``, ``ST``, ``S0T``, ``W`` and ``coef``.
 
-    ``lu_M`` is the LU factorisation of ``M`` (Newmark eliminates the acceleration with it).
+    ``lu_M`` is the LU factorisation of ``M`` (Newmark with ``gamma != 2 beta`` eliminates the acceleration
+    with it).
+
+    Newmark (alpha = 0) eliminates the acceleration through the equation of motion,
+    ``M a = F + B f - D v - K q``, which holds after every step. When ``c5 = h (1 - gamma / (2 beta))``
+    is zero (``gamma = 2 beta``: average acceleration) ``Ha = c2 A^-1 M``, so ``Ha M^-1 = c2 A^-1`` and
+    the predictor needs no ``M^-1``:
+
+        A q1 = F1 + B f1 + c2 (F0 + B f0) + (c0 M + c3 D - c2 K) q0 + (c1 M - (c4 + c2) D) v0,
+
+    for gamma = 1/2, beta = 1/4 (c2 = 1, c4 = -1): ``H = [I - 2 A^-1 K, (4/h) A^-1 M]``, evaluated as
+    ``[I - 2 A^-1 K, h (I - A^-1 (c3 D + K))]`` (identity minus small terms). Forming
+    ``Hq - Ha M^-1 K`` through ``M^-1`` instead cancels digits: with cond(M) ~ 2e6 (a Craig–Bampton
+    model) the round-off of that difference dominates the error below dt ~ 2.5e-6 s
+    (tests/test_roundoff.py).
     """
     Ainv, Hq, Hv, Ha = step_matrices(M, D, K, h, gamma, beta, alpha)
     S = Ainv @ B
-    if alpha == 0.0:
+    c = newmark_coefficients(h, gamma, beta)
+    if alpha == 0.0 and c[5] == 0.0:
+        # closed form without M^-1 (gamma = 2 beta): Ha M^-1 = c2 A^-1
+        # with c0 M = A - c3 D - K, written as identity minus small terms (a solve of A against a
+        # matrix close to A would leave ~cond(A) eps on the identity part)
+        lu_A = sla.lu_factor(c[0] * M + c[3] * D + K, check_finite=False)
+        AiK, AiD = sla.lu_solve(lu_A, K, check_finite=False), sla.lu_solve(lu_A, D, check_finite=False)
+        eye = np.eye(len(M))
+        Hq = eye - (1.0 + c[2]) * AiK
+        Hv = (c[1] / c[0]) * (eye - c[3] * AiD - AiK) - (c[4] + c[2]) * AiD
+        H = np.hstack([Hq, Hv])
+        U1, U0 = Ainv @ forces.F, c[2] * (Ainv @ forces.F)
+        S0T = c[2] * S.T
+    elif alpha == 0.0:
         # a = M^-1 (F + B f - D v - K q) holds at every step: eliminate it
         HaMinv = sla.lu_solve(lu_M, Ha.T, trans=1, check_finite=False).T  # Ha M^-1
         H = np.hstack([Hq - HaMinv @ K, Hv - HaMinv @ D])

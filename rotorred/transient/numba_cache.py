@@ -17,7 +17,9 @@ left to numba's own locators.
 
 Where the cache lives, first that works: ``NUMBA_CACHE_DIR`` if set; the ``__pycache__`` next to
 the source (numba's default); numba's user-wide cache directory (a read-only install); a
-``rotorred-numba-<uid>`` directory under the system's temporary directory.
+``rotorred-numba-<uid>`` directory under the system's temporary directory, announced by one line on
+stderr (once per process). A valid cache in a read-only package's ``__pycache__`` is not read (numba
+uses a cache folder only where it can write): such an install compiles once per user.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -66,14 +69,31 @@ def source_digest(package: Path = PACKAGE) -> str:
     return _digest_of(str(package), tuple(_stamp(p, package) for p in source_files(package)))
 
 
+#: whether the fallback to the temporary directory has been announced in this process
+_ANNOUNCED = []
+
+
+def temp_cache_root() -> str:
+    """The last-resort cache folder: ``rotorred-numba-<uid>`` under the system's temporary directory."""
+    user = str(os.getuid()) if hasattr(os, "getuid") else "user"
+    return os.path.join(tempfile.gettempdir(), f"rotorred-numba-{user}")
+
+
 class _TempDirLocator(caching.UserWideCacheLocator):
-    """Last resort: a per-user directory under the system's temporary directory."""
+    """Last resort: a per-user directory under the system's temporary directory (announced once on stderr)."""
 
     def __init__(self, py_func, py_file):
         super().__init__(py_func, py_file)
-        user = str(os.getuid()) if hasattr(os, "getuid") else "user"
-        self._cache_path = os.path.join(tempfile.gettempdir(), f"rotorred-numba-{user}",
-                                        self.get_suitable_cache_subpath(py_file))
+        self._cache_path = os.path.join(temp_cache_root(), self.get_suitable_cache_subpath(py_file))
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        self = super().from_function(py_func, py_file)
+        if self is not None and not _ANNOUNCED:
+            _ANNOUNCED.append(True)
+            print(f"rotorred: the package folder and numba's user cache are not writable; compiled kernels are "
+                  f"cached in {temp_cache_root()} (set NUMBA_CACHE_DIR to choose)", file=sys.stderr)
+        return self
 
 
 #: where the cache of a rotorred function may live, in order of preference

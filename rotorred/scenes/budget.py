@@ -1,0 +1,137 @@
+"""Size estimates checked before computing: steps, record and model size against the machine and stated limits.
+
+A run whose estimate exceeds a limit is refused with an :class:`rotorred.checks.InputError`
+that states the estimate; the commands' ``--force`` lets the user go on. The limits:
+
+* :data:`MAX_STEPS` time steps (about 100 s at 1 µs per step, the built-in scenes' reduced model);
+* :data:`MAX_DOFS` degrees of freedom of the finite-element model (dense eigen-solves and solves);
+* the memory the run needs (record, its copies for the files, the CSV text, the dense model
+  matrices) at most :data:`MEMORY_FRACTION` of the memory the machine has available
+  (``MemAvailable`` of ``/proc/meminfo``, else ``os.sysconf``).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+from rotorred import checks
+
+__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "check", "MAX_STEPS", "MAX_DOFS",
+           "MEMORY_FRACTION", "format_bytes"]
+
+MAX_STEPS = 100_000_000
+MAX_DOFS = 20_000
+MEMORY_FRACTION = 0.5
+#: bytes of one CSV value as written (9 significant digits, sign, exponent, separator)
+_CSV_BYTES = 17
+#: dense n x n float matrices held at once by the linear analyses (M, K, C, G per spool, factors, state space)
+_DENSE_MATRICES = 24
+
+
+def format_bytes(n: float) -> str:
+    """``1.5 GiB``-style size."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if abs(n) < 1024 or unit == "TiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024.0
+    return f"{n:.3g} TiB"
+
+
+def available_memory() -> int:
+    """Memory available to a new computation (bytes): ``MemAvailable``, else free physical pages."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return 1 << 62
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """What a run will need.
+
+    Attributes
+    ----------
+    steps : int
+        Time steps.
+    samples : int
+        Recorded samples.
+    record_bytes : int
+        Memory of the record and its copies for the files, and the CSV text (bytes).
+    n_dof : int
+        Degrees of freedom of the finite-element model.
+    model_bytes : int
+        Memory of the dense model matrices (bytes).
+    fields : dict of str to (str, object)
+        The key or option (and its value) a message names for each limit: ``"steps"``,
+        ``"memory"``, ``"dofs"`` (e.g. ``("solver.duration", 1e6)``).
+    """
+
+    steps: int
+    samples: int
+    record_bytes: int
+    n_dof: int
+    model_bytes: int
+    fields: dict
+
+    def describe(self) -> str:
+        parts = [f"{self.steps:.3g} steps" if self.steps else "",
+                 f"{self.samples:.3g} recorded samples ({format_bytes(self.record_bytes)})" if self.samples else "",
+                 f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
+        return "estimate: " + ", ".join(p for p in parts if p)
+
+
+def model_estimate(rotor) -> tuple[int, int]:
+    """(DOFs, bytes of the dense matrices) of ``rotor``'s finite-element model (4 DOFs per node)."""
+    n = 4 * len(rotor.nodes) + 4 * sum(1 for e in _elements(rotor) if getattr(e, "element", "") == "hierarchical")
+    return n, _DENSE_MATRICES * 8 * n * n
+
+
+def _elements(rotor):
+    for spool in getattr(rotor, "spools", ()):
+        yield from getattr(spool, "elements", ())
+
+
+def scene_estimate(scene) -> Estimate:
+    """Steps, record and model size of a scene's run (the run and its no-rub comparison)."""
+    s = scene.solver
+    transient = not (scene.is_linear and s.start == "settled")
+    steps = int(round(s.duration / s.dt)) if transient else 0
+    samples = int(round((s.duration - s.record_start) / s.dt)) + 1
+    cases = 2 if scene.plates and scene.output.compare_normal else 1
+    columns = 1 + cases * len(scene.output.dofs) + 8 * len(scene.plates)
+    record = samples * columns * (8 * 4 + _CSV_BYTES)  # record, result, NPZ/.mat copies; CSV text
+    n_dof, model_bytes = model_estimate(scene.rotor)
+    model = ("rotor", scene.rotor_source)
+    fields = {"steps": ("solver.duration", s.duration), "dofs": model,
+              "memory": ("solver.record_start", s.record_start) if record >= model_bytes else model}
+    return Estimate(steps, samples, record, n_dof, model_bytes, fields)
+
+
+def check(estimate: Estimate, force: bool = False, memory: int | None = None) -> Estimate:
+    """Refuse an estimate beyond :data:`MAX_STEPS`, :data:`MAX_DOFS` or the available memory (unless ``force``)."""
+    if force:
+        return estimate
+    memory = available_memory() if memory is None else memory
+    need = estimate.record_bytes + estimate.model_bytes
+    reasons = {}
+    if need > MEMORY_FRACTION * memory:
+        reasons["memory"] = (f"{format_bytes(need)} of memory, more than {MEMORY_FRACTION:g} x the "
+                             f"{format_bytes(memory)} available")
+    if estimate.n_dof > MAX_DOFS:
+        reasons["dofs"] = f"more than {MAX_DOFS} DOFs"
+    if estimate.steps > MAX_STEPS:
+        reasons["steps"] = f"more than {MAX_STEPS:.3g} steps"
+    if reasons:
+        field, value = estimate.fields[list(reasons)[-1]]
+        checks.fail(field, value,
+                    f"gives a run beyond the limits ({estimate.describe()}: {'; '.join(reasons.values())}); "
+                    f"use --force to go on")
+    return estimate

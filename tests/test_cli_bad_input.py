@@ -1,0 +1,162 @@
+"""Bad input through the command line: exit status 2, one message naming the key, the value and what is
+allowed, no traceback, no file written, nothing computed (every case is refused in well under a second).
+
+Each case is (argv, tokens): ``argv`` may name the inputs made by the ``inputs`` fixture as ``{d}/<file>``,
+and every token must appear in the one-line message. The rotor files are the seed rig and the scene files
+``paper-rub`` with one line changed (``R`` and ``S`` below); ``{ro}`` is a folder that cannot be written.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from importlib import resources
+from pathlib import Path
+
+import pytest
+
+from rotorred.cli import main
+
+#: words of a message that says what is allowed
+ALLOWED = re.compile(r"must|allowed|required|missing|--force|neither|unknown|expected|invalid", re.I)
+
+#: rotor files: name -> (text to replace in seed-rig.toml, replacement)
+R = {
+    "E_neg": ("E = 2.1e11", "E = -5.0"), "rho_zero": ("rho = 7850.0", "rho = 0.0"), "nu": ("nu = 0.3", "nu = 0.7"),
+    "mat_key": ("nu = 0.3", "nu = 0.3\nfoo = 1"), "D_i": ("D_i = 0.040", "D_i = 0.07"),
+    "L_neg": ("L = 0.08", "L = -0.08"), "repeat0": ("repeat = 12", "repeat = 0"),
+    "brass": ('material = "steel", repeat = 6', 'material = "brass", repeat = 6'),
+    "first_node": ("first_node = 1", "first_node = -1"), "disk_node": ("node = 3", "node = 99"),
+    "thickness": ("thickness = 0.015", "thickness = -0.015"), "k_neg": ("k = 2.0e7", "k = -1.0"),
+    "rpm_str": ("speed_rpm = 4200.0", 'speed_rpm = "fast"'),
+    "shear": ('name = "inner"', 'name = "inner"\nshear = "bogus"'),
+    "huge": ("repeat = 6 }", "repeat = 100000 }"),
+}
+#: scene files: name -> (text to replace in paper-rub.toml, replacement)
+S = {
+    "clearance": ("clearance = 13e-6", "clearance = -5e-06"), "section": ('name = "paper-rub"', 'name = "x"\n[foo]\nbar = 1'),
+    "dt0": ("dt = 2e-5 ", "dt = 0.0 "), "rec": ("record_start = 2.0", "record_start = 3.5"),
+    "model": ('model = "reduced"', 'model = "half"'), "out_node": ("nodes = [13, 14, 18]", "nodes = [13, 14, 99]"),
+    "table": ('table = "14:y"', 'table = "14:q"'), "unb_node": ("node = 11", "node = 99"),
+    "speed": ("inner = 70.0", "inner = -70.0"), "mu": ("mu_s = 0.2 ", 'mu_s = "x" '),
+    "K_nr": ("K_nr = 5e10", "K_nr = -5.0"), "preset": ('preset = "seed-rig"', 'preset = "nope"'),
+    "formats": ('formats = ["npz", "csv", "mat"]', 'formats = ["xls"]'),
+    "plots": ('plots = ["waveforms", "spectra", "orbits"]', 'plots = ["movie"]'),
+    "threshold": ("line_threshold = 0.005", "line_threshold = 2.0"),
+    "window": ("plot_window = [2.44, 2.58]", "plot_window = [5.0, 6.0]"), "modes": ("modes = 24 ", "modes = -3 "),
+}
+
+CASES = [
+    # ---- rotor files (through campbell and harmonic)
+    *[(["campbell", f"{{d}}/r_{k}.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], [f"r_{k}.toml", new.split("\n")[-1]
+      .split(" = ")[0].split(",")[-1].strip(" {"), new.split(" = ")[-1].split(",")[0].strip('"} ')])
+      for k, (old, new) in R.items() if k not in ("huge", "brass")],
+    (["campbell", "{d}/r_brass.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material", "brass"]),
+    (["campbell", "{d}/r_huge.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["ROTOR", "DOFs", "--force"]),
+    (["harmonic", "{d}/r_k_neg.toml", "--out", "{d}/o"], ["r_k_neg.toml", "k", "-1.0"]),
+    (["campbell", "{d}/missing.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["missing.toml"]),
+    # ---- scene files (through run, and one through sweep and harmonic)
+    *[(["run", f"{{d}}/s_{k}.toml", "--out", "{d}/o"], [f"s_{k}.toml", new.split("\n")[-1].split(" = ")[0],
+                                                        new.split("\n")[-1].split(" = ")[-1].strip('[]" ').split(",")[-1].strip('" ')])
+      for k, (old, new) in S.items()],
+    (["sweep", "{d}/s_clearance.toml", "--set", "rub.clearance=1e-6,-2e-6", "--out", "{d}/o"], ["rub[0].clearance"]),
+    (["harmonic", "{d}/s_unb_node.toml", "--out", "{d}/o"], ["unbalance[0].node", "99"]),
+    (["run", "{d}/missing.toml", "--out", "{d}/o"], ["missing.toml"]),
+    (["run", "nosuch-scene", "--out", "{d}/o"], ["nosuch-scene"]),
+    # ---- --set
+    (["run", "paper-rub", "--set", "rub.clearance", "--out", "{d}/o"], ["--set", "rub.clearance"]),
+    (["run", "paper-rub", "--set", "rub.foo=1", "--out", "{d}/o"], ["foo", "1"]),
+    (["run", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--out", "{d}/o"], ["--set", "rub.clearance=1e-6,2e-6"]),
+    (["run", "paper-rub", "--set", "solver.dt=-1e-5", "--out", "{d}/o"], ["solver.dt", "-1e-05"]),
+    # ---- absurd sizes: refused with the estimate, before anything is computed
+    (["run", "paper-rub", "--set", "solver.duration=1e6", "--out", "{d}/o"], ["solver.duration", "1000000.0", "steps",
+                                                                             "--force"]),
+    (["run", "paper-rub", "--set", "solver.dt=1e-12", "--out", "{d}/o"], ["solver.duration", "steps", "--force"]),
+    (["run", "paper-normal", "--set", "solver.duration=1e6", "--out", "{d}/o"], ["solver.record_start", "memory"]),
+    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.duration=1e6", "--out", "{d}/o"],
+     ["solver.duration", "steps"]),
+    (["campbell", "seed-rig", "--speeds", "0:1000:1000000000", "--out", "{d}/o"], ["--speeds", "COUNT"]),
+    # ---- campbell options
+    (["campbell", "seed-rig", "--speeds", "0:12000", "--out", "{d}/o"], ["--speeds", "0:12000"]),
+    (["campbell", "seed-rig", "--speeds=-100:100:5", "--out", "{d}/o"], ["--speeds", "-100:100:5", "rpm"]),
+    (["campbell", "seed-rig", "--speeds", "5,3", "--out", "{d}/o"], ["--speeds", "5,3", "increasing"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--modes", "0", "--out", "{d}/o"], ["--modes", "0"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--harmonics", "0", "--out", "{d}/o"], ["--harmonics", "0"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--harmonics", "x", "--out", "{d}/o"], ["--harmonics", "x"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--ratio", "-1", "--out", "{d}/o"], ["--ratio", "-1"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--reference", "mid", "--out", "{d}/o"], ["--reference", "mid"]),
+    # ---- harmonic options (all checked before the sweep: reliability.md section 8)
+    (["harmonic", "seed-rig", "--speeds=-100:100:5", "--out", "{d}/o"], ["--speeds", "-100:100:5", "rpm"]),
+    (["harmonic", "seed-rig", "--reduced", "--cutoff=-1", "--out", "{d}/o"], ["--cutoff", "-1", "Hz"]),
+    (["harmonic", "seed-rig", "--modes", "-1", "--reduced", "--out", "{d}/o"], ["--modes", "-1"]),
+    (["harmonic", "seed-rig", "--unbalance", "99:1e-5", "--out", "{d}/o"], ["--unbalance", "99"]),
+    (["harmonic", "seed-rig", "--unbalance", "11", "--out", "{d}/o"], ["--unbalance", "11"]),
+    (["harmonic", "seed-rig", "--outputs", "99:x", "--out", "{d}/o"], ["--outputs", "99"]),
+    (["harmonic", "seed-rig", "--outputs", "13:q", "--out", "{d}/o"], ["--outputs", "13:q"]),
+    (["harmonic", "seed-rig", "--frf", "18:x", "--out", "{d}/o"], ["--frf", "18:x"]),
+    (["harmonic", "seed-rig", "--frf", "18:x>99:x", "--out", "{d}/o"], ["--frf", "99"]),
+    (["harmonic", "seed-rig", "--frf", "18:x>13:x", "--frequencies", "0:500", "--out", "{d}/o"],
+     ["--frequencies", "0:500"]),
+    (["harmonic", "seed-rig", "--frf", "18:x>13:x", "--frequencies=-5:5:3", "--out", "{d}/o"],
+     ["--frequencies", "-5:5:3", "Hz"]),
+    (["harmonic", "seed-rig", "--ratio", "abc", "--out", "{d}/o"], ["--ratio", "abc"]),
+    (["harmonic", "seed-rig", "--reference-spool", "mid", "--out", "{d}/o"], ["--reference-spool", "mid"]),
+    (["harmonic", "seed-rig", "--reduced", "--boundary-nodes", "99", "--out", "{d}/o"], ["--boundary-nodes", "99"]),
+    # ---- sweep options
+    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--dof", "99:y", "--out", "{d}/o"], ["--dof", "99"]),
+    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--dof", "13:tx", "--out", "{d}/o"], ["--dof", "13:tx"]),
+    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.dt=1e-5,2e-5", "--out", "{d}/o"],
+     ["--set", "solver.dt=1e-5,2e-5"]),
+    (["sweep", "paper-rub", "--set", "rub.clearance=1:2:1", "--out", "{d}/o"], ["--set rub.clearance", "1:2:1"]),
+    # ---- --out problems, in every command: an existing file, below a file, empty, not writable
+    *[([*cmd, "--out", out], ["--out", token]) for cmd in (["run", "paper-rub"],
+                                                          ["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6"],
+                                                          ["campbell", "seed-rig", "--speeds", "0:6000:3"],
+                                                          ["harmonic", "seed-rig"])
+      for out, token in (("{d}/afile", "afile"), ("{d}/afile/sub", "afile"), ("", "''"), ("{ro}/sub", "ro"))],
+]
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory) -> Path:
+    """The bad rotor and scene files, a file ``afile`` and a read-only folder ``ro``."""
+    d = tmp_path_factory.mktemp("inputs")
+    rig = resources.files("rotorred.model.presets").joinpath("seed-rig.toml").read_text()
+    rub = resources.files("rotorred.scenes.builtin").joinpath("paper-rub.toml").read_text()
+    for prefix, base, table in (("r", rig, R), ("s", rub, S)):
+        for name, (old, new) in table.items():
+            assert old in base, (name, old)
+            (d / f"{prefix}_{name}.toml").write_text(base.replace(old, new, 1))
+    (d / "afile").write_text("not a folder")
+    (d / "ro").mkdir()
+    os.chmod(d / "ro", 0o555)
+    return d
+
+
+def _files(root: Path) -> set:
+    return {(str(p), p.stat().st_mtime_ns) for p in root.rglob("*")}
+
+
+@pytest.mark.parametrize("argv, tokens", CASES, ids=[f"{i:02d}-{c[0][0]}-{c[1][0]}" for i, c in enumerate(CASES)])
+def test_bad_input_is_refused_cleanly(argv, tokens, inputs, tmp_path, monkeypatch, capsys):
+    ro = str(inputs / "ro")
+    if os.geteuid() == 0:  # root writes anywhere: make the folder look read-only to the check
+        real = os.access
+        monkeypatch.setattr(os, "access", lambda p, mode, *a, **k: False if str(p) == ro else real(p, mode, *a, **k))
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)  # a default output folder would land here
+    argv = [a.format(d=inputs, ro=ro) for a in argv]
+    before = _files(inputs) | _files(work)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert err.startswith(f"rotorred {argv[0]}: error: "), err
+    for token in tokens:
+        assert token in err, (token, err)
+    assert ALLOWED.search(err), err
+    assert _files(inputs) | _files(work) == before, "files written"
+
+
+def test_there_are_at_least_60_kinds():
+    assert len(CASES) >= 60

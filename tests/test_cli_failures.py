@@ -1,0 +1,157 @@
+"""Failures during a run: divergence keeps its results, interrupts leave no traceback and no mixed folder,
+two runs into one ``--out`` stay consistent (reliability.md sections 1, 2 and 4)."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rotorred.cli import main
+
+#: paper-rub near a critical speed, from rest, with 4 kg m on the rub disk and the plate out of reach:
+#: the disk passes 1 m (the transient's divergence limit) at t = 0.3486 s (reliability.md section 2)
+DIVERGE = ["--set", "solver.start=rest", "--set", "rub.clearance=1.0", "--set", "speeds.inner=42.94111111111111",
+           "--set", "speeds.outer=55.21", "--set", "solver.duration=0.5", "--set", "solver.record_start=0.1",
+           "--set", "output.plot_window=[0.1, 0.2]", "--set", "output.formats=[\"npz\", \"csv\"]"]
+#: a short rub scene (0.3 s), no figures: the earlier result of the interrupt tests
+SHORT = ["--set", "solver.duration=0.3", "--set", "solver.record_start=0.1", "--set", "output.plot_window=[0.1, 0.2]",
+         "--set", "output.plots=[]", "--set", "output.formats=[\"npz\", \"csv\"]"]
+
+
+def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
+    out = tmp_path / "div"
+    assert main(["run", "paper-rub", "--out", str(out), "--set", "unbalance[1].m_e=4.0", *DIVERGE]) == 3
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1
+    # when, where and why, in scene key names
+    assert "t = 0.3486 s" in err and "rub[0] (node 18, x)" in err and "exceeded 1 m" in err
+    assert "displacement_limit" not in err and "INCOMPLETE" in err
+    assert "the transient diverged" in (out / "INCOMPLETE").read_text()
+    summary = (out / "summary.txt").read_text()
+    assert summary.startswith("INCOMPLETE: the transient diverged at t = 0.3486 s")
+    assert "WARNING: node 18 orbits" in summary  # the response left the small-displacement range
+    npz = np.load(out / "result.npz")
+    assert 0.34 < npz["t"][-1] < 0.3486 and np.all(np.isfinite(npz["rub_18_x"]))
+    assert len((out / "timeseries.csv").read_text().splitlines()) == len(npz["t"]) + 1
+    assert sorted((out / ".rotorred-files").read_text().split()) == sorted(
+        ["INCOMPLETE", "result.npz", "summary.txt", "timeseries.csv"])
+
+
+def test_diverging_sweep_point_is_recorded_and_the_others_kept(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    assert main(["sweep", "paper-rub", "--set", "unbalance[1].m_e=1e-3,4.0", *DIVERGE, "--out", str(out)]) == 3
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err and "1 of 2 values failed" in captured.err
+    rows = (out / "sweep.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[1].endswith(",ok")
+    assert "failed: the transient diverged at t = 0.3486 s at rub[0] (node 18, x)" in rows[2]
+    assert float(rows[1].split(",")[4]) > 0 and rows[2].split(",")[4] == "nan"
+    assert "FAILED: the transient diverged" in (out / "sweep.txt").read_text()
+    assert (out / "sweep.png").exists()
+
+
+# --------------------------------------------------------------------------- interrupts and concurrency
+def _rotorred(*args, **kw) -> subprocess.Popen:
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    return subprocess.Popen([sys.executable, "-c", "import sys; from rotorred.cli import main; sys.exit(main())", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, **kw)
+
+
+def _snapshot(folder: Path) -> dict:
+    """Every entry of the folder (hidden ones too) with the hash of its bytes."""
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+
+
+@pytest.fixture(scope="module")
+def earlier(tmp_path_factory) -> Path:
+    """A folder holding a complete earlier result (clearance 13 um)."""
+    out = tmp_path_factory.mktemp("earlier") / "out"
+    assert main(["run", "paper-rub", "--out", str(out), "--no-normal", *SHORT]) == 0
+    return out
+
+
+def _wait_for(condition, proc, timeout=60.0) -> None:
+    t0 = time.monotonic()
+    while not condition():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - t0 < timeout
+        time.sleep(0.005)
+
+
+@pytest.mark.parametrize("when, sig, status", [("solving", signal.SIGINT, 130), ("writing", signal.SIGINT, 130),
+                                               ("writing", signal.SIGTERM, 143)])
+def test_interrupt_leaves_the_earlier_result(earlier, tmp_path, when, sig, status):
+    out = tmp_path / "out"
+    os.system(f"cp -a {earlier} {out}")
+    before = _snapshot(out)
+    if when == "solving":  # 60 s simulated at dt = 1e-6: interrupted once the kernel's progress bar shows
+        proc = _rotorred("run", "paper-rub", "--out", str(out), *SHORT, "--set", "solver.duration=60",
+                         "--set", "solver.dt=1e-6", "--set", "solver.record_start=59.7",
+                         "--set", "output.plot_window=[59.7, 59.8]")
+        line = ""
+        while "rotorred transient" not in line:
+            ch = proc.stderr.read(1)
+            assert ch, (line, proc.communicate())
+            line += ch
+    else:  # a 1.5 s record (75 001 samples): interrupted once the first file is staged, while the CSVs are written
+        proc = _rotorred("run", "paper-rub", "--out", str(out), *SHORT, "--set", "rub.clearance=20e-6",
+                         "--set", "solver.duration=1.5")
+        _wait_for(lambda: any(p.is_dir() and any(p.iterdir()) for p in out.glob(".rotorred-staging-*")), proc)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == status, err
+    assert "Traceback" not in err and "earlier result" in err
+    assert _snapshot(out) == before  # the complete earlier result, no staging folder, no lock, nothing new
+
+
+def test_two_runs_into_one_folder(tmp_path):
+    """Both start at once with different clearances: the second refuses (the lock) or waits its turn;
+    whatever ran leaves a consistent folder (summary, NPZ and CSV of one run)."""
+    out = tmp_path / "same"
+    procs = [_rotorred("run", "paper-rub", "--out", str(out), *SHORT, "--set", f"rub.clearance={c}")
+             for c in ("13e-6", "20e-6")]
+    results = [(p.wait(timeout=120), p.communicate()[1]) for p in procs]
+    assert sorted(r[0] for r in results)[0] == 0 and {r[0] for r in results} <= {0, 4}, results
+    for code, err in results:
+        assert "Traceback" not in err
+        if code == 4:
+            assert "another rotorred run" in err and "choose another --out" in err
+    summary = (out / "summary.txt").read_text()
+    npz = np.load(out / "result.npz")
+    force = float(summary.split("max normal force ")[1].split()[0])
+    assert force == pytest.approx(npz["plate0_normal_force"].max(), rel=1e-3)
+    widths = {len(row.split(",")) for row in (out / "timeseries.csv").read_text().splitlines()}
+    assert len(widths) == 1 and len(npz["t"]) == len((out / "timeseries.csv").read_text().splitlines()) - 1
+    assert not list(out.glob(".rotorred-staging-*")) and not (out / ".rotorred.lock").exists()
+
+
+# --------------------------------------------------------------------------- internal errors, missing libraries
+def test_internal_error_says_so_and_logs_the_traceback(tmp_path, monkeypatch, capsys):
+    import rotorred.cli.campbell as command
+
+    def broken(args):
+        raise ZeroDivisionError("a bug")
+    monkeypatch.setattr(command, "run", broken)
+    out = tmp_path / "o"
+    assert main(["campbell", "seed-rig", "--speeds", "0:6000:3", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "internal error (ZeroDivisionError: a bug)" in err
+    assert str(out / "rotorred-error.log") in err
+    assert "Traceback" in (out / "rotorred-error.log").read_text()
+
+
+def test_missing_optional_library_names_its_install_command(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # import matplotlib now raises ModuleNotFoundError
+    monkeypatch.delitem(sys.modules, "rotorred.plots.campbell", raising=False)
+    assert main(["campbell", "seed-rig", "--speeds", "0:6000:3", "--out", str(tmp_path / "o")]) == 4
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and "'matplotlib'" in err and "pip install matplotlib" in err
+    assert not (tmp_path / "o").exists()  # the folder this run created is removed again
