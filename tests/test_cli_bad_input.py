@@ -31,6 +31,7 @@ R = {
     "rpm_str": ("speed_rpm = 4200.0", 'speed_rpm = "fast"'),
     "shear": ('name = "inner"', 'name = "inner"\nshear = "bogus"'),
     "huge": ("repeat = 6 }", "repeat = 100000 }"),
+    "E_huge": ("E = 2.1e11", "E = 1e300"), "rho_tiny": ("rho = 7850.0", "rho = 1e-300"),
 }
 #: scene files: name -> (text to replace in paper-rub.toml, replacement)
 S = {
@@ -50,11 +51,17 @@ CASES = [
     # ---- rotor files (through campbell and harmonic)
     *[(["campbell", f"{{d}}/r_{k}.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], [f"r_{k}.toml", new.split("\n")[-1]
       .split(" = ")[0].split(",")[-1].strip(" {"), new.split(" = ")[-1].split(",")[0].strip('"} ')])
-      for k, (old, new) in R.items() if k not in ("huge", "brass")],
+      for k, (old, new) in R.items() if k not in ("huge", "brass", "E_huge", "rho_tiny")],
+    (["campbell", "{d}/r_E_huge.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material[0].E", "1e+300", "1e+18"]),
+    (["campbell", "{d}/r_rho_tiny.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material[0].rho", "1e-300"]),
     (["campbell", "{d}/r_brass.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material", "brass"]),
     (["campbell", "{d}/r_huge.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["ROTOR", "DOFs", "--force"]),
     (["harmonic", "{d}/r_k_neg.toml", "--out", "{d}/o"], ["r_k_neg.toml", "k", "-1.0"]),
     (["campbell", "{d}/missing.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["missing.toml"]),
+    # a binary or Latin-1 file, and a key given twice (reliability findings, section 9)
+    (["campbell", "{d}/binary.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["binary.toml", "UTF-8"]),
+    (["run", "{d}/latin1.toml", "--out", "{d}/o"], ["latin1.toml", "UTF-8"]),
+    (["run", "{d}/twice.toml", "--out", "{d}/o"], ["twice.toml", "name", "given once", "line 2"]),
     # ---- scene files (through run, and one through sweep and harmonic)
     *[(["run", f"{{d}}/s_{k}.toml", "--out", "{d}/o"], [f"s_{k}.toml", new.split("\n")[-1].split(" = ")[0],
                                                         new.split("\n")[-1].split(" = ")[-1].strip('[]" ').split(",")[-1].strip('" ')])
@@ -128,6 +135,9 @@ def inputs(tmp_path_factory) -> Path:
             assert old in base, (name, old)
             (d / f"{prefix}_{name}.toml").write_text(base.replace(old, new, 1))
     (d / "afile").write_text("not a folder")
+    (d / "binary.toml").write_bytes(b"\x89PNG\r\n\x1a\n")
+    (d / "latin1.toml").write_bytes('name = "r\u00e9sum\u00e9"\n[rotor]\npreset = "seed-rig"\n'.encode("latin-1"))
+    (d / "twice.toml").write_text('name = "a"\nname = "b"\n[rotor]\npreset = "seed-rig"\n')
     (d / "ro").mkdir()
     os.chmod(d / "ro", 0o555)
     return d

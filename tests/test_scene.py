@@ -253,7 +253,7 @@ def test_an_error_in_the_scene_rotor_file_names_that_file(tmp_path):
     (tmp_path / "s.toml").write_text('[rotor]\nfile = "rig.toml"\n[[unbalance]]\nnode = 11\nm_e = 1e-4\n')
     with pytest.raises(SceneError) as info:
         load_scene(tmp_path / "s.toml")
-    assert str(info.value) == f"{tmp_path / 'rig.toml'}: material[0].rho = -7850.0: must be > 0 (kg/m^3)"
+    assert str(info.value) == f"{tmp_path / 'rig.toml'}: material[0].rho = -7850.0: must lie in [1e-09, 1e+06] (kg/m^3)"
     assert info.value.source == str(tmp_path / "rig.toml") and info.value.field == "material[0].rho"
 
 

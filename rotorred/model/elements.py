@@ -30,6 +30,14 @@ def _set(obj, name: str, value) -> None:
     object.__setattr__(obj, name, value)
 
 
+#: largest Young's modulus accepted (Pa): a million times steel's, room for the "rigid shaft" idiom
+#: (E = 1000 x steel) while keeping the stiffness matrix far inside double precision
+E_MAX = 1e18
+#: densities accepted (kg/m^3): far above osmium; down to 1e-9 for the "massless shaft" idiom (rho = 1e-6:
+#: a shaft mass 1e-11 of a disk's), below which a shaft's mass is lost in the round-off of a disk's
+RHO_RANGE = (1e-9, 1e6)
+
+
 @dataclass(frozen=True)
 class Material:
     """Isotropic linear-elastic material.
@@ -38,11 +46,20 @@ class Material:
     ----------
     name : str
     E : float
-        Young's modulus (Pa).
+        Young's modulus (Pa), 0 < E <= 1e18 (:data:`E_MAX`).
     rho : float
-        Density (kg/m^3).
+        Density (kg/m^3), 1e-9 <= rho <= 1e6 (:data:`RHO_RANGE`).
     nu : float
         Poisson's ratio (-), -1 < nu < 0.5.
+
+    Notes
+    -----
+    The bounds on ``E`` and ``rho`` are far outside every engineering material (diamond:
+    E = 1.2e12 Pa, and a "rigid" shaft modelled as 1000 x steel; osmium: rho = 22 600 kg/m^3;
+    a "massless" shaft modelled with rho = 1e-6) and keep the element
+    matrices inside double precision: ``E = 1e300`` overflows the stiffness and ``rho = 1e-300``
+    makes the mass matrix singular, which otherwise surfaced as an eigen-solver error far from
+    the key that caused it.
     """
 
     name: str
@@ -52,8 +69,8 @@ class Material:
 
     def __post_init__(self):
         _set(self, "name", checks.string("name", self.name))
-        _set(self, "E", checks.positive("E", self.E, "Pa"))
-        _set(self, "rho", checks.positive("rho", self.rho, "kg/m^3"))
+        _set(self, "E", checks.number("E", self.E, "Pa", gt=0.0, le=E_MAX))
+        _set(self, "rho", checks.number("rho", self.rho, "kg/m^3", ge=RHO_RANGE[0], le=RHO_RANGE[1]))
         _set(self, "nu", checks.number("nu", self.nu, "-", gt=-1.0, lt=0.5))
 
     @property

@@ -99,7 +99,17 @@ def load_rotor(spec: str | Path) -> Rotor:
     path = Path(spec)
     if not path.exists():
         raise FileNotFoundError(f"rotor {spec_str!r} is neither a preset ({', '.join(presets())}) nor an existing file")
-    return rotor_from_toml(path.read_text(), source=str(path))
+    return rotor_from_toml(read_text_file(path, RotorFileError), source=str(path))
+
+
+def read_text_file(path: Path, error: type[InputError] = InputError) -> str:
+    """The text of a TOML file; a file that is not UTF-8 text (a binary or Latin-1 file) is an ``error`` naming it."""
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(str(path), data[exc.start:exc.start + 1],
+                    f"must be a UTF-8 text (TOML) file; byte {exc.start} is not UTF-8") from None
 
 
 def read_toml(text: str, error: type[InputError] = InputError) -> dict[str, Any]:
@@ -114,6 +124,10 @@ def read_toml(text: str, error: type[InputError] = InputError) -> dict[str, Any]
         line, column = int(at.group(1)), int(at.group(2))
         lines = text.splitlines()
         value = lines[line - 1] if 0 < line <= len(lines) else ""
+        key = value.split("=", 1)[0].strip() if "=" in value else ""
+        if reason.startswith("Cannot overwrite a value") and key:
+            raise error(key, value.split("=", 1)[1].strip(), f"must be given once; it is given again on line {line}") \
+                from None
         raise error(f"line {line}", value, f"must be valid TOML: {reason[:at.start()]} at column {column}") from None
 
 

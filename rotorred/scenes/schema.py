@@ -47,7 +47,7 @@ from rotorred.checks import InputError, fail
 from rotorred.model.dofs import DIRECTIONS, parse_dof
 from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.rotor import Rotor
-from rotorred.model.rotor_file import load_rotor, presets, read_toml
+from rotorred.model.rotor_file import load_rotor, presets, read_text_file, read_toml
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
@@ -244,7 +244,7 @@ def _read(spec: str | Path) -> tuple[dict, str, Path | None]:
         if not path.is_file():
             raise FileNotFoundError(f"scene {spec_str!r} is neither a built-in scene "
                                     f"({', '.join(builtin_scenes())}) nor an existing file")
-        text, source, base = path.read_text(), str(path), path.parent
+        text, source, base = read_text_file(path, SceneError), str(path), path.parent
     try:
         return read_toml(text, SceneError), source, base
     except SceneError as exc:
