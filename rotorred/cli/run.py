@@ -50,10 +50,10 @@ def run(args) -> int:
     from rotorred.scenes.schema import load_scene
 
     t0 = time.perf_counter()
-    if args.out is not None:
-        out_dir("--out", args.out)
+    out = out_dir("--out", args.out) if args.out is not None else None  # refused before the scene is read
     scene = load_scene(args.scene, _settings(args.set))
-    out = out_dir("--out", args.out if args.out is not None else f"rotorred-{scene.name}")
+    if out is None:
+        out = out_dir("--out", f"rotorred-{scene.name}")
     budget.check(budget.scene_estimate(scene), force=args.force)
     with OutputFolder(out) as folder:
         status = _compute_and_write(scene, args, folder, out)

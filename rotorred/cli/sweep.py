@@ -90,9 +90,8 @@ def _check(args, key: str, values: list, fixed: dict):
     dof = parse_dof("--dof", args.dof, scenes[0].rotor.spool_of) if args.dof else None
     if dof is not None:
         check_dof(scenes[0], dof, text=args.dof)
-    for sc in scenes:
-        budget.check(budget.scene_estimate(sc), force=args.force)
-    total = sum(budget.scene_estimate(sc).steps for sc in scenes)
+    estimates = [budget.check(budget.scene_estimate(sc), force=args.force) for sc in scenes]
+    total = sum(e.steps for e in estimates)
     if total > budget.MAX_STEPS and not args.force:
         checks.fail("--set", f"{key}=<{len(values)} values>", f"gives {total:.3g} steps in all, more than "
                                                                f"{budget.MAX_STEPS:.3g}; use --force to go on")

@@ -87,10 +87,11 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
     out = Path(out)
     formats = result.scene.output.formats
     files = []
+    arrays = data_arrays(result) if {"npz", "mat"} & set(formats) else {}
     if "npz" in formats:
-        files.append(write_npz(out / "result.npz", data_arrays(result)))
+        files.append(write_npz(out / "result.npz", arrays))
     if "mat" in formats:
-        files.append(write_mat(out / "result.mat", data_arrays(result)))
+        files.append(write_mat(out / "result.mat", arrays))
     if "csv" in formats:
         files.append(_timeseries_csv(result, out / "timeseries.csv"))
         if result.spectra:

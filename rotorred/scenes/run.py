@@ -36,10 +36,10 @@ import numpy as np
 
 from rotorred.model.assembly import assemble
 from rotorred.linear.harmonic import SteadyState, steady_state
-from rotorred.signals.lines import format_table, label_lines
+from rotorred.signals.lines import label_lines
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
-from rotorred.signals.spectra import WINDOWS, settled_spectrum
+from rotorred.signals.spectra import settled_spectrum
 
 __all__ = ["SceneModel", "SceneResult", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
            "harmonic_outputs", "spool_frequencies"]

@@ -59,10 +59,9 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from rotorred.transient import contact, numba_cache
-from rotorred.transient.contact_solve import (  # noqa: F401 - re-exported: the kernel's constants and contact solve
-    C_ACTIVESET, C_CONTACT, C_MAXNEWTON, C_NEWTON, C_STEPS, C_SUBSTEPS, N_COUNTERS, N_PLATE_PAR, P_C, P_CLEAR,
-    P_COS, P_K, P_LAM, P_MP, P_MUD, P_MUS, P_SIN, P_V, P_W0, Condensed, _kinematics, _normal_law,
-    _normal_residual, _open_plates, _solve_small, contact_residual, solve_contact)
+from rotorred.transient.contact_solve import (  # noqa: F401 - also read as kernel.<name> by newmark, matrices, tests
+    C_CONTACT, C_MAXNEWTON, C_NEWTON, C_STEPS, C_SUBSTEPS, N_COUNTERS, N_PLATE_PAR, P_CLEAR, P_COS, P_MP, P_SIN, P_V,
+    P_W0, Condensed, _kinematics, _normal_law, _open_plates, _solve_small, contact_residual, solve_contact)
 
 numba_cache.register()
 
