@@ -121,3 +121,20 @@ def test_rig_at_96_5_hz_is_quasi_periodic_on_the_f_H_over_3_torus():
     assert (c.torus.k, c.torus.j) == (3, 1) and c.explained_share > 0.99
     assert c.poincare.frequency_hz == pytest.approx(96.5 / 3, rel=1e-12)
     assert c.curve_share is None or c.curve_share > 0.9
+
+
+def test_scene_summary_at_88_8_hz_on_the_default_record_says_unsettled_and_what_record_would_do():
+    """paper-rub at outer 88.8 Hz as a user runs it (record 2.0-2.6 s): the fit finds f_H/3 but explains
+    less than 90 % (measured 0.826), the settling windows (10 periods of f_H/3 ... resolved: 0.589 s)
+    do not fit twice in 0.6 s, so the class is "unsettled", and the summary names the record that would."""
+    from rotorred.scenes.summary import format_summary
+    res = run_scene(load_scene("paper-rub", {"speeds.outer": F_H, "output.nodes": [14], "output.directions": ["y"],
+                                             "output.table": "14:y", "output.plots": [], "output.formats": [],
+                                             "output.compare_normal": False}))
+    a = res.analysis
+    assert (a.fit.torus.k, a.fit.torus.j) == (3, 1) and a.fit.explained_share < 0.90
+    assert a.classification.kind == "unsettled" and not a.settling.settled
+    text = format_summary(res)
+    assert f"a recorded window of at least {2 * a.settling.window:.3g} s" in text
+    assert 2 * a.settling.window <= 1.5  # the 1.5 s record of the test above holds it
+    assert "class: unsettled" in text and "period" not in text[text.index("class:"):].split("\n")[0]

@@ -157,7 +157,8 @@ def test_write_outputs(rub, tmp_path):
     files = write_outputs(res, tmp_path)
     names = {f.name for f in files}
     assert {"waveforms.png", "spectra_node13.png", "spectra_node14.png", "spectra_node18.png", "orbits.png",
-            "result.npz", "result.mat", "timeseries.csv", "spectra.csv", "lines.csv", "summary.txt"} == names
+            "result.npz", "result.mat", "timeseries.csv", "spectra.csv", "lines.csv", "linefit.csv", "poincare.csv",
+            "summary.txt"} == names
     for f in files:
         assert f.stat().st_size > 0
     npz = np.load(tmp_path / "result.npz")

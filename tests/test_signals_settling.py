@@ -103,3 +103,29 @@ def test_commensurate_window_is_two_common_periods():
     s = settling_time(t, x, 70.0, 90.0)
     assert s.window == pytest.approx(0.2, abs=DT) and s.settled
     assert np.max(s.changes) < 1e-12  # orthogonal lines: the same amplitudes to round-off (measured 1e-15)
+
+
+def test_a_given_reference_fit_chooses_the_tracked_lines():
+    """A fit of a longer end of the record resolves more lines than the last quarter; it is used as given."""
+    from rotorred.signals.linefit import fit_lines
+    t = np.arange(6_000) * DT  # 0.6 s at 70/90 Hz; lines 10 Hz apart: the last quarter (0.15 s) resolves 13.3 Hz
+    x = sum(np.exp(-f / 100.0) * np.cos(2 * np.pi * f * t + 0.1 * f) for f in range(10, 200, 10))
+    fit = fit_lines(t, x, 70.0, 90.0)
+    s = settling_time(t, x, 70.0, 90.0, reference=fit)
+    assert s.reference is fit and s.settled and s.time == s.starts[0]
+    np.testing.assert_array_equal(s.frequencies_hz, np.sort(fit.frequencies_hz))
+    assert s.frequencies_hz.size == 19 > settling_time(t, x, 70.0, 90.0).frequencies_hz.size
+    assert np.max(s.changes) < 1e-12  # whole common periods: orthogonal lines (measured ~1e-14)
+
+
+def test_a_reference_of_another_record_is_refused():
+    from rotorred.signals.linefit import fit_lines
+    t = np.arange(6_000) * DT
+    x = np.cos(2 * np.pi * 90.0 * t)
+    with pytest.raises(InputError, match=r"^reference = 'f_L = 60, f_H = 90': must be fitted at this record's "
+                                         r"spool frequencies \(f_L = 70, f_H = 90\) \(Hz\)$"):
+        settling_time(t, x, 70.0, 90.0, reference=fit_lines(t, x, 60.0, 90.0))
+    with pytest.raises(InputError, match=r"^reference = '0 to 0\.2999': must be a fit of the end of this record"):
+        settling_time(t, x, 70.0, 90.0, reference=fit_lines(t[:3000], x[:3000], 70.0, 90.0))
+    with pytest.raises(InputError, match=r"^reference = .*: must be a LineFit \(from fit_lines\)$"):
+        settling_time(t, x, 70.0, 90.0, reference="fit")

@@ -15,7 +15,13 @@ from rotorred.scenes.run import SceneResult
 from rotorred.scenes.summary import format_summary
 from rotorred.writers import write_csv, write_mat, write_npz, write_text
 
-__all__ = ["data_arrays", "write_data", "write_outputs"]
+__all__ = ["data_arrays", "write_data", "write_outputs", "LINEFIT_HEADER", "POINCARE_HEADER"]
+
+#: columns of ``linefit.csv`` (docs/scenes.md)
+LINEFIT_HEADER = ["frequency (Hz)", "label", "labels", "m", "n", "k", "j", "amplitude (um)", "phase (rad)",
+                  "amplitude SE (um)", "share"]
+#: columns of ``poincare.csv``
+POINCARE_HEADER = ["t (s)", "x (um)", "velocity (um/s)"]
 
 
 def _key(case: str, d) -> str:
@@ -42,6 +48,12 @@ def data_arrays(result: SceneResult) -> dict[str, np.ndarray]:
             arrays[_key(c, d)] = r.outputs[d]
             if d in r.spectra:
                 arrays[_key(f"{c}_amp", d)] = r.spectra[d].amplitudes
+    a = result.analysis
+    if a is not None:
+        p = a.classification.poincare
+        arrays.update({"poincare_frequency": np.array(p.frequency_hz), "poincare_t": p.times, "poincare_x": p.x,
+                       "poincare_velocity": p.velocity,
+                       "poincare_dof": np.array(f"{a.dof[0]}:{a.dof[1]}")})
     for k, ch in enumerate(result.contacts):
         arrays[f"plate{k}_normal_force"] = ch.normal_force
         arrays[f"plate{k}_friction_force"] = ch.friction_force
@@ -82,6 +94,22 @@ def _lines_csv(result: SceneResult, path: Path) -> Path:
     return write_csv(path, header, list(zip(*rows)) if rows else [[]] * len(header))
 
 
+def _linefit_csv(result: SceneResult, path: Path) -> Path:
+    """Fitted lines of the table DOF, then its residual's strongest peaks (label ``unlabelled``)."""
+    a = result.analysis
+    fit, k, j = a.fit, a.fit.torus.k, a.fit.torus.j
+    rows = [[ln.frequency_hz, ln.label_ascii, ";".join(ln.labels), str(ln.m), str(ln.n), k, j, 1e6 * ln.amplitude,
+             ln.phase, 1e6 * ln.standard_error, ln.share] for ln in fit.lines]
+    rows += [[p.frequency_hz, "unlabelled", "", "", "", "", "", 1e6 * p.amplitude, "", "", ""] for p in fit.unlabelled]
+    cols = list(zip(*rows)) if rows else [[]] * len(LINEFIT_HEADER)
+    return write_csv(path, LINEFIT_HEADER, cols, digits=17)
+
+
+def _poincare_csv(result: SceneResult, path: Path) -> Path:
+    p = result.analysis.classification.poincare
+    return write_csv(path, POINCARE_HEADER, [p.times, 1e6 * p.x, 1e6 * p.velocity], digits=17)
+
+
 def write_data(result: SceneResult, out: str | Path) -> list[Path]:
     """Write the data files the scene's ``output.formats`` asks for; returns their paths."""
     out = Path(out)
@@ -96,6 +124,8 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
         files.append(_timeseries_csv(result, out / "timeseries.csv"))
         if result.spectra:
             files += [_spectra_csv(result, out / "spectra.csv"), _lines_csv(result, out / "lines.csv")]
+        if result.analysis is not None:
+            files += [_linefit_csv(result, out / "linefit.csv"), _poincare_csv(result, out / "poincare.csv")]
     return files
 
 

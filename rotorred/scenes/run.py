@@ -22,6 +22,14 @@ used (amplitude error below 0.0045 dB) and the spectrum's ``note`` says so. Line
 peaks above ``output.line_threshold`` of the largest, labelled by
 :func:`rotorred.signals.lines.label_lines` within half a bin.
 
+Line fit, settling and class (issue 19) of the table DOF (:func:`table_dof`): the lines
+``(m/k) f_H + (n/j) f_L`` are fitted by least squares (:func:`rotorred.signals.linefit.fit_lines`,
+torus found by the fit) on the same samples as the spectrum (the last whole common periods when
+the speeds are commensurate, where the fitted amplitudes equal the rectangular FFT's on-bin values;
+otherwise the whole record); the settling (:func:`rotorred.signals.settling.settling_time`) and the
+class (:func:`rotorred.signals.classify.classify`, Poincare samples) use the whole recorded window
+and the torus the fit found, so the search runs once (:class:`LineAnalysis`).
+
 The summary is :mod:`rotorred.scenes.summary`; the files (figures, NPZ, CSV, .mat, summary)
 are written by :func:`rotorred.scenes.outputs.write_outputs`.
 """
@@ -39,9 +47,12 @@ from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.signals.lines import label_lines
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
+from rotorred.signals.classify import Classification, classify
+from rotorred.signals.linefit import LineFit, fit_lines
+from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
-__all__ = ["SceneModel", "SceneResult", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
+__all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
            "harmonic_outputs", "spool_frequencies"]
 
 
@@ -65,6 +76,30 @@ class SceneModel:
     label: str
     build_time: float
     key: tuple
+
+
+@dataclass(frozen=True)
+class LineAnalysis:
+    """Line fit, measured settling and class of one recorded DOF (issue 19).
+
+    Attributes
+    ----------
+    dof : (int, str)
+    fit : LineFit
+        Least-squares line fit on the spectrum's samples (the commensurate record when there is one).
+    settling : Settling
+        Of the whole recorded window, lines tracked on the fit's torus.
+    classification : Classification
+        Of the whole recorded window (with ``settling``), Poincare samples included.
+    time : float
+        Wall time of the three (s).
+    """
+
+    dof: tuple
+    fit: LineFit
+    settling: Settling
+    classification: Classification
+    time: float
 
 
 @dataclass(frozen=True)
@@ -99,6 +134,11 @@ class SceneResult:
     incomplete : str or None
         Why the record stops early (a diverged transient, :class:`SceneDiverged`); None when complete.
         An incomplete result has no spectra, lines or normal comparison.
+    analyses : dict of (int, str) to LineAnalysis
+        Line fit, settling and class of the table DOF (:func:`table_dof`); empty for an incomplete
+        result and for the normal comparison.
+    analysis_errors : dict of (int, str) to str
+        Why a DOF has no analysis (e.g. a record too short to fit), one line each.
     """
 
     scene: Scene
@@ -117,6 +157,13 @@ class SceneResult:
     normal: SceneResult | None = None
     counters: dict = field(default_factory=dict)
     incomplete: str | None = None
+    analyses: dict = field(default_factory=dict)
+    analysis_errors: dict = field(default_factory=dict)
+
+    @property
+    def analysis(self) -> LineAnalysis | None:
+        """The :class:`LineAnalysis` of the table DOF, None when there is none."""
+        return self.analyses.get(table_dof(self.scene))
 
     def peak(self, dof) -> float:
         """Largest |displacement| of ``dof`` in the window (m); 0 for an empty (diverged) record."""
@@ -142,6 +189,16 @@ class SceneResult:
 
 
 # --------------------------------------------------------------------------- model
+def table_dof(scene: Scene) -> tuple[int, str]:
+    """The DOF whose lines are tabulated: ``output.table``, else the last non-rub node's y (or first direction)."""
+    out = scene.output
+    if out.table is not None:
+        return out.table
+    node = out.nodes[-1] if not scene.plates else next(
+        (n for n in reversed(out.nodes) if n != scene.plates[0].node), out.nodes[-1])
+    return (node, "y" if "y" in out.directions else out.directions[0])
+
+
 def spool_frequencies(scene: Scene) -> tuple[float, float]:
     """(f_L, f_H) (Hz): the lower and higher spool frequency (equal for one spool)."""
     f = sorted(w / (2 * math.pi) for w in scene.speeds.values())
@@ -245,7 +302,7 @@ def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- run
 def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: bool | None = None,
-              progress: bool | None = False) -> SceneResult:
+              progress: bool | None = False, analyse: bool = True) -> SceneResult:
     """Compute a scene's response, spectra and labelled lines.
 
     Parameters
@@ -258,6 +315,9 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
         ignored without plates).
     progress : bool or None
         Progress bar of long transients (None: after 2 s).
+    analyse : bool
+        Line fit, settling and class of the table DOF (:func:`analyse_lines`; not counted in
+        ``solve_time``).
 
     Returns
     -------
@@ -275,17 +335,49 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
         response = _transient_response(scene, model, progress, f_L, f_H)
     spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
+    analyses, errors = {}, {}
+    if analyse:
+        d = table_dof(scene)
+        try:
+            analyses[d] = analyse_lines(response.t, response.outputs[d], f_L, f_H, spectra[d].n_samples, d)
+        except ValueError as exc:  # a record too short to fit (checks' one-line message)
+            errors[d] = str(exc)
     if compare_normal is None:
         compare_normal = scene.output.compare_normal
     normal = None
     if scene.plates and compare_normal:
         without = scene.without_rub()
         normal = run_scene(without, SceneModel(model.model, model.label, 0.0, model_key(without)),
-                           compare_normal=False)
+                           compare_normal=False, analyse=False)
     return SceneResult(scene=scene, t=response.t, outputs=response.outputs, contacts=response.contacts,
                        spectra=spectra, lines=lines, f_L=f_L, f_H=f_H, method=response.method,
                        model_label=model.label, n_steps=response.n_steps, build_time=model.build_time,
-                       solve_time=solve_time, normal=normal, counters=response.counters)
+                       solve_time=solve_time, normal=normal, counters=response.counters, analyses=analyses,
+                       analysis_errors=errors)
+
+
+def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: int | None = None,
+                  dof: tuple = ()) -> LineAnalysis:
+    """Line fit of the last ``n_fit`` samples, then settling and class of the whole record on its torus.
+
+    Parameters
+    ----------
+    t, x : ndarray, shape (n,)
+        Record times (s) and response (m or rad).
+    f_L, f_H : float
+        Spool frequencies (Hz).
+    n_fit : int, optional
+        Samples fitted, from the end (the spectrum's ``n_samples``); default all.
+    dof : (int, str)
+        Recorded with the result.
+    """
+    t0 = time.perf_counter()
+    n = len(t) if n_fit is None else min(int(n_fit), len(t))
+    fit = fit_lines(t[-n:], x[-n:], f_L, f_H)
+    torus = (fit.torus.k, fit.torus.j)  # found once; settling and class reuse it
+    settling = settling_time(t, x, f_L, f_H, reference=fit)
+    cls = classify(t, x, f_L, f_H, settling=settling, torus=torus)
+    return LineAnalysis(tuple(dof), fit, settling, cls, time.perf_counter() - t0)
 
 
 @dataclass(frozen=True)

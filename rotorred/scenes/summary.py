@@ -9,6 +9,7 @@ import numpy as np
 
 from rotorred.model.dofs import direction_name
 from rotorred.scenes.run import SceneResult
+from rotorred.scenes.run import table_dof as _scene_table_dof
 from rotorred.signals.lines import format_table
 from rotorred.signals.spectra import WINDOWS
 from rotorred.writers import render_table
@@ -23,19 +24,13 @@ def table_dof(result) -> tuple[int, str]:
 
     ``result`` is a :class:`SceneResult` or a :class:`rotorred.scenes.schema.Scene`.
     """
-    scene = getattr(result, "scene", result)
-    out = scene.output
-    if out.table is not None:
-        return out.table
-    node = out.nodes[-1] if not scene.plates else next(
-        (n for n in reversed(out.nodes) if n != scene.plates[0].node), out.nodes[-1])
-    return (node, "y" if "y" in out.directions else out.directions[0])
+    return _scene_table_dof(getattr(result, "scene", result))
 
 
 def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
     """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form)."""
     parts = [_incomplete(result), _setup(result), _peaks(result), _range_warnings(result), _contacts(result),
-             _lines(result) if result.spectra else ""]
+             _lines(result) if result.spectra else "", _line_fit(result)]
     if files:
         parts.append("\n".join(f"wrote {f}" for f in files))
     return "\n\n".join(p for p in parts if p)
@@ -149,3 +144,52 @@ def _lines(result: SceneResult) -> str:
             f"({', '.join(ln.label_ascii for ln in result.lines[x][:6])}{', ...' if len(result.lines[x]) > 6 else ''})"
             for x in others))
     return "\n".join(lines)
+
+
+#: residual peaks listed in the summary
+N_UNLABELLED_SHOWN = 5
+
+
+def _line_fit(result: SceneResult) -> str:
+    """The issue-19 block: torus, explained share, lines kept, class, settling, unlabelled residual peaks."""
+    d = table_dof(result)
+    name = f"node {d[0]} {direction_name(d[1])}"
+    if d in result.analysis_errors:
+        return f"Line fit of {name}: not computed: {result.analysis_errors[d]}"
+    a = result.analyses.get(d)
+    if a is None:
+        return ""
+    fit, st, cls = a.fit, a.settling, a.classification
+    rot = d[1].startswith("theta")
+    scale, unit = 1e6, ("urad" if rot else "um")
+    tried = ", ".join(f"k={tr.k} j={tr.j}: {tr.n_lines} lines, {tr.explained_share:.6f}" for tr in fit.trials)
+    kind = cls.label + (f", period {cls.period:.6g} s" if cls.period is not None else "")
+    if cls.kind == "period-k":
+        kind += f" (k = {cls.subharmonic})"
+    settled = (st.reason if st.settled else
+               f"not settled by {result.t[-1]:.4g} s: " + st.reason.removeprefix("not settled: "))
+    rows = [[f"{ln.frequency_hz:.6g}", "; ".join(ln.labels), f"{scale * ln.amplitude:.4g}", f"{ln.phase:+.4f}",
+             f"{scale * ln.standard_error:.2g}", f"{ln.share:.4g}"] for ln in fit.lines]
+    peaks = "; ".join(f"{p.frequency_hz:.5g} Hz {scale * p.amplitude:.3g} {unit}"
+                      for p in fit.unlabelled[:N_UNLABELLED_SHOWN]) or "none above the floor"
+    lines = [f"Line fit of {name} (least squares at (m/k) f_H + (n/j) f_L on the time record, "
+             f"{fit.n_samples} samples from {fit.t0:.6g} s, {fit.duration:.4g} s; lines closer than "
+             f"{fit.resolution_hz:.4g} Hz merged; {a.time:.2f} s):",
+             f"torus found: {fit.torus.label} (tried {tried})",
+             f"explained share (1 - residual/signal energy): {fit.explained_share:.6f}; {fit.n_significant} "
+             f"significant lines, {len(fit.lines)} kept; residual rms {scale * fit.noise_rms:.3g} {unit}",
+             render_table(["frequency (Hz)", "label(s)", f"amplitude ({unit})", "phase (rad)", f"SE ({unit})",
+                           "share"], rows) if rows else "(no significant line)",
+             f"class: {kind} ({cls.rules[-1]})",
+             f"settling: {settled}" + _record_advice(result, st),
+             f"unlabelled residual peaks (strongest first): {peaks}"]
+    return "\n".join(lines)
+
+
+def _record_advice(result: SceneResult, settling) -> str:
+    """What recorded window would let the settling be measured, when the record is shorter than two windows."""
+    record = result.t[-1] - result.t[0] if result.t.size else 0.0
+    if settling.settled or not settling.window < math.inf or record >= 2 * settling.window:
+        return ""
+    return (f"\n  a recorded window of at least {2 * settling.window:.3g} s (solver.duration - solver.record_start, "
+            f"now {record:.3g} s) holds the two {settling.window:.3g} s windows settling compares")

@@ -7,8 +7,12 @@ fixed record start.
 
 Method
     1. Fit the lines on the last quarter of the record (:func:`rotorred.signals.linefit.fit_lines`,
-       torus found or given): their frequencies, and those of the residual's strongest peaks (the
-       unlabelled lines, at their interpolated frequencies, when at least c/T from every line),
+       torus found or given), or take a given ``reference`` fit of the record's end (a longer
+       record resolves more: a scene passes its fit of the last whole common periods, where the
+       last quarter of a 0.6 s record would resolve only 13 Hz): their frequencies, and those of the residual's strongest peaks (the
+       unlabelled lines, at their interpolated frequencies, when at least c/T from every line and,
+       for commensurate speeds, from every multiple of the torus's base: a peak nearer a multiple
+       of the base than the resolution is that multiple's leakage, not a tone of its own),
        are tracked, unchanged, in every window. Tracking the unlabelled lines too keeps a
        settled component the torus does not explain from leaking into the lines' coefficients
        (by ``1 / (pi df W)`` for a component df from a line) and making them beat from window to
@@ -112,12 +116,34 @@ class Settling:
 
 
 def _tracked(reference: LineFit) -> np.ndarray:
-    """Frequencies (Hz) of the reference's lines and of its residual peaks at least c/T from them."""
+    """Frequencies (Hz) of the reference's lines and of its residual peaks at least c/T from them
+    (and, for commensurate speeds, from every multiple of the torus's base)."""
     freqs = list(reference.frequencies_hz)
+    bases = reference.torus.bases
     for peak in reference.unlabelled:
-        if all(abs(peak.frequency_hz - f) >= reference.resolution_hz for f in freqs):
-            freqs.append(peak.frequency_hz)
+        f = peak.frequency_hz
+        near_lattice = len(bases) == 1 and abs(f - bases[0] * round(f / bases[0])) < reference.resolution_hz
+        if not near_lattice and all(abs(f - g) >= reference.resolution_hz for g in freqs):
+            freqs.append(f)
     return np.sort(np.array(freqs))
+
+
+def _reference(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, torus, reference: LineFit | None,
+               fit_options: dict) -> LineFit:
+    """The given reference fit, checked against the record, or the fit of the record's last quarter."""
+    if reference is None:
+        quarter = t.size // 4
+        return fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, torus=torus, **fit_options)
+    if not isinstance(reference, LineFit):
+        checks.fail("reference", reference, "must be a LineFit (from fit_lines)")
+    if not np.allclose((reference.torus.f_L, reference.torus.f_H), (f_L, f_H), rtol=1e-12, atol=0.0):
+        checks.fail("reference", f"f_L = {reference.torus.f_L:g}, f_H = {reference.torus.f_H:g}",
+                    f"must be fitted at this record's spool frequencies (f_L = {f_L:g}, f_H = {f_H:g})", "Hz")
+    t_end = reference.t0 + (reference.n_samples - 1) * reference.dt
+    if reference.t0 < t[0] - 0.5 * reference.dt or abs(t_end - t[-1]) > 0.5 * reference.dt:
+        checks.fail("reference", f"{reference.t0:g} to {t_end:g}",
+                    f"must be a fit of the end of this record ({t[0]:g} to {t[-1]:g})", "s")
+    return reference
 
 
 def _default_window(reference: LineFit, tracked: np.ndarray, n_cycles: float, resolution: float) -> float:
@@ -158,7 +184,8 @@ def _not_settled(reason: str, tol: float, reference: LineFit | None, freqs: np.n
 
 
 def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, window: float | None = None,
-                  torus=None, n_cycles: float = N_CYCLES, **fit_options) -> Settling:
+                  torus=None, n_cycles: float = N_CYCLES, reference: LineFit | None = None,
+                  **fit_options) -> Settling:
     """When the line amplitudes (and the offset and residual level) of a response stop changing.
 
     Parameters
@@ -177,6 +204,9 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
         Sub-harmonic orders; default: found on the last quarter of the record.
     n_cycles : float
         Periods of the slowest labelled line in a default window (speeds not commensurate).
+    reference : LineFit, optional
+        A fit of the end of this record (same f_L, f_H) that chooses the tracked lines, in place
+        of the fit of the last quarter (``torus`` and ``fit_options`` are then not used for it).
     **fit_options
         Passed to :func:`rotorred.signals.linefit.fit_lines` (``resolution``, ``z``, ...).
 
@@ -188,8 +218,7 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
     x = checks.vector("x", x, min_len=32)
     tol = checks.number("tol", tol, gt=0.0, lt=1.0)
     n_cycles = checks.positive("n_cycles", n_cycles)
-    quarter = t.size // 4
-    reference = fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, torus=torus, **fit_options)
+    reference = _reference(t, x, f_L, f_H, torus, reference, fit_options)
     freqs = _tracked(reference)
     if freqs.size == 0:
         return _not_settled("no significant line on the last quarter of the record to track", tol, reference, freqs)
