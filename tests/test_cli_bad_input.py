@@ -42,7 +42,7 @@ S = {
     "speed": ("inner = 70.0", "inner = -70.0"), "mu": ("mu_s = 0.2 ", 'mu_s = "x" '),
     "K_nr": ("K_nr = 5e10", "K_nr = -5.0"), "preset": ('preset = "seed-rig"', 'preset = "nope"'),
     "formats": ('formats = ["npz", "csv", "mat"]', 'formats = ["xls"]'),
-    "plots": ('plots = ["waveforms", "spectra", "orbits"]', 'plots = ["movie"]'),
+    "plots": ('plots = ["waveforms", "spectra", "orbits", "poincare"]', 'plots = ["movie"]'),
     "threshold": ("line_threshold = 0.005", "line_threshold = 2.0"),
     "window": ("plot_window = [2.44, 2.58]", "plot_window = [5.0, 6.0]"), "modes": ("modes = 24 ", "modes = -3 "),
 }

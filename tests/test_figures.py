@@ -80,6 +80,15 @@ def test_plot_spectra_with_labels_linear_and_log(tmp_path):
         plot_spectra({"rub": s_rub}, tmp_path / "bad.png", f_max=-1.0)
 
 
+def test_plot_poincare(tmp_path):
+    from rotorred.plots.scene import plot_poincare
+    theta = np.linspace(0.0, 2 * np.pi, 150, endpoint=False)
+    _assert_png(plot_poincare(50e-6 * np.cos(theta), 0.03 * np.sin(theta), tmp_path / "poincare.png",
+                              label="quasi-periodic", title="Poincare"), n_series=1)
+    with pytest.raises(ValueError, match=r"^velocity = array of shape \(149,\): must be a 1-D array of 150 values$"):
+        plot_poincare(np.zeros(150), np.zeros(149), tmp_path / "bad.png")
+
+
 def test_plot_orbits(tmp_path):
     rub_x, rub_y = _signal(np.pi / 2), _signal()
     nx, ny = 60e-6 * np.sin(2 * np.pi * 90 * T), 60e-6 * np.cos(2 * np.pi * 90 * T)

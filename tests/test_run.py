@@ -161,6 +161,8 @@ def test_write_outputs(rub, tmp_path):
             "summary.txt"} == names
     for f in files:
         assert f.stat().st_size > 0
+    # no poincare.png: 0.2 s at a 10 Hz section holds no sample 10 spline intervals from the ends
+    assert res.analysis.classification.poincare.x.size == 0
     npz = np.load(tmp_path / "result.npz")
     mat = loadmat(tmp_path / "result.mat")
     for key in ("t", "rub_14_y", "normal_14_y", "rub_amp_14_y", "frequency", "plate0_normal_force", "plate0_state"):

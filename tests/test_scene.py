@@ -150,7 +150,7 @@ BAD = [
     ("unknown format", "output.formats", ["xlsx"], "output.formats[0] = 'xlsx': must be one of 'npz', 'csv', 'mat'"),
     ("missing output node", "output.nodes", [13, 77], "output.nodes[1] = 77: must be a node of the rotor (1-20)"),
     ("output node twice", "output.nodes", [13, 13], "output.nodes = [13, 13]: must not list an entry twice"),
-    ("orbits without y", "output.directions", ["x"], "output.plots = ['waveforms', 'spectra', 'orbits']: must not ask "
+    ("orbits without y", "output.directions", ["x"], "output.plots = ['waveforms', 'spectra', 'orbits', 'poincare']: must not ask "
      "for \"orbits\" unless output.directions holds both \"x\" and \"y\""),
     ("plot window outside the record", "output.plot_window", [0.1, 0.2], "output.plot_window = [0.1, 0.2]: must be "
      "[start, end] inside the recorded window [0.3, 0.5] with start < end (s)"),

@@ -1,4 +1,4 @@
-"""Plot helpers for waveforms, spectra and orbits (matplotlib, Agg; plain arrays in).
+"""Plot helpers for waveforms, spectra, orbits and Poincare sections (matplotlib, Agg; plain arrays in).
 
 Every helper takes SI arrays (s, m, Hz), plots displacements in µm by default
 (``scale=1e6``, ``unit="µm"``), writes one file and returns its path. Figures are built
@@ -27,7 +27,7 @@ from rotorred.model.dofs import direction_name
 from rotorred.signals.lines import SpectralLine
 from rotorred.signals.spectra import Spectrum
 
-__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_scene"]
+__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene"]
 
 
 # --------------------------------------------------------------------------- helpers
@@ -311,9 +311,47 @@ def plot_orbits(
     return _save(fig, path, title)
 
 
+# --------------------------------------------------------------------------- Poincare section
+def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "", scale: float = 1e6,
+                  unit: str = "µm") -> Path:
+    """Poincare section: the sampled displacement against the sampled velocity, one dot per sample.
+
+    A periodic response shows as k points (period-k), a quasi-periodic one as a closed curve, a
+    chaotic one as a cloud (:mod:`rotorred.signals.classify`).
+
+    Parameters
+    ----------
+    x, velocity : array_like, shape (n,)
+        Samples in SI (m and m/s, or rad and rad/s), n >= 1.
+    path : str or Path
+        Output file.
+    title, label : str
+        Figure title; legend text of the samples (e.g. the class and section frequency).
+    scale, unit : float, str
+        Plotted values are ``scale * x`` in ``unit`` and ``scale * velocity`` in ``unit``/s.
+
+    Returns
+    -------
+    Path
+    """
+    scale = checks.positive("scale", scale)
+    x = checks.vector("x", x, min_len=1)
+    velocity = checks.vector("velocity", velocity, min_len=x.size, max_len=x.size)
+    path = _path(path)
+    fig = Figure(figsize=(5.6, 5.0), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(scale * x, scale * velocity, ".", ms=4 if x.size < 200 else 2, label=f"{label} ({x.size} samples)".strip())
+    ax.set_xlabel(f"displacement ({unit})")
+    ax.set_ylabel(f"velocity ({unit}/s)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
+    return _save(fig, path, title)
+
+
 # --------------------------------------------------------------------------- a scene's figures
 def plot_scene(result, out: str | Path) -> list[Path]:
-    """The figures a scene's ``output.plots`` asks for, written into ``out``: waveforms, spectra, orbits.
+    """The figures a scene's ``output.plots`` asks for, written into ``out``: waveforms, spectra, orbits,
+    the Poincare section of the table DOF.
 
     Parameters
     ----------
@@ -368,4 +406,18 @@ def plot_scene(result, out: str | Path) -> list[Path]:
             orbits[title] = {label: (r.outputs[(n, "x")], r.outputs[(n, "y")]) for label, r in pairs}
         files.append(plot_orbits(orbits, out / "orbits.png",
                                  title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
+    if "poincare" in plots and result.analysis is not None and result.analysis.classification.poincare.x.size:
+        files.append(_scene_poincare(result, out / "poincare.png", speeds, rub_text))
     return files
+
+
+def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> Path:
+    """The Poincare section of the table DOF, labelled with its class and section frequency."""
+    a = result.analysis
+    c = a.classification
+    rot = a.dof[1].startswith("theta")
+    return plot_poincare(c.poincare.x, c.poincare.velocity, path, scale=1e6, unit="µrad" if rot else "µm",
+                         label=f"{c.label}, once per {1.0 / c.poincare.frequency_hz:.4g} s "
+                               f"({c.poincare.frequency_hz:.6g} Hz)",
+                         title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])} "
+                               f"({speeds}; {rub_text})")

@@ -54,7 +54,7 @@ from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 __all__ = ["Scene", "SolverSpec", "OutputSpec", "SceneError", "load_scene", "scene_from_toml", "scene_from_dict",
            "builtin_scenes", "apply_settings", "parse_setting", "DIRECTIONS", "PLOTS", "FORMATS"]
 
-PLOTS = ("waveforms", "spectra", "orbits")
+PLOTS = ("waveforms", "spectra", "orbits", "poincare")
 FORMATS = ("npz", "csv", "mat")
 MODELS = ("reduced", "full")
 STARTS = ("settled", "rest")
@@ -146,7 +146,8 @@ class OutputSpec:
     directions : tuple of str
         Directions recorded at every node ("x", "y", "theta_x", "theta_y").
     plots : tuple of str
-        Figures to draw: "waveforms", "spectra", "orbits".
+        Figures to draw: "waveforms", "spectra", "orbits", "poincare" (the Poincare section of the
+        table DOF, :mod:`rotorred.signals.classify`).
     formats : tuple of str
         Data files: "npz", "csv", "mat".
     plot_window : (float, float) or None

@@ -148,6 +148,8 @@ def _lines(result: SceneResult) -> str:
 
 #: residual peaks listed in the summary
 N_UNLABELLED_SHOWN = 5
+#: lines listed in the summary: those with at least 0.1 % of the energy (all are in linefit.csv)
+SHARE_SHOWN = 1e-3
 
 
 def _line_fit(result: SceneResult) -> str:
@@ -168,8 +170,9 @@ def _line_fit(result: SceneResult) -> str:
         kind += f" (k = {cls.subharmonic})"
     settled = (st.reason if st.settled else
                f"not settled by {result.t[-1]:.4g} s: " + st.reason.removeprefix("not settled: "))
+    shown = [ln for ln in fit.lines if ln.share >= SHARE_SHOWN]
     rows = [[f"{ln.frequency_hz:.6g}", "; ".join(ln.labels), f"{scale * ln.amplitude:.4g}", f"{ln.phase:+.4f}",
-             f"{scale * ln.standard_error:.2g}", f"{ln.share:.4g}"] for ln in fit.lines]
+             f"{scale * ln.standard_error:.2g}", f"{ln.share:.4g}"] for ln in shown]
     peaks = "; ".join(f"{p.frequency_hz:.5g} Hz {scale * p.amplitude:.3g} {unit}"
                       for p in fit.unlabelled[:N_UNLABELLED_SHOWN]) or "none above the floor"
     lines = [f"Line fit of {name} (least squares at (m/k) f_H + (n/j) f_L on the time record, "
@@ -179,11 +182,14 @@ def _line_fit(result: SceneResult) -> str:
              f"explained share (1 - residual/signal energy): {fit.explained_share:.6f}; {fit.n_significant} "
              f"significant lines, {len(fit.lines)} kept; residual rms {scale * fit.noise_rms:.3g} {unit}",
              render_table(["frequency (Hz)", "label(s)", f"amplitude ({unit})", "phase (rad)", f"SE ({unit})",
-                           "share"], rows) if rows else "(no significant line)",
+                           "share"], rows) if rows else "(no line with 0.1 % of the energy)",
+             f"({len(fit.lines) - len(shown)} lines with less than {SHARE_SHOWN:.1%} of the energy each, "
+             f"{sum(ln.share for ln in fit.lines if ln.share < SHARE_SHOWN):.2g} together: see linefit.csv)"
+             if len(shown) < len(fit.lines) else "",
              f"class: {kind} ({cls.rules[-1]})",
              f"settling: {settled}" + _record_advice(result, st),
              f"unlabelled residual peaks (strongest first): {peaks}"]
-    return "\n".join(lines)
+    return "\n".join(line for line in lines if line)
 
 
 def _record_advice(result: SceneResult, settling) -> str:
