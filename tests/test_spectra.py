@@ -167,6 +167,8 @@ def test_record_length_70_90_hz():
 
 
 def test_record_length_bad_inputs():
+    with pytest.raises(NotCommensurateError, match="^n_available = 9999: must hold at least one common period"):
+        commensurate_record(70, 90, 1e-5, n_available=9999)  # a window must be used: settled_spectrum falls back
     cases = [
         (dict(f_L=70, f_H=90, dt=-1e-5), "dt = -1e-05: must be > 0 (s)"),
         (dict(f_L=70, f_H=90, dt=0.0), "dt = 0.0: must be > 0 (s)"),

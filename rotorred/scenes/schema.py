@@ -514,7 +514,7 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float]) -> SolverSpec:
     d = SolverSpec()
     model = checks.choice("solver.model", table.get("model", d.model), MODELS)
     modes, cutoff, boundary = _solver_reduction(table, rotor)
-    dt, duration, record_start = _solver_times(table, d, speeds)
+    dt, duration, record_start = _solver_times(table, d)
     start = checks.choice("solver.start", table.get("start", d.start), STARTS)
     method = checks.choice("solver.method", table.get("method", d.method), METHODS)
     alpha = table.get("alpha")
@@ -551,7 +551,7 @@ def _solver_reduction(table: dict, rotor: Rotor) -> tuple[int | None, float | No
     return modes, cutoff, boundary
 
 
-def _solver_times(table: dict, d: SolverSpec, speeds: dict[str, float]) -> tuple[float, float, float]:
+def _solver_times(table: dict, d: SolverSpec) -> tuple[float, float, float]:
     """``solver.dt``, ``solver.duration`` and ``solver.record_start`` (s), consistent with each other."""
     dt = checks.positive("solver.dt", table.get("dt", d.dt), "s")
     duration = checks.positive("solver.duration", table.get("duration", d.duration), "s")
@@ -566,17 +566,8 @@ def _solver_times(table: dict, d: SolverSpec, speeds: dict[str, float]) -> tuple
         if abs(steps - round(steps)) > _RTOL * max(steps, 1.0):
             fail(f"solver.{name}", value, f"must be a whole number of steps of solver.dt = {dt:g}; it is "
                  f"{steps:.6g} steps", "s")
-    # The spectrum needs two common periods of the spools (lines 1/T apart must be resolved).
-    f = sorted(w / (2 * math.pi) for w in speeds.values() if w > 0)
-    if len(f) >= 2:
-        from fractions import Fraction
-        ratio = Fraction(f[-1] / f[0]).limit_denominator(100)
-        if abs(f[-1] / f[0] - float(ratio)) <= _RTOL * f[-1] / f[0]:
-            period = ratio.denominator / f[0]
-            if duration - record_start < 2 * period * (1 - _RTOL):
-                fail("solver.record_start", record_start, f"must leave a recorded window solver.duration - "
-                     f"solver.record_start of at least two common periods of the spools, 2 x {period:g}, to "
-                     f"resolve their combination lines; it leaves {duration - record_start:g}", "s")
+    # Any record length is accepted at any speeds (issue 19): the line fit needs no whole common
+    # period, and the spectrum uses a window when the record holds none (signals.spectra.settled_spectrum).
     return dt, duration, record_start
 
 

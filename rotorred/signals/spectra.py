@@ -457,8 +457,9 @@ def commensurate_record(
     NotCommensurateError
         (a ValueError) for frequencies not commensurate within ``rtol`` with ``q <=
         max_denominator``, or ``T / dt`` not an integer within ``rtol``.
+        Also when ``n_available`` holds no whole common period (e.g. 70 and 81 Hz: T = 1 s).
     ValueError
-        For bad inputs, or a record that does not fit in ``n_available``.
+        For bad inputs, or ``n_periods`` that do not fit in ``n_available``.
     """
     f_L = checks.positive("f_L", f_L, "Hz")
     f_H = checks.positive("f_H", f_H, "Hz")
@@ -491,9 +492,9 @@ def commensurate_record(
         k = 1 if n_periods is None else int(n_periods)
     else:
         k_max = int(n_available) // spp
-        if k_max < 1:
-            checks.fail("n_available", n_available, f"must hold at least one common period T = {period!r} s = "
-                        f"{spp} samples")
+        if k_max < 1:  # no common period on this record: a window must be used (settled_spectrum falls back)
+            raise NotCommensurateError("n_available", n_available, f"must hold at least one common period T = "
+                                       f"{period!r} s = {spp} samples")
         if n_periods is None:
             k = k_max
         elif n_periods > k_max:
