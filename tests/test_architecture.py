@@ -23,8 +23,9 @@ LAYERS = {
     "rotorred.transient": 3,
     "rotorred.plots": 4,
     "rotorred.scenes": 5,
-    "rotorred.cli": 6,
-    "rotorred": 7,
+    "rotorred.maps": 6,
+    "rotorred.cli": 7,
+    "rotorred": 8,
 }
 #: where matplotlib may be imported
 MATPLOTLIB_ALLOWED = ("rotorred.plots", "rotorred.cli")

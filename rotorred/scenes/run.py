@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rotorred import checks
 from rotorred.model.assembly import assemble
 from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.signals.lines import label_lines
@@ -139,6 +140,9 @@ class SceneResult:
         result and for the normal comparison.
     analysis_errors : dict of (int, str) to str
         Why a DOF has no analysis (e.g. a record too short to fit), one line each.
+    final : rotorred.transient.results.FinalState or None
+        State at the end of a transient (model coordinates), the start of a continuation; None
+        for the harmonic solution.
     """
 
     scene: Scene
@@ -159,6 +163,7 @@ class SceneResult:
     incomplete: str | None = None
     analyses: dict = field(default_factory=dict)
     analysis_errors: dict = field(default_factory=dict)
+    final: object = None
 
     @property
     def analysis(self) -> LineAnalysis | None:
@@ -302,7 +307,7 @@ def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- run
 def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: bool | None = None,
-              progress: bool | None = False, analyse: bool = True) -> SceneResult:
+              progress: bool | None = False, analyse: bool = True, initial=None) -> SceneResult:
     """Compute a scene's response, spectra and labelled lines.
 
     Parameters
@@ -318,6 +323,9 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     analyse : bool
         Line fit, settling and class of the table DOF (:func:`analyse_lines`; not counted in
         ``solve_time``).
+    initial : (ndarray, ndarray), optional
+        Start state (q0, v0) in model coordinates, shape (n,) each, in place of ``solver.start``
+        (a continuation from another run's ``final``); the transient is then always stepped.
 
     Returns
     -------
@@ -329,10 +337,10 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
         raise ValueError("`model` was built for a different rotor, solver model or rub nodes than `scene`")
     f_L, f_H = spool_frequencies(scene)
     t0 = time.perf_counter()
-    if scene.is_linear and scene.solver.start == "settled":
+    if scene.is_linear and scene.solver.start == "settled" and initial is None:
         response = _harmonic_response(scene, model.model)
     else:
-        response = _transient_response(scene, model, progress, f_L, f_H)
+        response = _transient_response(scene, model, progress, f_L, f_H, initial)
     spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
     analyses, errors = {}, {}
@@ -353,7 +361,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
                        spectra=spectra, lines=lines, f_L=f_L, f_H=f_H, method=response.method,
                        model_label=model.label, n_steps=response.n_steps, build_time=model.build_time,
                        solve_time=solve_time, normal=normal, counters=response.counters, analyses=analyses,
-                       analysis_errors=errors)
+                       analysis_errors=errors, final=response.final)
 
 
 def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: int | None = None,
@@ -388,6 +396,7 @@ class _Response:
     method: str
     n_steps: int
     counters: dict
+    final: object = None
 
 
 def _harmonic_response(scene: Scene, model) -> _Response:
@@ -399,7 +408,7 @@ def _harmonic_response(scene: Scene, model) -> _Response:
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,
-                        f_H: float) -> _Response:
+                        f_H: float, initial=None) -> _Response:
     """Time stepping from the settled linear state or from rest (:func:`rotorred.transient.newmark.simulate`).
 
     Raises :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
@@ -408,7 +417,11 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
     from rotorred.transient.results import SimulationDiverged
 
     s, model = scene.solver, scene_model.model
-    q0, v0 = settled_state(scene, model) if s.start == "settled" else (None, None)
+    if initial is not None:
+        q0, v0 = (checks.vector(name, v, min_len=model.M.shape[0], max_len=model.M.shape[0])
+                  for name, v in zip(("initial q0", "initial v0"), initial))
+    else:
+        q0, v0 = settled_state(scene, model) if s.start == "settled" else (None, None)
     kw = {"alpha": s.alpha} if s.method == "hht" else {}
     try:
         res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
@@ -416,7 +429,7 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
                        gravity=s.gravity or None, q0=q0, v0=v0, progress=progress, **kw)
     except SimulationDiverged as exc:
         raise SceneDiverged.of(scene, scene_model, exc, f_L, f_H) from None
-    return _Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res))
+    return _Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res), res.final)
 
 
 def _counters(res) -> dict:

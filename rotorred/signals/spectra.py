@@ -60,11 +60,28 @@ import numpy as np
 
 from rotorred import checks
 
-try:  # optional: the spectra fall back to numpy.fft (same values, slower for long records)
-    import pyfftw
-    import pyfftw.builders
-except ImportError:
-    pyfftw = None
+
+def _import_pyfftw():
+    """pyFFTW's builders, or None when it is not installed (the spectra then use numpy.fft).
+
+    ``import pyfftw`` also imports dask.array (1.2 s) when dask is installed, for an interface
+    rotorred does not use; dask is hidden from it unless something has imported dask already.
+    """
+    hide = "dask" not in sys.modules
+    if hide:
+        sys.modules["dask"] = None  # `import dask` raises ImportError: pyfftw skips its dask interface
+    try:
+        import pyfftw
+        import pyfftw.builders
+    except ImportError:
+        return None
+    finally:
+        if hide and sys.modules.get("dask", False) is None:
+            del sys.modules["dask"]
+    return pyfftw
+
+
+pyfftw = _import_pyfftw()  # optional: the spectra fall back to numpy.fft (same values, slower for long records)
 
 #: the one-line note printed (once per process) when pyFFTW is missing
 NO_PYFFTW_NOTE = ("rotorred: pyFFTW is not installed; spectra use numpy.fft "

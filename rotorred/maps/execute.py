@@ -1,0 +1,155 @@
+"""Running a map: its chains of points, serially or on a Dask cluster, written as they finish.
+
+Serial (``client=None``)
+    Chains one after the other in this process.
+
+Dask (``client`` a :class:`distributed.Client`)
+    Each point is one task that depends on the previous point of its chain (it takes that
+    point's final state), so a chain runs in order while chains run side by side; Dask keeps a
+    chain's tasks on the worker that holds its previous result. The structural model of each
+    model key is built once, here, and scattered to every worker (``broadcast=True``), not
+    rebuilt per point; each worker process loads the compiled kernels once (numba's on-disk
+    cache). A worker that dies has its tasks (and any lost result they need) recomputed by Dask
+    on another worker: every point is deterministic, so the dataset is the same.
+
+Both write each point (:class:`rotorred.maps.store.PointStore`) as soon as it has finished and
+skip the points already on disk: a map that was interrupted resumes where it stopped, each
+resumed chain from its last finished point's final state. ``on_point`` is called after each
+point (the progress bar).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from rotorred.maps.point import PointResult, StartState, run_point
+from rotorred.maps.spec import Chain, MapSpec
+from rotorred.maps.store import PointStore
+from rotorred.scenes.run import SceneModel, build_model, model_key
+
+__all__ = ["run_points", "local_cluster", "connect"]
+
+
+def _models(spec: MapSpec) -> dict:
+    """One structural model per model key of the grid (most maps: one)."""
+    models = {}
+    for scene in spec.scenes():
+        key = model_key(scene)
+        if key not in models:
+            models[key] = build_model(scene)
+    return models
+
+
+def _pending(spec: MapSpec, chain: Chain, done: dict) -> tuple[list, StartState | None]:
+    """The chain's points not yet on disk, and the start state of the first of them."""
+    points = chain.points()
+    start = None
+    for k, point in enumerate(points):
+        if point not in done:
+            return points[k:], None if spec.cold else start
+        start = done[point].final
+    return [], None
+
+
+#: models as this process uses them, one per model key (a worker's copy of a scattered model)
+_MODELS: dict = {}
+
+
+def _local(model: SceneModel) -> SceneModel:
+    """This process's copy of ``model``, made once per model key.
+
+    Dask delivers a scattered model's arrays in its message buffers, which need not be 8-byte
+    aligned; LAPACK (``scipy.linalg.solve``) refuses unaligned arrays. A deep copy is aligned.
+    """
+    import copy
+
+    if model.key not in _MODELS:
+        _MODELS[model.key] = copy.deepcopy(model)
+    return _MODELS[model.key]
+
+
+def _point_task(scene, model: SceneModel, previous, cold: bool) -> PointResult:
+    """Run one point from the previous point's final state (a StartState, a PointResult, or None)."""
+    start = previous.final if isinstance(previous, PointResult) else previous
+    return run_point(scene, _local(model), None if cold else start)
+
+
+def run_points(spec: MapSpec, store: PointStore, client=None,
+               on_point: Callable[[str, tuple, PointResult], None] | None = None) -> dict:
+    """Run every point of ``spec`` not yet in ``store``; return all finished points.
+
+    Returns
+    -------
+    dict of (direction, index) to PointResult
+    """
+    done = store.read()
+    models = _models(spec)
+    report = on_point or (lambda *_: None)
+    if client is None:
+        return _run_serial(spec, store, models, done, report)
+    return _run_dask(spec, store, client, models, done, report)
+
+
+def _run_serial(spec: MapSpec, store: PointStore, models: dict, done: dict, report) -> dict:
+    """The chains one after the other, BLAS on one thread as on a worker (the same arithmetic, so the
+    same answer to the last bit: a chaotic point amplifies a rounding difference e^(lambda t))."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        for chain in spec.chains():
+            points, start = _pending(spec, chain, done)
+            for direction, index in points:
+                scene = spec.scene_at(index)
+                p = _point_task(scene, models[model_key(scene)], start, spec.cold)
+                store.write(direction, index, p)
+                done[(direction, index)] = p
+                report(direction, index, p)
+                start = p.final
+    return done
+
+
+def _run_dask(spec: MapSpec, store: PointStore, client, models: dict, done: dict, report) -> dict:
+    from distributed import as_completed
+
+    scattered = {key: client.scatter(m, broadcast=True) for key, m in models.items()}
+    futures = {}
+    for chain in spec.chains():
+        points, start = _pending(spec, chain, done)
+        previous = start
+        for direction, index in points:
+            scene = spec.scene_at(index)
+            previous = client.submit(_point_task, scene, scattered[model_key(scene)], previous, spec.cold, pure=False)
+            futures[previous] = (direction, index)
+    for future in as_completed(futures):
+        direction, index = futures[future]
+        p = future.result()
+        store.write(direction, index, p)
+        done[(direction, index)] = p
+        report(direction, index, p)
+    return done
+
+
+def local_cluster(n_workers: int | None = None):
+    """A :class:`distributed.LocalCluster` with one single-threaded worker process per core, BLAS pinned to
+    one thread, and its client."""
+    import os
+
+    from distributed import Client, LocalCluster
+
+    n = n_workers or os.cpu_count() or 1
+    one = {v: "1" for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")}
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, env=one)
+    return Client(cluster)
+
+
+def connect(address: str, timeout: float = 10.0):
+    """A client of the scheduler at ``address``; a clear error after ``timeout`` s when it cannot be reached."""
+    from distributed import Client
+
+    from rotorred import checks
+
+    try:
+        return Client(address, timeout=f"{timeout}s")
+    except (OSError, TimeoutError) as exc:
+        checks.fail("--scheduler", address, f"must be a reachable Dask scheduler address (tcp://host:port); "
+                    f"none answered within {timeout:g} s ({type(exc).__name__})")

@@ -1,0 +1,173 @@
+"""What a map varies: a scene, one or more keys over a grid, the sweep direction and the start.
+
+A map runs a scene at every point of a grid of scene keys (:func:`rotorred.scenes.schema.apply_settings`
+names, e.g. ``speeds.outer`` in Hz or ``rub.clearance`` in m). The first key is the
+**continuation axis**: along it, each point starts from its neighbour's final state (unless
+``cold``), up, down or both ways; every combination of the other keys is one such **chain**.
+
+Every point's scene is loaded and validated when the :class:`MapSpec` is checked
+(:meth:`MapSpec.scenes`), before any worker starts, so a bad key or value is refused with the
+scene's own message naming the key.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rotorred import checks
+from rotorred.scenes.schema import Scene, load_scene
+
+__all__ = ["Axis", "MapSpec", "Chain", "DIRECTIONS", "axis_unit"]
+
+#: sweep directions along the continuation axis
+DIRECTIONS = ("up", "down", "both")
+
+#: how the varied keys are shown: (scale from SI to the shown unit, unit) by key suffix
+_SHOWN = {"clearance": (1e6, "µm"), "speeds": (1.0, "Hz"), "m_e": (1e6, "g mm")}
+
+
+def axis_unit(key: str) -> tuple[float, str]:
+    """(scale, unit) in which a varied key is shown: µm for a clearance, Hz for a speed, else SI."""
+    section, _, name = key.rpartition(".")
+    for part in (name, section.split("[")[0]):
+        if part in _SHOWN:
+            return _SHOWN[part]
+    return 1.0, ""
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One varied key and its values (scene units: Hz for speeds, m for a clearance)."""
+
+    key: str
+    values: tuple[float, ...]
+
+    def __post_init__(self):
+        checks.string("--vary", self.key)
+        values = tuple(checks.vector(f"--vary {self.key}", list(self.values), min_len=1))
+        if len(set(values)) != len(values):
+            checks.fail(f"--vary {self.key}", list(values), "must not repeat a value")
+        object.__setattr__(self, "values", values)
+
+    @property
+    def label(self) -> str:
+        scale, unit = axis_unit(self.key)
+        return f"{self.key} ({unit})" if unit else self.key
+
+
+@dataclass(frozen=True)
+class Chain:
+    """Points run in order, each from the previous one's final state (continuation).
+
+    ``direction`` is "up" or "down"; ``index`` the grid index of the other axes; ``order`` the
+    continuation-axis indices in the order run.
+    """
+
+    direction: str
+    index: tuple[int, ...]
+    order: tuple[int, ...]
+
+    def points(self) -> list[tuple[str, tuple[int, ...]]]:
+        """(direction, full grid index) of each point, in the order run."""
+        return [(self.direction, (i, *self.index)) for i in self.order]
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """A map: a scene, the varied axes (the first is the continuation axis), fixed settings.
+
+    Attributes
+    ----------
+    scene : str
+        Built-in scene name or scene file.
+    axes : tuple of Axis
+        Varied keys, at least one; the first is the continuation axis.
+    settings : tuple of (str, value)
+        Fixed overrides of the scene (``--set``).
+    ratios : tuple of (str, float)
+        ``(spool, r)``: that spool turns at ``r`` times the varied speed (``--ratio``); only with a
+        ``speeds.<spool>`` continuation axis.
+    direction : {"up", "down", "both"}
+    cold : bool
+        Every point from the scene's own start (no continuation).
+    """
+
+    scene: str
+    axes: tuple[Axis, ...]
+    settings: tuple = ()
+    ratios: tuple = ()
+    direction: str = "up"
+    cold: bool = False
+    _scenes: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self):
+        if isinstance(self.scene, Path):
+            object.__setattr__(self, "scene", str(self.scene))
+        checks.string("scene", self.scene)
+        if not self.axes:
+            checks.fail("--vary", [], "must give at least one key to vary, e.g. --vary speeds.outer=60:110:51")
+        keys = [a.key for a in self.axes]
+        if len(set(keys)) != len(keys):
+            checks.fail("--vary", keys, "must name each key once")
+        fixed = {k for k, _ in self.settings}
+        if fixed & set(keys):
+            checks.fail("--set", sorted(fixed & set(keys)), "must not fix a key that --vary varies")
+        checks.choice("--direction", self.direction, DIRECTIONS)
+        self._check_ratios()
+
+    def _check_ratios(self) -> None:
+        if not self.ratios:
+            return
+        key = self.axes[0].key
+        if not key.startswith("speeds."):
+            checks.fail("--ratio", dict(self.ratios), f"must go with a speeds.<spool> continuation axis, not {key!r}")
+        for spool, r in self.ratios:
+            checks.positive(f"--ratio {spool}", r)
+            if f"speeds.{spool}" == key or any(a.key == f"speeds.{spool}" for a in self.axes):
+                checks.fail("--ratio", spool, "must name a spool that --vary does not vary")
+
+    # ------------------------------------------------------------------ grid
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(a.values) for a in self.axes)
+
+    @property
+    def directions(self) -> tuple[str, ...]:
+        return ("up", "down") if self.direction == "both" else (self.direction,)
+
+    @property
+    def n_points(self) -> int:
+        return math.prod(self.shape) * len(self.directions)
+
+    def settings_at(self, index: tuple[int, ...]) -> dict:
+        """The scene overrides of grid point ``index``: fixed settings, varied keys, ratio-bound speeds."""
+        out = dict(self.settings)
+        for axis, i in zip(self.axes, index):
+            out[axis.key] = axis.values[i]
+        for spool, r in self.ratios:
+            out[f"speeds.{spool}"] = r * self.axes[0].values[index[0]]
+        return out
+
+    def scene_at(self, index: tuple[int, ...]) -> Scene:
+        """The validated scene of grid point ``index`` (loaded once)."""
+        index = tuple(index)
+        if index not in self._scenes:
+            self._scenes[index] = load_scene(self.scene, self.settings_at(index))
+        return self._scenes[index]
+
+    def scenes(self) -> list[Scene]:
+        """Every grid point's scene, validated (raises the scene's error naming the key)."""
+        return [self.scene_at(ix) for ix in itertools.product(*(range(n) for n in self.shape))]
+
+    def chains(self) -> list[Chain]:
+        """The chains along the continuation axis: one per direction and combination of the other axes."""
+        n0 = self.shape[0]
+        out = []
+        for direction in self.directions:
+            order = tuple(range(n0)) if direction == "up" else tuple(reversed(range(n0)))
+            for rest in itertools.product(*(range(n) for n in self.shape[1:])):
+                out.append(Chain(direction, tuple(rest), order))
+        return out

@@ -1,0 +1,179 @@
+"""A map's points on disk, written one by one as they finish, and the labelled dataset built from them.
+
+Layout of ``--out``
+    ``points/<direction>/<i>_<j>....npz``: one file per finished point (written atomically by
+    :func:`rotorred.writers.write_npz`, so a killed run leaves whole files only), with the
+    state the next point of its chain starts from. ``spec.json`` names the map the points belong
+    to: a run into a folder holding another map's points is refused, the same map resumes.
+    ``map.nc``, ``map.csv``, ``map_lines.csv`` and the figures are rebuilt from the points.
+
+Dataset (:func:`to_dataset`, xarray)
+    Dimensions: ``direction`` ("up", "down"), one per varied key (named by the key, values in
+    the scene's units), ``line`` (strongest first), ``sample`` (Poincare samples, the last ones)
+    and ``node`` (output nodes). Points not run (yet) are missing: status "", NaN, -1. Every
+    variable carries ``units`` and ``long_name``; the dataset carries the scene, the fixed
+    settings and the table DOF as attributes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult, StartState
+from rotorred.maps.spec import MapSpec, axis_unit
+from rotorred.writers import write_csv, write_npz, write_text
+
+__all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
+
+#: the per-point scalars: name -> (dtype, missing value, units, long name)
+SCALARS = {
+    "status": ("U8", "", "", "ok, diverged or failed"),
+    "reason": ("U1000", "", "", "why the point has no results"),
+    "kind": ("U14", "", "", "response class of the table DOF"),
+    "subharmonic": ("i8", -1, "", "k of a period-k response"),
+    "period": ("f8", np.nan, "s", "period of a periodic response"),
+    "settling_time": ("f8", np.nan, "s", "measured settling time (NaN: not settled)"),
+    "explained_share": ("f8", np.nan, "1", "share of the energy the labelled lines explain"),
+    "torus_k": ("i8", -1, "", "sub-harmonic order of f_H"),
+    "torus_j": ("i8", -1, "", "sub-harmonic order of f_L"),
+    "poincare_frequency": ("f8", np.nan, "Hz", "Poincare section frequency"),
+    "contact_fraction": ("f8", np.nan, "1", "fraction of the record in contact (first plate)"),
+    "n_impacts": ("i8", -1, "", "contact onsets in the record (first plate)"),
+    "max_contact_force": ("f8", np.nan, "N", "largest normal contact force (first plate)"),
+    "start": ("U4", "", "", "cold (scene's start) or warm (neighbour's final state)"),
+    "wall_time": ("f8", np.nan, "s", "wall time of the point"),
+}
+#: per-point vectors: name -> (dimension, length, dtype, missing, units, long name)
+VECTORS = {
+    "line_frequency": ("line", N_LINES, "f8", np.nan, "Hz", "labelled line frequency"),
+    "line_amplitude": ("line", N_LINES, "f8", np.nan, "m", "labelled line amplitude"),
+    "line_phase": ("line", N_LINES, "f8", np.nan, "rad", "labelled line phase"),
+    "line_label": ("line", N_LINES, "U40", "", "", "labelled line combination"),
+    "poincare_x": ("sample", N_SAMPLES, "f8", np.nan, "m", "Poincare samples of the table DOF"),
+    "poincare_velocity": ("sample", N_SAMPLES, "f8", np.nan, "m/s", "Poincare samples of its velocity"),
+}
+
+
+def _point_name(direction: str, index: tuple[int, ...]) -> str:
+    return f"{direction}/" + "_".join(str(i) for i in index) + ".npz"
+
+
+def _arrays(p: PointResult) -> dict:
+    arrays = {name: np.array(getattr(p, name)) for name in SCALARS if name not in ("torus_k", "torus_j")}
+    arrays.update(torus_k=np.array(p.torus[0]), torus_j=np.array(p.torus[1]), peak_orbit=p.peak_orbit,
+                  **{name: np.asarray(getattr(p, name)) for name in VECTORS})
+    if p.final is not None:
+        arrays.update(final_q=p.final.q, final_v=p.final.v, final_phases=np.array(p.final.phases))
+    return arrays
+
+
+def _point(arrays) -> PointResult:
+    final = (StartState(arrays["final_q"], arrays["final_v"], tuple(arrays["final_phases"]))
+             if "final_q" in arrays else None)
+    scalars = {name: arrays[name].item() for name in SCALARS if name not in ("torus_k", "torus_j")}
+    vectors = {name: arrays[name] for name in VECTORS}
+    vectors["line_label"] = tuple(str(s) for s in vectors["line_label"])
+    return PointResult(**scalars, **vectors, torus=(int(arrays["torus_k"]), int(arrays["torus_j"])),
+                       peak_orbit=arrays["peak_orbit"], final=final)
+
+
+class PointStore:
+    """The finished points of one map in ``folder/points``: written as they finish, read back on resume."""
+
+    def __init__(self, folder: str | Path, spec: MapSpec):
+        self.root = Path(folder) / "points"
+        self.spec = spec
+        self._check_spec()
+
+    def _identity(self) -> str:
+        s = self.spec
+        return json.dumps({"scene": s.scene, "axes": [[a.key, list(a.values)] for a in s.axes],
+                           "settings": [[k, repr(v)] for k, v in s.settings], "ratios": [list(r) for r in s.ratios],
+                           "cold": s.cold}, sort_keys=True)
+
+    def _check_spec(self) -> None:
+        from rotorred import checks
+
+        path = self.root / "spec.json"
+        if path.exists() and path.read_text(encoding="utf-8") != self._identity():
+            checks.fail("--out", str(self.root.parent), "holds the points of a different map (points/spec.json); "
+                        "choose another --out or remove its points/ folder")
+
+    def write(self, direction: str, index: tuple[int, ...], point: PointResult) -> Path:
+        """Write one finished point (atomically)."""
+        path = self.root / _point_name(direction, index)
+        if not (self.root / "spec.json").exists():
+            write_text(self.root / "spec.json", self._identity())
+        return write_npz(path, _arrays(point))
+
+    def read(self) -> dict:
+        """Every finished point: {(direction, index): PointResult}."""
+        out = {}
+        for direction in ("up", "down"):
+            for path in sorted((self.root / direction).glob("*.npz")):
+                index = tuple(int(i) for i in path.stem.split("_"))
+                with np.load(path) as arrays:
+                    out[(direction, index)] = _point(dict(arrays))
+        return out
+
+
+def _padded(values, n: int, dtype: str, missing):
+    out = np.full(n, missing, dtype=dtype)
+    values = np.asarray(values)[:n]
+    out[:values.size] = values
+    return out
+
+
+def to_dataset(spec: MapSpec, points: dict, nodes: tuple[int, ...], attrs: dict | None = None):
+    """The labelled dataset of a map's points (module docstring), missing points left blank."""
+    import xarray as xr
+
+    dirs = spec.directions
+    shape = (len(dirs), *spec.shape)
+    dims = ("direction", *(a.key for a in spec.axes))
+    data = {name: np.full(shape, missing, dtype=dtype) for name, (dtype, missing, *_) in SCALARS.items()}
+    data.update({name: np.full((*shape, n), missing, dtype=dtype) for name, (_, n, dtype, missing, *_) in VECTORS.items()})
+    data["peak_orbit"] = np.full((*shape, len(nodes)), np.nan)
+    for (direction, index), p in points.items():
+        at = (dirs.index(direction), *index)
+        arrays = _arrays(p)
+        for name in SCALARS:
+            data[name][at] = arrays[name]
+        for name, (_, n, dtype, missing, *_) in VECTORS.items():
+            data[name][at] = _padded(arrays[name], n, dtype, missing)
+        data["peak_orbit"][at] = p.peak_orbit
+    variables = {name: (dims, data[name], {"units": u, "long_name": ln}) for name, (_, _, u, ln) in SCALARS.items()}
+    variables.update({name: ((*dims, dim), data[name], {"units": u, "long_name": ln})
+                      for name, (dim, _, _, _, u, ln) in VECTORS.items()})
+    variables["peak_orbit"] = ((*dims, "node"), data["peak_orbit"], {"units": "m", "long_name": "largest orbit radius"})
+    coords = {"direction": list(dirs), "node": list(nodes)}
+    for a in spec.axes:
+        scale, unit = axis_unit(a.key)
+        coords[a.key] = (a.key, np.array(a.values), {"units": "Hz" if unit == "Hz" else "SI", "long_name": a.key})
+    return xr.Dataset(variables, coords=coords, attrs=dict(attrs or {}))
+
+
+def write_tables(ds, folder: Path) -> list[Path]:
+    """``map.csv`` (one row per point) and ``map_lines.csv`` (one row per point and line), tidy."""
+    keys = [k for k in ds.dims if k not in ("direction", "line", "sample", "node")]
+    flat = ds.drop_dims(["line", "sample", "node"]).to_dataframe().reset_index()
+    flat = flat[flat["status"] != ""]
+    header = [f"{c} ({ds[c].attrs['units']})" if c in ds and ds[c].attrs.get("units") not in (None, "", "SI")
+              else c for c in flat.columns]
+    orbit = ds["peak_orbit"].stack(point=("direction", *keys)).transpose("point", "node")
+    done = (ds["status"] != "").stack(point=("direction", *keys)).values
+    extra = [f"peak orbit node {n} (um)" for n in ds["node"].values]
+    columns = [flat[c].to_numpy() for c in flat.columns] + [1e6 * orbit.values[done, i] for i in range(len(extra))]
+    files = [write_csv(folder / "map.csv", header + extra, columns)]
+    lines = ds[["line_frequency", "line_amplitude", "line_phase", "line_label"]].to_dataframe().reset_index()
+    lines = lines[lines["line_label"] != ""]
+    lines["line_amplitude"] *= 1e6
+    header = [c for c in lines.columns if c != "line"]
+    named = {"line_frequency": "frequency (Hz)", "line_amplitude": "amplitude (um)", "line_phase": "phase (rad)",
+             "line_label": "label"}
+    files.append(write_csv(folder / "map_lines.csv", [named.get(c, c) for c in header],
+                           [lines[c].to_numpy() for c in header]))
+    return files

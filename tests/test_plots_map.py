@@ -1,0 +1,190 @@
+"""Map figures (bifurcation diagram, waterfall, heat map) write legible PNGs from NaN-padded arrays;
+bad inputs are refused with the one message form."""
+
+import matplotlib.colors
+import matplotlib.image
+import numpy as np
+import pytest
+from matplotlib import colormaps
+
+from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_waterfall
+from rotorred.signals.classify import KINDS
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+SPEEDS = np.linspace(60.0, 110.0, 26)  # outer spool speed (Hz)
+S = 40  # Poincaré samples per point, NaN-padded
+VIRIDIS_TOP, VIRIDIS_BOTTOM = colormaps["viridis"](1.0)[:3], colormaps["viridis"](0.0)[:3]
+
+
+def _pixels(path, colour, plot_area=False) -> int:
+    """Pixels of ``colour`` in the PNG (within 0.1 in RGB); with ``plot_area`` only in the left 70 % of
+    the image, which holds the axes but not the colour bar."""
+    rgb = matplotlib.image.imread(path)[..., :3]
+    if plot_area:
+        rgb = rgb[:, : int(0.7 * rgb.shape[1])]
+    target = np.array(matplotlib.colors.to_rgb(colour))
+    return int(np.sum(np.linalg.norm(rgb - target, axis=-1) < 0.1))
+
+
+def _assert_png(path, colours=(), plot_area=False):
+    """A PNG, bigger than empty labelled axes, in which each of ``colours`` covers >= 300 pixels."""
+    data = path.read_bytes()
+    assert data[:8] == PNG_SIGNATURE
+    assert len(data) > 20_000
+    for colour in colours:
+        n = _pixels(path, colour, plot_area)
+        assert n >= 300, (colour, n)
+
+
+def _poincare(shift=0.0):
+    """Period-1 below 80 Hz, period-2 to 95 Hz, a quasi-periodic smear above (m), NaN-padded to S."""
+    out = np.full((SPEEDS.size, S), np.nan)
+    for i, f in enumerate(SPEEDS):
+        if f < 80.0 + shift:
+            out[i, :5] = 20e-6
+        elif f < 95.0 + shift:
+            out[i, :6] = np.resize([15e-6, 30e-6], 6)
+        else:
+            out[i] = 25e-6 + 10e-6 * np.sin(2.4 * np.arange(S))
+    return out
+
+
+def test_class_colours_name_every_class_and_failed():
+    assert set(CLASS_COLOURS) == set(KINDS) | {"failed"}
+    rgb = {matplotlib.colors.to_hex(c) for c in CLASS_COLOURS.values()}
+    assert len(rgb) == len(CLASS_COLOURS)
+
+
+def test_plot_bifurcation_up_and_down(tmp_path):
+    down = _poincare(shift=-4.0)
+    down[3] = np.nan  # a failed run
+    out = plot_bifurcation(SPEEDS, {"up": _poincare(), "down": down}, tmp_path / "sub" / "bifurcation.png",
+                           xlabel="Outer spool speed (Hz)", title="Bifurcation")
+    assert out == tmp_path / "sub" / "bifurcation.png"
+    _assert_png(out, ["tab:blue", "tab:red"], plot_area=True)
+
+
+def test_plot_bifurcation_xscale_and_all_failed(tmp_path):
+    clearances = np.linspace(0.0, 45e-6, 10)
+    out = plot_bifurcation(clearances, {"up": np.full((10, 3), np.nan)}, tmp_path / "failed.png",
+                           xlabel="Rub clearance (µm)", xscale=1e6)
+    _assert_png(out)
+    assert _pixels(out, "tab:blue", plot_area=True) < 50  # nothing drawn but the legend marker
+
+
+def test_plot_bifurcation_refuses_bad_input(tmp_path):
+    bad = tmp_path / "bad.png"
+    with pytest.raises(ValueError, match=r"^samples\['up'\] = array of shape \(25, 40\): must have shape \(26, S\) "
+                                         r"\(m\)$"):
+        plot_bifurcation(SPEEDS, {"up": _poincare()[1:]}, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^samples\['down'\] = array of shape \(26,\): must have shape \(26, S\) "
+                                         r"\(m\)$"):
+        plot_bifurcation(SPEEDS, {"up": _poincare(), "down": np.zeros(26)}, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^samples = \{\}: must be a non-empty mapping sweep label -> array "
+                                         r"\(n, S\)$"):
+        plot_bifurcation(SPEEDS, {}, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^samples\['up'\] = array of shape \(26, 40\): must hold finite numbers or "
+                                         r"NaN \(padding\) only \(m\)$"):
+        plot_bifurcation(SPEEDS, {"up": np.where(np.isnan(_poincare()), np.inf, _poincare())}, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^values = \[\]: must be a 1-D array of at least 1 value$"):
+        plot_bifurcation([], {"up": np.zeros((0, 1))}, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^scale = 0: must be > 0$"):
+        plot_bifurcation(SPEEDS, {"up": _poincare()}, bad, xlabel="x", scale=0)
+    with pytest.raises(ValueError, match=r"^path = .*no_extension': must have a file extension \(e.g. .png\)$"):
+        plot_bifurcation(SPEEDS, {"up": _poincare()}, tmp_path / "no_extension", xlabel="x")
+    assert not bad.exists()
+
+
+def _lines():
+    """Per speed f: 1x at f (strong), 2x (weaker), a combination at 1.5x (weak), NaN-padded to 6 lines;
+    the point at index 5 failed (all NaN)."""
+    f = np.full((SPEEDS.size, 6), np.nan)
+    a = np.full_like(f, np.nan)
+    f[:, :3] = SPEEDS[:, None] * [1.0, 2.0, 1.5]
+    a[:, :3] = [50e-6, 5e-6, 1e-12]  # the weakest below the colour range: lowest colour
+    f[5], a[5] = np.nan, np.nan
+    return f, a
+
+
+def test_plot_waterfall(tmp_path):
+    f, a = _lines()
+    out = plot_waterfall(SPEEDS, f, a, tmp_path / "waterfall.png", xlabel="Outer spool speed (Hz)", f_max=400.0,
+                         orders={"1× outer": 1.0, "2× outer": 2.0, "3× outer": 3.0}, title="Waterfall")
+    _assert_png(out, [VIRIDIS_TOP, VIRIDIS_BOTTOM], plot_area=True)  # strongest and weakest lines
+    plain = plot_waterfall(SPEEDS, f, a, tmp_path / "plain.png", xlabel="Outer spool speed (Hz)", f_max=400.0)
+    assert _pixels(out, "0.35", plot_area=True) > _pixels(plain, "0.35", plot_area=True) + 200  # the order lines
+    empty = plot_waterfall(SPEEDS[:2], np.full((2, 3), np.nan), np.full((2, 3), np.nan), tmp_path / "empty.png",
+                           xlabel="Outer spool speed (Hz)", orders={"1×": 1.0})
+    assert empty.read_bytes()[:8] == PNG_SIGNATURE
+
+
+def test_plot_waterfall_refuses_bad_input(tmp_path):
+    f, a = _lines()
+    bad = tmp_path / "bad.png"
+    with pytest.raises(ValueError, match=r"^amplitudes = array of shape \(26, 5\): must have shape \(26, 6\) \(m\)$"):
+        plot_waterfall(SPEEDS, f, a[:, :5], bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^frequencies = array of shape \(25, 6\): must have shape \(26, L\) \(Hz\)$"):
+        plot_waterfall(SPEEDS, f[1:], a, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^amplitudes = array of shape \(26, 6\): must hold values >= 0 or NaN "
+                                         r"\(padding\) only \(m\)$"):
+        plot_waterfall(SPEEDS, f, -a, bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^f_max = 0: must be > 0 \(Hz\)$"):
+        plot_waterfall(SPEEDS, f, a, bad, xlabel="x", f_max=0)
+    with pytest.raises(ValueError, match=r"^orders\['1×'\] = -1.0: must be > 0 \(Hz per unit of values\)$"):
+        plot_waterfall(SPEEDS, f, a, bad, xlabel="x", orders={"1×": -1.0})
+    with pytest.raises(ValueError, match=r"^dynamic_range = 1: must be > 1$"):
+        plot_waterfall(SPEEDS, f, a, bad, xlabel="x", dynamic_range=1)
+    assert not bad.exists()
+
+
+CLEARANCES = np.array([0.0, 5e-6, 10e-6, 20e-6, 45e-6])  # non-uniform (m)
+SPEEDS_2D = np.array([60.0, 70.0, 80.0, 90.0, 100.0, 110.0])
+
+
+def test_plot_heatmap_classes(tmp_path):
+    names = list(CLASS_COLOURS)
+    z = np.arange(CLEARANCES.size * SPEEDS_2D.size).reshape(CLEARANCES.size, SPEEDS_2D.size) % len(names)
+    full = plot_heatmap(SPEEDS_2D, CLEARANCES, z, tmp_path / "classes.png", xlabel="Outer spool speed (Hz)",
+                        ylabel="Rub clearance (µm)", zlabel="Response class", yscale=1e6, categories=names)
+    _assert_png(full, CLASS_COLOURS.values(), plot_area=True)
+    z[0, :] = -1  # missing points are blank
+    gaps = plot_heatmap(SPEEDS_2D, CLEARANCES, z, tmp_path / "gaps.png", xlabel="Outer spool speed (Hz)",
+                        ylabel="Rub clearance (µm)", zlabel="Response class", yscale=1e6, categories=names)
+    assert _pixels(gaps, "white", plot_area=True) > _pixels(full, "white", plot_area=True) + 5_000
+
+
+def test_plot_heatmap_continuous_single_row_and_nan(tmp_path):
+    z = np.linspace(0.0, 1.0, CLEARANCES.size * SPEEDS_2D.size).reshape(CLEARANCES.size, SPEEDS_2D.size)
+    full = plot_heatmap(SPEEDS_2D, CLEARANCES, z, tmp_path / "contact.png", xlabel="Outer spool speed (Hz)",
+                        ylabel="Rub clearance (µm)", zlabel="Contact fraction (-)", yscale=1e6)
+    _assert_png(full, [VIRIDIS_TOP, VIRIDIS_BOTTOM], plot_area=True)
+    z[2, 3] = z[4, :] = np.nan
+    holes = plot_heatmap(SPEEDS_2D, CLEARANCES, z, tmp_path / "holes.png", xlabel="Outer spool speed (Hz)",
+                         ylabel="Rub clearance (µm)", zlabel="Contact fraction (-)", yscale=1e6)
+    assert _pixels(holes, "white", plot_area=True) > _pixels(full, "white", plot_area=True) + 5_000
+    row = plot_heatmap(SPEEDS_2D[::-1], [20e-6], z[1:2], tmp_path / "row.png", xlabel="Outer spool speed (Hz)",
+                       ylabel="Rub clearance (µm)", zlabel="Contact fraction (-)", yscale=1e6)
+    _assert_png(row)
+    blank = plot_heatmap([60.0], [20e-6], [[np.nan]], tmp_path / "blank.png", xlabel="x", ylabel="y", zlabel="z")
+    assert blank.read_bytes()[:8] == PNG_SIGNATURE
+
+
+def test_plot_heatmap_refuses_bad_input(tmp_path):
+    bad = tmp_path / "bad.png"
+    z = np.zeros((CLEARANCES.size, SPEEDS_2D.size))
+    kw = dict(xlabel="x", ylabel="y", zlabel="z")
+    with pytest.raises(ValueError, match=r"^z = array of shape \(6, 5\): must have shape \(5, 6\)$"):
+        plot_heatmap(SPEEDS_2D, CLEARANCES, z.T, bad, **kw)
+    with pytest.raises(ValueError, match=r"^x = \[60.0, 80.0, 70.0\]: must be strictly increasing or strictly "
+                                         r"decreasing$"):
+        plot_heatmap([60.0, 80.0, 70.0], CLEARANCES, z[:, :3], bad, **kw)
+    with pytest.raises(ValueError, match=r"^z = array of shape \(5, 6\): must hold category indices 0 to 1, "
+                                         r"or -1 for missing$"):
+        plot_heatmap(SPEEDS_2D, CLEARANCES, z + 2, bad, categories=["periodic", "chaotic"], **kw)
+    with pytest.raises(ValueError, match=r"^categories = \['periodic', 'periodic'\]: must not list an entry twice$"):
+        plot_heatmap(SPEEDS_2D, CLEARANCES, z, bad, categories=["periodic", "periodic"], **kw)
+    with pytest.raises(ValueError, match=r"^categories = 'periodic': must be a list of category names$"):
+        plot_heatmap(SPEEDS_2D, CLEARANCES, z, bad, categories="periodic", **kw)
+    with pytest.raises(ValueError, match=r"^yscale = -1.0: must be > 0$"):
+        plot_heatmap(SPEEDS_2D, CLEARANCES, z, bad, yscale=-1.0, **kw)
+    assert not bad.exists()
