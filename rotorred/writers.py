@@ -1,4 +1,4 @@
-"""One writer per output format: CSV, NPZ, MATLAB .mat and text.
+"""One writer per output format: CSV, NPZ, MATLAB .mat, NetCDF and text.
 
 Every file rotorred writes goes through this module. Each writer writes to a temporary file
 beside the target and renames it into place (``os.replace``), so a reader never sees a
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "write_npz", "write_mat", "write_text", "atomic_path", "render_table", "OutputFolder",
+__all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "atomic_path", "render_table", "OutputFolder",
            "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
 
 
@@ -102,6 +102,14 @@ def write_mat(path: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
     path = Path(path)
     with atomic_path(path, ".mat") as tmp:
         savemat(tmp, dict(arrays), do_compression=True)
+    return path
+
+
+def write_netcdf(path: str | Path, dataset) -> Path:
+    """Write an :class:`xarray.Dataset` as NetCDF-4 (engine h5netcdf; attributes and units kept)."""
+    path = Path(path)
+    with atomic_path(path, ".nc") as tmp:
+        dataset.to_netcdf(tmp, engine="h5netcdf")
     return path
 
 

@@ -25,6 +25,7 @@ from pathlib import Path
 COMMANDS = [
     "campbell",
     "harmonic",
+    "map",
     "run",
     "sweep",
 ]

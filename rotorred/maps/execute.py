@@ -68,10 +68,10 @@ def _local(model: SceneModel) -> SceneModel:
     return _MODELS[model.key]
 
 
-def _point_task(scene, model: SceneModel, previous, cold: bool) -> PointResult:
+def _point_task(scene, model: SceneModel, previous, cold: bool, limit: float | None) -> PointResult:
     """Run one point from the previous point's final state (a StartState, a PointResult, or None)."""
     start = previous.final if isinstance(previous, PointResult) else previous
-    return run_point(scene, _local(model), None if cold else start)
+    return run_point(scene, _local(model), None if cold else start, limit)
 
 
 def run_points(spec: MapSpec, store: PointStore, client=None,
@@ -100,7 +100,7 @@ def _run_serial(spec: MapSpec, store: PointStore, models: dict, done: dict, repo
             points, start = _pending(spec, chain, done)
             for direction, index in points:
                 scene = spec.scene_at(index)
-                p = _point_task(scene, models[model_key(scene)], start, spec.cold)
+                p = _point_task(scene, models[model_key(scene)], start, spec.cold, spec.limit)
                 store.write(direction, index, p)
                 done[(direction, index)] = p
                 report(direction, index, p)
@@ -118,7 +118,8 @@ def _run_dask(spec: MapSpec, store: PointStore, client, models: dict, done: dict
         previous = start
         for direction, index in points:
             scene = spec.scene_at(index)
-            previous = client.submit(_point_task, scene, scattered[model_key(scene)], previous, spec.cold, pure=False)
+            previous = client.submit(_point_task, scene, scattered[model_key(scene)], previous, spec.cold, spec.limit,
+                                     pure=False)
             futures[previous] = (direction, index)
     for future in as_completed(futures):
         direction, index = futures[future]

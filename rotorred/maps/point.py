@@ -7,6 +7,14 @@ Continuation
     key) changes at the junction. A cold point starts as its scene says (``solver.start``). A
     point after a diverged one starts cold.
 
+Run until settled
+    When the table DOF's response has not settled on the scene's record
+    (:func:`rotorred.signals.settling.settling_time`), the run goes on from its final state in
+    segments as long as the scene's recorded window, and the settling is measured again on the
+    joined record, until it has settled or ``limit`` seconds have been simulated. The line fit
+    and class then use the last recorded window's length (its last whole common periods where
+    the speeds are commensurate).
+
 Recorded per point (:class:`PointResult`)
     The class, settling time, explained share and torus of the table DOF
     (:mod:`rotorred.signals.classify`); its labelled lines, strongest first, at most
@@ -24,8 +32,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from rotorred.scenes.run import SceneDiverged, SceneModel, run_scene
+from rotorred.scenes.run import SceneDiverged, SceneModel, analyse_lines, run_scene, spool_frequencies, table_dof
 from rotorred.scenes.schema import Scene
+from rotorred.signals.spectra import settled_spectrum
 
 __all__ = ["N_LINES", "N_SAMPLES", "StartState", "PointResult", "run_point"]
 
@@ -71,6 +80,8 @@ class PointResult:
     contact_fraction, n_impacts, max_contact_force : float, int, float
         First plate (0, 0, 0 without plates); N.
     start : {"cold", "warm"}
+    simulated : float
+        Simulated time (s): the scene's duration, plus the segments run until settled.
     wall_time : float
         s.
     final : StartState or None
@@ -97,6 +108,7 @@ class PointResult:
     n_impacts: int = -1
     max_contact_force: float = math.nan
     start: str = "cold"
+    simulated: float = math.nan
     wall_time: float = math.nan
     final: StartState | None = None
 
@@ -108,43 +120,83 @@ def continued(scene: Scene, start: StartState | None) -> Scene:
     return replace(scene, unbalances=tuple(replace(u, phase=p) for u, p in zip(scene.unbalances, start.phases)))
 
 
-def run_point(scene: Scene, model: SceneModel, start: StartState | None = None) -> PointResult:
-    """Run one point and keep what a map records (:class:`PointResult`)."""
+def _angles(scene: Scene, T: float) -> tuple[float, ...]:
+    """Each unbalance's angle (rad, in (-pi, pi]) after ``T`` seconds of the scene."""
+    return tuple(math.remainder(u.phase + scene.speeds[scene.rotor.spool_of[u.node]] * T, 2 * math.pi)
+                 for u in scene.unbalances)
+
+
+def _segment(scene: Scene, T: float) -> Scene:
+    """The scene continued after ``T`` s for one more recorded window, recorded whole."""
+    s = scene.solver
+    solver = replace(s, duration=s.duration - s.record_start, record_start=0.0)
+    return replace(continued(scene, StartState(None, None, _angles(scene, T))), solver=solver)
+
+
+@dataclass
+class _Record:
+    """The table DOF's record so far, joined over segments, and the last segment's result."""
+
+    t: np.ndarray
+    x: np.ndarray
+    last: object
+    T: float  # simulated time (s)
+
+
+def _until_settled(scene: Scene, model: SceneModel, record: _Record, limit: float):
+    """Run segments from the last state until the settling is measured or ``limit`` s are simulated."""
+    d = table_dof(scene)
+    f_L, f_H = spool_frequencies(scene)
+    analysis = record.last.analysis
+    while analysis is not None and not analysis.settling.settled and record.T < limit - 1e-9:
+        seg = _segment(scene, record.T)
+        final = record.last.final
+        res = run_scene(seg, model, compare_normal=False, analyse=False, initial=(final.q, final.v))
+        new = res.t > 0.0  # its first sample is the previous segment's last
+        record = _Record(np.concatenate((record.t, res.t[new] + record.T)),
+                         np.concatenate((record.x, res.outputs[d][new])), res, record.T + seg.solver.duration)
+        n_fit = settled_spectrum(res.outputs[d], seg.solver.dt, f_L, f_H).n_samples
+        analysis = analyse_lines(record.t, record.x, f_L, f_H, n_fit, d)
+    return analysis, record
+
+
+def run_point(scene: Scene, model: SceneModel, start: StartState | None = None,
+              limit: float | None = None) -> PointResult:
+    """Run one point until settled or ``limit`` s simulated (default: the scene's duration) and keep what
+    a map records (:class:`PointResult`)."""
     t0 = time.perf_counter()
     scene = continued(scene, start)
-    initial = None if start is None else (start.q, start.v)
+    how = "cold" if start is None else "warm"
     try:
-        res = run_scene(scene, model, compare_normal=False, initial=initial)
+        res = run_scene(scene, model, compare_normal=False, initial=None if start is None else (start.q, start.v))
+        record = _Record(res.t, res.outputs.get(table_dof(scene)), res, scene.solver.duration)
+        analysis, record = _until_settled(scene, model, record, limit or scene.solver.duration)
     except SceneDiverged as exc:
-        return PointResult("diverged", reason=str(exc), start="cold" if start is None else "warm",
-                           wall_time=time.perf_counter() - t0)
-    if res.analysis is None:
+        return PointResult("diverged", reason=str(exc), start=how, wall_time=time.perf_counter() - t0)
+    if analysis is None:
         reason = "; ".join(res.analysis_errors.values()) or "no line analysis of the table DOF"
-        return PointResult("failed", reason=reason, wall_time=time.perf_counter() - t0)
-    return replace(_recorded(res), start="cold" if start is None else "warm", wall_time=time.perf_counter() - t0,
-                   final=_final(scene, res))
+        return PointResult("failed", reason=reason, start=how, wall_time=time.perf_counter() - t0)
+    return replace(_recorded(analysis, record.last), start=how, simulated=record.T,
+                   wall_time=time.perf_counter() - t0, final=_final(scene, record))
 
 
-def _final(scene: Scene, res) -> StartState | None:
+def _final(scene: Scene, record: _Record) -> StartState | None:
     """The state the next point starts from: the run's last state and the unbalance angles reached."""
-    if res.final is None:
+    final = record.last.final
+    if final is None:
         return None
-    T = scene.solver.duration
-    phases = tuple(math.remainder(u.phase + scene.speeds[scene.rotor.spool_of[u.node]] * T, 2 * math.pi)
-                   for u in scene.unbalances)
-    return StartState(np.array(res.final.q), np.array(res.final.v), phases)
+    return StartState(np.array(final.q), np.array(final.v), _angles(scene, record.T))
 
 
-def _recorded(res) -> PointResult:
-    """The class, lines, Poincare samples, orbits and contact of a finished run."""
-    a = res.analysis
+def _recorded(a, res) -> PointResult:
+    """The class, lines, Poincare samples (line analysis ``a``), orbits and contact (last segment ``res``)."""
     c = a.classification
     lines = sorted(a.fit.lines, key=lambda ln: -ln.amplitude)[:N_LINES]
     return PointResult(
         "ok", kind=c.kind, subharmonic=-1 if c.subharmonic is None else int(c.subharmonic),
         period=math.nan if c.period is None else float(c.period),
         settling_time=float(c.settling.time) if c.settling.settled else math.nan,
-        explained_share=float(a.fit.explained_share), torus=(a.fit.torus.k, a.fit.torus.j),
+        explained_share=float(c.explained_share), torus=(a.fit.torus.k, a.fit.torus.j),
         line_frequency=np.array([ln.frequency_hz for ln in lines]),
         line_amplitude=np.array([ln.amplitude for ln in lines]), line_phase=np.array([ln.phase for ln in lines]),
         line_label=tuple(ln.label_ascii for ln in lines),

@@ -93,6 +93,10 @@ class MapSpec:
     direction : {"up", "down", "both"}
     cold : bool
         Every point from the scene's own start (no continuation).
+    limit : float, optional
+        Simulated time (s) up to which a point that has not settled runs on
+        (:func:`rotorred.maps.point.run_point`); default the scene's ``solver.duration`` (no
+        extension).
     """
 
     scene: str
@@ -101,6 +105,7 @@ class MapSpec:
     ratios: tuple = ()
     direction: str = "up"
     cold: bool = False
+    limit: float | None = None
     _scenes: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self):
@@ -116,6 +121,8 @@ class MapSpec:
         if fixed & set(keys):
             checks.fail("--set", sorted(fixed & set(keys)), "must not fix a key that --vary varies")
         checks.choice("--direction", self.direction, DIRECTIONS)
+        if self.limit is not None:
+            object.__setattr__(self, "limit", checks.positive("--limit", self.limit, "s"))
         self._check_ratios()
 
     def _check_ratios(self) -> None:
@@ -164,10 +171,10 @@ class MapSpec:
 
     def chains(self) -> list[Chain]:
         """The chains along the continuation axis: one per direction and combination of the other axes."""
-        n0 = self.shape[0]
+        up = tuple(int(i) for i in sorted(range(self.shape[0]), key=lambda i: self.axes[0].values[i]))
         out = []
         for direction in self.directions:
-            order = tuple(range(n0)) if direction == "up" else tuple(reversed(range(n0)))
+            order = up if direction == "up" else up[::-1]
             for rest in itertools.product(*(range(n) for n in self.shape[1:])):
                 out.append(Chain(direction, tuple(rest), order))
         return out

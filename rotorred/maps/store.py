@@ -44,6 +44,7 @@ SCALARS = {
     "n_impacts": ("i8", -1, "", "contact onsets in the record (first plate)"),
     "max_contact_force": ("f8", np.nan, "N", "largest normal contact force (first plate)"),
     "start": ("U4", "", "", "cold (scene's start) or warm (neighbour's final state)"),
+    "simulated": ("f8", np.nan, "s", "simulated time, segments run until settled included"),
     "wall_time": ("f8", np.nan, "s", "wall time of the point"),
 }
 #: per-point vectors: name -> (dimension, length, dtype, missing, units, long name)
@@ -92,7 +93,7 @@ class PointStore:
         s = self.spec
         return json.dumps({"scene": s.scene, "axes": [[a.key, list(a.values)] for a in s.axes],
                            "settings": [[k, repr(v)] for k, v in s.settings], "ratios": [list(r) for r in s.ratios],
-                           "cold": s.cold}, sort_keys=True)
+                           "cold": s.cold, "limit": s.limit}, sort_keys=True)
 
     def _check_spec(self) -> None:
         from rotorred import checks

@@ -303,17 +303,18 @@ def scene_from_dict(data: dict, source: str = "<string>", base: Path | None = No
 _SET_FORM = "must be KEY=VALUES (e.g. rub.clearance=10e-6,20e-6) or KEY=START:STOP:N"
 
 
-def parse_setting(text: str) -> tuple[str, list]:
+def parse_setting(text: str, option: str = "--set") -> tuple[str, list]:
     """Parse ``"section.key=v1,v2,..."`` or ``"section.key=start:stop:n"`` into (key, values).
 
     Values are TOML values (numbers, strings, booleans); a bare word is a string.
-    ``start:stop:n`` gives ``n`` evenly spaced numbers (n >= 2).
+    ``start:stop:n`` gives ``n`` evenly spaced numbers (n >= 2). ``option`` names the command-line
+    option in messages.
     """
-    checks.string("--set", text)
+    checks.string(option, text)
     key, _, rhs = text.partition("=")
     key, rhs = key.strip(), rhs.strip()
     if "=" not in text or not key or not rhs:
-        fail("--set", text, _SET_FORM)
+        fail(option, text, _SET_FORM)
     if rhs.count(":") == 2 and "," not in rhs:
         a, b, n = rhs.split(":")
         try:
@@ -321,7 +322,7 @@ def parse_setting(text: str) -> tuple[str, list]:
         except ValueError:
             n = None
         if n is None or n < 2:
-            fail(f"--set {key}", rhs, "must be START:STOP:N with numbers START, STOP and an integer N >= 2")
+            fail(f"{option} {key}", rhs, "must be START:STOP:N with numbers START, STOP and an integer N >= 2")
         return key, [a + (b - a) * i / (n - 1) for i in range(n)]
     return key, [_toml_value(v.strip(), key) for v in _split_top(rhs) if v.strip()]
 

@@ -1,0 +1,102 @@
+"""``rotorred map SCENE --vary KEY=START:STOP:N [--vary ...] --out DIR``: a map of the operating envelope.
+
+Runs the scene at every point of the grid of the varied keys on a Dask cluster (a
+LocalCluster, one single-threaded worker per core, unless ``--scheduler`` names one; ``--workers
+0`` runs serially), each point from its neighbour's final state along the first key (``--cold``:
+from the scene's start), up, down or both ways, each until settled or ``--limit`` seconds. Writes
+``map.nc`` (xarray/NetCDF), ``map.csv``, ``map_lines.csv``, ``map.txt`` and the figures; the
+points are kept in ``DIR/points`` as they finish, and the same command resumes an interrupted map.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rotorred import checks
+from rotorred.cli.options import out_dir
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "map", help="run a scene over a grid of keys (speeds, clearance) on Dask: classes, bifurcation diagram",
+        description="Run a scene at every point of a grid of one or more keys, each point continued from its "
+                    "neighbour's final state along the first key, and write the classes, labelled lines, "
+                    "Poincare samples, orbits and contact as NetCDF and CSV with a bifurcation diagram, a waterfall "
+                    "and heat maps. Example: rotorred map paper-rub --vary speeds.outer=60:110:51 --direction both "
+                    "--out envelope")
+    p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file")
+    p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
+                   help="KEY=START:STOP:N or KEY=v1,v2,... (scene units: speeds in Hz, clearance in m); repeat for "
+                        "a 2-D map; the first is the continuation axis")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
+    p.add_argument("--ratio", action="append", default=[], metavar="SPOOL=R",
+                   help="that spool turns at R times the varied speed, e.g. inner=0.7778 with --vary speeds.outer=...")
+    p.add_argument("--direction", default="up", help="up, down or both (hysteresis, coexisting responses)")
+    p.add_argument("--cold", action="store_true", help="start every point from the scene's start (no continuation)")
+    p.add_argument("--limit", type=float, default=None, metavar="SECONDS",
+                   help="simulate a point that has not settled up to this time (default: the scene's duration)")
+    p.add_argument("--workers", type=int, default=None, help="local Dask workers (default one per core; 0: serial)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="an existing Dask scheduler, tcp://host:port")
+    p.add_argument("--out", required=True, help="output directory (its points/ are kept: the same command resumes)")
+    return p
+
+
+def spec_of(args):
+    """The :class:`rotorred.maps.spec.MapSpec` of the options, every point's scene validated."""
+    from rotorred.maps.spec import Axis, MapSpec
+    from rotorred.scenes.schema import parse_setting
+
+    axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
+    fixed = []
+    for item in args.set:
+        key, values = parse_setting(item)
+        if len(values) != 1:
+            checks.fail("--set", item, "must fix one value; use --vary to vary a key")
+        fixed.append((key, values[0]))
+    ratios = tuple(_ratio(item) for item in args.ratio)
+    if args.workers is not None:
+        checks.integer("--workers", args.workers, ge=0)
+    spec = MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
+    spec.scenes()
+    return spec
+
+
+def _values(parsed, item: str) -> tuple[str, tuple]:
+    key, values = parsed
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        checks.fail(f"--vary {key}", item.partition("=")[2], "must be numbers: START:STOP:N or v1,v2,...")
+    return key, tuple(float(v) for v in values)
+
+
+def _ratio(item: str) -> tuple[str, float]:
+    spool, _, r = item.partition("=")
+    try:
+        return spool.strip(), float(r)
+    except ValueError:
+        checks.fail("--ratio", item, "must be SPOOL=R with a number R > 0, e.g. inner=0.7778")
+
+
+def run(args) -> int:
+    """Check everything, then run the map into ``--out`` (exit 3 when points failed, 130 when interrupted)."""
+    from rotorred.cli import EXIT_DIVERGED, EXIT_SIGINT
+    from rotorred.maps.run import format_map, run_map
+
+    out = out_dir("--out", args.out)
+    spec = spec_of(args)
+    print(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
+          f"{'/'.join(spec.directions)}, {spec.n_points} points, "
+          f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
+    result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler)
+    print(format_map(result.dataset, spec))
+    for f in result.files:
+        print(f"wrote {f}")
+    print(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
+          f"wall time {result.wall_time:.2f} s")
+    if result.incomplete:
+        print(f"rotorred map: {result.incomplete}", file=sys.stderr)
+        return EXIT_SIGINT
+    if result.n_failed:
+        print(f"rotorred map: error: {result.n_failed} points failed (named in map.csv and map.txt); the other "
+              "points are kept", file=sys.stderr)
+        return EXIT_DIVERGED
+    return 0

@@ -1,0 +1,163 @@
+"""``run_map``: check a map, run its points (serially or on Dask), and write the dataset, tables and figures.
+
+Order of work
+    1. Check: every grid point's scene is loaded and validated (:meth:`MapSpec.scenes`), the
+       folder is locked (a second map into it is refused), and points already in
+       ``folder/points`` of another map are refused. Nothing runs before this passes.
+    2. Run the points not on disk (:func:`rotorred.maps.execute.run_points`), each written as
+       it finishes, with a progress bar (points done, failures, ETA).
+    3. Build the dataset from every point on disk and write ``map.nc``, ``map.csv``,
+       ``map_lines.csv``, the figures and ``map.txt`` through a staged
+       :class:`rotorred.writers.OutputFolder`. When interrupted (Ctrl-C) or when a worker's
+       error stops the run, step 3 still runs on the points finished so far, the folder is
+       marked INCOMPLETE with the reason, and the same command later completes it.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rotorred.maps.execute import connect, local_cluster, run_points
+from rotorred.maps.spec import MapSpec, axis_unit
+from rotorred.maps.store import PointStore, to_dataset, write_tables
+from rotorred.scenes.run import table_dof
+from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
+
+__all__ = ["MapRun", "run_map", "format_map"]
+
+
+@dataclass(frozen=True)
+class MapRun:
+    """What :func:`run_map` did: the dataset, the files written, the counts, why it stopped early."""
+
+    dataset: object
+    files: tuple
+    n_run: int
+    n_resumed: int
+    n_failed: int
+    incomplete: str | None
+    wall_time: float
+
+
+class _Progress:
+    """tqdm bar over the map's points, with the failures in its postfix; silent when off."""
+
+    def __init__(self, total: int, done: int, enabled: bool):
+        self.failed = 0
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, initial=done, unit="point", desc="map", dynamic_ncols=True)
+
+    def __call__(self, direction: str, index: tuple, point) -> None:
+        self.failed += point.status != "ok"
+        if self.bar is not None:
+            self.bar.set_postfix(failed=self.failed, refresh=False)
+            self.bar.update(1)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _client(workers: int | None, scheduler: str | None):
+    """None for a serial map (``workers == 0``), else a client of ``scheduler`` or of a new LocalCluster."""
+    if scheduler:
+        return connect(scheduler)
+    if workers == 0:
+        return None
+    return local_cluster(workers)
+
+
+def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
+            progress: bool = True, figures: bool = True) -> MapRun:
+    """Run a map into ``out`` (module docstring); resumable.
+
+    Parameters
+    ----------
+    spec : MapSpec
+    out : str or Path
+        Output folder; its ``points/`` are kept between runs.
+    workers : int, optional
+        Local Dask workers (default: one per core); 0 runs serially in this process.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:port``), in place of a local cluster.
+    progress, figures : bool
+        Progress bar; figures.
+    """
+    t0 = time.perf_counter()
+    scenes = spec.scenes()  # 1. every point validated before anything runs
+    out = Path(out)
+    with OutputFolder(out) as folder:
+        store = PointStore(out, spec)
+        n_resumed = len(store.read())
+        client = _client(workers, scheduler) if n_resumed < spec.n_points else None
+        bar = _Progress(spec.n_points, n_resumed, progress)
+        incomplete = None
+        try:
+            points = run_points(spec, store, client, on_point=bar)
+        except KeyboardInterrupt:
+            incomplete = "interrupted (Ctrl-C); run the same command again to complete the map"
+        finally:
+            bar.close()
+            if client is not None:
+                _close(client, scheduler)
+        if incomplete is not None:
+            points = store.read()
+        ds = _dataset(spec, scenes[0], points)
+        files = _write(ds, spec, folder, figures)
+        files = tuple(folder.commit(incomplete))
+    n_failed = sum(p.status != "ok" for p in points.values())
+    return MapRun(ds, files, len(points) - n_resumed, n_resumed, n_failed, incomplete, time.perf_counter() - t0)
+
+
+def _close(client, scheduler: str | None) -> None:
+    """Close the client, and the local cluster it started (not a cluster given by ``--scheduler``)."""
+    cluster = None if scheduler else client.cluster
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def _dataset(spec: MapSpec, scene, points: dict):
+    d = table_dof(scene)
+    attrs = {"scene": spec.scene, "settings": repr(dict(spec.settings)), "ratios": repr(dict(spec.ratios)),
+             "table_dof": f"{d[0]}:{d[1]}", "continuation": "cold" if spec.cold else "warm",
+             "directions": ",".join(spec.directions), "rotorred_map": "issue 12"}
+    return to_dataset(spec, points, tuple(scene.output.nodes), attrs)
+
+
+def _write(ds, spec: MapSpec, folder: OutputFolder, figures: bool) -> list[Path]:
+    staging = folder.staging
+    files = [write_netcdf(staging / "map.nc", ds), *write_tables(ds, staging)]
+    if figures:
+        from rotorred.maps.figures import map_figures
+
+        files += map_figures(ds, spec, staging)
+    files.append(write_text(staging / "map.txt", format_map(ds, spec) + "\n"))
+    return files
+
+
+def format_map(ds, spec: MapSpec) -> str:
+    """Text table of a map: per point, the class, settling time, explained share, contact and peak orbit."""
+    status = ds["status"].values
+    rows = []
+    for at in zip(*np.nonzero(status != "")):
+        point = {name: ds[name].values[at] for name in ("status", "kind", "settling_time", "explained_share",
+                                                         "contact_fraction", "n_impacts", "reason")}
+        keys = [f"{axis_unit(a.key)[0] * a.values[i]:.6g}" for a, i in zip(spec.axes, at[1:])]
+        rows.append([str(ds["direction"].values[at[0]]), *keys,
+                     point["kind"] if point["status"] == "ok" else f"{point['status']}: {point['reason'][:60]}",
+                     "-" if np.isnan(point["settling_time"]) else f"{point['settling_time']:.3g}",
+                     f"{point['explained_share']:.4f}", f"{point['contact_fraction']:.3f}", str(point["n_impacts"])])
+    header = ["sweep", *[a.label for a in spec.axes], "class", "settled (s)", "explained", "contact", "impacts"]
+    counts = Counter(str(k) for k in ds["kind"].values.ravel() if k)
+    done = int(np.sum(status != ""))
+    return (f"map of {spec.scene}: {done} of {spec.n_points} points; classes: "
+            + ", ".join(f"{k} {n}" for k, n in counts.most_common()) + "\n" + render_table(header, rows))
