@@ -4,7 +4,9 @@ Continuation
     A warm point starts from the previous point's final state ``(q, v)`` (model coordinates) and
     with each unbalance at the angle it had reached, ``phase + Omega T`` (T the previous run's
     duration), so the forcing turns on without a jump in angle; only the speed (or the varied
-    key) changes at the junction. A cold point starts as its scene says (``solver.start``). A
+    key) changes at the junction. The rub plates restart at rest (:func:`rotorred.transient.newmark.simulate`
+    takes no plate state): at 90 Hz two runs of 0.5 s joined so differ from one run of 1 s by 2.8e-11
+    of the peak (tests/test_maps.py). A cold point starts as its scene says (``solver.start``). A
     point after a diverged one starts cold.
 
 Run until settled
