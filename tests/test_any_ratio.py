@@ -2,15 +2,14 @@
 validation/any_ratio.py (--quick)."""
 
 import functools
-import importlib.util
-import sys
 from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 import pytest
+from validation_scripts import load_validation
 
-from rotorred.scenes.run import build_model, run_scene
+from rotorred.scenes.run import run_scene
 from rotorred.scenes.schema import load_scene
 from rotorred.signals.linefit import fit_lines
 
@@ -19,11 +18,7 @@ F_L, F_H = 70.0, 88.8
 
 
 def _load_validation(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "validation" / f"{name.removeprefix('validation_')}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return load_validation(name.removeprefix("validation_"))
 
 
 @functools.lru_cache(maxsize=1)

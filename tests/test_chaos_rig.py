@@ -14,10 +14,10 @@ runs), not only the value measured on this machine, which is stated next to it.
 """
 
 import functools
-import importlib.util
 import math
-import sys
 from pathlib import Path
+
+from validation_scripts import load_validation
 
 ROOT = Path(__file__).resolve().parents[1]
 F_CHAOS, F_PERIOD_3 = 81.5, 88.0
@@ -25,11 +25,7 @@ RUN, DISCARD, T_RESTART = 10.0, 2.0, 6.0  # s
 
 
 def _load_validation(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "validation" / f"{name.removeprefix('validation_')}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return load_validation(name.removeprefix("validation_"))
 
 
 @functools.lru_cache(maxsize=1)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import importlib.util
 import math
 from pathlib import Path
 
@@ -196,10 +195,9 @@ def test_cli_run(tmp_path, capsys):
 
 
 def _load_validation(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "validation" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from validation_scripts import load_validation
+
+    return load_validation(name)
 
 
 def test_paper_reproduction():
