@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.maps.spec import MapSpec, axis_unit
+from rotorred.maps.spec import MapSpec
+from rotorred.scenes.sweep import key_unit
 from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_waterfall
 
 __all__ = ["map_figures"]
@@ -35,7 +36,7 @@ def map_figures(ds, spec: MapSpec, folder: Path) -> list[Path]:
 def _first_of_the_rest(ds, spec: MapSpec, n_kept: int):
     """The dataset at index 0 of every axis after the first ``n_kept``, and a title suffix naming them."""
     rest = {a.key: 0 for a in spec.axes[n_kept:]}
-    text = ", ".join(f"{a.key} = {axis_unit(a.key)[0] * a.values[0]:.4g} {axis_unit(a.key)[1]}".rstrip()
+    text = ", ".join(f"{a.key} = {key_unit(a.key)[0] * a.values[0]:.4g} {key_unit(a.key)[1]}".rstrip()
                      for a in spec.axes[n_kept:])
     return ds.isel(rest), (f" at {text}" if text else "")
 
@@ -43,7 +44,7 @@ def _first_of_the_rest(ds, spec: MapSpec, n_kept: int):
 def _along(ds, spec: MapSpec, folder: Path) -> list[Path]:
     """Bifurcation diagram and waterfall along the continuation axis (the other axes at their first value)."""
     axis = spec.axes[0]
-    scale, unit = axis_unit(axis.key)
+    scale, unit = key_unit(axis.key)
     sub, where = _first_of_the_rest(ds, spec, 1)
     samples = {str(d): sub["poincare_x"].sel(direction=d).values for d in sub["direction"].values}
     d = ds.attrs.get("table_dof", "")
@@ -68,7 +69,7 @@ def _largest(amplitudes: np.ndarray) -> np.ndarray:
 def _heat_maps(ds, spec: MapSpec, folder: Path) -> list[Path]:
     """Class, contact fraction, explained share and largest line amplitude over the first two axes."""
     ax, ay = spec.axes[0], spec.axes[1]
-    (sx, _), (sy, _) = axis_unit(ax.key), axis_unit(ay.key)
+    (sx, _), (sy, _) = key_unit(ax.key), key_unit(ay.key)
     sub, where = _first_of_the_rest(ds, spec, 2)
     files = []
     for d in sub["direction"].values:

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.maps.execute import connect, local_cluster, run_points
-from rotorred.maps.spec import MapSpec, axis_unit
+from rotorred.maps.spec import MapSpec
+from rotorred.scenes.sweep import key_unit
 from rotorred.maps.store import PointStore, to_dataset, write_tables
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
@@ -151,7 +152,7 @@ def format_map(ds, spec: MapSpec) -> str:
     for at in zip(*np.nonzero(status != "")):
         point = {name: ds[name].values[at] for name in ("status", "kind", "settling_time", "explained_share",
                                                          "contact_fraction", "n_impacts", "reason")}
-        keys = [f"{axis_unit(a.key)[0] * a.values[i]:.6g}" for a, i in zip(spec.axes, at[1:])]
+        keys = [f"{key_unit(a.key)[0] * a.values[i]:.6g}" for a, i in zip(spec.axes, at[1:])]
         rows.append([str(ds["direction"].values[at[0]]), *keys,
                      point["kind"] if point["status"] == "ok" else f"{point['status']}: {point['reason'][:60]}",
                      "-" if np.isnan(point["settling_time"]) else f"{point['settling_time']:.3g}",

@@ -19,23 +19,12 @@ from pathlib import Path
 
 from rotorred import checks
 from rotorred.scenes.schema import Scene, load_scene
+from rotorred.scenes.sweep import key_unit
 
-__all__ = ["Axis", "MapSpec", "Chain", "DIRECTIONS", "axis_unit"]
+__all__ = ["Axis", "MapSpec", "Chain", "DIRECTIONS"]
 
 #: sweep directions along the continuation axis
 DIRECTIONS = ("up", "down", "both")
-
-#: how the varied keys are shown: (scale from SI to the shown unit, unit) by key suffix
-_SHOWN = {"clearance": (1e6, "µm"), "speeds": (1.0, "Hz"), "m_e": (1e6, "g mm")}
-
-
-def axis_unit(key: str) -> tuple[float, str]:
-    """(scale, unit) in which a varied key is shown: µm for a clearance, Hz for a speed, else SI."""
-    section, _, name = key.rpartition(".")
-    for part in (name, section.split("[")[0]):
-        if part in _SHOWN:
-            return _SHOWN[part]
-    return 1.0, ""
 
 
 @dataclass(frozen=True)
@@ -54,8 +43,7 @@ class Axis:
 
     @property
     def label(self) -> str:
-        scale, unit = axis_unit(self.key)
-        return f"{self.key} ({unit})" if unit else self.key
+        return f"{self.key} ({key_unit(self.key)[1]})"
 
 
 @dataclass(frozen=True)

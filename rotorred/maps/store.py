@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult, StartState
-from rotorred.maps.spec import MapSpec, axis_unit
+from rotorred.maps.spec import MapSpec
+from rotorred.scenes.sweep import key_unit
 from rotorred.writers import write_csv, write_npz, write_text
 
 __all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
@@ -152,7 +153,7 @@ def to_dataset(spec: MapSpec, points: dict, nodes: tuple[int, ...], attrs: dict 
     variables["peak_orbit"] = ((*dims, "node"), data["peak_orbit"], {"units": "m", "long_name": "largest orbit radius"})
     coords = {"direction": list(dirs), "node": list(nodes)}
     for a in spec.axes:
-        scale, unit = axis_unit(a.key)
+        scale, unit = key_unit(a.key)
         coords[a.key] = (a.key, np.array(a.values), {"units": "Hz" if unit == "Hz" else "SI", "long_name": a.key})
     return xr.Dataset(variables, coords=coords, attrs=dict(attrs or {}))
 

@@ -27,7 +27,7 @@ from rotorred.scenes.schema import Scene, load_scene
 from rotorred.scenes.summary import table_dof
 from rotorred.writers import render_table, write_csv, write_text
 
-__all__ = ["SweepResult", "sweep", "free_reach", "write_sweep", "format_sweep", "axis_of"]
+__all__ = ["SweepResult", "sweep", "free_reach", "write_sweep", "format_sweep", "axis_of", "key_unit"]
 
 
 @dataclass(frozen=True)
@@ -231,14 +231,23 @@ class _Points:
                 f"peak {1e6 * self.peak[i]:.4g} um")
 
 
+#: how a varied scene key is shown, by its last name: (scale from the scene's unit, unit shown)
+_KEY_UNITS = {"clearance": (1e6, "µm"), "m_e": (1.0, "kg m"), "dt": (1.0, "s"), "mu_s": (1.0, "-"),
+              "mu_d": (1.0, "-"), "k_n": (1.0, "N/m"), "K_nr": (1.0, "N/m^1.5"), "theta_deg": (1.0, "deg")}
+
+
+def key_unit(key: str) -> tuple[float, str]:
+    """(scale, unit) in which a varied scene key is shown: ``"rub.clearance"`` -> (1e6, "µm"), a speed in Hz."""
+    if key.startswith("speeds."):
+        return 1.0, "Hz"
+    return _KEY_UNITS.get(key.split(".")[-1], (1.0, "scene units"))
+
+
 def axis_of(key: str) -> tuple[float, str]:
     """Plot scale and axis label of a swept scene key: ``"rub.clearance"`` -> (1e6, "Rub clearance (µm)")."""
-    name = key.split(".")[-1]
-    if name == "clearance":
-        return 1e6, "Rub clearance (µm)"
-    units = {"m_e": (1.0, "kg m"), "dt": (1.0, "s"), "mu_s": (1.0, "-"), "mu_d": (1.0, "-"),
-             "k_n": (1.0, "N/m"), "K_nr": (1.0, "N/m^1.5"), "theta_deg": (1.0, "deg")}
-    scale, unit = units.get(name, (1.0, "scene units"))
+    scale, unit = key_unit(key)
+    if key.split(".")[-1] == "clearance":
+        return scale, "Rub clearance (µm)"
     return scale, f"{key} ({unit})"
 
 
