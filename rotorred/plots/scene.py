@@ -312,6 +312,21 @@ def plot_orbits(
 
 
 # --------------------------------------------------------------------------- Poincare section
+#: smallest axis span of a Poincare plot, relative to the largest |value| on that axis: the samples of a
+#: periodic response agree to round-off, and autoscaling would zoom into it (offset tick labels)
+SPAN_MIN = 0.05
+
+
+def _span_at_least(ax, x: np.ndarray, y: np.ndarray, rel: float) -> None:
+    """Widen each axis about its centre to at least ``rel`` times the largest |value| on it."""
+    for values, set_lim in ((x, ax.set_xlim), (y, ax.set_ylim)):
+        lo, hi = float(np.min(values)), float(np.max(values))
+        need = rel * max(abs(lo), abs(hi))
+        if hi - lo < need:
+            mid = 0.5 * (lo + hi)
+            set_lim(mid - need, mid + need)
+
+
 def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "", scale: float = 1e6,
                   unit: str = "µm") -> Path:
     """Poincare section: the sampled displacement against the sampled velocity, one dot per sample.
@@ -341,6 +356,8 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
     fig = Figure(figsize=(5.6, 5.0), layout="constrained")
     ax = fig.subplots()
     ax.plot(scale * x, scale * velocity, ".", ms=4 if x.size < 200 else 2, label=f"{label} ({x.size} samples)".strip())
+    _span_at_least(ax, scale * x, scale * velocity, SPAN_MIN)
+    ax.ticklabel_format(useOffset=False)
     ax.set_xlabel(f"displacement ({unit})")
     ax.set_ylabel(f"velocity ({unit}/s)")
     ax.grid(True, alpha=0.3)
@@ -419,5 +436,5 @@ def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> Path:
     return plot_poincare(c.poincare.x, c.poincare.velocity, path, scale=1e6, unit="µrad" if rot else "µm",
                          label=f"{c.label}, once per {1.0 / c.poincare.frequency_hz:.4g} s "
                                f"({c.poincare.frequency_hz:.6g} Hz)",
-                         title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])} "
+                         title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])}\n"
                                f"({speeds}; {rub_text})")
