@@ -463,6 +463,14 @@ def test_bad_input():
         simulate(system, sp, 0.01, 1e-4, plates=[RubPlate(node=1)], spool_of={1: "shaft"})
     with pytest.raises(ValueError, match=r"^decimate = 0: must be an integer >= 1$"):
         simulate(system, sp, 0.01, 1e-4, decimate=0)
+    final = simulate(system, sp, 0.01, 1e-4).final
+    with pytest.raises(ValueError, match=r"^start = 'a FinalState': must not be given with q0 or v0"):
+        simulate(system, sp, 0.01, 1e-4, start=final, q0=[0, 0, 0, 0])
+    with pytest.raises(ValueError, match=r"^start = 'tuple': must be a FinalState \(another run's `final`\)$"):
+        simulate(system, sp, 0.01, 1e-4, start=(final.q, final.v))
+    plate = RubPlate(node=1, disk_radius=0.05)  # the start state holds no plate
+    with pytest.raises(ValueError, match=r"^start\.plate = .*: must have shape \(1, 2, 3\)$"):
+        simulate(system, sp, 0.01, 1e-4, start=final, plates=[plate], spool_of={1: "shaft"})
 
 
 def test_gravity_settles_to_static_sag():

@@ -166,6 +166,21 @@ def test_record_plan_counts(t_end, dt, start, every):
     assert plan.first == recorded[0] and plan.n_records == len(recorded)
 
 
+def test_record_plan_counts_at_many_steps():
+    """A run of 60 s at dt = 1e-6 recorded from 59.7 s: in floating point 59.7 / 1e-6 = 59700000.00000001, a
+    rounding error (1e-8 steps) above the old fixed slack of 1e-9 steps, which started the record one
+    step late (300 000 samples where the time axis had 300 001; a run died writing its CSV). The counts
+    are checked against exact decimal arithmetic."""
+    from fractions import Fraction as F
+
+    for t_end, dt, start in (("60", "1e-6", "59.7"), ("1000", "1e-5", "999.3"), ("0.3", "0.1", "0.1"),
+                             ("1", "3e-4", "0.25")):
+        plan = record_plan(float(t_end), float(dt), float(start), 1)
+        n, first = F(t_end) / F(dt), F(start) / F(dt)
+        assert plan.n_steps == math.ceil(n) and plan.first == math.ceil(first)
+        assert plan.n_records == plan.n_steps - plan.first + 1
+
+
 def test_one_compiled_step_is_the_newmark_step():
     """Two steps of the kernel (no contact) equal q1 = Hq q0 + Hv v0 + Ha a0 + A^-1 F(t1) from step_matrices,
     for HHT (the form with the acceleration kept) and Newmark (the acceleration eliminated)."""

@@ -1,12 +1,12 @@
 """One point of a map: run its scene (from rest or from a neighbour's final state) and keep what a map records.
 
 Continuation
-    A warm point starts from the previous point's final state ``(q, v)`` (model coordinates) and
-    with each unbalance at the angle it had reached, ``phase + Omega T`` (T the previous run's
+    A warm point starts from the previous point's final state (model coordinates, the rub
+    plates' own states, contact forces and slip modes: ``simulate(..., start=final)``) and with
+    each unbalance at the angle it had reached, ``phase + Omega T`` (T the previous run's
     duration), so the forcing turns on without a jump in angle; only the speed (or the varied
-    key) changes at the junction. The rub plates restart at rest (:func:`rotorred.transient.newmark.simulate`
-    takes no plate state): at 90 Hz two runs of 0.5 s joined so differ from one run of 1 s by 2.8e-11
-    of the peak (tests/test_maps.py). A cold point starts as its scene says (``solver.start``). A
+    key) changes at the junction. At 90 Hz two runs of 0.5 s joined so equal one run of 1 s to
+    round-off (tests/test_maps.py). A cold point starts as its scene says (``solver.start``). A
     point after a diverged one starts cold.
 
 Run until settled
@@ -16,7 +16,10 @@ Run until settled
     (:func:`rotorred.signals.settling.settling_time`), the run goes on from its final state in
     segments as long as the scene's recorded window, and the settling is measured again on the
     joined record, until it has settled or ``limit`` seconds have been simulated. The line fit
-    then uses the last segment (its last whole common periods where the speeds are commensurate).
+    uses the last segment (its last whole common periods where the speeds are commensurate); the
+    class (:func:`rotorred.signals.classify.classify`) is found once, on the final record. Only
+    the response is computed per segment (:func:`rotorred.scenes.run.respond`): no spectra of the
+    other output DOFs, which a map does not keep.
 
 Recorded per point (:class:`PointResult`)
     The class, settling time, explained share and torus of the table DOF
@@ -35,9 +38,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from rotorred.scenes.run import SceneDiverged, SceneModel, analyse_lines, run_scene, spool_frequencies, table_dof
+from rotorred.scenes.run import (SceneDiverged, SceneModel, analyse_lines, fit_and_settling, respond,
+                                 spool_frequencies, table_dof)
 from rotorred.scenes.schema import Scene
 from rotorred.signals.spectra import settled_spectrum
+from rotorred.transient.results import FinalState
 
 __all__ = ["N_LINES", "N_SAMPLES", "StartState", "PointResult", "run_point"]
 
@@ -47,10 +52,9 @@ N_SAMPLES = 400  #: Poincare samples kept per point, the last ones
 
 @dataclass(frozen=True)
 class StartState:
-    """Where a continued point starts: model state and the unbalance angles (rad) reached."""
+    """Where a continued point starts: the transient's final state and the unbalance angles (rad) reached."""
 
-    q: np.ndarray
-    v: np.ndarray
+    state: FinalState | None
     phases: tuple[float, ...]
 
 
@@ -145,34 +149,40 @@ def _segment(scene: Scene, T: float) -> Scene:
     """
     s = scene.solver
     solver = replace(s, duration=s.duration - s.record_start, record_start=0.0)
-    return replace(continued(scene, StartState(None, None, _angles(scene, T))), solver=solver)
+    return replace(continued(scene, StartState(None, _angles(scene, T))), solver=solver)
 
 
 @dataclass
 class _Record:
-    """The table DOF's record so far, joined over segments, and the last segment's result."""
+    """The table DOF's record so far, joined over segments, and the last segment's response."""
 
     t: np.ndarray
     x: np.ndarray
-    last: object
+    last: object  # rotorred.scenes.run.Response
     T: float  # simulated time (s)
 
 
 def _until_settled(scene: Scene, model: SceneModel, record: _Record, limit: float):
-    """Run segments from the last state until the settling is measured or ``limit`` s are simulated."""
+    """Run segments from the last state until the settling is measured or ``limit`` s are simulated.
+
+    Returns the last record's (LineFit, Settling) and the record."""
     d = table_dof(scene)
-    f_L, f_H = spool_frequencies(scene)
-    analysis = record.last.analysis
-    while analysis is not None and not analysis.settling.settled and record.T < limit - 1e-9:
+    settled = _fit_and_settling(scene, record)
+    while not settled[1].settled and record.T < limit - 1e-9:
         seg = _segment(scene, record.T)
-        final = record.last.final
-        res = run_scene(seg, model, compare_normal=False, analyse=False, initial=(final.q, final.v))
+        res = respond(seg, model, record.last.final)
         new = res.t > 0.0  # its first sample is the previous segment's last
         record = _Record(np.concatenate((record.t, res.t[new] + record.T)),
                          np.concatenate((record.x, res.outputs[d][new])), res, record.T + seg.solver.duration)
-        n_fit = settled_spectrum(res.outputs[d], seg.solver.dt, f_L, f_H).n_samples
-        analysis = analyse_lines(record.t, record.x, f_L, f_H, n_fit, d)
-    return analysis, record
+        settled = _fit_and_settling(scene, record)
+    return settled, record
+
+
+def _fit_and_settling(scene: Scene, record: _Record):
+    """Line fit of the last segment's settled part (the spectrum's samples) and the settling of the record."""
+    f_L, f_H = spool_frequencies(scene)
+    n_fit = settled_spectrum(record.last.outputs[table_dof(scene)], scene.solver.dt, f_L, f_H).n_samples
+    return fit_and_settling(record.t, record.x, f_L, f_H, n_fit)
 
 
 def run_point(scene: Scene, model: SceneModel, start: StartState | None = None,
@@ -183,28 +193,27 @@ def run_point(scene: Scene, model: SceneModel, start: StartState | None = None,
     scene = continued(scene, start)
     how = "cold" if start is None else "warm"
     first = scene if start is None else _recorded_from_start(scene)
+    d = table_dof(scene)
     try:
-        res = run_scene(first, model, compare_normal=False, initial=None if start is None else (start.q, start.v))
-        record = _Record(res.t, res.outputs.get(table_dof(scene)), res, first.solver.duration)
-        analysis, record = _until_settled(scene, model, record, limit or scene.solver.duration)
+        res = respond(first, model, None if start is None else start.state)
+        record = _Record(res.t, res.outputs[d], res, first.solver.duration)
+        settled, record = _until_settled(scene, model, record, limit or scene.solver.duration)
+        analysis = analyse_lines(record.t, record.x, *spool_frequencies(scene), dof=d, settled=settled)
     except SceneDiverged as exc:
         return PointResult("diverged", reason=str(exc), start=how, wall_time=time.perf_counter() - t0)
-    if analysis is None:
-        reason = "; ".join(res.analysis_errors.values()) or "no line analysis of the table DOF"
-        return PointResult("failed", reason=reason, start=how, wall_time=time.perf_counter() - t0)
-    return replace(_recorded(analysis, record.last), start=how, simulated=record.T,
+    except ValueError as exc:  # a record too short to fit (checks' one-line message)
+        return PointResult("failed", reason=str(exc), start=how, wall_time=time.perf_counter() - t0)
+    return replace(_recorded(analysis, scene, record.last), start=how, simulated=record.T,
                    wall_time=time.perf_counter() - t0, final=_final(scene, record))
 
 
 def _final(scene: Scene, record: _Record) -> StartState | None:
     """The state the next point starts from: the run's last state and the unbalance angles reached."""
     final = record.last.final
-    if final is None:
-        return None
-    return StartState(np.array(final.q), np.array(final.v), _angles(scene, record.T))
+    return None if final is None else StartState(final, _angles(scene, record.T))
 
 
-def _recorded(a, res) -> PointResult:
+def _recorded(a, scene: Scene, res) -> PointResult:
     """The class, lines, Poincare samples (line analysis ``a``), orbits and contact (last segment ``res``)."""
     c = a.classification
     lines = sorted(a.fit.lines, key=lambda ln: -ln.amplitude)[:N_LINES]
@@ -217,14 +226,14 @@ def _recorded(a, res) -> PointResult:
         line_amplitude=np.array([ln.amplitude for ln in lines]), line_phase=np.array([ln.phase for ln in lines]),
         line_label=tuple(ln.label_ascii for ln in lines),
         poincare_x=c.poincare.x[-N_SAMPLES:], poincare_velocity=c.poincare.velocity[-N_SAMPLES:],
-        poincare_frequency=float(c.poincare.frequency_hz), peak_orbit=_peak_orbits(res),
+        poincare_frequency=float(c.poincare.frequency_hz), peak_orbit=_peak_orbits(scene, res),
         **_contact(res))
 
 
-def _peak_orbits(res) -> np.ndarray:
+def _peak_orbits(scene: Scene, res) -> np.ndarray:
     """Largest orbit radius (m) at each output node with x and y recorded (NaN for a node without both)."""
     out = []
-    for n in res.scene.output.nodes:
+    for n in scene.output.nodes:
         x, y = res.outputs.get((n, "x")), res.outputs.get((n, "y"))
         out.append(float(np.max(np.hypot(x, y))) if x is not None and y is not None else math.nan)
     return np.array(out)
@@ -234,6 +243,7 @@ def _contact(res) -> dict:
     """Contact fraction, impacts and largest normal force (N) of the first plate."""
     if not res.contacts:
         return {"contact_fraction": 0.0, "n_impacts": 0, "max_contact_force": 0.0}
-    force = np.asarray(res.contacts[0].normal_force)
-    return {"contact_fraction": float(res.contact_fraction()), "n_impacts": int(res.n_impacts()),
+    first = res.contacts[0]
+    force = np.asarray(first.normal_force)
+    return {"contact_fraction": 1.0 - first.fraction("open"), "n_impacts": first.n_impacts(),
             "max_contact_force": float(np.max(np.abs(force))) if force.size else 0.0}

@@ -18,6 +18,7 @@ Dataset (:func:`to_dataset`, xarray)
 from __future__ import annotations
 
 import json
+from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,7 @@ import numpy as np
 from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult, StartState
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.sweep import key_unit
+from rotorred.transient.results import FinalState
 from rotorred.writers import write_csv, write_npz, write_text
 
 __all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
@@ -68,13 +70,20 @@ def _arrays(p: PointResult) -> dict:
     arrays.update(torus_k=np.array(p.torus[0]), torus_j=np.array(p.torus[1]), peak_orbit=p.peak_orbit,
                   **{name: np.asarray(getattr(p, name)) for name in VECTORS})
     if p.final is not None:
-        arrays.update(final_q=p.final.q, final_v=p.final.v, final_phases=np.array(p.final.phases))
+        arrays.update({f"final_{name}": np.asarray(getattr(p.final.state, name)) for name in _FINAL},
+                      final_phases=np.array(p.final.phases))
     return arrays
 
 
+#: the fields of the transient's FinalState kept with a point, the start of its chain's next point
+_FINAL = tuple(f.name for f in fields(FinalState))
+
+
 def _point(arrays) -> PointResult:
-    final = (StartState(arrays["final_q"], arrays["final_v"], tuple(arrays["final_phases"]))
-             if "final_q" in arrays else None)
+    final = None
+    if "final_q" in arrays:
+        state = FinalState(**{name: arrays[f"final_{name}"] for name in _FINAL})
+        final = StartState(replace(state, t=float(state.t)), tuple(float(p) for p in arrays["final_phases"]))
     scalars = {name: arrays[name].item() for name in SCALARS if name not in ("torus_k", "torus_j")}
     vectors = {name: arrays[name] for name in VECTORS}
     vectors["line_label"] = tuple(str(s) for s in vectors["line_label"])

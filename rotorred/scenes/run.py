@@ -53,7 +53,8 @@ from rotorred.signals.linefit import LineFit, fit_lines
 from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
-__all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
+__all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "fit_and_settling", "Response", "respond",
+           "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
            "harmonic_outputs", "spool_frequencies"]
 
 
@@ -180,10 +181,7 @@ class SceneResult:
 
     def n_impacts(self, plate: int = 0) -> int:
         """Number of contact onsets (open -> slip/stick) of plate ``plate`` in the window."""
-        if not self.contacts:
-            return 0
-        touching = self.contacts[plate].state != 0
-        return int(np.count_nonzero(touching[1:] & ~touching[:-1]))
+        return self.contacts[plate].n_impacts() if self.contacts else 0
 
     def line_amplitude(self, dof, m: int, n) -> float:
         """Amplitude (m) of the labelled line m f_H + n f_L of ``dof``, 0 if it is not a peak."""
@@ -323,9 +321,9 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     analyse : bool
         Line fit, settling and class of the table DOF (:func:`analyse_lines`; not counted in
         ``solve_time``).
-    initial : (ndarray, ndarray), optional
-        Start state (q0, v0) in model coordinates, shape (n,) each, in place of ``solver.start``
-        (a continuation from another run's ``final``); the transient is then always stepped.
+    initial : rotorred.transient.results.FinalState, optional
+        Continue from another run's ``final`` state (model coordinates, the plates' states and
+        contact forces) in place of ``solver.start``; the transient is then always stepped.
 
     Returns
     -------
@@ -337,10 +335,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
         raise ValueError("`model` was built for a different rotor, solver model or rub nodes than `scene`")
     f_L, f_H = spool_frequencies(scene)
     t0 = time.perf_counter()
-    if scene.is_linear and scene.solver.start == "settled" and initial is None:
-        response = _harmonic_response(scene, model.model)
-    else:
-        response = _transient_response(scene, model, progress, f_L, f_H, initial)
+    response = respond(scene, model, initial, progress)
     spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
     analyses, errors = {}, {}
@@ -365,7 +360,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
 
 
 def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: int | None = None,
-                  dof: tuple = ()) -> LineAnalysis:
+                  dof: tuple = (), settled: tuple | None = None) -> LineAnalysis:
     """Line fit of the last ``n_fit`` samples, then settling and class of the whole record on its torus.
 
     Parameters
@@ -378,18 +373,42 @@ def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: i
         Samples fitted, from the end (the spectrum's ``n_samples``); default all.
     dof : (int, str)
         Recorded with the result.
+    settled : (LineFit, Settling), optional
+        :func:`fit_and_settling` of this record, when already computed.
     """
     t0 = time.perf_counter()
-    n = len(t) if n_fit is None else min(int(n_fit), len(t))
-    fit = fit_lines(t[-n:], x[-n:], f_L, f_H)
-    torus = (fit.torus.k, fit.torus.j)  # found once; settling and class reuse it
-    settling = settling_time(t, x, f_L, f_H, reference=fit)
-    cls = classify(t, x, f_L, f_H, settling=settling, torus=torus)
+    fit, settling = settled or fit_and_settling(t, x, f_L, f_H, n_fit)
+    cls = classify(t, x, f_L, f_H, settling=settling, torus=(fit.torus.k, fit.torus.j))
     return LineAnalysis(tuple(dof), fit, settling, cls, time.perf_counter() - t0)
 
 
+def fit_and_settling(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float,
+                     n_fit: int | None = None) -> tuple[LineFit, Settling]:
+    """The first two steps of :func:`analyse_lines`: the line fit of the last ``n_fit`` samples and the
+    settling of the whole record, which tracks that fit's lines (its torus is found once)."""
+    n = len(t) if n_fit is None else min(int(n_fit), len(t))
+    fit = fit_lines(t[-n:], x[-n:], f_L, f_H)
+    return fit, settling_time(t, x, f_L, f_H, reference=fit)
+
+
 @dataclass(frozen=True)
-class _Response:
+class Response:
+    """A scene's response in its recorded window, before any spectrum (:func:`respond`).
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Record times (s).
+    outputs : dict of (int, str) to ndarray, shape (n,)
+        Recorded DOFs (m or rad).
+    contacts : tuple of ContactHistory
+    method : {"harmonic", "transient"}
+    n_steps : int
+    counters : dict
+    final : FinalState or None
+        End state of a transient (None for the harmonic solution).
+    """
+
     t: np.ndarray
     outputs: dict
     contacts: tuple
@@ -399,16 +418,28 @@ class _Response:
     final: object = None
 
 
-def _harmonic_response(scene: Scene, model) -> _Response:
+def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None = False) -> Response:
+    """The response in the recorded window: harmonic for a linear scene started settled, else stepped in time.
+
+    ``initial`` (a FinalState) continues another run (:func:`run_scene`). Raises
+    :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
+    """
+    if scene.is_linear and scene.solver.start == "settled" and initial is None:
+        return _harmonic_response(scene, model.model)
+    f_L, f_H = spool_frequencies(scene)
+    return _transient_response(scene, model, progress, f_L, f_H, initial)
+
+
+def _harmonic_response(scene: Scene, model) -> Response:
     """The settled linear response at the record times (no time stepping)."""
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
-    return _Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+    return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,
-                        f_H: float, initial=None) -> _Response:
+                        f_H: float, initial=None) -> Response:
     """Time stepping from the settled linear state or from rest (:func:`rotorred.transient.newmark.simulate`).
 
     Raises :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
@@ -417,19 +448,15 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
     from rotorred.transient.results import SimulationDiverged
 
     s, model = scene.solver, scene_model.model
-    if initial is not None:
-        q0, v0 = (checks.vector(name, v, min_len=model.M.shape[0], max_len=model.M.shape[0])
-                  for name, v in zip(("initial q0", "initial v0"), initial))
-    else:
-        q0, v0 = settled_state(scene, model) if s.start == "settled" else (None, None)
+    q0, v0 = settled_state(scene, model) if s.start == "settled" and initial is None else (None, None)
     kw = {"alpha": s.alpha} if s.method == "hht" else {}
     try:
         res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
                        rotor=scene.rotor, outputs=scene.output.dofs, record_start=s.record_start, method=s.method,
-                       gravity=s.gravity or None, q0=q0, v0=v0, progress=progress, **kw)
+                       gravity=s.gravity or None, q0=q0, v0=v0, start=initial, progress=progress, **kw)
     except SimulationDiverged as exc:
         raise SceneDiverged.of(scene, scene_model, exc, f_L, f_H) from None
-    return _Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res), res.final)
+    return Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res), res.final)
 
 
 def _counters(res) -> dict:

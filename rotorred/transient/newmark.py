@@ -169,46 +169,87 @@ def check_loads(model, speeds, rotor, spool_of, plates, unbalances, outputs) -> 
     return Loads(speeds, spool_of, plates, unbalances, outputs)
 
 
-def initial_vector(n: int, q0, v0) -> np.ndarray:
-    """(q0, v0, 0), shape (3 n,), from the optional initial displacement and velocity (model coordinates)."""
+def initial_vector(n: int, q0, v0, start: FinalState | None = None) -> np.ndarray:
+    """(q0, v0, 0), shape (3 n,), from the optional initial displacement and velocity or the ``start`` state
+    (model coordinates)."""
+    if start is not None:
+        if q0 is not None or v0 is not None:
+            checks.fail("start", "a FinalState", "must not be given with q0 or v0 (it holds both)")
+        q0, v0 = start.q, start.v
     x0 = np.zeros(3 * n)
     for name, vec, off in (("q0", q0, 0), ("v0", v0, n)):
         if vec is not None:
-            x0[off:off + n] = checks.array(name, vec, (n,))
+            x0[off:off + n] = checks.array(name if start is None else f"start.{name[0]}", vec, (n,))
     return x0
+
+
+def check_start(start: FinalState | None, n_p: int) -> None:
+    """A continued run's plates are the run's plates: ``start`` holds the state of ``n_p`` plates."""
+    if start is None:
+        return
+    if not isinstance(start, FinalState):
+        checks.fail("start", type(start).__name__, "must be a FinalState (another run's `final`)")
+    shapes = {"plate": (n_p, 2, 3), "forces": (n_p, 2), "mode": (n_p,), "sgn": (n_p,)}
+    for name, shape in shapes.items():
+        checks.array(f"start.{name}", getattr(start, name), shape)
 
 
 # ----------------------------------------------------------------------------------- 2. initial state, records
 def initial_state(M, D, K, B, par: np.ndarray, plates: Sequence[RubPlate], forces: ForceColumns,
-                  x0: np.ndarray) -> kernel.State:
+                  x0: np.ndarray, start: FinalState | None = None) -> kernel.State:
     """The kernel's :class:`~rotorred.transient.kernel.State` at t = 0.
 
-    The plates start at rest; a plate already pressed at t = 0 starts slipping with the law's
-    force, which the plate's acceleration balances. The acceleration follows from the equation of
-    motion, ``a0 = M^-1 (F(0) + B f(0) - D v0 - K q0)``.
+    From rest or (q0, v0), the plates start at rest; a plate already pressed at t = 0 starts
+    slipping with the law's force, which the plate's acceleration balances. From another run's
+    ``start`` state, the plates' states, contact forces, slip modes and directions are carried
+    over. Either way the acceleration follows from the equation of motion at t = 0,
+    ``a0 = M^-1 (F(0) + B f(0) - D v0 - K q0)`` (the forcing may differ from the run that ended
+    in ``start``: another speed).
     """
     n, n_p = len(M), len(plates)
     q, v = x0[:n], x0[n:2 * n]
     xc = np.zeros((2 * n_p, 3))
     xc[:, 0], xc[:, 1] = B.T @ q, B.T @ v
-    z, sgn = np.zeros(2 * n_p), np.ones(n_p)
-    pinfo, ps = np.zeros((n_p, 3)), np.zeros((n_p, 2, 3))
-    for k, p in enumerate(plates):
-        c, s = par[k, kernel.P_COS], par[k, kernel.P_SIN]
-        (x, vx), (y, vy) = xc[2 * k, :2], xc[2 * k + 1, :2]
-        pen = x * c + y * s - p.clearance
-        vrel = par[k, kernel.P_V] + (-vx * s + vy * c)
-        P, _ = normal_force(pen, vx * c + vy * s, p)
-        T = -p.mu_d * P * np.sign(vrel)
-        sgn[k] = 1.0 if vrel >= 0 else -1.0
-        z[2 * k], z[2 * k + 1] = P, T
-        pinfo[k] = (vrel, -pen, OPEN if P == 0 else SLIP)
-        ps[k, 0, 2], ps[k, 1, 2] = P / p.m_p, -T / p.m_p
+    if start is None:
+        z, ps, mode, sgn = _plates_from_rest(xc, par, plates)
+    else:
+        z, ps = start.forces.ravel().astype(float), np.array(start.plate, float)
+        mode, sgn = np.array(start.mode, dtype=np.int64), np.array(start.sgn, float)
+    pinfo = _plate_info(xc, ps, z, mode, par)
     f = np.column_stack(disk_force(z[0::2], z[1::2], par[:, kernel.P_COS], par[:, kernel.P_SIN])).ravel()
     x0 = x0.copy()
     x0[2 * n:] = sla.solve(M, forces.at(0.0) + B @ f - D @ v - K @ q)
     xc[:, 2] = B.T @ x0[2 * n:]
-    return kernel.State(x=x0, xc=xc, ps=ps, z=z, mode=np.ones(n_p, dtype=np.int64), sgn=sgn, pinfo=pinfo)
+    return kernel.State(x=x0, xc=xc, ps=ps, z=z, mode=mode, sgn=sgn, pinfo=pinfo)
+
+
+def _plates_from_rest(xc: np.ndarray, par: np.ndarray, plates: Sequence[RubPlate]):
+    """(z, ps, mode, sgn) of plates at rest at t = 0: a pressed plate slips with the law's force."""
+    n_p = len(plates)
+    z, ps, sgn = np.zeros(2 * n_p), np.zeros((n_p, 2, 3)), np.ones(n_p)
+    for k, p in enumerate(plates):
+        c, s = par[k, kernel.P_COS], par[k, kernel.P_SIN]
+        (x, vx), (y, vy) = xc[2 * k, :2], xc[2 * k + 1, :2]
+        vrel = par[k, kernel.P_V] + (-vx * s + vy * c)
+        P, _ = normal_force(x * c + y * s - p.clearance, vx * c + vy * s, p)
+        T = -p.mu_d * P * np.sign(vrel)
+        sgn[k] = 1.0 if vrel >= 0 else -1.0
+        z[2 * k], z[2 * k + 1] = P, T
+        ps[k, 0, 2], ps[k, 1, 2] = P / p.m_p, -T / p.m_p
+    return z, ps, np.ones(n_p, dtype=np.int64), sgn
+
+
+def _plate_info(xc: np.ndarray, ps: np.ndarray, z: np.ndarray, mode: np.ndarray, par: np.ndarray) -> np.ndarray:
+    """The kernel's ``pinfo`` at t = 0: v_rel (m/s), gap (m) and contact state (0 open, 1 slip, 2 stick)."""
+    pinfo = np.zeros((len(ps), 3))
+    for k in range(len(ps)):
+        c, s = par[k, kernel.P_COS], par[k, kernel.P_SIN]
+        (x, vx), (y, vy) = xc[2 * k, :2], xc[2 * k + 1, :2]
+        vrel = par[k, kernel.P_V] + (-vx * s + vy * c) - ps[k, 1, 1]
+        gap = par[k, kernel.P_CLEAR] + ps[k, 0, 0] - (x * c + y * s)
+        state = OPEN if z[2 * k] == 0 else (STICK if mode[k] == 2 else SLIP)
+        pinfo[k] = (vrel, gap, state)
+    return pinfo
 
 
 @dataclass(frozen=True)
@@ -231,13 +272,23 @@ class RecordPlan:
     n_records: int
 
 
+def whole_steps(x: float) -> int:
+    """The steps a time covers, ``x`` = time / dt: the nearest integer when ``x`` is one up to its rounding, else
+    ``x`` rounded up.
+
+    The slack is 1e-9 + 1e-12 |x| steps: the quotient of two decimal times carries a rounding error of
+    about |x| 2e-16 (59.7 / 1e-6 = 59700000.00000001), more than a fixed 1e-9 steps once a run has
+    some 1e7 steps, and any fraction below the slack means nothing at that step count.
+    """
+    n = round(x)
+    return int(n) if abs(x - n) <= 1e-9 + 1e-12 * abs(x) else int(math.ceil(x))
+
+
 def record_plan(t_end: float, dt: float, record_start: float, decimate: int) -> RecordPlan:
-    """Steps and records of a run to ``t_end`` (s): ``t_end / dt`` steps (rounded up unless within 1e-9 of an integer),
-    records from the first step at or after ``record_start`` (s, 1e-9 steps of slack), every ``decimate``-th."""
-    N = int(round(t_end / dt))
-    if abs(N * dt - t_end) > 1e-9 * t_end:
-        N = int(math.ceil(t_end / dt - 1e-9))
-    first = int(math.ceil(record_start / dt - 1e-9))
+    """Steps and records of a run to ``t_end`` (s): ``t_end / dt`` steps, records from the first step at or after
+    ``record_start`` (s), every ``decimate``-th (each count by :func:`whole_steps`)."""
+    N = whole_steps(t_end / dt)
+    first = whole_steps(record_start / dt)
     return RecordPlan(n_steps=N, first=first, every=decimate,
                       n_records=(N - first) // decimate + 1 if first <= N else 0)
 
@@ -307,7 +358,7 @@ def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: R
         message, dof, cause = failure(model, loads.plates, status, diag.err, run.max_halvings, t_done)
     x = state.x
     final = FinalState(t=t_done, q=x[:n].copy(), v=x[n:2 * n].copy(), a=x[2 * n:].copy(), plate=state.ps.copy(),
-                       forces=state.z.reshape(n_p, 2).copy())
+                       forces=state.z.reshape(n_p, 2).copy(), mode=state.mode.copy(), sgn=state.sgn.copy())
     result = TransientResult(
         t=record.t[:nr].copy(), outputs={o: record.y[:nr, j].copy() for j, o in enumerate(loads.outputs)},
         contacts=contact_histories(loads.plates, record), success=success, status=0 if success else int(status),
@@ -327,7 +378,8 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
              spool_of: Mapping[int, str] | None = None, outputs: Sequence[tuple[int, str]] = (),
              record_start: float = 0.0, decimate: int = 1, method: str = "newmark",
              gamma: float | None = None, beta: float | None = None, alpha: float | None = None,
-             gravity: float | None = None, q0=None, v0=None, progress: bool | None = None,
+             gravity: float | None = None, q0=None, v0=None, start: FinalState | None = None,
+             progress: bool | None = None,
              newton_tol: float = 1e-10, max_newton: int = 50, max_halvings: int = 4,
              displacement_limit: float = 1.0, chunk_steps: int | None = None, **unknown) -> TransientResult:
     """Transient response with unbalance, optional gravity and rub-impact plates.
@@ -366,6 +418,11 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
         Gravity acceleration along -y (m/s^2), e.g. 9.81.
     q0, v0 : array_like, shape (n,), optional
         Initial displacement and velocity in model coordinates (default 0).
+    start : FinalState, optional
+        Continue another run from its ``final`` state, in place of ``q0, v0``: its displacement,
+        velocity, the plates' own states, the contact forces and slip modes are carried over
+        (the plates must be the same); the time restarts at 0, so give each unbalance the angle
+        it had reached. The speeds may differ (a map's next point).
     progress : bool, optional
         Progress bar on stderr; default: shown once a run has taken more than 2 s.
     newton_tol : float
@@ -402,7 +459,8 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
                             displacement_limit, gravity, chunk_steps)
     loads = check_loads(model, speeds, rotor, spool_of, plates, unbalances, outputs)
     n = model.M.shape[0]
-    x0 = initial_vector(n, q0, v0)
+    check_start(start, len(loads.plates))
+    x0 = initial_vector(n, q0, v0, start)
     # 2. prepare the matrices: forces, plates, step matrices (with the condensed contact operator) per level
     M, K, D = np.asarray(model.M, float), np.asarray(model.K, float), np.asarray(model.damping(loads.speeds), float)
     forces = force_columns(model, loads.speeds, loads.spool_of, loads.unbalances, run.gravity)
@@ -411,7 +469,7 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
     contact = kernel_plates(M, B, par, atol)
     levels = step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha,
                          run.max_halvings + 1)
-    state = initial_state(M, D, K, B, par, loads.plates, forces, x0)
+    state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
     # 3. plan the record
     plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
     rows = model.output_rows(loads.outputs) if loads.outputs else np.zeros((0, n))

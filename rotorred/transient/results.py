@@ -79,6 +79,11 @@ class ContactHistory:
         code = {v: k for k, v in STATE_NAMES.items()}[state]
         return float(np.mean(self.state == code)) if len(self.state) else 0.0
 
+    def n_impacts(self) -> int:
+        """Number of contact onsets (open -> slip or stick) in the record."""
+        touching = self.state != 0
+        return int(np.count_nonzero(touching[1:] & ~touching[:-1]))
+
 
 @dataclass(frozen=True)
 class FinalState:
@@ -94,6 +99,12 @@ class FinalState:
         Per plate, (normal, tangential) x (displacement (m), velocity (m/s), acceleration (m/s^2)).
     forces : ndarray, shape (n_p, 2)
         Per plate (P, T) (N).
+    mode : ndarray of int64, shape (n_p,)
+        Per plate, the contact law's branch the next step starts from: 1 slip, 2 stick.
+    sgn : ndarray, shape (n_p,)
+        Per plate, the slip direction sign(v_rel).
+
+    A run continues another exactly from its ``final`` (``simulate(..., start=final)``).
     """
 
     t: float
@@ -102,6 +113,8 @@ class FinalState:
     a: np.ndarray
     plate: np.ndarray
     forces: np.ndarray
+    mode: np.ndarray
+    sgn: np.ndarray
 
 
 @dataclass(frozen=True)
