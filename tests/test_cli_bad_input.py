@@ -62,11 +62,11 @@ CASES = [
     (["campbell", "{d}/binary.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["binary.toml", "UTF-8"]),
     (["run", "{d}/latin1.toml", "--out", "{d}/o"], ["latin1.toml", "UTF-8"]),
     (["run", "{d}/twice.toml", "--out", "{d}/o"], ["twice.toml", "name", "given once", "line 2"]),
-    # ---- scene files (through run, and one through sweep and harmonic)
+    # ---- scene files (through run, and one through sweep (= map) and harmonic)
     *[(["run", f"{{d}}/s_{k}.toml", "--out", "{d}/o"], [f"s_{k}.toml", new.split("\n")[-1].split(" = ")[0],
                                                         new.split("\n")[-1].split(" = ")[-1].strip('[]" ').split(",")[-1].strip('" ')])
       for k, (old, new) in S.items()],
-    (["sweep", "{d}/s_clearance.toml", "--set", "rub.clearance=1e-6,-2e-6", "--out", "{d}/o"], ["rub[0].clearance"]),
+    (["sweep", "{d}/s_clearance.toml", "--vary", "rub.clearance=1e-6,-2e-6", "--out", "{d}/o"], ["rub[0].clearance"]),
     (["harmonic", "{d}/s_unb_node.toml", "--out", "{d}/o"], ["unbalance[0].node", "99"]),
     (["run", "{d}/missing.toml", "--out", "{d}/o"], ["missing.toml"]),
     (["run", "nosuch-scene", "--out", "{d}/o"], ["nosuch-scene"]),
@@ -80,8 +80,10 @@ CASES = [
                                                                              "--force"]),
     (["run", "paper-rub", "--set", "solver.dt=1e-12", "--out", "{d}/o"], ["solver.duration", "steps", "--force"]),
     (["run", "paper-normal", "--set", "solver.duration=1e6", "--out", "{d}/o"], ["solver.record_start", "memory"]),
-    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.duration=1e6", "--out", "{d}/o"],
+    (["sweep", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6", "--set", "solver.duration=1e6", "--out", "{d}/o"],
      ["solver.duration", "steps"]),
+    (["map", "paper-rub", "--vary", "speeds.outer=60:110:101", "--limit", "1e4", "--out", "{d}/o"],
+     ["--vary", "speeds.outer=<101 values>", "steps in all", "--force"]),
     (["campbell", "seed-rig", "--speeds", "0:1000:1000000000", "--out", "{d}/o"], ["--speeds", "COUNT"]),
     # ---- campbell options
     (["campbell", "seed-rig", "--speeds", "0:12000", "--out", "{d}/o"], ["--speeds", "0:12000"]),
@@ -109,15 +111,17 @@ CASES = [
     (["harmonic", "seed-rig", "--ratio", "abc", "--out", "{d}/o"], ["--ratio", "abc"]),
     (["harmonic", "seed-rig", "--reference-spool", "mid", "--out", "{d}/o"], ["--reference-spool", "mid"]),
     (["harmonic", "seed-rig", "--reduced", "--boundary-nodes", "99", "--out", "{d}/o"], ["--boundary-nodes", "99"]),
-    # ---- sweep options
-    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--dof", "99:y", "--out", "{d}/o"], ["--dof", "99"]),
-    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--dof", "13:tx", "--out", "{d}/o"], ["--dof", "13:tx"]),
-    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.dt=1e-5,2e-5", "--out", "{d}/o"],
+    # ---- sweep (= map) options
+    (["sweep", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6", "--set", "output.table=[99, \"y\"]", "--out",
+      "{d}/o"], ["output.table", "99"]),
+    (["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--out", "{d}/o"],
+     ["--set", "rub.clearance=1e-6,2e-6", "--vary"]),
+    (["sweep", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6", "--set", "solver.dt=1e-5,2e-5", "--out", "{d}/o"],
      ["--set", "solver.dt=1e-5,2e-5"]),
-    (["sweep", "paper-rub", "--set", "rub.clearance=1:2:1", "--out", "{d}/o"], ["--set rub.clearance", "1:2:1"]),
+    (["sweep", "paper-rub", "--vary", "rub.clearance=1:2:1", "--out", "{d}/o"], ["--vary rub.clearance", "1:2:1"]),
     # ---- --out problems, in every command: an existing file, below a file, empty, not writable
     *[([*cmd, "--out", out], ["--out", token]) for cmd in (["run", "paper-rub"],
-                                                          ["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6"],
+                                                          ["sweep", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6"],
                                                           ["campbell", "seed-rig", "--speeds", "0:6000:3"],
                                                           ["harmonic", "seed-rig"])
       for out, token in (("{d}/afile", "afile"), ("{d}/afile/sub", "afile"), ("", "''"), ("{ro}/sub", "ro"))],

@@ -3,6 +3,9 @@ two runs into one ``--out`` stay consistent (reliability.md sections 1, 2 and 4)
 
 from __future__ import annotations
 
+import csv
+import io
+
 import hashlib
 import os
 import signal
@@ -46,16 +49,22 @@ def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
 
 
 def test_diverging_sweep_point_is_recorded_and_the_others_kept(tmp_path, capsys):
+    """A one-key sweep (a map) with a value whose transient diverges: that point is recorded with the reason, the
+    other is kept, exit 3."""
     out = tmp_path / "sweep"
-    assert main(["sweep", "paper-rub", "--set", "unbalance[1].m_e=1e-3,4.0", *DIVERGE, "--out", str(out)]) == 3
+    assert main(["sweep", "paper-rub", "--vary", "unbalance[1].m_e=1e-3,4.0", "--cold", "--workers", "0", *DIVERGE,
+                 "--out", str(out)]) == 3
     captured = capsys.readouterr()
-    assert "Traceback" not in captured.err and "1 of 2 values failed" in captured.err
-    rows = (out / "sweep.csv").read_text().splitlines()
-    assert len(rows) == 3 and rows[1].endswith(",ok")
-    assert "failed: the transient diverged at t = 0.3486 s at rub[0] (node 18, x)" in rows[2]
-    assert float(rows[1].split(",")[4]) > 0 and rows[2].split(",")[4] == "nan"
-    assert "FAILED: the transient diverged" in (out / "sweep.txt").read_text()
-    assert (out / "sweep.png").exists()
+    assert "Traceback" not in captured.err and "rotorred sweep: error: 1 of 2 points failed" in captured.err
+    rows = list(csv.reader(io.StringIO((out / "map.csv").read_text())))
+    header = rows[0]
+    status, reason, contact = (header.index(c) for c in ("status", "reason", "contact_fraction (1)"))
+    first, second = rows[1:]
+    assert len(rows) == 3 and first[status] == "ok" and second[status] == "diverged"
+    assert "the transient diverged at t = 0.3486 s at rub[0] (node 18, x)" in second[reason]
+    assert float(first[contact]) >= 0 and second[contact] == "nan"
+    assert "diverged: the transient diverged" in (out / "map.txt").read_text()
+    assert (out / "lines.png").exists()
 
 
 # --------------------------------------------------------------------------- interrupts and concurrency

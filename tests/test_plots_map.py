@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from matplotlib import colormaps
 
-from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_waterfall
+from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_lines, plot_waterfall
 from rotorred.signals.classify import KINDS
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -134,6 +134,26 @@ def test_plot_waterfall_refuses_bad_input(tmp_path):
         plot_waterfall(SPEEDS, f, a, bad, xlabel="x", orders={"1×": -1.0})
     with pytest.raises(ValueError, match=r"^dynamic_range = 1: must be > 1$"):
         plot_waterfall(SPEEDS, f, a, bad, xlabel="x", dynamic_range=1)
+    assert not bad.exists()
+
+
+def test_plot_lines_of_a_clearance_sweep(tmp_path):
+    """Lines, contact and the free reach marker; a failed point (NaN) is a gap, not an error."""
+    c = np.array([5e-6, 20e-6, 40e-6, 50e-6, 60e-6])
+    amps = {"f_L": np.array([9e-6, 9e-6, 9e-6, 9e-6, np.nan]), "f_H": np.full(5, 12e-6),
+            "2f_H-f_L": np.array([3e-6, 2e-6, 1e-6, 0.0, np.nan]), "f_H-f_L": np.array([1e-6, 1e-6, 0.5e-6, 0.0, 0.0])}
+    out = plot_lines(c, amps, [0.1, 0.08, 0.03, 0.0, np.nan], [9, 7, 2, 0, np.nan], tmp_path / "lines.png",
+                     xlabel="Rub clearance (µm)", xscale=1e6, reach=43e-6, title="sweep")
+    _assert_png(out, ["C0", "C1", "C3"])  # f_L, f_H and the contact fraction drawn
+    without = plot_lines(c, amps, np.zeros(5), np.zeros(5), tmp_path / "plain.png", xlabel="x", xscale=1e6)
+    assert _pixels(out, "0.4") > _pixels(without, "0.4") + 100  # the reach's dashed lines
+    bad = tmp_path / "bad.png"
+    with pytest.raises(ValueError, match=r"^amplitudes\['f_L'\] = array of shape \(4,\): must have shape \(5\) \(m\)$"):
+        plot_lines(c, {"f_L": np.ones(4)}, np.zeros(5), np.zeros(5), bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^amplitudes\['f_L'\] = .*must hold values >= 0 or NaN"):
+        plot_lines(c, {"f_L": -np.ones(5)}, np.zeros(5), np.zeros(5), bad, xlabel="x")
+    with pytest.raises(ValueError, match=r"^amplitudes = \[1, 2\]: must be a mapping line label -> array \(n,\)$"):
+        plot_lines(c, [1, 2], np.zeros(5), np.zeros(5), bad, xlabel="x")
     assert not bad.exists()
 
 

@@ -1,19 +1,23 @@
-"""Clearance sweeps: the trend at the free orbit's reach, model reuse, files, CLI."""
+"""One-key sweeps are one-key maps (``rotorred sweep`` is ``rotorred map``): the clearance trend at the free
+orbit's reach, one model for the whole sweep, the files, the command."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-import rotorred.scenes.sweep as sweep_mod
+import rotorred.maps.execute as execute
 from rotorred.linear.harmonic import unbalance_response
+from rotorred.maps.run import run_map
+from rotorred.maps.spec import Axis, MapSpec
+from rotorred.scenes.reach import free_reach
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
-from rotorred.scenes.sweep import free_reach, sweep, write_sweep
 
 #: paper-rub on a short window (the rub settles within 0.3 s from the settled linear state)
 SHORT = {"solver.duration": 0.6, "solver.record_start": 0.4, "output.plot_window": [0.4, 0.5],
          "output.formats": [], "output.plots": []}
+CLEARANCES = (60e-6, 45e-6, 10e-6)
 
 
 def test_free_reach_against_the_harmonic_module():
@@ -35,76 +39,68 @@ def test_free_reach_against_the_harmonic_module():
 
 
 @pytest.fixture(scope="module")
-def result(monkeypatch_module):
+def swept(tmp_path_factory):
+    """A cold clearance sweep, serial, counting the structural models built."""
     calls = []
-    original = sweep_mod.build_model
+    original = execute.build_model
 
     def counting(scene):
         calls.append(scene.name)
         return original(scene)
-    monkeypatch_module.setattr(sweep_mod, "build_model", counting)
-    res = sweep("paper-rub", "rub.clearance", [60e-6, 45e-6, 10e-6], settings=SHORT)
-    return res, calls
 
-
-@pytest.fixture(scope="module")
-def monkeypatch_module():
     mp = pytest.MonkeyPatch()
-    yield mp
-    mp.undo()
+    mp.setattr(execute, "build_model", counting)
+    out = tmp_path_factory.mktemp("sweep") / "out"
+    spec = MapSpec("paper-rub", (Axis("rub.clearance", CLEARANCES),), settings=tuple(SHORT.items()), cold=True)
+    try:
+        result = run_map(spec, out, workers=0, progress=False)
+    finally:
+        mp.undo()
+    return result, calls, out
 
 
-def test_no_lines_beyond_the_free_reach_and_lines_below(result):
-    res, _ = result
-    far = res.values > res.free_reach
+def test_no_lines_beyond_the_free_reach_and_lines_below(swept):
+    """Beyond the free orbit's reach the plate is never touched and the fit finds f_L and f_H only (the
+    linear response); below it the plate is struck and combination lines appear."""
+    result, _, _ = swept
+    ds = result.dataset.sel(direction="up")
+    reach = ds["free_reach"].values
+    assert np.ptp(reach) == 0.0  # the clearance does not change the free orbit
+    far = np.array(CLEARANCES) > reach
     assert list(far) == [True, True, False]  # 60 and 45 um lie beyond the reach (~43 um), 10 um below
-    assert np.all(res.contact_fraction[far] == 0) and np.all(res.n_combinations[far] == 0)
-    assert np.all(res.n_impacts[far] == 0)
-    assert res.contact_fraction[2] > 0 and res.n_impacts[2] > 0 and res.n_combinations[2] >= 18
-    # beyond the reach the lines are the linear ones: identical for both clearances
-    for k in ("f_L", "f_H"):
-        assert res.amplitudes[k][0] == res.amplitudes[k][1] > 0
-    assert res.combination_total()[2] > 0.1 * res.amplitudes["f_H"][2]
+    labels = [set(str(x) for x in row if x) for row in ds["line_label"].values]
+    for i in np.flatnonzero(far):
+        assert ds["contact_fraction"].values[i] == 0 and ds["n_impacts"].values[i] == 0
+        assert labels[i] == {"f_L", "f_H"}
+    assert ds["contact_fraction"].values[2] > 0 and ds["n_impacts"].values[2] > 0
+    assert len(labels[2] - {"f_L", "f_H"}) >= 30  # measured 58 (the map keeps the strongest 60 lines)
 
 
-def test_one_model_for_the_whole_sweep(result):
-    _, calls = result
+def test_one_model_for_the_whole_sweep(swept):
+    _, calls, _ = swept
     assert len(calls) == 1
 
 
-def test_write_sweep(result, tmp_path):
-    res, _ = result
-    files = write_sweep(res, tmp_path)
-    assert sorted(f.name for f in files) == ["sweep.csv", "sweep.png", "sweep.txt"]
-    header = (tmp_path / "sweep.csv").read_text().splitlines()[0].split(",")
-    assert header[:5] == ["rub.clearance (SI)", "contact fraction", "impacts", "combination lines", "peak (um)"]
-    assert header[-1] == "status"  # "ok", or "failed: <why>" for a diverged value (tests/test_cli_failures.py)
-    assert [row.rsplit(",", 1)[1] for row in (tmp_path / "sweep.csv").read_text().splitlines()[1:]] == ["ok"] * 3
-    data = np.loadtxt(tmp_path / "sweep.csv", delimiter=",", skiprows=1, usecols=range(len(header) - 1))
-    np.testing.assert_allclose(data[:, 0], res.values, rtol=1e-8)
-    np.testing.assert_allclose(data[:, header.index("f_H (um)")], 1e6 * res.amplitudes["f_H"], rtol=1e-5)
+def test_sweep_files(swept):
+    result, _, out = swept
+    names = sorted(p.name for p in out.iterdir() if p.is_file() and not p.name.startswith("."))
+    assert names == ["bifurcation.png", "lines.png", "map.csv", "map.nc", "map.txt", "map_lines.csv",
+                     "waterfall.png"]
+    header = (out / "map.csv").read_text().splitlines()[0].split(",")
+    assert "free_reach (m)" in header and "contact_fraction (1)" in header and "status" in header
 
 
-def test_sweep_validates_every_value_before_computing(monkeypatch):
-    def boom(*a, **k):
-        raise AssertionError("computed before validating all values")
-    monkeypatch.setattr(sweep_mod, "run_scene", boom)
-    with pytest.raises(ValueError, match=r"rub\[0\]\.clearance = -5e-06: must be >= 0 \(m\)"):
-        sweep("paper-rub", "rub.clearance", [20e-6, -5e-6], settings=SHORT)
-
-
-def test_cli_sweep(tmp_path, capsys):
+def test_rotorred_sweep_is_rotorred_map(tmp_path, capsys):
     from rotorred.cli import main
-    args = ["sweep", "paper-rub", "--set", "rub.clearance=60e-6,50e-6", "--out", str(tmp_path)]
+
+    args = ["sweep", "paper-rub", "--vary", "rub.clearance=60e-6,50e-6", "--cold", "--workers", "0",
+            "--out", str(tmp_path)]
     for k, v in SHORT.items():
         args += ["--set", f"{k}={v!r}".replace("'", '"')]
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert "sweep of rub.clearance over 2 values" in out and (tmp_path / "sweep.png").exists()
-    # two swept keys are refused
-    assert main(["sweep", "paper-rub", "--set", "rub.clearance=1e-6,2e-6", "--set", "solver.dt=1e-5,2e-5",
-                 "--out", str(tmp_path)]) == 2
-    assert "sweep one key" in capsys.readouterr().err
+    assert "map of paper-rub: rub.clearance (2)" in out and "2 points run" in out
+    assert (tmp_path / "map.nc").exists() and (tmp_path / "lines.png").exists()
 
 
 def test_no_plate_no_reach():

@@ -27,7 +27,6 @@ COMMANDS = [
     "harmonic",
     "map",
     "run",
-    "sweep",
 ]
 
 EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_DIVERGED, EXIT_ENVIRONMENT = 0, 1, 2, 3, 4
@@ -39,8 +38,8 @@ EXIT_STATUSES = {
     EXIT_INTERNAL: "internal error (a bug): the traceback is in rotorred-error.log in --out (or the temp folder)",
     EXIT_INPUT: "bad input (a file, a key, an option, --out, a size beyond the limits): nothing computed, "
                 "nothing written",
-    EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `sweep` keeps the other "
-                   "points and names the failed ones in sweep.csv and sweep.txt",
+    EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `map` (and `sweep`) keeps "
+                   "the other points and names the failed ones in map.csv and map.txt",
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
                       "an optional library is missing (the message gives its install command)",
     EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result",

@@ -1,5 +1,8 @@
 """``rotorred map SCENE --vary KEY=START:STOP:N [--vary ...] --out DIR``: a map of the operating envelope.
 
+``rotorred sweep`` is the same command (one code path): a one-key sweep is a map with one
+``--vary``, e.g. ``rotorred sweep paper-rub --vary rub.clearance=0:45e-6:10 --cold --out c``.
+
 Runs the scene at every point of the grid of the varied keys on a Dask cluster (a
 LocalCluster, one single-threaded worker per core, unless ``--scheduler`` names one; ``--workers
 0`` runs serially), each point from its neighbour's final state along the first key (``--cold``:
@@ -18,14 +21,14 @@ from rotorred.cli.options import out_dir
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "map", help="run a scene over a grid of keys (speeds, clearance) on Dask: classes, bifurcation diagram",
+        "map", aliases=["sweep"], help="run a scene over a grid of keys (speeds, clearance) on Dask: classes, bifurcation diagram",
         description="Run a scene at every point of a grid of one or more keys, each point continued from its "
                     "neighbour's final state along the first key, and write the classes, labelled lines, "
                     "Poincare samples, orbits and contact as NetCDF and CSV with a bifurcation diagram, a waterfall "
                     "and heat maps. Example: rotorred map paper-rub --vary speeds.outer=60:110:51 --direction both "
                     "--out envelope")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file")
-    p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
+    p.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
                    help="KEY=START:STOP:N or KEY=v1,v2,... (scene units: speeds in Hz, clearance in m); repeat for "
                         "a 2-D map; the first is the continuation axis")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
@@ -38,6 +41,8 @@ def add_parser(subparsers):
     p.add_argument("--workers", type=int, default=None, help="local Dask workers (default one per core; 0: serial)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="an existing Dask scheduler, tcp://host:port")
     p.add_argument("--out", required=True, help="output directory (its points/ are kept: the same command resumes)")
+    p.add_argument("--force", action="store_true",
+                   help="go on with maps beyond the size limits (steps, memory, model size; see the message)")
     return p
 
 
@@ -46,18 +51,19 @@ def spec_of(args):
     from rotorred.maps.spec import Axis, MapSpec
     from rotorred.scenes.schema import parse_setting
 
-    axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
     fixed = []
     for item in args.set:
         key, values = parse_setting(item)
         if len(values) != 1:
-            checks.fail("--set", item, "must fix one value; use --vary to vary a key")
+            checks.fail("--set", item, "must fix one value; use --vary to vary a key (rotorred sweep is rotorred "
+                                       "map: --vary KEY=v1,v2,...)")
         fixed.append((key, values[0]))
+    axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
     ratios = tuple(_ratio(item) for item in args.ratio)
     if args.workers is not None:
         checks.integer("--workers", args.workers, ge=0)
     spec = MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
-    spec.scenes()
+    spec.check_size(force=args.force)
     return spec
 
 
@@ -93,10 +99,10 @@ def run(args) -> int:
     print(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
           f"wall time {result.wall_time:.2f} s")
     if result.incomplete:
-        print(f"rotorred map: {result.incomplete}", file=sys.stderr)
+        print(f"rotorred {args.command}: {result.incomplete}", file=sys.stderr)
         return EXIT_SIGINT
     if result.n_failed:
-        print(f"rotorred map: error: {result.n_failed} points failed (named in map.csv and map.txt); the other "
+        print(f"rotorred {args.command}: error: {result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
               "points are kept", file=sys.stderr)
         return EXIT_DIVERGED
     return 0

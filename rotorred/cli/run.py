@@ -69,7 +69,7 @@ def _settings(items: list[str]) -> dict:
     for item in items:
         key, values = parse_setting(item)
         if len(values) != 1:
-            checks.fail("--set", item, "must have one value in `rotorred run` (use `rotorred sweep` for several)")
+            checks.fail("--set", item, "must have one value in `rotorred run` (use `rotorred sweep --vary KEY=v1,v2,...` for several)")
         settings[key] = values[0]
     return settings
 

@@ -1,10 +1,12 @@
 """A map's figures from its dataset: bifurcation diagram and waterfall along the continuation axis,
 heat maps over two axes (:mod:`rotorred.plots.map`).
 
-One figure set per value of the axes beyond the first two (named in the file name): for a
-1-D map, ``bifurcation.png`` (Poincare samples of the table DOF against the varied key, the
-up and down sweeps in two colours) and ``waterfall.png`` (each point's labelled lines; the
-spools' 1x order lines when the key is a speed); for a 2-D map also ``class_map.png``,
+The figures along the continuation axis are drawn at the first value of the other axes:
+``bifurcation.png`` (Poincare samples of the table DOF against the varied key, the up and down
+sweeps in two colours), ``waterfall.png`` (each point's labelled lines; the spools' 1x order
+lines when the key is a speed) and ``lines.png`` (the amplitudes of f_L, f_H and the strongest
+other lines, the contact fraction and the impacts against the key, with the free orbit's reach
+on a clearance axis: the one-key sweep's figure); for a 2-D map also ``class_map.png``,
 ``contact_map.png``, ``explained_map.png`` and ``amplitude_map.png`` (largest line) per sweep
 direction.
 """
@@ -16,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.maps.spec import MapSpec
-from rotorred.scenes.sweep import key_unit
-from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_waterfall
+from rotorred.scenes.keys import key_unit
+from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_lines, plot_waterfall
 
 __all__ = ["map_figures"]
 
@@ -57,7 +59,31 @@ def _along(ds, spec: MapSpec, folder: Path) -> list[Path]:
                                 sub["line_amplitude"].sel(direction=first).values, folder / "waterfall.png",
                                 xlabel=axis.label, xscale=scale, orders=orders,
                                 title=f"{spec.scene}: labelled lines of {d} ({first} sweep){where}"))
+    one = sub.sel(direction=first)
+    reach = float(np.nanmedian(one["free_reach"].values)) if axis.key.endswith("clearance") else None
+    files.append(plot_lines(np.array(axis.values), _by_label(one), one["contact_fraction"].values,
+                            _impacts(one), folder / "lines.png", xlabel=axis.label,
+                            xscale=scale, reach=None if reach is None or np.isnan(reach) else reach,
+                            ylabel=f"Line amplitude of {d}",
+                            title=f"{spec.scene}: lines and contact ({first} sweep){where}"))
     return files
+
+
+def _impacts(one) -> np.ndarray:
+    n = one["n_impacts"].values
+    return np.where(n >= 0, n, np.nan).astype(float)
+
+
+def _by_label(one) -> dict:
+    """{line label: amplitude (m) per point}: 0 where a point has no such line, NaN where it has no result."""
+    labels, amps = one["line_label"].values, one["line_amplitude"].values
+    ok = one["status"].values == "ok"
+    out = {}
+    for i in range(labels.shape[0]):
+        for label, a in zip(labels[i], amps[i]):
+            if label:
+                out.setdefault(str(label), np.where(ok, 0.0, np.nan))[i] = a
+    return out
 
 
 def _largest(amplitudes: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ Recorded per point (:class:`PointResult`)
     (:mod:`rotorred.signals.classify`); its labelled lines, strongest first, at most
     ``N_LINES``; its Poincare samples, the last ``N_SAMPLES``; the peak orbit radius
     ``max sqrt(x^2 + y^2)`` at each output node (m); the contact fraction, impact count and
-    largest normal force of the first plate; the wall time. A diverged run records the reason
+    largest normal force of the first plate, and the free orbit's reach towards it; the wall time. A diverged run records the reason
     in place of the results.
 """
 
@@ -40,6 +40,7 @@ import numpy as np
 
 from rotorred.scenes.run import (SceneDiverged, SceneModel, analyse_lines, fit_and_settling, respond,
                                  spool_frequencies, table_dof)
+from rotorred.scenes.reach import free_reach
 from rotorred.scenes.schema import Scene
 from rotorred.signals.spectra import settled_spectrum
 from rotorred.transient.results import FinalState
@@ -86,6 +87,10 @@ class PointResult:
         Largest orbit radius at each output node (m).
     contact_fraction, n_impacts, max_contact_force : float, int, float
         First plate (0, 0, 0 without plates); N.
+    free_reach : float
+        Reach of the settled no-rub orbit towards the first plate (m,
+        :func:`rotorred.scenes.reach.free_reach`): contact cannot start from the free orbit at a
+        larger clearance. NaN without plates.
     start : {"cold", "warm"}
     simulated : float
         Simulated time (s): the scene's duration, plus the segments run until settled.
@@ -114,6 +119,7 @@ class PointResult:
     contact_fraction: float = math.nan
     n_impacts: int = -1
     max_contact_force: float = math.nan
+    free_reach: float = math.nan
     start: str = "cold"
     simulated: float = math.nan
     wall_time: float = math.nan
@@ -203,8 +209,10 @@ def run_point(scene: Scene, model: SceneModel, start: StartState | None = None,
         return PointResult("diverged", reason=str(exc), start=how, wall_time=time.perf_counter() - t0)
     except ValueError as exc:  # a record too short to fit (checks' one-line message)
         return PointResult("failed", reason=str(exc), start=how, wall_time=time.perf_counter() - t0)
+    reach = free_reach(scene, model)
     return replace(_recorded(analysis, scene, record.last), start=how, simulated=record.T,
-                   wall_time=time.perf_counter() - t0, final=_final(scene, record))
+                   free_reach=math.nan if reach is None else reach, wall_time=time.perf_counter() - t0,
+                   final=_final(scene, record))
 
 
 def _final(scene: Scene, record: _Record) -> StartState | None:

@@ -24,7 +24,7 @@ import numpy as np
 
 from rotorred.maps.execute import connect, local_cluster, run_points
 from rotorred.maps.spec import MapSpec
-from rotorred.scenes.sweep import key_unit
+from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, to_dataset, write_tables
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from rotorred import checks
 from rotorred.scenes.schema import Scene, load_scene
-from rotorred.scenes.sweep import key_unit
+from rotorred.scenes.keys import key_unit
 
 __all__ = ["Axis", "MapSpec", "Chain", "DIRECTIONS"]
 
@@ -156,6 +156,21 @@ class MapSpec:
     def scenes(self) -> list[Scene]:
         """Every grid point's scene, validated (raises the scene's error naming the key)."""
         return [self.scene_at(ix) for ix in itertools.product(*(range(n) for n in self.shape))]
+
+    def check_size(self, force: bool = False) -> None:
+        """Every point's scene validated and within the size limits (:mod:`rotorred.scenes.budget`), and the
+        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS``; ``force`` lets a
+        map beyond them go on."""
+        from rotorred.scenes import budget
+
+        total = 0
+        for scene in self.scenes():
+            budget.check(budget.scene_estimate(scene), force=force)
+            total += max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
+        if total > budget.MAX_STEPS and not force:
+            checks.fail("--vary", " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes),
+                        f"gives {total:.3g} steps in all (--limit {self.limit or 'the scene duration'}), more than "
+                        f"{budget.MAX_STEPS:.3g}; use --force to go on")
 
     def chains(self) -> list[Chain]:
         """The chains along the continuation axis: one per direction and combination of the other axes."""

@@ -25,7 +25,7 @@ import numpy as np
 
 from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult, StartState
 from rotorred.maps.spec import MapSpec
-from rotorred.scenes.sweep import key_unit
+from rotorred.scenes.keys import key_unit
 from rotorred.transient.results import FinalState
 from rotorred.writers import write_csv, write_npz, write_text
 
@@ -46,6 +46,7 @@ SCALARS = {
     "contact_fraction": ("f8", np.nan, "1", "fraction of the record in contact (first plate)"),
     "n_impacts": ("i8", -1, "", "contact onsets in the record (first plate)"),
     "max_contact_force": ("f8", np.nan, "N", "largest normal contact force (first plate)"),
+    "free_reach": ("f8", np.nan, "m", "reach of the settled no-rub orbit towards the first plate"),
     "start": ("U4", "", "", "cold (scene's start) or warm (neighbour's final state)"),
     "simulated": ("f8", np.nan, "s", "simulated time, segments run until settled included"),
     "wall_time": ("f8", np.nan, "s", "wall time of the point"),
@@ -155,7 +156,8 @@ def to_dataset(spec: MapSpec, points: dict, nodes: tuple[int, ...], attrs: dict 
             data[name][at] = arrays[name]
         for name, (_, n, dtype, missing, *_) in VECTORS.items():
             data[name][at] = _padded(arrays[name], n, dtype, missing)
-        data["peak_orbit"][at] = p.peak_orbit
+        if p.peak_orbit.size:  # none for a point without results
+            data["peak_orbit"][at] = p.peak_orbit
     variables = {name: (dims, data[name], {"units": u, "long_name": ln}) for name, (_, _, u, ln) in SCALARS.items()}
     variables.update({name: ((*dims, dim), data[name], {"units": u, "long_name": ln})
                       for name, (dim, _, _, _, u, ln) in VECTORS.items()})

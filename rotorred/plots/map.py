@@ -25,7 +25,7 @@ from matplotlib.figure import Figure
 from rotorred import checks
 from rotorred.plots.scene import _path, _save
 
-__all__ = ["plot_bifurcation", "plot_waterfall", "plot_heatmap", "CLASS_COLOURS"]
+__all__ = ["plot_bifurcation", "plot_waterfall", "plot_lines", "plot_heatmap", "CLASS_COLOURS"]
 
 #: fixed colour of each response class (:data:`rotorred.signals.classify.KINDS`) and of a failed run
 CLASS_COLOURS = {
@@ -173,6 +173,86 @@ def _sweep_dots(ax, x: np.ndarray, y: np.ndarray, label: str, colour: str, i: in
 
 def _no_data(ax, text: str) -> None:
     ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4")
+
+
+# --------------------------------------------------------------------------- line amplitudes
+def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscale: float = 1.0,
+               reach: float | None = None, n_lines: int = 4, scale: float = 1e6, unit: str = "µm",
+               ylabel: str = "Line amplitude", title: str | None = None) -> Path:
+    """Labelled line amplitudes and the rub contact against the varied key (one sweep).
+
+    Top: the spools' lines f_L and f_H, the ``n_lines`` other lines strongest over the map, and
+    the sum of every other line. Bottom: the contact fraction (%) and the impacts in the record.
+    ``reach`` (a clearance axis) marks the free orbit's reach, beyond which the settled free
+    orbit touches nothing.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        The varied key (SI), n >= 1.
+    amplitudes : mapping
+        ``{line label: array shape (n,)}``: amplitude (m) of that line at each point, 0 where the
+        line is not among the point's lines, NaN for a failed point.
+    contact, impacts : array_like, shape (n,)
+        Contact fraction (0..1) and contact onsets per point (NaN for a failed point).
+    path : str or Path
+        Output file (e.g. .png).
+    xlabel : str
+        Name and unit of the varied key as plotted.
+    xscale : float
+        Plotted values are ``xscale * values``.
+    reach : float, optional
+        Free orbit reach (SI, the key's unit), drawn as a dashed line at ``xscale * reach``.
+    n_lines : int
+        Other lines drawn besides f_L and f_H.
+    scale, unit, ylabel : float, str, str
+        Plotted amplitudes are ``scale * amplitudes`` in ``unit``.
+    title : str, optional
+
+    Returns
+    -------
+    Path
+    """
+    scale, xscale = checks.positive("scale", scale), checks.positive("xscale", xscale)
+    values = checks.vector("values", values, min_len=1)
+    if not isinstance(amplitudes, Mapping):
+        checks.fail("amplitudes", amplitudes, "must be a mapping line label -> array (n,)")
+    amps = {str(k): _not_negative(f"amplitudes[{k!r}]", _padded(f"amplitudes[{k!r}]", v, (values.size,), "m"), "m")
+            for k, v in amplitudes.items()}
+    contact = _padded("contact", contact, (values.size,))
+    impacts = _padded("impacts", impacts, (values.size,))
+    n_lines = checks.integer("n_lines", n_lines, ge=0)
+    path = _path(path)
+    x = xscale * values
+    fig = Figure(figsize=(9, 7.5), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    spools = [k for k in ("f_L", "f_H") if k in amps]
+    others = sorted((k for k in amps if k not in spools), key=lambda k: -float(np.nanmax(amps[k], initial=0.0)))
+    for k in spools + others[:n_lines]:
+        ax1.plot(x, scale * amps[k], "-o" if k in spools else "--s", ms=4, label=k)
+    if others:
+        total = np.sum([amps[k] for k in others], axis=0)
+        ax1.plot(x, scale * total, ":", color="k", label=f"sum of the {len(others)} other lines")
+    if not amps:
+        _no_data(ax1, "no labelled lines (every run failed)")
+    ax1.set_ylabel(f"{ylabel} ({unit})")
+    ax1.grid(True, alpha=0.3)
+    ax2.plot(x, 100 * contact, "-o", ms=4, color="C3", label="contact fraction")
+    ax2.set_ylabel("Contact fraction of the record (%)")
+    ax2.set_xlabel(xlabel)
+    ax2.grid(True, alpha=0.3)
+    ax3 = ax2.twinx()
+    ax3.plot(x, impacts, "-^", ms=4, color="C4", label="impacts in the record")
+    ax3.set_ylabel("Impacts")
+    if reach is not None and np.isfinite(reach):
+        for ax in (ax1, ax2):
+            ax.axvline(xscale * reach, color="0.4", ls="--", lw=1.0, label=f"free orbit reach {xscale * reach:.3g}")
+    h2, l2 = ax2.get_legend_handles_labels()
+    h3, l3 = ax3.get_legend_handles_labels()
+    ax2.legend(h2 + h3, l2 + l3, loc="upper right", fontsize=8)
+    if amps:
+        ax1.legend(loc="upper right", fontsize=8)
+    return _save(fig, path, title)
 
 
 # --------------------------------------------------------------------------- waterfall
