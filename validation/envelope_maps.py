@@ -32,27 +32,31 @@ CLEARANCES = tuple(0.0 + (45e-6 - 0.0) * i / 9 for i in range(10))  #: m, as the
 LIMIT = 4.0
 
 
-def speed_map(out: Path):
+def speed_map(out: Path, report=sys.stdout):
     spec = MapSpec("paper-rub", (Axis("speeds.outer", SPEEDS),), direction="both", limit=LIMIT)
-    return run_map(spec, out, progress=False).dataset
+    run = run_map(spec, out, progress=False)
+    print(f"speed map: {spec.n_points} points in {run.wall_time:.0f} s", file=report)
+    return run.dataset
 
 
-def clearance_map(out: Path):
+def clearance_map(out: Path, report=sys.stdout):
     spec = MapSpec("paper-rub", (Axis("rub.clearance", CLEARANCES),), direction="both", limit=LIMIT)
-    return run_map(spec, out, progress=False).dataset
+    run = run_map(spec, out, progress=False)
+    print(f"clearance map: {spec.n_points} points in {run.wall_time:.0f} s", file=report)
+    return run.dataset
 
 
 def report_speed(ds, out=sys.stdout) -> None:
     f = ds["speeds.outer"].values
     up, down = (ds["kind"].sel(direction=d).values for d in ("up", "down"))
-    k = ds["subharmonic"].sel(direction="up").values
+    k_up, k_down = (ds["subharmonic"].sel(direction=d).values for d in ("up", "down"))
     contact = ds["contact_fraction"].values
     chaotic = f[up == "chaotic"].tolist() + f[down == "chaotic"].tolist()
     inside = [x for x in chaotic if 74.5 <= x <= 86.5]
     i63, i90 = int(np.argmin(abs(f - 63.0))), int(np.argmin(abs(f - 90.0)))
     orbit = 1e6 * ds["peak_orbit"].sel(node=14).values[:, i63]
     print(f"speed map: points without contact: {int((contact == 0).sum())} of {contact.size}", file=out)
-    print(f"90 Hz: up {up[i90]} (k = {k[i90]}), down {down[i90]}", file=out)
+    print(f"90 Hz: up {up[i90]} (k = {k_up[i90]}), down {down[i90]} (k = {k_down[i90]})", file=out)
     print(f"chaotic points: {len(chaotic)} of {up.size + down.size}, {len(inside)} in 74.5-86.5 Hz", file=out)
     print(f"speeds where up and down differ in class: {int((up != down).sum())} of {f.size}", file=out)
     print(f"peak orbit at node 14, 63 Hz: up {orbit[0]:.1f} um, down {orbit[1]:.1f} um", file=out)
@@ -76,8 +80,8 @@ def main(argv=None, out=sys.stdout) -> None:
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(args.out or tmp)
-        report_speed(speed_map(root / "speed"), out)
-        report_clearance(clearance_map(root / "clearance"), out)
+        report_speed(speed_map(root / "speed", out), out)
+        report_clearance(clearance_map(root / "clearance", out), out)
     print(f"total time {time.perf_counter() - t0:.1f} s", file=out)
 
 
