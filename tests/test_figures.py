@@ -5,7 +5,7 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from rotorred.plots.scene import plot_orbits, plot_spectra, plot_waveforms
+from rotorred.plots.scene import plot_label, plot_orbits, plot_spectra, plot_waveforms
 from rotorred.signals.lines import label_lines
 from rotorred.signals.spectra import settled_spectrum
 
@@ -106,3 +106,9 @@ def test_plot_orbits(tmp_path):
         plot_orbits({"a": nx}, tmp_path / "bad.png")
     with pytest.raises(ValueError, match="^path = .*no_extension': must have a file extension"):
         plot_orbits({"a": (nx, ny)}, tmp_path / "no_extension")
+
+
+def test_line_labels_are_plain_text_with_subscripts():
+    """Spectrum annotations are ordinary text (no mathtext): f_H and f_L with Unicode subscripts h and l."""
+    assert plot_label("2f_H\u2212f_L") == "2f\u2095\u2212f\u2097"
+    assert plot_label("f_H+3f_L/2") == "f\u2095+3f\u2097/2" and "$" not in plot_label("f_H")

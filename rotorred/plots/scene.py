@@ -220,7 +220,7 @@ def plot_spectra(
                 y = scale * ln.amplitude
                 ax.plot(ln.frequency_hz, y, "v", ms=4, color=handle.get_color())
                 ax.annotate(
-                    ln.label_math, (ln.frequency_hz, y), xytext=(0, 6),
+                    plot_label(ln.label), (ln.frequency_hz, y), xytext=(0, 6),
                     textcoords="offset points", rotation=90, ha="center", va="bottom",
                     fontsize=8, color=handle.get_color(),
                 )
@@ -237,6 +237,15 @@ def plot_spectra(
     axes[-1].set_xlabel("Frequency (Hz)")
     axes[-1].set_xlim(0, f_max if f_max is not None else None)
     return _save(fig, path, title)
+
+
+def plot_label(label: str) -> str:
+    """A line label as plain text with Unicode subscripts, ``"2f_H−f_L"`` -> ``"2fₕ−fₗ"``.
+
+    Rendered as ordinary text: the mathtext labels (``label_math``) took about 1.2 s of the 4.4 s
+    that the figures of ``paper-rub`` took (some 330 labels).
+    """
+    return label.replace("f_H", "f\u2095").replace("f_L", "f\u2097")
 
 
 # --------------------------------------------------------------------------- orbits

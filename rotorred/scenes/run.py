@@ -461,7 +461,7 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
 
 def _counters(res) -> dict:
     return {"n_newton": res.n_newton, "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
-            "us_per_step": res.us_per_step}
+            "us_per_step": res.us_per_step, "kernel_load_time": res.kernel_load_time}
 
 
 # --------------------------------------------------------------------------- divergence

@@ -305,7 +305,7 @@ def record_buffers(plan: RecordPlan, rows: np.ndarray, n_p: int) -> kernel.Recor
 # ----------------------------------------------------------------------------------- 3. run
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
                record: kernel.Record, settings: kernel.Settings, diag: kernel.Diagnostics, n_steps: int,
-               chunk: int, progress: bool | None) -> tuple[int, float, float]:
+               chunk: int, progress: bool | None) -> tuple[int, float, float, float]:
     """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar.
 
     Returns
@@ -314,9 +314,12 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
         The kernel's status (``kernel.RUNNING`` when every step completed).
     run_time, run_cpu_time : float
         Wall and CPU time of the loop (s).
+    load_time : float
+        Time to compile or load the kernel before the loop (s, :func:`load_kernel`).
     """
     spare = kernel.spare_state(state)
     work = kernel.work_arrays(len(state.x) // 3, len(plates.par), len(forcing.kind))
+    load_time = load_kernel((0, 0, levels, forcing, plates, state, spare, work, record, settings, diag))
     t_run, cpu_run = time.perf_counter(), time.process_time()
     status, i, shown = kernel.RUNNING, 0, False
     while i < n_steps:
@@ -331,7 +334,39 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
             _show_progress(i / n_steps, i * settings.dt, elapsed)
     if shown:
         print(file=sys.stderr)
-    return status, time.perf_counter() - t_run, time.process_time() - cpu_run
+    return status, time.perf_counter() - t_run, time.process_time() - cpu_run, load_time
+
+
+#: printed on stderr before the step kernel is compiled (not when numba's on-disk cache holds it)
+COMPILING_NOTE = "rotorred: compiling the step kernel, once per install (numba; 20-30 s, then cached on disk)"
+
+
+def load_kernel(args: tuple) -> float:
+    """Compile the step kernel for the types of ``args`` (a ``run_steps`` call), or load it from numba's
+    on-disk cache, before the timed loop; returns the seconds it took (0 when this process has it).
+
+    A compilation is announced on its own line (:data:`COMPILING_NOTE`), so neither the wait nor the
+    µs per step of the first run after an install hide it.
+    """
+    import numba
+
+    dispatcher = kernel.run_steps
+    sig = tuple(numba.typeof(a) for a in args)
+    if sig in dispatcher.overloads:
+        return 0.0
+    t0 = time.perf_counter()
+    if not _cached(dispatcher, sig):
+        print(COMPILING_NOTE, file=sys.stderr, flush=True)
+    dispatcher.compile(sig)
+    return time.perf_counter() - t0
+
+
+def _cached(dispatcher, sig) -> bool:
+    """Whether numba's on-disk cache holds the kernel for ``sig`` (True when this cannot be told)."""
+    try:
+        return dispatcher._cache.load_overload(sig, dispatcher.targetctx) is not None  # numba's own check
+    except Exception:  # noqa: BLE001 - an internal of numba: say nothing rather than fail
+        return True
 
 
 def _show_progress(frac: float, t: float, elapsed: float) -> None:
@@ -366,7 +401,8 @@ def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: R
         beta=float(scheme.beta), alpha=float(scheme.alpha), n_steps=int(counters[kernel.C_STEPS]),
         n_substeps=int(counters[kernel.C_SUBSTEPS]), n_newton=int(counters[kernel.C_NEWTON]),
         n_contact_steps=int(counters[kernel.C_CONTACT]), max_newton_per_solve=int(counters[kernel.C_MAXNEWTON]),
-        n_factorizations=run.max_halvings + 1, setup_time=times[0], run_time=times[1], run_cpu_time=times[2])
+        n_factorizations=run.max_halvings + 1, setup_time=times[0], run_time=times[1], run_cpu_time=times[2],
+        kernel_load_time=times[3])
     if not success:
         raise SimulationDiverged(message, result, float(diag.err[kernel.E_TIME]), dof, cause)
     return result
@@ -479,12 +515,12 @@ def simulate(model, speeds: Mapping[str, float] | None, t_end: float, dt: float 
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
                                max_newton=run.max_newton, limit=run.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
-    status, run_time, run_cpu_time = run_kernel(
+    status, run_time, run_cpu_time, load_time = run_kernel(
         levels, kernel.Forcing(forces.kind, forces.omega), contact, state, record, settings, diag, plan.n_steps,
         run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                          (setup_time, run_time, run_cpu_time))
+                          (setup_time, run_time, run_cpu_time, load_time))
 
 
 __all__ = ["simulate", "TransientResult", "ContactHistory", "FinalState", "SimulationDiverged", "METHODS",

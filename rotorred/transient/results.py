@@ -151,6 +151,9 @@ class TransientResult:
         Wall time of the matrix preparation and of the step loop (s).
     run_cpu_time : float
         CPU time of the step loop (s).
+    kernel_load_time : float
+        Time to compile the step kernel (first run after an install) or load it from numba's cache,
+        before the loop (s); not in ``run_time`` nor in µs per step.
     """
 
     t: np.ndarray
@@ -174,6 +177,7 @@ class TransientResult:
     setup_time: float
     run_time: float
     run_cpu_time: float = 0.0
+    kernel_load_time: float = 0.0
 
     @property
     def us_per_step(self) -> float:
