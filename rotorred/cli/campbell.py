@@ -13,8 +13,9 @@ from rotorred.writers import OutputFolder
 
 
 def parse_speeds(text: str) -> np.ndarray:
-    """``"0:12000:61"`` or ``"0,1000,2500"`` (rpm, >= 0, increasing, at least 2) -> speeds (rad/s)."""
-    return grid("--speeds", text, "rpm", min_count=2, ge=0.0, increasing=True) * math.pi / 30.0
+    """``"0:12000:61"``, ``"0,1000,2500"`` or ``"3000"`` (rpm, >= 0, increasing) -> speeds (rad/s)."""
+    single = ":" not in text and "," not in text  # one speed; a range or a list holds at least two
+    return grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True) * math.pi / 30.0
 
 
 def parse_harmonics(text: str) -> tuple[float, ...]:
@@ -31,7 +32,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "campbell.png to --out and prints the critical speeds.")
     p.add_argument("rotor", metavar="ROTOR", help="preset name (e.g. seed-rig) or rotor TOML file")
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
-                   help="reference-spool speeds in rpm, e.g. 0:12000:61, or a comma list (increasing, >= 0)")
+                   help="reference-spool speeds in rpm, e.g. 0:12000:61, a comma list (increasing, >= 0), or one "
+                        "speed (prints the whirl frequencies, directions and damping there)")
     p.add_argument("--ratio", type=float, default=None,
                    help="two spools: speed of the second spool / speed of the first (Omega_H/Omega_L for "
                         "the seed rig); default: ratio of the nominal speeds")
@@ -62,12 +64,14 @@ def run(args) -> int:
     with OutputFolder(out) as folder:
         result = campbell(rotor, speeds, ratio=args.ratio, reference=args.reference, n_modes=args.modes,
                           harmonics=harmonics)
-        result.to_csv(folder.staged("campbell.csv"))
+        files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
-        plot_campbell(result, folder.staged("campbell.png"), operating_speed=ref_nominal if ref_nominal > 0 else None)
+        if len(result.speeds) > 1:  # one speed is a table, not a diagram
+            files.append(plot_campbell(result, folder.staged("campbell.png"),
+                                       operating_speed=ref_nominal if ref_nominal > 0 else None))
         folder.commit()
-    print(format_critical_speeds(result))
-    print(f"wrote {out / 'campbell.csv'} and {out / 'campbell.png'}")
+    print(format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result))
+    print("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
 
 
@@ -79,6 +83,18 @@ def check_model_size(rotor, force: bool) -> None:
     name = rotor.name or "the rotor"
     budget.check(budget.Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}),
                  force=force)
+
+
+def format_whirl_table(result, i: int = 0) -> str:
+    """The whirl frequencies, directions, damping ratios and log decrements at speed ``i``, as a text table."""
+    others = ", ".join(f"{s} at {r:.4g}x" for s, r in result.speed_ratios.items() if s != result.reference)
+    lines = [f"whirl frequencies of {result.rotor_name or 'rotor'} at {result.speeds_rpm[i]:.6g} rpm of "
+             f"{result.reference}" + (f" ({others})" if others else ""),
+             f"{'mode':>5} {'freq Hz':>12} {'whirl':>9} {'damping ratio':>14} {'log dec':>10}"]
+    for j in range(result.n_modes):
+        lines.append(f"{j:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
+                     f"{result.damping_ratio[i, j]:14.6f} {result.log_dec[i, j]:10.5f}")
+    return "\n".join(lines)
 
 
 def format_critical_speeds(result) -> str:

@@ -180,6 +180,11 @@ class CampbellResult:
         """(spool, harmonic, slope) of each excitation line; frequency (rad/s) = slope x reference speed."""
         return tuple((s, h, h * r) for s, r in self.speed_ratios.items() if r > 0 for h in self.harmonics)
 
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        """Damping ratio zeta = -Re(lambda) / |lambda| = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
+        return self.log_dec / np.sqrt(self.log_dec ** 2 + 4.0 * np.pi ** 2)
+
     def to_csv(self, path: str | Path) -> Path:
         """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec``.
 
@@ -372,7 +377,8 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     ----------
     rotor : Rotor
     speeds : sequence of float, shape (n_speeds,)
-        Speeds of the reference spool (rad/s), >= 0, strictly increasing, at least 2.
+        Speeds of the reference spool (rad/s), >= 0, strictly increasing. One speed gives the whirl
+        frequencies, directions and damping there (no crossing can be found, so no critical speed).
     ratio : float, optional
         Two-spool rotors: Omega of the second spool / Omega of the first (``rotor.spools`` order;
         Omega_H / Omega_L for the seed rig). Default: ratio of the nominal spool speeds.
@@ -387,7 +393,7 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     -------
     CampbellResult
     """
-    Omega = checks.vector("speeds", speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
+    Omega = checks.vector("speeds", speeds, "rad/s", min_len=1, ge=0.0, increasing=True)
     n_modes = checks.integer("n_modes", n_modes, ge=1)
     h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
     ratios = speed_ratios(rotor, ratio, reference)
