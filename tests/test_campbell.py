@@ -415,3 +415,26 @@ def test_cli_one_speed_prints_the_whirl_table(tmp_path, capsys):
     assert "damping ratio" in out and "critical speeds" not in out
     assert len((tmp_path / "campbell.csv").read_text().splitlines()) == 1 + 6
     assert not (tmp_path / "campbell.png").exists()  # one speed is a table, not a diagram
+
+
+def test_critical_speeds_csv_and_a_shared_line_listed_once(tmp_path):
+    """At speed ratio 1 the lines 1x inner and 1x outer coincide: each crossing is listed once, as many as the
+    sign changes of omega_j - Omega on the grid. The CSV holds every critical speed with its margin to the
+    operating point, (n_c - n_op) / n_op, and the damping ratio delta / sqrt(delta^2 + 4 pi^2)."""
+    from rotorred.model.rotor_file import load_rotor
+
+    rig = load_rotor("seed-rig")
+    speeds = np.linspace(0.0, 12000.0, 61) * math.pi / 30
+    one = campbell(rig, speeds, ratio=1.0, n_modes=6)
+    g = one.frequencies - speeds[:, None]
+    assert len(one.critical_speeds) == int(np.sum(g[:-1] * g[1:] < 0)) == 6
+    assert all(c.line == "1× inner = 1× outer" for c in one.critical_speeds)
+    result = campbell(rig, speeds, n_modes=6)
+    op = rig.speeds["inner"]
+    rows = list(csv.reader(result.critical_speeds_to_csv(tmp_path / "c.csv", op).open()))
+    assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][-1] == "margin to operating point (%)"
+    assert len(rows) == 1 + len(result.critical_speeds) >= 10
+    for row, c in zip(rows[1:], result.critical_speeds):
+        assert float(row[0]) == pytest.approx(c.speed_rpm, rel=1e-8) and row[1] == c.line
+        assert float(row[-1]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
+        assert float(row[-2]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|

@@ -29,7 +29,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Whirl frequencies against the speed of a reference spool (other spools at a fixed speed "
                     "ratio), forward/backward whirl, modes tracked by MAC, and the critical speeds where a "
                     "whirl curve crosses an excitation line h x (spool speed). Writes campbell.csv and "
-                    "campbell.png to --out and prints the critical speeds.")
+                    "campbell.png and critical_speeds.csv (excitation, mode, whirl, damping and margin to the "
+                    "operating point) to --out and prints the critical speeds.")
     p.add_argument("rotor", metavar="ROTOR", help="preset name (e.g. seed-rig) or rotor TOML file")
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
                    help="reference-spool speeds in rpm, e.g. 0:12000:61, a comma list (increasing, >= 0), or one "
@@ -67,8 +68,9 @@ def run(args) -> int:
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
-            files.append(plot_campbell(result, folder.staged("campbell.png"),
-                                       operating_speed=ref_nominal if ref_nominal > 0 else None))
+            operating = ref_nominal if ref_nominal > 0 else None
+            files.append(plot_campbell(result, folder.staged("campbell.png"), operating_speed=operating))
+            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
         folder.commit()
     print(format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result))
     print("wrote " + " and ".join(str(out / f.name) for f in files))
@@ -100,11 +102,12 @@ def format_whirl_table(result, i: int = 0) -> str:
 def format_critical_speeds(result) -> str:
     """The critical speeds as a text table."""
     ratios = ", ".join(f"{s}: {r:.4g}" for s, r in result.speed_ratios.items())
+    w = max([12] + [len(c.line) for c in result.critical_speeds])
     lines = [f"critical speeds of {result.rotor_name or 'rotor'} (speed ratios to {result.reference}: {ratios})",
-             f"{result.reference + ' rpm':>14} {'line':>12} {'mode':>5} {'freq Hz':>10} {'whirl':>9} {'log dec':>9}"]
+             f"{result.reference + ' rpm':>14} {'line':>{w}} {'mode':>5} {'freq Hz':>10} {'whirl':>9} {'log dec':>9}"]
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")
     for c in result.critical_speeds:
-        lines.append(f"{c.speed_rpm:14.1f} {c.line:>12} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
+        lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")
     return "\n".join(lines)

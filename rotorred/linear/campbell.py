@@ -33,7 +33,7 @@ Allemang, "The modal assurance criterion - twenty years of use and abuse", Sound
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -83,6 +83,9 @@ class CriticalSpeed:
         ``"forward"``, ``"backward"``, ``"mixed"`` or ``"planar"``.
     log_dec : float
         Logarithmic decrement of the mode at the crossing (-).
+    same_line : tuple of str
+        Other excitations on the same line (equal slope), e.g. ``("1× outer",)`` for ``1× inner``
+        at speed ratio 1: the crossing is listed once.
     """
 
     speed: float
@@ -92,6 +95,7 @@ class CriticalSpeed:
     frequency: float
     whirl: str
     log_dec: float
+    same_line: tuple[str, ...] = ()
 
     @property
     def speed_rpm(self) -> float:
@@ -110,8 +114,13 @@ class CriticalSpeed:
 
     @property
     def line(self) -> str:
-        """Label of the excitation line, e.g. ``"1× inner"``."""
-        return excitation_label(self.harmonic, self.spool)
+        """Label of the excitation line, e.g. ``"1× inner"``, or ``"1× inner = 1× outer"`` for a shared line."""
+        return " = ".join((excitation_label(self.harmonic, self.spool), *self.same_line))
+
+    @property
+    def damping_ratio(self) -> float:
+        """Damping ratio of the mode at the crossing, delta / sqrt(delta^2 + 4 pi^2) (-)."""
+        return self.log_dec / math.sqrt(self.log_dec ** 2 + 4.0 * math.pi ** 2)
 
 
 @dataclass(frozen=True)
@@ -179,6 +188,23 @@ class CampbellResult:
     def excitation_lines(self) -> tuple[tuple[str, float, float], ...]:
         """(spool, harmonic, slope) of each excitation line; frequency (rad/s) = slope x reference speed."""
         return tuple((s, h, h * r) for s, r in self.speed_ratios.items() if r > 0 for h in self.harmonics)
+
+    def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None) -> Path:
+        """Write the critical speeds, one row each: the reference spool's speed (rpm), the excitation line,
+        the excited spool's speed (rpm), the mode, its frequency (Hz), whirl, log dec and damping ratio at
+        the crossing, and the margin to ``operating_speed`` (rad/s of the reference spool), in % of it
+        (positive: the critical speed lies above the operating point; empty without one)."""
+        def margin(c):
+            return "" if not operating_speed else f"{100.0 * (c.speed - operating_speed) / operating_speed:.4f}"
+
+        cs = self.critical_speeds
+        header = [f"{self.reference} speed (rpm)", "excitation", "excited spool speed (rpm)", "mode",
+                  "frequency (Hz)", "whirl", "log dec", "damping ratio", "margin to operating point (%)"]
+        columns = [np.array([c.speed_rpm for c in cs]), [c.line for c in cs],
+                   np.array([c.spool_speed * 30.0 / math.pi for c in cs]), np.array([c.mode for c in cs]),
+                   np.array([c.frequency_hz for c in cs]), [c.whirl for c in cs], np.array([c.log_dec for c in cs]),
+                   np.array([c.damping_ratio for c in cs]), [margin(c) for c in cs]]
+        return writers.write_csv(path, header, columns)
 
     @property
     def damping_ratio(self) -> np.ndarray:
@@ -428,9 +454,8 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     log_dec = -2.0 * np.pi * lam_all.real / freq
     whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
 
-    lines = [(s, hh, hh * r) for s, r in ratios.items() if r > 0 for hh in h]
     crit = []
-    for spool, hh, slope in lines:
+    for spool, hh, slope, same in _distinct_lines(ratios, h):
         g = freq - slope * Omega[:, None]
         for j in range(n_modes):
             for i in range(n_s - 1):
@@ -438,11 +463,30 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
                     continue  # counted as the right end of interval i - 1
                 if g[i, j] * g[i + 1, j] > 0:
                     continue
-                crit.append(_refine(solver, Omega, freq, lam_all, shapes, whirl, i, j, spool, hh, slope))
+                crit.append(replace(
+                    _refine(solver, Omega, freq, lam_all, shapes, whirl, i, j, spool, hh, slope), same_line=same))
     crit.sort(key=lambda c: (c.speed, c.mode))
     return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
                           critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
                           harmonics=h, rotor_name=rotor.name)
+
+
+def _distinct_lines(ratios: Mapping[str, float], harmonics: tuple[float, ...]):
+    """(spool, h, slope, other labels on the line) of each distinct excitation line h x Omega_s: lines of equal
+    slope (1x inner and 1x outer at speed ratio 1) are one line, crossed once."""
+    out = []
+    for s, r in ratios.items():
+        for hh in harmonics:
+            if r <= 0:
+                continue
+            slope = hh * r
+            for k, (_, _, other, same) in enumerate(out):
+                if math.isclose(slope, other, rel_tol=1e-12):
+                    out[k] = out[k][:3] + ((*same, excitation_label(hh, s)),)
+                    break
+            else:
+                out.append((s, hh, slope, ()))
+    return out
 
 
 def _refine(solver: _Solver, Omega, freq, lam_grid, shapes, whirl, i, j, spool, harmonic, slope) -> CriticalSpeed:
