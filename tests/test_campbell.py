@@ -438,3 +438,27 @@ def test_critical_speeds_csv_and_a_shared_line_listed_once(tmp_path):
         assert float(row[0]) == pytest.approx(c.speed_rpm, rel=1e-8) and row[1] == c.line
         assert float(row[-1]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
         assert float(row[-2]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|
+
+
+def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():
+    """A free-free steel shaft (no bearings): its rigid-body modes (frequency ~1e-4 Hz at rest) used to be
+    reported as critical speeds at ~0.01 rpm. They are now listed apart, and every critical speed is a
+    bending mode. The first bending pair at rest is checked against the Euler-Bernoulli free-free beam,
+    beta L from cos(beta L) cosh(beta L) = 1 by brentq: Timoshenko lies 0.65 % below it at D/L = 1/20
+    (shear and rotary inertia), so it must lie within 0 to 1 % below."""
+    steel = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
+    n, L, D = 20, 1.0, 0.05
+    free = Rotor((Spool("shaft", tuple(ShaftElement(i, i + 1, L / n, D, 0.0, steel) for i in range(n)),
+                        speed=100.0),), name="free-free")
+    result = campbell(free, np.linspace(0.0, 2000.0 * math.pi, 41), n_modes=8)  # to 60 000 rpm
+    assert result.rigid_modes and all(result.frequencies_hz[0, j] < 1e-2 for j in result.rigid_modes)
+    assert result.critical_speeds and all(c.frequency_hz > 100.0 for c in result.critical_speeds)
+    from rotorred.cli.campbell import format_critical_speeds
+    assert "rigid-body modes (a free or singly supported spool; not critical speeds): modes 0, 1" in \
+        format_critical_speeds(result)
+    assert campbell(rigid_rotor(2.1e11), SPEEDS_RIGID, n_modes=4).rigid_modes == ()  # held by bearings
+    bl = brentq(lambda x: math.cos(x) * math.cosh(x) - 1.0, 4.0, 5.0)
+    A, I = math.pi * D ** 2 / 4, math.pi * D ** 4 / 64
+    f_eb = bl ** 2 / (2 * math.pi * L ** 2) * math.sqrt(steel.E * I / (steel.rho * A))
+    bending = min(result.frequencies_hz[0, j] for j in range(result.n_modes) if j not in result.rigid_modes)
+    assert 0.0 < (f_eb - bending) / f_eb < 0.01

@@ -105,6 +105,10 @@ BAD = [
      "bad.toml: spool[0].elements[0].D_i = 0.03: must be < D_o = 0.02 (m)"),
     ("rho = 7850.0", "rho = -7850.0", "bad.toml: material[0].rho = -7850.0: must lie in [1e-09, 1e+06] (kg/m^3)"),
     ("nu = 0.3", "nu = 0.7", "bad.toml: material[0].nu = 0.7: must lie in (-1, 0.5)"),
+    ("nu = 0.3", "nu = 0.3\nG = 8e10", "bad.toml: material[0].G = 80000000000.0: must not be given with nu "
+     "(G = E / (2 (1 + nu)) fixes one by the other) (Pa)"),
+    ("nu = 0.3", "G = 5e10", "bad.toml: material[0].G = 50000000000.0: must be > E / 3 = 7e+10 so that "
+     "nu = E / (2 G) - 1 < 0.5 (Pa)"),
     ("E = 2.1e11", 'E = "hard"', "bad.toml: material[0].E = 'hard': must be a finite number in (0, 1e+18] (Pa)"),
     ("[[disk]]\nnode = 3", "[[disk]]\nnode = 30",
      "bad.toml: disk[0].node = 30: must be a node of the rotor (1-5, 10-12)"),
@@ -148,6 +152,25 @@ def test_bad_files(old, new, message):
     text = GOOD.replace(old, new, 1)
     with pytest.raises(RotorFileError, match=f"^{re.escape(message)}$"):
         rotor_from_toml(text, source="bad.toml")
+
+
+def test_shear_modulus_in_place_of_poisson_ratio():
+    """A material given by E, G and rho (the textbooks' data) is the material of nu = E / (2 G) - 1: the same
+    element matrices (measured: identical; 1e-14 allowed for the rounding of nu = E / (2 G) - 1), and G is used
+    as given."""
+    import numpy as np
+
+    E = 2.1e11
+    by_g = rotor_from_toml(GOOD.replace("nu = 0.3", f"G = {E / 2.6!r}"))
+    by_nu = rotor_from_toml(GOOD)
+    (m_g,), (m_nu,) = {e.material for e in by_g.spools[0].elements}, {e.material for e in by_nu.spools[0].elements}
+    assert m_g.G == E / 2.6 and m_g.G_s == E / 2.6 and abs(m_g.nu - 0.3) < 1e-15
+    for a, b in zip(by_g.spools[0].elements, by_nu.spools[0].elements):
+        for K_g, K_nu in ((a.K(), b.K()), (a.M(), b.M())):
+            assert np.max(np.abs(K_g - K_nu)) <= 1e-14 * np.max(np.abs(K_nu))
+    friswell = rotor_from_toml(GOOD.replace("nu = 0.3", "G = 81.2e9").replace("E = 2.1e11", "E = 211e9"))
+    steel = friswell.spools[0].elements[0].material
+    assert steel.G_s == 81.2e9 and steel.nu == pytest.approx(211.0 / (2 * 81.2) - 1.0, rel=1e-15)
 
 
 def test_spool_with_no_elements_message():

@@ -107,6 +107,10 @@ def format_critical_speeds(result) -> str:
              f"{result.reference + ' rpm':>14} {'line':>{w}} {'mode':>5} {'freq Hz':>10} {'whirl':>9} {'log dec':>9}"]
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")
+    if result.rigid_modes:
+        f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
+        lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "
+                     f"{', '.join(str(j) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
     for c in result.critical_speeds:
         lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")

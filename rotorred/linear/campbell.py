@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
+import scipy.linalg as sla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
@@ -150,6 +151,10 @@ class CampbellResult:
     harmonics : tuple of float
         Multiples of each spool's speed used as excitation lines.
     rotor_name : str
+    rigid_modes : tuple of int
+        Tracked modes that are rigid-body modes of a free or singly supported spool (most of their
+        kinetic energy in the null space of K at the first speed, :func:`rigid_body_share`). No
+        critical speed is reported where a mode is rigid at either end of a speed interval.
     """
 
     speeds: np.ndarray
@@ -162,6 +167,7 @@ class CampbellResult:
     speed_ratios: Mapping[str, float]
     harmonics: tuple[float, ...]
     rotor_name: str = ""
+    rigid_modes: tuple[int, ...] = ()
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -454,11 +460,15 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     log_dec = -2.0 * np.pi * lam_all.real / freq
     whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
 
+    null = rigid_body_motions(sm.M, sm.K)
+    is_rigid = np.array([rigid_body_share(sm.M, null, v) > RIGID_SHARE for v in shapes])  # (n_s, n_modes)
     crit = []
     for spool, hh, slope, same in _distinct_lines(ratios, h):
         g = freq - slope * Omega[:, None]
         for j in range(n_modes):
             for i in range(n_s - 1):
+                if is_rigid[i, j] or is_rigid[i + 1, j]:
+                    continue  # a rigid-body mode has no critical speed
                 if g[i, j] == 0 and i > 0:
                     continue  # counted as the right end of interval i - 1
                 if g[i, j] * g[i + 1, j] > 0:
@@ -468,7 +478,33 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     crit.sort(key=lambda c: (c.speed, c.mode))
     return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
                           critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
-                          harmonics=h, rotor_name=rotor.name)
+                          harmonics=h, rotor_name=rotor.name,
+                          rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])))
+
+
+#: a tracked mode with more than this share of its kinetic energy in the null space of K is a rigid-body mode
+RIGID_SHARE = 0.5
+#: generalised eigenvalues w^2 of (K, M) below this fraction of the largest span the null space of K
+_NULL_RTOL = 1e-10
+
+
+def rigid_body_motions(M: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """The rigid-body motions of a structure, M-orthonormal, shape (n, r): the eigenvectors of
+    K phi = w^2 M phi with w^2 <= 1e-10 max(w^2) (a free spool's translations and tilts; r = 0 when
+    every spool is held)."""
+    w2, phi = sla.eigh(K, M)
+    return phi[:, w2 <= _NULL_RTOL * max(float(np.max(np.abs(w2))), 1e-300)]
+
+
+def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.ndarray:
+    """Share of each mode's kinetic energy in the rigid-body motions ``null`` (:func:`rigid_body_motions`),
+    ``|null^T M v|^2 / (v^H M v)``: 1 for a rigid-body mode, 0 for a mode M-orthogonal to them (every mode
+    of a spool held by bearings). Shape (n_modes,); ``modes`` shape (n, n_modes), complex."""
+    if null.shape[1] == 0:
+        return np.zeros(modes.shape[1])
+    Mv = M @ modes
+    energy = np.real(np.einsum("ij,ij->j", modes.conj(), Mv))
+    return np.sum(np.abs(null.T @ Mv) ** 2, axis=0) / energy
 
 
 def _distinct_lines(ratios: Mapping[str, float], harmonics: tuple[float, ...]):

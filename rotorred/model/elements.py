@@ -49,8 +49,11 @@ class Material:
         Young's modulus (Pa), 0 < E <= 1e18 (:data:`E_MAX`).
     rho : float
         Density (kg/m^3), 1e-9 <= rho <= 1e6 (:data:`RHO_RANGE`).
-    nu : float
-        Poisson's ratio (-), -1 < nu < 0.5.
+    nu : float, optional
+        Poisson's ratio (-), -1 < nu < 0.5; default 0.3 when ``G`` is not given either.
+    G : float, optional
+        Shear modulus (Pa), in place of ``nu`` (textbooks give E, G and rho): then
+        ``nu = E / (2 G) - 1``, which must lie in (-1, 0.5), i.e. E / 3 < G. Not with ``nu``.
 
     Notes
     -----
@@ -65,18 +68,28 @@ class Material:
     name: str
     E: float
     rho: float
-    nu: float = 0.3
+    nu: float | None = None
+    G: float | None = None
 
     def __post_init__(self):
         _set(self, "name", checks.string("name", self.name))
         _set(self, "E", checks.number("E", self.E, "Pa", gt=0.0, le=E_MAX))
         _set(self, "rho", checks.number("rho", self.rho, "kg/m^3", ge=RHO_RANGE[0], le=RHO_RANGE[1]))
-        _set(self, "nu", checks.number("nu", self.nu, "-", gt=-1.0, lt=0.5))
+        if self.G is None:
+            _set(self, "nu", checks.number("nu", 0.3 if self.nu is None else self.nu, "-", gt=-1.0, lt=0.5))
+            return
+        if self.nu is not None:
+            checks.fail("G", self.G, "must not be given with nu (G = E / (2 (1 + nu)) fixes one by the other)", "Pa")
+        G = checks.number("G", self.G, "Pa", gt=0.0)
+        if G <= self.E / 3.0:
+            checks.fail("G", G, f"must be > E / 3 = {self.E / 3.0:.6g} so that nu = E / (2 G) - 1 < 0.5", "Pa")
+        _set(self, "G", G)
+        _set(self, "nu", self.E / (2.0 * G) - 1.0)
 
     @property
     def G_s(self) -> float:
-        """Shear modulus E / (2 (1 + nu)) (Pa)."""
-        return self.E / (2.0 * (1.0 + self.nu))
+        """Shear modulus (Pa): ``G`` as given, else E / (2 (1 + nu))."""
+        return self.G if self.G is not None else self.E / (2.0 * (1.0 + self.nu))
 
 
 def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper") -> float:

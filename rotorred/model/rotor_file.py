@@ -4,7 +4,7 @@ A rotor is given by a preset name (``seed-rig``, ``nelson-mcvaugh``; see :func:`
 path to a TOML file. The format is documented in the README ("Rotor files"); in short::
 
     name = "my-rotor"
-    [[material]]                       # E (Pa), rho (kg/m^3), nu (-)
+    [[material]]                       # E (Pa), rho (kg/m^3), nu (-) or G (Pa, shear modulus)
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
     [[spool]]                          # a chain of elements on consecutive node numbers
     name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
@@ -53,7 +53,7 @@ __all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping",
              "defaults"}
-_MATERIAL_KEYS = {"name", "E", "rho", "nu"}
+_MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "elements"}
 _ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
@@ -194,7 +194,7 @@ def _materials(value) -> dict[str, Material]:
         name = checks.string(f"{where}.name", m["name"], empty=False)
         if name in materials:
             checks.fail(f"{where}.name", name, "must differ from the names of the other [[material]] tables")
-        materials[name] = _build(where, Material, name=name, E=m["E"], rho=m["rho"], nu=m.get("nu", 0.3))
+        materials[name] = _build(where, Material, name=name, E=m["E"], rho=m["rho"], nu=m.get("nu"), G=m.get("G"))
     return materials
 
 
