@@ -107,6 +107,8 @@ BAD = [
     ("nu = 0.3", "nu = 0.7", "bad.toml: material[0].nu = 0.7: must lie in (-1, 0.5)"),
     ("nu = 0.3", "nu = 0.3\nG = 8e10", "bad.toml: material[0].G = 80000000000.0: must not be given with nu "
      "(G = E / (2 (1 + nu)) fixes one by the other) (Pa)"),
+    ("first_node = 1\n", 'first_node = 1\nrotary_inertia = "no"\n',
+     "bad.toml: spool[0].elements[0].rotary_inertia = 'no': must be true or false"),
     ("nu = 0.3", "G = 5e10", "bad.toml: material[0].G = 50000000000.0: must be > E / 3 = 7e+10 so that "
      "nu = E / (2 G) - 1 < 0.5 (Pa)"),
     ("E = 2.1e11", 'E = "hard"', "bad.toml: material[0].E = 'hard': must be a finite number in (0, 1e+18] (Pa)"),
@@ -171,6 +173,15 @@ def test_shear_modulus_in_place_of_poisson_ratio():
     friswell = rotor_from_toml(GOOD.replace("nu = 0.3", "G = 81.2e9").replace("E = 2.1e11", "E = 211e9"))
     steel = friswell.spools[0].elements[0].material
     assert steel.G_s == 81.2e9 and steel.nu == pytest.approx(211.0 / (2 * 81.2) - 1.0, rel=1e-15)
+
+
+def test_rotary_inertia_per_spool_and_element():
+    text = GOOD.replace("first_node = 1\n", "first_node = 1\nrotary_inertia = false\n")
+    text = text.replace('material = "steel", repeat = 4 }', 'material = "steel", repeat = 3 }, '
+                        '{ L = 0.1, D_o = 0.02, material = "steel", rotary_inertia = true }')
+    r = rotor_from_toml(text)
+    assert [e.rotary_inertia for e in r.spool("inner").elements] == [False, False, False, True]
+    assert all(e.rotary_inertia for e in r.spool("outer").elements)
 
 
 def test_spool_with_no_elements_message():

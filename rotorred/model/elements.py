@@ -150,6 +150,10 @@ class ShaftElement:
         small constant. ``"hierarchical"``: cubic displacement and quadratic rotation with 6
         internal bubble DOFs per element (``n_internal``); eigenvalues converge as h^4. See
         docs/model.md, "Shaft element".
+    rotary_inertia : bool
+        Rotary inertia of the cross-section (default True). False leaves out the rotary mass and
+        with it the shaft's own gyroscopic matrix (both are rho I): with ``shear = "none"`` this
+        is the Euler-Bernoulli beam of the textbooks (no shear, no rotary inertia).
     """
 
     left: int
@@ -160,9 +164,12 @@ class ShaftElement:
     material: Material
     shear: str = "cowper"
     element: str = "nelson"
+    rotary_inertia: bool = True
 
     def __post_init__(self):
         _set(self, "left", checks.integer("left", self.left, ge=0))
+        if not isinstance(self.rotary_inertia, (bool, np.bool_)):
+            checks.fail("rotary_inertia", self.rotary_inertia, "must be true or false")
         _set(self, "right", checks.integer("right", self.right, ge=0))
         if self.left == self.right:
             checks.fail("right", self.right, f"must differ from left = {self.left}")
@@ -217,11 +224,12 @@ class ShaftElement:
     def M(self) -> np.ndarray:
         """Mass matrix (translational + rotary), shape (8 + n_internal,) * 2 (kg, kg m, kg m^2)."""
         rho, phi = self.material.rho, self.phi
+        I_r = self.I if self.rotary_inertia else 0.0  # no rotary mass: the generated term at I = 0
         if self.element == "hierarchical":
             return (_gen.hierarchical_mass_translational(self.L, rho, self.A, phi)
-                    + _gen.hierarchical_mass_rotary(self.L, rho, self.I, phi))
+                    + _gen.hierarchical_mass_rotary(self.L, rho, I_r, phi))
         return (_gen.timoshenko_mass_translational(self.L, rho, self.A, phi)
-                + _gen.timoshenko_mass_rotary(self.L, rho, self.I, phi))
+                + _gen.timoshenko_mass_rotary(self.L, rho, I_r, phi))
 
     def K(self) -> np.ndarray:
         """Stiffness matrix, shape (8 + n_internal,) * 2 (N/m, N, N m)."""
@@ -231,15 +239,16 @@ class ShaftElement:
 
     def G(self) -> np.ndarray:
         """Gyroscopic matrix per unit spin speed, shape (8 + n_internal,) * 2 (kg m^2 per rad)."""
+        I_r = self.I if self.rotary_inertia else 0.0  # the gyroscopic matrix is rotary inertia spun
         if self.element == "hierarchical":
-            return _gen.hierarchical_gyroscopic(self.L, self.material.rho, self.I, self.phi)
-        return _gen.timoshenko_gyroscopic(self.L, self.material.rho, self.I, self.phi)
+            return _gen.hierarchical_gyroscopic(self.L, self.material.rho, I_r, self.phi)
+        return _gen.timoshenko_gyroscopic(self.L, self.material.rho, I_r, self.phi)
 
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1)."""
         chain = [self.left, *new_nodes, self.right]
         return [ShaftElement(chain[i], chain[i + 1], self.L / n, self.D_o, self.D_i, self.material, self.shear,
-                             self.element) for i in range(n)]
+                             self.element, self.rotary_inertia) for i in range(n)]
 
 
 @dataclass(frozen=True)

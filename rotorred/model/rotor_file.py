@@ -54,8 +54,8 @@ __all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping",
              "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
-_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "elements"}
-_ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element"}
+_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements"}
+_ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element", "rotary_inertia"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
@@ -216,6 +216,7 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
     node = checks.integer(f"{where}.first_node", s["first_node"], ge=0)
     shear = checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS)
     element = checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS)
+    rotary = s.get("rotary_inertia", True)
     elements = []
     for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
         ew = f"{where}.elements[{j}]"
@@ -224,7 +225,8 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
         for _ in range(checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1)):
             elements.append(_build(ew, ShaftElement, left=node, right=node + 1, L=e["L"], D_o=e["D_o"],
                                    D_i=e.get("D_i", 0.0), material=mat, shear=e.get("shear", shear),
-                                   element=e.get("element", element)))
+                                   element=e.get("element", element),
+                                   rotary_inertia=e.get("rotary_inertia", rotary)))
             node += 1
     speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
     return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0,
