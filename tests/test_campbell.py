@@ -310,7 +310,7 @@ def test_csv_and_png(tmp_path):
     result = campbell(rigid_rotor(2.1e13), SPEEDS_RIGID[:6], n_modes=4)
     assert isinstance(result, CampbellResult)
     rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
-    assert rows[0] == ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"]
+    assert rows[0] == ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"]
     assert len(rows) == 1 + 6 * 4
     assert float(rows[2][2]) == pytest.approx(result.frequencies[0, 1] / (2 * math.pi), rel=1e-8)
     png = plot_campbell(result, tmp_path / "c.png")
@@ -326,7 +326,7 @@ def test_cli_writes_csv_png_and_prints_critical_speeds(tmp_path, capsys):
                  "--harmonics", "1,2", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "critical speeds" in out and "1× shaft" in out and "2× shaft" in out
-    assert (tmp_path / "campbell.csv").read_text().startswith("speed_rpm,mode,frequency_hz,whirl,log_dec\n")
+    assert (tmp_path / "campbell.csv").read_text().startswith("speed_rpm,mode,frequency_hz,whirl,log_dec,stable\n")
     assert (tmp_path / "campbell.png").stat().st_size > 10_000
 
 
@@ -462,3 +462,37 @@ def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():
     f_eb = bl ** 2 / (2 * math.pi * L ** 2) * math.sqrt(steel.E * I / (steel.rho * A))
     bending = min(result.frequencies_hz[0, j] for j in range(result.n_modes) if j not in result.rigid_modes)
     assert 0.0 < (f_eb - bending) / f_eb < 0.01
+
+
+def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polynomial(tmp_path):
+    """The rigid rotor on bearings with cross-coupled stiffness k_xy = -k_yx = 3e5 N/m and damping c = 300 N s/m:
+    the forward conical mode is unstable at rest and stable above the speed where Re(lambda) = 0. For the
+    forward whirl phi = theta_x + i theta_y the rigid rotor's equation is
+    I_d phi'' + (c_t - i I_p Omega) phi' + (k_t - i k_xt) phi = 0 (c_t, k_t, k_xt = 2 a^2 (c, k, k_xy)), whose
+    roots (numpy.roots) give Re(lambda) at each speed; brentq finds its zero. Measured agreement 2.0e-6
+    (the shaft is stiff, not rigid: E = 2.1e13); 2e-5 allowed. The mode is flagged in the table, the CSV
+    (stable = no) and the plot."""
+    from rotorred.cli.campbell import format_critical_speeds
+
+    c, kxy = 300.0, 3e5
+    rotor = dataclasses.replace(rigid_rotor(2.1e13), bearings=tuple(
+        Bearing(k_xx=K_BRG, k_yy=K_BRG, k_xy=kxy, k_yx=-kxy, c_xx=c, c_yy=c, node=n) for n in (0, 4)))
+    result = campbell(rotor, np.linspace(0.0, 1500.0, 31), n_modes=4)
+    _, I_d, I_p = rigid_body_properties()
+    kt, ct, kxt = (2 * A_HALF ** 2 * v for v in (K_BRG, c, kxy))
+
+    def growth(W):
+        r = np.roots([I_d, ct - 1j * I_p * W, kt - 1j * kxt])
+        return float(r.real[r.imag > 0].max())
+
+    limit = brentq(growth, 1.0, 1500.0)
+    (change,) = [s for s in result.stability_changes if s.mode == 0]
+    assert change.whirl == "forward" and not change.onset  # unstable below, stable above
+    assert abs(change.speed / limit - 1) < 2e-5
+    assert change.frequency == pytest.approx(kxy / c, rel=2e-5)  # neutral where c w = k_xy
+    assert "UNSTABLE: mode 0 (forward" in format_critical_speeds(result)
+    rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
+    assert rows[1][:2] == ["0", "0"] and rows[1][-1] == "no"  # mode 0 at rest
+    assert plot_campbell(result, tmp_path / "c.png").stat().st_size > 10_000
+    stable = campbell(rigid_rotor(2.1e13), np.linspace(0.0, 1500.0, 31), n_modes=4)
+    assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off

@@ -107,6 +107,10 @@ def format_critical_speeds(result) -> str:
              f"{result.reference + ' rpm':>14} {'line':>{w}} {'mode':>5} {'freq Hz':>10} {'whirl':>9} {'log dec':>9}"]
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")
+    for c in result.stability_changes:
+        lines.append(f"UNSTABLE: mode {c.mode} ({c.whirl}, {c.frequency_hz:.2f} Hz) "
+                     + (f"becomes unstable above {c.speed_rpm:.1f} rpm (log dec < 0)" if c.onset
+                        else f"is unstable below {c.speed_rpm:.1f} rpm (log dec < 0), stable above"))
     if result.rigid_modes:
         f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
         lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "

@@ -11,7 +11,10 @@ criterion (MAC, :func:`rotorred.linear.modal.mac`) with an optimal one-to-one as
 (:func:`scipy.optimize.linear_sum_assignment`), so a curve keeps its identity where two curves
 cross. A critical speed is a speed where a tracked curve omega_j(Omega) meets an excitation line
 ``h r_s Omega`` (harmonic ``h`` of spool ``s``); it is bracketed on the speed grid and refined with
-:func:`scipy.optimize.brentq`, solving the eigenproblem at the intermediate speeds.
+:func:`scipy.optimize.brentq`, solving the eigenproblem at the intermediate speeds. A speed where a
+tracked mode's log decrement changes sign (it becomes unstable, or stable again) is refined the same
+way, on Re(lambda) = 0 (:class:`StabilityChange`). Rigid-body modes of a free or singly supported
+spool (:func:`rigid_body_share`) give neither.
 
 Whirl direction (spin about +z): at a node with complex amplitudes X, Y of x and y,
 ``x + i y = (X + iY)/2 e^{i w t} + conj(X - iY)/2 e^{-i w t}``, so the forward (counter-clockwise,
@@ -125,6 +128,39 @@ class CriticalSpeed:
 
 
 @dataclass(frozen=True)
+class StabilityChange:
+    """A speed where a tracked mode's log decrement crosses zero.
+
+    Attributes
+    ----------
+    speed : float
+        Speed of the reference spool (rad/s), found by Brent's method on Re(lambda) = 0.
+    mode : int
+        Column of :attr:`CampbellResult.frequencies`.
+    frequency : float
+        Whirl frequency there (rad/s).
+    whirl : str
+    onset : bool
+        True where the mode becomes unstable as the speed rises (log dec > 0 below, < 0 above),
+        False where it becomes stable again.
+    """
+
+    speed: float
+    mode: int
+    frequency: float
+    whirl: str
+    onset: bool
+
+    @property
+    def speed_rpm(self) -> float:
+        return self.speed * 30.0 / math.pi
+
+    @property
+    def frequency_hz(self) -> float:
+        return self.frequency / (2.0 * math.pi)
+
+
+@dataclass(frozen=True)
 class CampbellResult:
     """Whirl frequencies of tracked modes against the speed of a reference spool.
 
@@ -151,6 +187,9 @@ class CampbellResult:
     harmonics : tuple of float
         Multiples of each spool's speed used as excitation lines.
     rotor_name : str
+    stability_changes : tuple of StabilityChange
+        Speeds where a (non rigid-body) mode's log decrement crosses zero, sorted by speed: where it
+        becomes unstable (a negative log dec: the rotor's own motion grows) and stable again.
     rigid_modes : tuple of int
         Tracked modes that are rigid-body modes of a free or singly supported spool (most of their
         kinetic energy in the null space of K at the first speed, :func:`rigid_body_share`). No
@@ -168,6 +207,7 @@ class CampbellResult:
     harmonics: tuple[float, ...]
     rotor_name: str = ""
     rigid_modes: tuple[int, ...] = ()
+    stability_changes: tuple[StabilityChange, ...] = ()
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -213,12 +253,18 @@ class CampbellResult:
         return writers.write_csv(path, header, columns)
 
     @property
+    def unstable(self) -> np.ndarray:
+        """Where a mode's log dec is negative beyond round-off (< -NEUTRAL_LOG_DEC), shape (n_speeds, n_modes)."""
+        return self.log_dec < -NEUTRAL_LOG_DEC
+
+    @property
     def damping_ratio(self) -> np.ndarray:
         """Damping ratio zeta = -Re(lambda) / |lambda| = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
         return self.log_dec / np.sqrt(self.log_dec ** 2 + 4.0 * np.pi ** 2)
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec``.
+        """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec,stable``
+        (``stable``: ``no`` where the log dec is below ``-NEUTRAL_LOG_DEC``).
 
         Speeds with 10 significant digits, frequencies with 9, log decrements with 6. The
         diagram itself is drawn by :func:`rotorred.plots.campbell.plot_campbell`.
@@ -229,8 +275,9 @@ class CampbellResult:
         # mixed precision: frequency and log dec are formatted here, the speed by the writer (digits=10)
         freq = [f"{v:.9g}" for v in self.frequencies_hz.ravel()]
         log_dec = [f"{v:.6g}" for v in self.log_dec.ravel()]
-        return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec"],
-                                 [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec], digits=10)
+        stable = ["no" if v < -NEUTRAL_LOG_DEC else "yes" for v in self.log_dec.ravel()]
+        return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"],
+                                 [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec, stable], digits=10)
 
 
 def excitation_label(harmonic: float, spool: str) -> str:
@@ -474,14 +521,19 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
                 if g[i, j] * g[i + 1, j] > 0:
                     continue
                 crit.append(replace(
-                    _refine(solver, Omega, freq, lam_all, shapes, whirl, i, j, spool, hh, slope), same_line=same))
+                    _refine(solver, Omega, lam_all, shapes, whirl, i, j, spool, hh, slope), same_line=same))
     crit.sort(key=lambda c: (c.speed, c.mode))
+    changes = _stability_changes(solver, Omega, lam_all, shapes, whirl, log_dec, is_rigid)
     return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
                           critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
                           harmonics=h, rotor_name=rotor.name,
-                          rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])))
+                          rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])),
+                          stability_changes=changes)
 
 
+#: |log dec| at most this is neutral: an undamped mode, whose computed log dec is round-off (up to 2e-9
+#: measured on a stiff undamped rotor, tests/test_campbell.py); a damping ratio of 1.6e-7
+NEUTRAL_LOG_DEC = 1e-6
 #: a tracked mode with more than this share of its kinetic energy in the null space of K is a rigid-body mode
 RIGID_SHARE = 0.5
 #: generalised eigenvalues w^2 of (K, M) below this fraction of the largest span the null space of K
@@ -525,8 +577,9 @@ def _distinct_lines(ratios: Mapping[str, float], harmonics: tuple[float, ...]):
     return out
 
 
-def _refine(solver: _Solver, Omega, freq, lam_grid, shapes, whirl, i, j, spool, harmonic, slope) -> CriticalSpeed:
-    """Brent's root of omega_j(Omega) - slope Omega on [Omega_i, Omega_i+1], mode j tracked by MAC.
+def _root(solver: _Solver, Omega, lam_grid, shapes, i: int, j: int, f):
+    """Speed W in [Omega_i, Omega_i+1] where ``f(lam_j(W), W)`` = 0 (Brent), mode j tracked by MAC; returns
+    (W, lam, shape) there.
 
     At intermediate speeds the eigenpair is found by Newton's method started from the linear
     interpolation of the bracketing eigenpairs; it is accepted if its shape has MAC >= 0.9 with a
@@ -552,19 +605,39 @@ def _refine(solver: _Solver, Omega, freq, lam_grid, shapes, whirl, i, j, spool, 
 
     def g(W):
         if W == a:
-            return freq[i, j] - slope * a
+            return f(lam_grid[i, j], a)
         if W == b:
-            return freq[i + 1, j] - slope * b
-        return pick(W).imag - slope * W
+            return f(lam_grid[i + 1, j], b)
+        return f(pick(W), W)
 
     # rtol 1e-10: the eigenvalues themselves carry ~1e-12 relative roundoff
     root = brentq(g, a, b, xtol=1e-12 * max(b, 1.0), rtol=1e-10)
     if root == a:
-        lam, shape = lam_grid[i, j], shapes[i][:, j]
-    elif root == b:
-        lam, shape = lam_grid[i + 1, j], shapes[i + 1][:, j]
-    else:
-        lam, shape = found[root] if root in found else (pick(root), found[root][1])
+        return root, lam_grid[i, j], shapes[i][:, j]
+    if root == b:
+        return root, lam_grid[i + 1, j], shapes[i + 1][:, j]
+    if root not in found:
+        pick(root)
+    return (root, *found[root])
+
+
+def _stability_changes(solver: _Solver, Omega, lam_grid, shapes, whirl, log_dec, is_rigid):
+    """Where each tracked mode's log dec changes sign between grid speeds: the root of Re(lambda) (:func:`_root`)."""
+    out = []
+    for j in range(log_dec.shape[1]):
+        for i in range(len(Omega) - 1):
+            a, b = log_dec[i, j], log_dec[i + 1, j]
+            if is_rigid[i, j] or is_rigid[i + 1, j] or not (min(a, b) < -NEUTRAL_LOG_DEC < NEUTRAL_LOG_DEC < max(a, b)):
+                continue  # a change from stable to unstable, not round-off about an undamped mode's zero
+            root, lam, _ = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.real)
+            w = str(whirl[i, j]) if whirl[i, j] == whirl[i + 1, j] else "mixed"
+            out.append(StabilityChange(float(root), j, float(lam.imag), w, bool(log_dec[i, j] > 0)))
+    return tuple(sorted(out, key=lambda c: (c.speed, c.mode)))
+
+
+def _refine(solver: _Solver, Omega, lam_grid, shapes, whirl, i, j, spool, harmonic, slope) -> CriticalSpeed:
+    """The crossing of whirl curve j with the line slope x Omega in [Omega_i, Omega_i+1] (:func:`_root`)."""
+    root, lam, shape = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.imag - slope * W)
     if whirl[i, j] == whirl[i + 1, j]:
         label = str(whirl[i, j])  # also right inside a multiple eigenvalue, where the shape is any basis vector
     else:

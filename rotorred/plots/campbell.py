@@ -49,6 +49,13 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
     if result.critical_speeds:
         ax.plot([c.speed_rpm for c in result.critical_speeds], [c.frequency_hz for c in result.critical_speeds],
                 "o", mfc="none", mec="black", ms=8, mew=1.5, label="critical speed", zorder=5)
+    unstable = result.unstable
+    if np.any(unstable):  # grid points where a mode's own motion grows
+        ax.plot(np.broadcast_to(result.speeds_rpm[:, None], unstable.shape)[unstable], result.frequencies_hz[unstable],
+                "x", color="tab:red", ms=6, mew=1.5, label="unstable (log dec < 0)", zorder=6)
+    for c in result.stability_changes:
+        ax.plot(c.speed_rpm, c.frequency_hz, "D", color="tab:red", ms=7, zorder=7,
+                label=None if c is not result.stability_changes[0] else "stability limit")
     if operating_speed is not None:
         op = operating_speed * 30 / np.pi
         ax.axvline(op, color="tab:green", lw=1.2, label=f"operating point {op:.0f} rpm")
