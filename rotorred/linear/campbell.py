@@ -67,8 +67,25 @@ _DEGENERATE_RTOL = 1e-7
 _FREQ_TIEBREAK = 1e-3
 
 
+class _PointOnTheDiagram:
+    """A point of a Campbell diagram: ``speed`` of the reference spool and whirl ``frequency`` (rad/s)."""
+
+    speed: float
+    frequency: float
+
+    @property
+    def speed_rpm(self) -> float:
+        """Speed of the reference spool (rpm)."""
+        return self.speed * 30.0 / math.pi
+
+    @property
+    def frequency_hz(self) -> float:
+        """Whirl frequency (Hz)."""
+        return self.frequency / (2.0 * math.pi)
+
+
 @dataclass(frozen=True)
-class CriticalSpeed:
+class CriticalSpeed(_PointOnTheDiagram):
     """A crossing of a whirl curve with an excitation line h x Omega_s.
 
     Attributes
@@ -102,16 +119,6 @@ class CriticalSpeed:
     same_line: tuple[str, ...] = ()
 
     @property
-    def speed_rpm(self) -> float:
-        """Speed of the reference spool (rpm)."""
-        return self.speed * 30.0 / math.pi
-
-    @property
-    def frequency_hz(self) -> float:
-        """Whirl frequency (Hz)."""
-        return self.frequency / (2.0 * math.pi)
-
-    @property
     def spool_speed(self) -> float:
         """Speed of the excited spool at the crossing (rad/s)."""
         return self.frequency / self.harmonic
@@ -128,7 +135,7 @@ class CriticalSpeed:
 
 
 @dataclass(frozen=True)
-class StabilityChange:
+class StabilityChange(_PointOnTheDiagram):
     """A speed where a tracked mode's log decrement crosses zero.
 
     Attributes
@@ -150,14 +157,6 @@ class StabilityChange:
     frequency: float
     whirl: str
     onset: bool
-
-    @property
-    def speed_rpm(self) -> float:
-        return self.speed * 30.0 / math.pi
-
-    @property
-    def frequency_hz(self) -> float:
-        return self.frequency / (2.0 * math.pi)
 
 
 @dataclass(frozen=True)
