@@ -496,3 +496,31 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     assert plot_campbell(result, tmp_path / "c.png").stat().st_size > 10_000
     stable = campbell(rigid_rotor(2.1e13), np.linspace(0.0, 1500.0, 31), n_modes=4)
     assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off
+
+
+def _three_spools(speeds=(100.0, 0.0, 0.0)) -> Rotor:
+    steel = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
+    spools = tuple(Spool(name, tuple(ShaftElement(first + i, first + i + 1, 0.1, 0.03, 0.0, steel) for i in range(4)),
+                         speed=w) for name, first, w in zip(("a", "b", "c"), (0, 10, 20), speeds))
+    disks = tuple(Disk(first + 2, 5.0, 0.02, 0.04) for first in (0, 10, 20))
+    bearings = tuple(Bearing(k_xx=1e7, k_yy=1e7, c_xx=50.0, c_yy=50.0, node=n) for n in (0, 4, 10, 14, 20, 24))
+    return Rotor(spools, disks=disks, bearings=bearings, name="three")
+
+
+def test_three_spools_take_ratios_by_name():
+    """Ratios to the reference spool by name, for any number of spools: the same diagram as a rotor whose
+    nominal speeds have those ratios (two paths, equal to the last bit); a spool without a ratio keeps its
+    nominal one; where the rotor gives none, the message names every missing spool."""
+    speeds = np.linspace(0.0, 800.0, 9)
+    by_name = campbell(_three_spools(), speeds, ratio={"b": 1.5, "c": 0.5}, n_modes=6)
+    by_nominal = campbell(_three_spools((100.0, 150.0, 50.0)), speeds, n_modes=6)
+    assert by_name.speed_ratios == {"a": 1.0, "b": 1.5, "c": 0.5}
+    np.testing.assert_array_equal(by_name.frequencies, by_nominal.frequencies)
+    assert [c.line for c in by_name.critical_speeds] == [c.line for c in by_nominal.critical_speeds]
+    assert campbell(_three_spools((100.0, 150.0, 50.0)), speeds, ratio={"c": 2.0}).speed_ratios == \
+        {"a": 1.0, "b": 1.5, "c": 2.0}
+    with pytest.raises(InputError, match=r"^ratio = \{'b': 1\.5\}: must give the ratio to 'a' of every other spool; "
+                                         r"missing \['c'\] \(--ratio c=R\): the nominal speed of 'a' is 0"):
+        campbell(_three_spools((0.0, 0.0, 0.0)), speeds, ratio={"b": 1.5})
+    with pytest.raises(InputError, match=r"^ratio = 1\.5: must name its spools"):
+        campbell(_three_spools(), speeds, ratio=1.5)

@@ -18,6 +18,30 @@ def parse_speeds(text: str) -> np.ndarray:
     return grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True) * math.pi / 30.0
 
 
+def parse_ratio(items: list[str]):
+    """``["1.2857"]`` (two spools) -> 1.2857; ``["outer=1.2857", "mid=0.9"]`` -> {spool: ratio}; [] -> None."""
+    if not items:
+        return None
+    if len(items) == 1 and "=" not in items[0]:
+        return checks.number("--ratio", _float("--ratio", items[0]), ge=0.0)
+    out = {}
+    for item in items:
+        spool, eq, r = item.partition("=")
+        if not eq or not spool.strip():
+            checks.fail("--ratio", item, "must be SPOOL=R (repeat for each spool), or one number R for two spools")
+        if spool.strip() in out:
+            checks.fail("--ratio", item, f"must give spool {spool.strip()!r} once")
+        out[spool.strip()] = checks.number(f"--ratio {spool.strip()}", _float(f"--ratio {spool.strip()}", r), ge=0.0)
+    return out
+
+
+def _float(option: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        checks.fail(option, text, "must be a number")
+
+
 def parse_harmonics(text: str) -> tuple[float, ...]:
     """``"1,2"`` -> (1.0, 2.0); each > 0."""
     return number_list("--harmonics", text, gt=0.0)
@@ -35,9 +59,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
                    help="reference-spool speeds in rpm, e.g. 0:12000:61, a comma list (increasing, >= 0), or one "
                         "speed (prints the whirl frequencies, directions and damping there)")
-    p.add_argument("--ratio", type=float, default=None,
-                   help="two spools: speed of the second spool / speed of the first (Omega_H/Omega_L for "
-                        "the seed rig); default: ratio of the nominal speeds")
+    p.add_argument("--ratio", action="append", default=[], metavar="SPOOL=R",
+                   help="SPOOL turns at R times the reference spool (repeat for more spools); or, for two spools, "
+                        "one number R: speed of the second spool / speed of the first (Omega_H/Omega_L for the seed "
+                        "rig); default: the ratios of the nominal speeds")
     p.add_argument("--reference", default=None, metavar="SPOOL", help="spool on the x-axis (default: the first)")
     p.add_argument("--modes", type=int, default=6, metavar="N", help="number of tracked modes (default 6)")
     p.add_argument("--harmonics", default="1", metavar="H1,H2",
@@ -56,14 +81,13 @@ def run(args) -> int:
     speeds = parse_speeds(args.speeds)
     harmonics = parse_harmonics(args.harmonics)
     checks.integer("--modes", args.modes, ge=1)
-    if args.ratio is not None:
-        checks.number("--ratio", args.ratio, ge=0.0)
+    ratio = parse_ratio(args.ratio)
     rotor = load_rotor(args.rotor)
     check_model_size(rotor, args.force)
     if args.reference is not None and args.reference not in rotor.speeds:
         checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
     with OutputFolder(out) as folder:
-        result = campbell(rotor, speeds, ratio=args.ratio, reference=args.reference, n_modes=args.modes,
+        result = campbell(rotor, speeds, ratio=ratio, reference=args.reference, n_modes=args.modes,
                           harmonics=harmonics)
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]

@@ -355,16 +355,17 @@ def _canonical_basis(lam: np.ndarray, modes: np.ndarray, x_rows, y_rows) -> np.n
 
 # --- the analysis ------------------------------------------------------------------------------
 
-def speed_ratios(rotor: Rotor, ratio: float | None = None, reference: str | None = None) -> dict[str, float]:
+def speed_ratios(rotor: Rotor, ratio=None, reference: str | None = None) -> dict[str, float]:
     """Omega_s / Omega_reference of each spool.
 
     Parameters
     ----------
     rotor : Rotor
-    ratio : float, optional
-        Two-spool rotors only: Omega of the second spool / Omega of the first, in
-        ``rotor.spools`` order (for the seed rig (inner, outer): Omega_H / Omega_L), >= 0.
-        Default: the ratio of the spools' nominal speeds.
+    ratio : float or mapping of str to float, optional
+        A mapping ``{spool: Omega_s / Omega_reference}`` (any number of spools, each >= 0); a spool
+        not in it keeps the ratio of the nominal speeds. A float, for a two-spool rotor only:
+        Omega of the second spool / Omega of the first, in ``rotor.spools`` order (for the seed rig
+        (inner, outer): Omega_H / Omega_L). Default: the ratios of the spools' nominal speeds.
     reference : str, optional
         The spool on the x-axis (default the first).
 
@@ -374,19 +375,42 @@ def speed_ratios(rotor: Rotor, ratio: float | None = None, reference: str | None
     """
     names = [s.name for s in rotor.spools]
     reference = checks.choice("reference", names[0] if reference is None else reference, names)
+    if isinstance(ratio, Mapping):
+        return _given_ratios(rotor, dict(ratio), reference)
     if ratio is not None:
-        if len(names) != 2:
+        if len(names) == 1:
             checks.fail("ratio", ratio, f"must be left unset: it applies to two-spool rotors only, and rotor "
-                        f"{rotor.name!r} has {len(names)} spool(s) {names}")
+                        f"{rotor.name!r} has one spool {names}")
+        if len(names) != 2:
+            checks.fail("ratio", ratio, f"must name its spools ({{spool: ratio to {reference!r}}}, --ratio SPOOL=R) "
+                        f"for rotor {rotor.name!r} with {len(names)} spool(s) {names}; a single number is the "
+                        "second spool's ratio to the first, for two spools")
         absolute = {names[0]: 1.0, names[1]: checks.non_negative("ratio", ratio)}
     else:
         absolute = dict(rotor.speeds)
         if len(names) == 1:
             absolute = {names[0]: 1.0}
     if absolute[reference] <= 0:
+        missing = [n for n in names if n != reference]
         checks.fail("reference", reference, "must be a spool with a nominal speed > 0, or ratio must be given: "
-                    f"spool {reference!r} has nominal speed 0, so the speed ratios are undefined")
+                    f"spool {reference!r} has nominal speed 0, so the speed ratios are undefined (give "
+                    + ", ".join(f"--ratio {n}=R" for n in missing) + ")")
     return {n: absolute[n] / absolute[reference] for n in names}
+
+
+def _given_ratios(rotor: Rotor, given: dict, reference: str) -> dict[str, float]:
+    """The ratios of ``given`` (checked), the others from the nominal speeds, or a message naming what is missing."""
+    names = [s.name for s in rotor.spools]
+    for name, r in given.items():
+        checks.choice("ratio", name, [n for n in names if n != reference])
+        given[name] = checks.non_negative(f"ratio[{name!r}]", r)
+    nominal = rotor.speeds
+    missing = [n for n in names if n != reference and n not in given]
+    if missing and nominal[reference] <= 0:
+        checks.fail("ratio", given, f"must give the ratio to {reference!r} of every other spool; missing "
+                    f"{missing} (" + ", ".join(f"--ratio {n}=R" for n in missing) + f"): the nominal speed of "
+                    f"{reference!r} is 0, so the rotor gives none")
+    return {n: 1.0 if n == reference else given.get(n, nominal[n] / max(nominal[reference], 1e-300)) for n in names}
 
 
 class _Solver:
@@ -447,7 +471,8 @@ def _assign(prev_modes, prev_freq, lam, modes):
     return cols[np.argsort(rows)], m[rows, cols][np.argsort(rows)]
 
 
-def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = None, reference: str | None = None,
+def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
+             reference: str | None = None,
              n_modes: int = 6, harmonics: Sequence[float] = (1,)) -> CampbellResult:
     """Campbell diagram of ``rotor`` with critical speeds.
 
@@ -457,9 +482,11 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | None = Non
     speeds : sequence of float, shape (n_speeds,)
         Speeds of the reference spool (rad/s), >= 0, strictly increasing. One speed gives the whirl
         frequencies, directions and damping there (no crossing can be found, so no critical speed).
-    ratio : float, optional
-        Two-spool rotors: Omega of the second spool / Omega of the first (``rotor.spools`` order;
-        Omega_H / Omega_L for the seed rig). Default: ratio of the nominal spool speeds.
+    ratio : float or mapping of str to float, optional
+        ``{spool: Omega_s / Omega_reference}`` for any number of spools (the others keep the
+        ratio of their nominal speeds), or, for two spools, Omega of the second spool / Omega of
+        the first (``rotor.spools`` order; Omega_H / Omega_L for the seed rig). Default: the ratios
+        of the nominal spool speeds (:func:`speed_ratios`).
     reference : str, optional
         Spool whose speed is the x-axis (default the first spool).
     n_modes : int
