@@ -67,6 +67,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--modes", type=int, default=6, metavar="N", help="number of tracked modes (default 6)")
     p.add_argument("--harmonics", default="1", metavar="H1,H2",
                    help="multiples of each spool's speed used as excitation lines (default 1)")
+    p.add_argument("--reduce", type=int, default=None, metavar="MODES",
+                   help="solve the Craig-Bampton model with MODES fixed-interface modes (0: chosen to the default "
+                        "target) and print its largest difference against the full model")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
@@ -82,13 +85,16 @@ def run(args) -> int:
     harmonics = parse_harmonics(args.harmonics)
     checks.integer("--modes", args.modes, ge=1)
     ratio = parse_ratio(args.ratio)
+    if args.reduce is not None:
+        checks.integer("--reduce", args.reduce, ge=0)
     rotor = load_rotor(args.rotor)
     check_model_size(rotor, args.force)
     if args.reference is not None and args.reference not in rotor.speeds:
         checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
     with OutputFolder(out) as folder:
-        result = campbell(rotor, speeds, ratio=ratio, reference=args.reference, n_modes=args.modes,
-                          harmonics=harmonics)
+        kw = dict(ratio=ratio, reference=args.reference, n_modes=args.modes, harmonics=harmonics)
+        result = campbell(rotor, speeds, **kw, model=_reduced(rotor, args.reduce))
+        comparison = None if args.reduce is None else format_reduction_error(result, campbell(rotor, speeds, **kw))
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
@@ -97,8 +103,34 @@ def run(args) -> int:
             files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
         folder.commit()
     print(format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result))
+    if comparison:
+        print(comparison)
     print("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
+
+
+def _reduced(rotor, modes: int | None):
+    """The Craig-Bampton model of ``rotor`` with ``modes`` fixed-interface modes (0: the default choice), or None."""
+    if modes is None:
+        return None
+    from rotorred.linear.reduction import reduce_rotor
+
+    return reduce_rotor(rotor, n_modes=modes or None)
+
+
+def format_reduction_error(reduced, full) -> str:
+    """The reduced model's largest whirl-frequency and critical-speed differences against the full model."""
+    rel = np.abs(reduced.frequencies / full.frequencies - 1.0)
+    i, j = np.unravel_index(int(np.argmax(rel)), rel.shape)
+    text = (f"reduced model against the full one: whirl frequencies within {100 * rel[i, j]:.3g} % (largest: mode {j} "
+            f"at {full.speeds_rpm[i]:.6g} rpm)")
+    pairs = list(zip(reduced.critical_speeds, full.critical_speeds))
+    if pairs and len(reduced.critical_speeds) == len(full.critical_speeds):
+        text += f"; critical speeds within {100 * max(abs(a.speed / b.speed - 1) for a, b in pairs):.3g} %"
+    elif full.critical_speeds or reduced.critical_speeds:
+        text += (f"; {len(reduced.critical_speeds)} critical speeds against the full model's "
+                 f"{len(full.critical_speeds)}: keep more modes")
+    return text
 
 
 def check_model_size(rotor, force: bool) -> None:

@@ -286,10 +286,19 @@ def excitation_label(harmonic: float, spool: str) -> str:
 
 # --- whirl direction ---------------------------------------------------------------------------
 
-def _xy_rows(dofs) -> tuple[np.ndarray, np.ndarray]:
-    x = np.array([dofs.index(n, "x") for n in dofs.nodes])
-    y = np.array([dofs.index(n, "y") for n in dofs.nodes])
-    return x, y
+def _xy_rows(model) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices (n_nodes, n) mapping the model's coordinates to the x and y displacement of every node: rows of
+    the identity for a full model, rows of ``T`` for a Craig-Bampton model (its interior nodes recovered)."""
+    dofs = model.dofs if isinstance(model, SystemMatrices) else model.full_dofs
+    x = [dofs.index(n, "x") for n in dofs.nodes]
+    y = [dofs.index(n, "y") for n in dofs.nodes]
+    T = np.eye(model.n_dof) if isinstance(model, SystemMatrices) else model.T
+    return T[x], T[y]
+
+
+def _take(rows: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """``A[rows]`` for index rows, ``rows @ A`` for a matrix of rows."""
+    return rows @ A if np.ndim(rows) == 2 else A[rows]
 
 
 def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -> list[str]:
@@ -299,8 +308,9 @@ def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -
     ----------
     modes : ndarray, shape (n, k), complex
         Mode shapes (columns).
-    x_rows, y_rows : ndarray of int, shape (n_nodes,)
-        Rows of the x and y displacement of each node.
+    x_rows, y_rows : ndarray of int, shape (n_nodes,), or ndarray, shape (n_nodes, n)
+        Rows of the x and y displacement of each node, or matrices giving them from the coordinates
+        (a reduced model's rows of T).
 
     Returns
     -------
@@ -309,7 +319,7 @@ def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -
         the mode's orbit size sum_n (|X_n|^2 + |Y_n|^2), ``"backward"`` likewise, ``"mixed"`` otherwise,
         ``"planar"`` if every orbit is a straight line (|X + iY| = |X - iY|).
     """
-    X, Y = modes[x_rows], modes[y_rows]
+    X, Y = _take(x_rows, modes), _take(y_rows, modes)
     f2, b2 = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
     amp = f2 + b2  # = 2 (|X|^2 + |Y|^2)
     d = (f2 - b2) / np.where(amp > 0, amp, 1.0)
@@ -345,7 +355,7 @@ def _canonical_basis(lam: np.ndarray, modes: np.ndarray, x_rows, y_rows) -> np.n
             e += 1
         if e - j > 1:
             Q = np.linalg.qr(modes[:, j:e])[0]  # orthonormal basis of the eigenspace
-            FQ = Q[x_rows] + 1j * Q[y_rows]
+            FQ = _take(x_rows, Q) + 1j * _take(y_rows, Q)
             V = np.linalg.eigh(FQ.conj().T @ FQ)[1]  # ascending forward content
             W = Q @ V
             modes[:, j:e] = W / np.linalg.norm(W, axis=0)
@@ -416,11 +426,11 @@ def _given_ratios(rotor: Rotor, given: dict, reference: str) -> dict[str, float]
 class _Solver:
     """Eigen-solves of one rotor along the speed axis (matrices assembled once)."""
 
-    def __init__(self, sm: SystemMatrices, ratios: Mapping[str, float], n_candidates: int):
+    def __init__(self, sm, ratios: Mapping[str, float], n_candidates: int):
         self.M, self.K, self.C = sm.M, sm.K, sm.C
         self.G = sm.gyroscopic(ratios)  # sum_s r_s G_s, per unit reference speed
         self.n_candidates = n_candidates
-        self.x_rows, self.y_rows = _xy_rows(sm.dofs)
+        self.x_rows, self.y_rows = _xy_rows(sm)
 
     def solve(self, Omega: float):
         sol = eigen(self.M, self.C + Omega * self.G, self.K, n_modes=self.n_candidates)
@@ -473,7 +483,7 @@ def _assign(prev_modes, prev_freq, lam, modes):
 
 def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
              reference: str | None = None,
-             n_modes: int = 6, harmonics: Sequence[float] = (1,)) -> CampbellResult:
+             n_modes: int = 6, harmonics: Sequence[float] = (1,), model=None) -> CampbellResult:
     """Campbell diagram of ``rotor`` with critical speeds.
 
     Parameters
@@ -493,6 +503,9 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
         Number of modes tracked: the lowest ``n_modes`` at ``speeds[0]``.
     harmonics : sequence of float
         Excitation lines h x Omega_s for each h and each spinning spool s (default 1x).
+    model : ReducedSystem, optional
+        A Craig-Bampton model of ``rotor`` (:func:`rotorred.linear.reduction.reduce_rotor`) to solve in
+        place of the full one; whirl directions are read from the recovered physical shapes (T v).
 
     Returns
     -------
@@ -503,7 +516,7 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
     h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
     ratios = speed_ratios(rotor, ratio, reference)
     reference = reference or rotor.spools[0].name
-    sm = assemble(rotor)
+    sm = assemble(rotor) if model is None else _checked_model(model, rotor)
     n_available = sm.n_dof  # at most one frequency per DOF
     if n_modes > n_available:
         checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
@@ -583,6 +596,17 @@ def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.n
     Mv = M @ modes
     energy = np.real(np.einsum("ij,ij->j", modes.conj(), Mv))
     return np.sum(np.abs(null.T @ Mv) ** 2, axis=0) / energy
+
+
+def _checked_model(model, rotor: Rotor):
+    """``model`` if it is a reduced model of ``rotor``'s spools."""
+    from rotorred.linear.reduction import ReducedSystem
+
+    if not isinstance(model, ReducedSystem):
+        checks.fail("model", type(model).__name__, "must be a ReducedSystem (reduce_rotor) of the rotor, or None")
+    if set(model.G) != {s.name for s in rotor.spools} or tuple(model.full_dofs.nodes) != tuple(rotor.nodes):
+        checks.fail("model", "a ReducedSystem", f"must be reduced from rotor {rotor.name!r} (its spools and nodes)")
+    return model
 
 
 def _distinct_lines(ratios: Mapping[str, float], harmonics: tuple[float, ...]):
