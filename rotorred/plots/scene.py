@@ -65,16 +65,31 @@ def _path(path) -> Path:
     return p
 
 
+#: fixed figure margins in inches (left, right, bottom, top) and the gap between panels: room for the figure
+#: title, each panel's title and the axis labels. Constrained layout measured every text of a figure at each
+#: draw, about 0.2 s a figure here.
+_MARGINS, _GAP = (0.8, 0.25, 0.6, 0.95), 0.6
+
+
 def _stacked(width: float, panel_height: float, n: int) -> tuple[Figure, np.ndarray]:
-    """A figure of ``n`` panels one above the other sharing x, with fixed margins in inches (room for the
-    title, each panel's title and the axis labels): constrained layout measured every text of the
-    figure at each draw, about 0.2 s a figure here."""
-    height = panel_height * n + 1.0
-    gap = 0.6  # between panels (in): a panel title and the tick marks
+    """A figure of ``n`` panels one above the other sharing x, with fixed margins (:data:`_MARGINS`)."""
+    left, right, bottom, top = _MARGINS
+    height = panel_height * n + bottom + top - _GAP
     fig = Figure(figsize=(width, height))
-    fig.subplots_adjust(left=0.8 / width, right=1 - 0.25 / width, bottom=0.6 / height, top=1 - 0.95 / height,
-                        hspace=gap / (panel_height - gap))
+    fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
+                        hspace=_GAP / (panel_height - _GAP))
     return fig, fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+
+
+def _side_by_side(panel_width: float, height: float, n: int) -> tuple[Figure, np.ndarray]:
+    """A figure of ``n`` panels in a row, each with its own axis labels, with fixed margins (:data:`_MARGINS`)."""
+    left, right, bottom, top = _MARGINS
+    gap = left  # the next panel's y label and tick labels
+    width = panel_width * n + left + right - gap
+    fig = Figure(figsize=(width, height))
+    fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
+                        wspace=gap / (panel_width - gap))
+    return fig, fig.subplots(1, n, squeeze=False)[0]
 
 
 def _save(fig: Figure, path: Path, title: str | None) -> Path:
@@ -303,8 +318,7 @@ def plot_orbits(
         checks.positive("clearance", radius, "m")
     path = _path(path)
     n = len(panels)
-    fig = Figure(figsize=(4.6 * n + 0.4, 5.0), layout="constrained")
-    axes = fig.subplots(1, n, squeeze=False)[0]
+    fig, axes = _side_by_side(4.6, 5.3, n)
     for ax, (panel, series) in zip(axes, panels.items()):
         for label, xy in series.items():
             if not (isinstance(xy, Sequence) and len(xy) == 2):
