@@ -549,3 +549,12 @@ def test_campbell_of_the_craig_bampton_model_converges_to_the_full_one(tmp_path,
         campbell(rigid_rotor(2.1e11), SPEEDS_RIGID, model=reduce_rotor(rig, n_modes=8))
     assert main(["campbell", "seed-rig", "--speeds", "0:12000:61", "--reduce", "16", "--out", str(tmp_path)]) == 0
     assert "reduced model against the full one: whirl frequencies within" in capsys.readouterr().out
+
+
+def test_ratio_option_reads_repeated_and_comma_separated_items():
+    """One parser of SPOOL=R (rotorred.cli.options.spool_ratios) for campbell, harmonic and map: repeated
+    options and comma lists give the same ratios; a bare number stays the two-spool form."""
+    from rotorred.cli.campbell import parse_ratio
+
+    assert parse_ratio(["b=1.5", "c=0.5"]) == parse_ratio(["b=1.5,c=0.5"]) == {"b": 1.5, "c": 0.5}
+    assert parse_ratio(["1.2857"]) == 1.2857 and parse_ratio([]) is None

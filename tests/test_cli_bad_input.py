@@ -93,6 +93,10 @@ CASES = [
     (["campbell", "seed-rig", "--speeds", "0:6000:3", "--harmonics", "0", "--out", "{d}/o"], ["--harmonics", "0"]),
     (["campbell", "seed-rig", "--speeds", "0:6000:3", "--harmonics", "x", "--out", "{d}/o"], ["--harmonics", "x"]),
     (["campbell", "seed-rig", "--speeds", "0:6000:3", "--ratio", "-1", "--out", "{d}/o"], ["--ratio", "-1"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--ratio", "outer=x", "--out", "{d}/o"],
+     ["--ratio", "outer=x", "SPOOL=R"]),
+    (["campbell", "seed-rig", "--speeds", "0:6000:3", "--ratio", "outer=1.2,outer=1.3", "--out", "{d}/o"],
+     ["--ratio", "outer=1.3", "once"]),
     (["campbell", "seed-rig", "--speeds", "0:6000:3", "--reference", "mid", "--out", "{d}/o"], ["--reference", "mid"]),
     # ---- harmonic options (all checked before the sweep: reliability.md section 8)
     (["harmonic", "seed-rig", "--speeds=-100:100:5", "--out", "{d}/o"], ["--speeds", "-100:100:5", "rpm"]),

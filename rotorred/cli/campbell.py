@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from rotorred import checks
-from rotorred.cli.options import grid, number_list, out_dir
+from rotorred.cli.options import grid, number_list, out_dir, ratio_number, spool_ratios
 from rotorred.writers import OutputFolder
 
 
@@ -23,23 +23,8 @@ def parse_ratio(items: list[str]):
     if not items:
         return None
     if len(items) == 1 and "=" not in items[0]:
-        return checks.number("--ratio", _float("--ratio", items[0]), ge=0.0)
-    out = {}
-    for item in items:
-        spool, eq, r = item.partition("=")
-        if not eq or not spool.strip():
-            checks.fail("--ratio", item, "must be SPOOL=R (repeat for each spool), or one number R for two spools")
-        if spool.strip() in out:
-            checks.fail("--ratio", item, f"must give spool {spool.strip()!r} once")
-        out[spool.strip()] = checks.number(f"--ratio {spool.strip()}", _float(f"--ratio {spool.strip()}", r), ge=0.0)
-    return out
-
-
-def _float(option: str, text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        checks.fail(option, text, "must be a number")
+        return checks.number("--ratio", ratio_number("--ratio", items[0]), ge=0.0)
+    return {spool: checks.number(f"--ratio {spool}", r, ge=0.0) for spool, r in spool_ratios("--ratio", items).items()}
 
 
 def parse_harmonics(text: str) -> tuple[float, ...]:

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred import checks
-from rotorred.cli.options import dof_list, grid, node_list, out_dir
+from rotorred.cli.options import dof_list, grid, node_list, out_dir, ratio_number, spool_ratios
 from rotorred.writers import OutputFolder
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
@@ -106,21 +106,13 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
         others = [s for s in names if s != reference]
         if len(others) != 1:
             checks.fail("--ratio", text, f"a bare number needs a two-spool rotor; spools are {names}: write SPOOL=R,...")
-        out[others[0]] = checks.number("--ratio", _float("--ratio", text), gt=0.0)
+        out[others[0]] = checks.number("--ratio", ratio_number("--ratio", text), gt=0.0)
         return out
-    for item in text.split(","):
-        spool, _, r = item.partition("=")
-        if spool.strip() not in names:
-            checks.fail("--ratio", text, f"names unknown spool {spool.strip()!r}; spools are {names}")
-        out[spool.strip()] = checks.number("--ratio", _float("--ratio", r), ge=0.0)
+    for spool, r in spool_ratios("--ratio", [text]).items():
+        if spool not in names:
+            checks.fail("--ratio", text, f"names unknown spool {spool!r}; spools are {names}")
+        out[spool] = checks.number("--ratio", r, ge=0.0)
     return out
-
-
-def _float(option: str, text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        checks.fail(option, text, "must be a number or SPOOL=R,...")
 
 
 def _load(spec: str):

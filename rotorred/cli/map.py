@@ -16,7 +16,7 @@ from __future__ import annotations
 import sys
 
 from rotorred import checks
-from rotorred.cli.options import out_dir
+from rotorred.cli.options import out_dir, spool_ratios
 
 
 def add_parser(subparsers):
@@ -59,7 +59,7 @@ def spec_of(args):
                                        "map: --vary KEY=v1,v2,...)")
         fixed.append((key, values[0]))
     axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
-    ratios = tuple(_ratio(item) for item in args.ratio)
+    ratios = tuple(spool_ratios("--ratio", args.ratio, bound="> 0", example="inner=0.7778").items())
     if args.workers is not None:
         checks.integer("--workers", args.workers, ge=0)
     spec = MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
@@ -72,14 +72,6 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         checks.fail(f"--vary {key}", item.partition("=")[2], "must be numbers: START:STOP:N or v1,v2,...")
     return key, tuple(float(v) for v in values)
-
-
-def _ratio(item: str) -> tuple[str, float]:
-    spool, _, r = item.partition("=")
-    try:
-        return spool.strip(), float(r)
-    except ValueError:
-        checks.fail("--ratio", item, "must be SPOOL=R with a number R > 0, e.g. inner=0.7778")
 
 
 def run(args) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,7 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.dofs import parse_dof
 
-__all__ = ["grid", "number_list", "dof_list", "node_list", "out_dir", "MAX_COUNT"]
+__all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "out_dir", "MAX_COUNT"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -76,6 +77,34 @@ def number_list(option: str, text: str, unit: str = "", *, gt: float | None = No
     if not all(math.isfinite(v) and (gt is None or v > gt) for v in values):
         checks.fail(option, text, requirement, unit)
     return values
+
+
+def ratio_number(option: str, text: str) -> float:
+    """A bare speed ratio ``"1.2857"`` (a two-spool rotor's): a number; its bounds are the caller's."""
+    try:
+        return float(text)
+    except ValueError:
+        checks.fail(option, text, "must be a number or SPOOL=R,...")
+
+
+def spool_ratios(option: str, items: Sequence[str], *, bound: str = ">= 0",
+                 example: str = "outer=1.2857") -> dict[str, float]:
+    """``["outer=1.2857", "mid=0.9,low=0.5"]`` -> {spool: ratio}: an option's ``SPOOL=R`` items, repeated or
+    comma-separated, each spool once. ``bound`` only words the message; the caller checks R's bounds and the
+    spool names against its rotor."""
+    out = {}
+    for item in (part for text in items for part in text.split(",")):
+        spool, eq, r = item.partition("=")
+        try:
+            value = float(r)
+        except ValueError:
+            value = None
+        if not eq or not spool.strip() or value is None:
+            checks.fail(option, item, f"must be SPOOL=R with a number R {bound}, e.g. {example}")
+        if spool.strip() in out:
+            checks.fail(option, item, f"must give spool {spool.strip()!r} once")
+        out[spool.strip()] = value
+    return out
 
 
 def dof_list(option: str, text: str, nodes=None) -> list[tuple[int, str]]:

@@ -287,13 +287,13 @@ def excitation_label(harmonic: float, spool: str) -> str:
 # --- whirl direction ---------------------------------------------------------------------------
 
 def _xy_rows(model) -> tuple[np.ndarray, np.ndarray]:
-    """Matrices (n_nodes, n) mapping the model's coordinates to the x and y displacement of every node: rows of
-    the identity for a full model, rows of ``T`` for a Craig-Bampton model (its interior nodes recovered)."""
-    dofs = model.dofs if isinstance(model, SystemMatrices) else model.full_dofs
-    x = [dofs.index(n, "x") for n in dofs.nodes]
-    y = [dofs.index(n, "y") for n in dofs.nodes]
-    T = np.eye(model.n_dof) if isinstance(model, SystemMatrices) else model.T
-    return T[x], T[y]
+    """The x and y displacement of every node from the model's coordinates (:func:`_take`): their row indices for
+    a full model, the rows of ``T`` (n_nodes, m) for a Craig-Bampton model (its interior nodes recovered)."""
+    full = isinstance(model, SystemMatrices)
+    dofs = model.dofs if full else model.full_dofs
+    x = np.array([dofs.index(n, "x") for n in dofs.nodes])
+    y = np.array([dofs.index(n, "y") for n in dofs.nodes])
+    return (x, y) if full else (model.T[x], model.T[y])
 
 
 def _take(rows: np.ndarray, A: np.ndarray) -> np.ndarray:

@@ -66,6 +66,10 @@ def _point_name(direction: str, index: tuple[int, ...]) -> str:
     return f"{direction}/" + "_".join(str(i) for i in index) + ".npz"
 
 
+#: the fields of the transient's FinalState kept with a point, the start of its chain's next point
+_FINAL = tuple(f.name for f in fields(FinalState))
+
+
 def _arrays(p: PointResult) -> dict:
     arrays = {name: np.array(getattr(p, name)) for name in SCALARS if name not in ("torus_k", "torus_j")}
     arrays.update(torus_k=np.array(p.torus[0]), torus_j=np.array(p.torus[1]), peak_orbit=p.peak_orbit,
@@ -74,10 +78,6 @@ def _arrays(p: PointResult) -> dict:
         arrays.update({f"final_{name}": np.asarray(getattr(p.final.state, name)) for name in _FINAL},
                       final_phases=np.array(p.final.phases))
     return arrays
-
-
-#: the fields of the transient's FinalState kept with a point, the start of its chain's next point
-_FINAL = tuple(f.name for f in fields(FinalState))
 
 
 def _point(arrays) -> PointResult:

@@ -1,12 +1,12 @@
-"""How a varied scene key is shown: its unit and axis label (``rub.clearance`` in µm, a speed in Hz).
+"""How a varied scene key is shown: its unit (``rub.clearance`` in µm, a speed in Hz).
 
 Scene files hold SI values (speeds in Hz); plots and tables of a map show a key scaled to the
-unit an engineer reads (:func:`key_unit`), and label an axis with it (:func:`axis_of`).
+unit an engineer reads (:func:`key_unit`).
 """
 
 from __future__ import annotations
 
-__all__ = ["key_unit", "axis_of"]
+__all__ = ["key_unit"]
 
 #: how a varied scene key is shown, by its last name: (scale from the scene's unit, unit shown)
 _KEY_UNITS = {"clearance": (1e6, "µm"), "m_e": (1.0, "kg m"), "dt": (1.0, "s"), "mu_s": (1.0, "-"),
@@ -18,11 +18,3 @@ def key_unit(key: str) -> tuple[float, str]:
     if key.startswith("speeds."):
         return 1.0, "Hz"
     return _KEY_UNITS.get(key.split(".")[-1], (1.0, "scene units"))
-
-
-def axis_of(key: str) -> tuple[float, str]:
-    """Plot scale and axis label of a varied scene key: ``"rub.clearance"`` -> (1e6, "Rub clearance (µm)")."""
-    scale, unit = key_unit(key)
-    if key.split(".")[-1] == "clearance":
-        return scale, "Rub clearance (µm)"
-    return scale, f"{key} ({unit})"
