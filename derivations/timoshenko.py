@@ -5,14 +5,21 @@ Every matrix is the Hessian of an energy written with the shape functions of
 
 * translational kinetic energy  T_t = 1/2 int rho A (x'^2 + y'^2) dz           -> M_t
 * rotary kinetic energy         T_r = 1/2 int rho I (theta_x'^2 + theta_y'^2) dz -> M_r
-* gyroscopic kinetic energy     T_g = Omega int rho (2 I) theta_x' theta_y dz    -> G
+* gyroscopic kinetic energy     T_g = Omega int rho (2 I) theta_x' theta_y dz    -> G, K_G
 * strain energy                 U   = 1/2 int [EI (psi_xz'^2 + psi_yz'^2)
                                         + kappa G A ((x' - psi_xz)^2 + (y' - psi_yz)^2)] dz -> K
 
 with (.)' a time derivative in T and a z derivative in U. ``kappa G A`` is eliminated in
 favour of the shear parameter ``phi = 12 EI / (kappa G A L^2)``.
-For ``T_g = Omega qdot^T A q``, Lagrange's equations give the term ``Omega (A - A^T) qdot``,
-so ``G = A - A^T`` and the equation of motion reads M q'' + (C + Omega G) q' + K q = F.
+For ``T_g = Omega qdot^T A q``, Lagrange's equations give
+``d/dt (Omega A q) - Omega A^T qdot = Omega (A - A^T) qdot + Omega' A q``, so ``G = A - A^T``
+and, when the spin speed varies, ``K_G = A`` multiplies the angular acceleration ``Omega'``:
+
+    M q'' + (C + Omega G) q' + (K + Omega' K_G) q = F.
+
+At constant speed the ``K_G`` term vanishes (Xu et al. 2016, Eq. 13); ``K_G`` is not skew: its
+symmetric part depends on how the small rotations are defined (here theta_x, then theta_y, the
+convention of the energy that gives G), so it is generated from the same ``T_g`` as ``G``.
 
 References
 ----------
@@ -46,8 +53,8 @@ def shaft_matrices(formulation: str = "nelson") -> dict[str, sp.Matrix]:
     -------
     dict
         ``"mass_translational"`` (rho, A, L, phi), ``"mass_rotary"`` (rho, I, L, phi),
-        ``"stiffness"`` (E, I, L, phi), ``"gyroscopic"`` (rho, I, L, phi), each a
-        sympy.Matrix, shape (8, 8), in the DOF order (x1, y1, theta_x1, theta_y1, x2, ...).
+        ``"stiffness"`` (E, I, L, phi), ``"gyroscopic"`` and ``"spin_acceleration"`` (rho, I, L, phi),
+        each a sympy.Matrix, shape (8, 8), in the DOF order (x1, y1, theta_x1, theta_y1, x2, ...).
     """
     N = spatial_shape_functions() if formulation == "nelson" else hierarchical_shape_functions()
     Nx, Ny, Ntx, Nty = N["x"], N["y"], N["theta_x"], N["theta_y"]
@@ -71,6 +78,7 @@ def shaft_matrices(formulation: str = "nelson") -> dict[str, sp.Matrix]:
         "mass_rotary": M_r.applyfunc(sp.factor),
         "stiffness": K,
         "gyroscopic": G.applyfunc(sp.factor),
+        "spin_acceleration": A_g.applyfunc(sp.factor),
     }
 
 
@@ -78,12 +86,12 @@ def disk_matrices() -> dict[str, sp.Matrix]:
     """Return the 4x4 matrices of a rigid disk on one node.
 
     The disk's kinetic energy is T = 1/2 m (x'^2 + y'^2) + 1/2 I_d (theta_x'^2 + theta_y'^2)
-    + I_p Omega theta_x' theta_y (+ const), whose Hessians give M and G.
+    + I_p Omega theta_x' theta_y (+ const), whose Hessians give M, G and K_G.
 
     Returns
     -------
     dict
-        ``"mass"`` (m, I_d) and ``"gyroscopic"`` (I_p), sympy.Matrix, shape (4, 4).
+        ``"mass"`` (m, I_d), ``"gyroscopic"`` and ``"spin_acceleration"`` (I_p), sympy.Matrix, shape (4, 4).
     """
     m, I_d, I_p = sp.symbols("m I_d I_p", positive=True)
     qd = sp.Matrix(sp.symbols("xd yd txd tyd"))
@@ -93,7 +101,7 @@ def disk_matrices() -> dict[str, sp.Matrix]:
     T_g = I_p * qd[2] * q[3]  # per unit Omega
     M = sp.hessian(T, qd)
     A_g = sp.Matrix(4, 4, lambda i, j: sp.diff(T_g, qd[i], q[j]))
-    return {"mass": M, "gyroscopic": A_g - A_g.T}
+    return {"mass": M, "gyroscopic": A_g - A_g.T, "spin_acceleration": A_g}
 
 
 def module_text() -> str:
@@ -134,6 +142,14 @@ def module_text() -> str:
             " the polar moment is 2 I.\n\n"
             f"    Returns\n    -------\n    ndarray, shape (8, 8)\n        Skew-symmetric, DOF order {order}.\n",
         ),
+        GeneratedFunction(
+            "timoshenko_spin_acceleration", (L, rho, I, phi), sh["spin_acceleration"],
+            "Spin-acceleration matrix K_G of a Timoshenko shaft element per unit angular acceleration (1 rad/s^2).\n"
+            f"{common}"
+            "    rho : float\n        Density (kg/m^3).\n    I : float\n        Diametral area moment (m^4);"
+            " the polar moment is 2 I.\n\n"
+            f"    Returns\n    -------\n    ndarray, shape (8, 8)\n        ``A`` of ``G = A - A^T``, DOF order {order}.\n",
+        ),
     ]
     hi = shaft_matrices("hierarchical")
     order_h = ("(x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y);"
@@ -146,6 +162,9 @@ def module_text() -> str:
         ("stiffness", (L, E, I, phi), "Bending-plus-shear stiffness matrix (phi > 0)",
          "    E : float\n        Young's modulus (Pa).\n    I : float\n        Diametral area moment (m^4).\n"),
         ("gyroscopic", (L, rho, I, phi), "Gyroscopic matrix per unit spin speed (1 rad/s)",
+         "    rho : float\n        Density (kg/m^3).\n    I : float\n        Diametral area moment (m^4).\n"),
+        ("spin_acceleration", (L, rho, I, phi),
+         "Spin-acceleration matrix K_G per unit angular acceleration (1 rad/s^2)",
          "    rho : float\n        Density (kg/m^3).\n    I : float\n        Diametral area moment (m^4).\n"),
     ):
         fns.append(GeneratedFunction(
@@ -165,11 +184,19 @@ def module_text() -> str:
             "    Parameters\n    ----------\n    I_p : float\n        Polar moment of inertia (kg m^2).\n\n"
             "    Returns\n    -------\n    ndarray, shape (4, 4)\n        DOF order (x, y, theta_x, theta_y).\n",
         ),
+        GeneratedFunction(
+            "disk_spin_acceleration", (I_p,), dk["spin_acceleration"],
+            "Spin-acceleration matrix K_G of a rigid disk per unit angular acceleration (1 rad/s^2).\n\n"
+            "    Parameters\n    ----------\n    I_p : float\n        Polar moment of inertia (kg m^2).\n\n"
+            "    Returns\n    -------\n    ndarray, shape (4, 4)\n        ``A`` of ``G = A - A^T``,"
+            " DOF order (x, y, theta_x, theta_y).\n",
+        ),
     ]
     doc = (
         "Timoshenko shaft element and rigid disk matrices.\n\n"
         "Derived in derivations/timoshenko.py from the interdependent shape functions of\n"
         "derivations/shape_functions.py (Nelson 1980; Friedman & Kosmatka 1993).\n"
-        "Equation of motion: M q'' + (C + Omega G) q' + K q = F  (Xu et al. 2016, Eq. 13)."
+        "Equation of motion: M q'' + (C + Omega G) q' + (K + Omega' K_G) q = F  (Xu et al. 2016, Eq. 13,\n"
+        "with the spin acceleration Omega'; docs/model.md, Eq. (R2))."
     )
     return render_module("derivations/timoshenko.py", fns, doc)

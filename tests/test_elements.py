@@ -136,11 +136,27 @@ def test_gyroscopic_coupling_of_rigid_tilt_is_polar_inertia(element):
     assert ry @ element.G() @ rx == pytest.approx(-polar, rel=1e-12)
 
 
+def test_spin_acceleration_matrix_is_the_gyroscopic_energy_form(element):
+    """K_G = A of G = A - A^T (docs/model.md, Eq. R2): its skew part is G, and on the rigid tilts
+    (uniform theta_x = 1, resp. theta_y = 1) the form int 2 rho I theta_x theta_y dz gives
+    r_x^T K_G r_y = 2 rho I L (the polar inertia) and r_y^T K_G r_x = 0 (theta_x of r_y is zero)."""
+    K_G, G = element.K_G(), element.G()
+    np.testing.assert_allclose(K_G - K_G.T, G, rtol=0, atol=1e-15 * np.abs(G).max())
+    _, _, rx, ry = rigid_body_vectors(element.L, element.n_internal)
+    polar = 2 * element.material.rho * element.I * element.L
+    assert rx @ K_G @ ry == pytest.approx(polar, rel=1e-12)
+    assert abs(ry @ K_G @ rx) < 1e-12 * polar
+    # not skew: a symmetric part the gyroscopic matrix does not show (it acts only when Omega varies)
+    assert np.abs(K_G + K_G.T).max() > 0.1 * np.abs(K_G).max()
+
+
 def test_disk_matrices():
     d = Disk(3, m=2.0, I_d=0.01, I_p=0.02)
     np.testing.assert_array_equal(d.M(), np.diag([2.0, 2.0, 0.01, 0.01]))
     G = d.G()
     assert G[2, 3] == 0.02 and G[3, 2] == -0.02 and np.count_nonzero(G) == 2
+    K_G = d.K_G()  # Id theta_x'' + I_p Omega theta_y' + I_p Omega' theta_y = M_x
+    assert K_G[2, 3] == 0.02 and np.count_nonzero(K_G) == 1
 
 
 @pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])

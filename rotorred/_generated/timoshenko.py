@@ -6,7 +6,8 @@
 
 Derived in derivations/timoshenko.py from the interdependent shape functions of
 derivations/shape_functions.py (Nelson 1980; Friedman & Kosmatka 1993).
-Equation of motion: M q'' + (C + Omega G) q' + K q = F  (Xu et al. 2016, Eq. 13).
+Equation of motion: M q'' + (C + Omega G) q' + (K + Omega' K_G) q = F  (Xu et al. 2016, Eq. 13,
+with the spin acceleration Omega'; docs/model.md, Eq. (R2)).
 """
 import numpy as np
 
@@ -278,6 +279,55 @@ def timoshenko_gyroscopic(L, rho, I, phi):
     return out
 
 
+def timoshenko_spin_acceleration(L, rho, I, phi):
+    """Spin-acceleration matrix K_G of a Timoshenko shaft element per unit angular acceleration (1 rad/s^2).
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    rho : float
+        Density (kg/m^3).
+    I : float
+        Diametral area moment (m^4); the polar moment is 2 I.
+
+    Returns
+    -------
+    ndarray, shape (8, 8)
+        ``A`` of ``G = A - A^T``, DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2).
+    """
+    _t0 = I*rho/(phi + 1.0)**2.0
+    _t1 = ((12.0/5.0))*_t0/L
+    _t2 = -_t1
+    _t3 = 5.0*phi
+    _t4 = ((1.0/5.0))*_t0*(_t3 - 1.0)
+    _t5 = -_t4
+    _t6 = phi**2.0
+    _t7 = ((1.0/15.0))*L*_t0
+    _t8 = _t7*(_t3 + 10.0*_t6 + 4.0)
+    _t9 = _t7*(-_t3 + 5.0*_t6 - 1.0)
+    out = np.zeros((8, 8))
+    out[1, 0] = _t2
+    out[1, 3] = _t4
+    out[1, 4] = _t1
+    out[1, 7] = _t4
+    out[2, 0] = _t5
+    out[2, 3] = _t8
+    out[2, 4] = _t4
+    out[2, 7] = _t9
+    out[5, 0] = _t1
+    out[5, 3] = _t5
+    out[5, 4] = _t2
+    out[5, 7] = _t5
+    out[6, 0] = _t5
+    out[6, 3] = _t9
+    out[6, 4] = _t4
+    out[6, 7] = _t8
+    return out
+
+
 def hierarchical_mass_translational(L, rho, A, phi):
     """Translational mass matrix of the hierarchical (cubic/quadratic) Timoshenko element.
 
@@ -538,6 +588,42 @@ def hierarchical_gyroscopic(L, rho, I, phi):
     return out
 
 
+def hierarchical_spin_acceleration(L, rho, I, phi):
+    """Spin-acceleration matrix K_G per unit angular acceleration (1 rad/s^2) of the hierarchical (cubic/quadratic) Timoshenko element.
+
+    Parameters
+    ----------
+    L : float
+        Element length (m).
+    phi : float
+        Shear parameter 12 E I / (kappa G A L^2) (-); 0 for Euler-Bernoulli.
+    rho : float
+        Density (kg/m^3).
+    I : float
+        Diametral area moment (m^4).
+
+    Returns
+    -------
+    ndarray, shape (14, 14)
+        DOF order (x1, y1, theta_x1, theta_y1, x2, y2, theta_x2, theta_y2, a_x1, a_x2, a_y1, a_y2, c_x, c_y); a_*, c_* are internal bubble amplitudes (derivations/shape_functions.py).
+    """
+    _t0 = I*L*rho
+    _t1 = ((2.0/3.0))*_t0
+    _t2 = ((1.0/3.0))*_t0
+    _t3 = ((1.0/6.0))*_t0
+    out = np.zeros((14, 14))
+    out[2, 3] = _t1
+    out[2, 7] = _t2
+    out[2, 13] = _t3
+    out[6, 3] = _t2
+    out[6, 7] = _t1
+    out[6, 13] = _t3
+    out[12, 3] = _t3
+    out[12, 7] = _t3
+    out[12, 13] = ((1.0/15.0))*_t0
+    return out
+
+
 def disk_mass(m, I_d):
     """Mass matrix of a rigid disk.
 
@@ -577,4 +663,22 @@ def disk_gyroscopic(I_p):
     out = np.zeros((4, 4))
     out[2, 3] = I_p
     out[3, 2] = -I_p
+    return out
+
+
+def disk_spin_acceleration(I_p):
+    """Spin-acceleration matrix K_G of a rigid disk per unit angular acceleration (1 rad/s^2).
+
+    Parameters
+    ----------
+    I_p : float
+        Polar moment of inertia (kg m^2).
+
+    Returns
+    -------
+    ndarray, shape (4, 4)
+        ``A`` of ``G = A - A^T``, DOF order (x, y, theta_x, theta_y).
+    """
+    out = np.zeros((4, 4))
+    out[2, 3] = I_p
     return out

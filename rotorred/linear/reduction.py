@@ -182,6 +182,8 @@ class ReducedSystem(SpoolSpeedMixin):
         Natural frequencies of the kept fixed-interface modes (rad/s).
     selection : ModeSelection
         Record of how ``n_modes`` was chosen.
+    K_G : dict of str to ndarray, shape (m, m)
+        Reduced spin-acceleration matrix of each spool per unit angular acceleration: ``T^T K_G,s T``.
     """
 
     M: np.ndarray
@@ -195,6 +197,7 @@ class ReducedSystem(SpoolSpeedMixin):
     n_modes: int
     interior_frequencies: np.ndarray
     selection: ModeSelection
+    K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
     _bpos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -311,13 +314,14 @@ def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
     return _Basis(b, i, Psi, Phi, omega)
 
 
-def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict, dict]:
     def p(X):
         return T.T @ X @ T
     Mr, Kr = p(system.M), p(system.K)
     # symmetrise away round-off so that M_r, K_r stay exactly symmetric
     Mr, Kr = 0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T)
-    return Mr, Kr, p(system.C), {s: p(G) for s, G in system.G.items()}
+    return (Mr, Kr, p(system.C), {s: p(G) for s, G in system.G.items()},
+            {s: p(KG) for s, KG in system.K_G.items()})
 
 
 #: eigenvalues with a damping ratio -Re(lambda)/|lambda| at or above this are not counted as whirl modes
@@ -493,10 +497,10 @@ def _checked_options(system: SystemMatrices, n_modes, cutoff, band, target, n_ch
 
 
 def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
-    Mr, Kr, Cr, Gr = _project(system, T)
+    Mr, Kr, Cr, Gr, KGr = _project(system, T)
     return ReducedSystem(M=Mr, K=Kr, C=Cr, G=Gr, T=T, full_dofs=system.dofs, boundary_nodes=nodes,
                          boundary_dofs=basis.b.copy(), n_modes=n_modes,
-                         interior_frequencies=basis.omega[:n_modes].copy(), selection=selection)
+                         interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr)
 
 
 def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,

@@ -2,11 +2,13 @@
 
 The equation of motion (Xu et al. 2016, Eq. 13, with two spools) is
 
-    M q'' + (C + sum_s Omega_s G_s) q' + K q = F(t) + F_L,
+    M q'' + (C + sum_s Omega_s G_s) q' + (K + sum_s Omega_s' K_G,s) q = F(t) + F_L,
 
 where ``M = M_T + M_R`` (translational and rotary), ``K`` includes bearing stiffness,
-``C`` bearing and (optional) Rayleigh shaft damping, and ``G_s`` collects the shaft and disk
-gyroscopic matrices of spool ``s`` per unit spin speed (1 rad/s).
+``C`` bearing and (optional) Rayleigh shaft damping, ``G_s`` collects the shaft and disk
+gyroscopic matrices of spool ``s`` per unit spin speed (1 rad/s), and ``K_G,s`` their
+spin-acceleration matrices per unit angular acceleration (1 rad/s^2; zero at constant speed,
+docs/model.md, Eq. R2).
 
 Matrices are dense ndarrays: rotorred's models have at most a few thousand DOFs, where
 dense LAPACK beats sparse solvers and keeps eigen-analysis simple. They are built from COO
@@ -15,7 +17,7 @@ triplets in one pass.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
@@ -67,6 +69,9 @@ class SystemMatrices(SpoolSpeedMixin):
     G : dict of str to ndarray, shape (n, n)
         Skew-symmetric gyroscopic matrix of each spool per unit spin speed (1 rad/s).
     dofs : DofMap
+    K_G : dict of str to ndarray, shape (n, n)
+        Spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2), ``A_s`` of
+        ``G_s = A_s - A_s^T``; needed only when a spool's speed varies (empty for a model built by hand).
     """
 
     M: np.ndarray
@@ -74,6 +79,7 @@ class SystemMatrices(SpoolSpeedMixin):
     C: np.ndarray
     G: Mapping[str, np.ndarray]
     dofs: DofMap
+    K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_dof(self) -> int:
@@ -143,6 +149,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     next_internal = 4 * len(rotor.nodes)
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
     G = {s.name: _Triplets() for s in rotor.spools}
+    K_G = {s.name: _Triplets() for s in rotor.spools}
     for s in rotor.spools:
         for e in s.elements:
             internal = np.arange(next_internal, next_internal + e.n_internal)
@@ -154,11 +161,13 @@ def assemble(rotor: Rotor) -> SystemMatrices:
             M_shaft.add(idx, Me)
             K_shaft.add(idx, Ke)
             G[s.name].add(idx, e.G())
+            K_G[s.name].add(idx, e.K_G())
     spool_of = rotor.spool_of
     for d in rotor.disks:
         idx = dofs.node_dofs(d.node)
         M.add(idx, d.M())
         G[spool_of[d.node]].add(idx, d.G())
+        K_G[spool_of[d.node]].add(idx, d.K_G())
     for b in rotor.bearings:
         idx = dofs.node_dofs(b.node)[:2]
         K.add(idx, b.K)
@@ -173,4 +182,5 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     alpha, beta = rotor.rayleigh
     if alpha or beta:
         Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
-    return SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs)
+    return SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
+                          K_G={k: v.dense(n) for k, v in K_G.items()})

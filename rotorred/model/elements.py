@@ -244,6 +244,14 @@ class ShaftElement:
             return _gen.hierarchical_gyroscopic(self.L, self.material.rho, I_r, self.phi)
         return _gen.timoshenko_gyroscopic(self.L, self.material.rho, I_r, self.phi)
 
+    def K_G(self) -> np.ndarray:
+        """Spin-acceleration matrix per unit angular acceleration, shape (8 + n_internal,) * 2 (kg m^2 per rad):
+        the ``A`` of ``G = A - A^T`` (docs/model.md, Eq. R2)."""
+        I_r = self.I if self.rotary_inertia else 0.0
+        if self.element == "hierarchical":
+            return _gen.hierarchical_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
+        return _gen.timoshenko_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
+
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1)."""
         chain = [self.left, *new_nodes, self.right]
@@ -291,6 +299,10 @@ class Disk:
     def G(self) -> np.ndarray:
         """Gyroscopic matrix per unit spin speed, shape (4, 4)."""
         return _gen.disk_gyroscopic(self.I_p)
+
+    def K_G(self) -> np.ndarray:
+        """Spin-acceleration matrix per unit angular acceleration, shape (4, 4): ``I_p`` at (theta_x, theta_y)."""
+        return _gen.disk_spin_acceleration(self.I_p)
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,8 @@ numba_cache.register()
 P_COS, P_SIN, P_CLEAR, P_W0, P_LAM, P_K, P_C, P_MUS, P_MUD, P_V, P_MP = range(11)
 N_PLATE_PAR = 11
 # Diagnostics.counters
-C_STEPS, C_NEWTON, C_SUBSTEPS, C_CONTACT, C_MAXNEWTON, C_ACTIVESET = range(6)
+# (C_PASSES, C_MAXPASSES: fixed-point passes of the varying-speed step, rotorred.transient.ramp_kernel)
+C_STEPS, C_NEWTON, C_SUBSTEPS, C_CONTACT, C_MAXNEWTON, C_ACTIVESET, C_PASSES, C_MAXPASSES = range(8)
 N_COUNTERS = 8
 
 

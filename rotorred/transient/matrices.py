@@ -79,11 +79,14 @@ class ForceColumns:
         0 constant, 1 cos(omega t), 2 sin(omega t); a cos column is followed by its sin column.
     omega : ndarray, shape (nf,)
         Angular frequency (rad/s).
+    spool : tuple of str or None, length nf
+        Spool whose unbalances make each column (None for gravity).
     """
 
     F: np.ndarray
     kind: np.ndarray
     omega: np.ndarray
+    spool: tuple = ()
 
     def at(self, t: float) -> np.ndarray:
         """F(t) (N), shape (n,)."""
@@ -101,11 +104,12 @@ def force_columns(model, speeds: Mapping[str, float], spool_of: Mapping[int, str
     ``m_e Omega^2 (cos(Omega t + phi), sin(Omega t + phi))`` (rotorred.model.loads).
     """
     n = model.M.shape[0]
-    cols, kinds, omegas = [], [], []
+    cols, kinds, omegas, owners = [], [], [], []
     if gravity:
         cols.append(gravity_force(model, float(gravity)))
         kinds.append(0)
         omegas.append(0.0)
+        owners.append(None)
     per_spool: dict[str, list[np.ndarray]] = {}
     for k, u in enumerate(unbalances):
         s = spool_of.get(u.node)
@@ -122,8 +126,9 @@ def force_columns(model, speeds: Mapping[str, float], spool_of: Mapping[int, str
         cols += [fc, fs]
         kinds += [1, 2]
         omegas += [speeds[s], speeds[s]]
+        owners += [s, s]
     return ForceColumns(F=np.array(cols).T if cols else np.zeros((n, 0)), kind=np.array(kinds, dtype=np.int64),
-                        omega=np.array(omegas, dtype=float))
+                        omega=np.array(omegas, dtype=float), spool=tuple(owners))
 
 
 def fold_forcing(U1: np.ndarray, U0: np.ndarray, kinds: np.ndarray, omegas: np.ndarray, h: float) -> np.ndarray:
@@ -168,6 +173,16 @@ def contact_rows(model, plates: Sequence[RubPlate]) -> np.ndarray:
     return B
 
 
+def disk_radii(plates: Sequence[RubPlate], rotor) -> list[float]:
+    """The disk radius under each plate (m): the plate's ``disk_radius``, else the rotor's disk at its node."""
+    radii = []
+    for k, p in enumerate(plates):
+        if p.disk_radius is None and rotor is None:
+            checks.fail(f"plates[{k}].disk_radius", None, "must be given when no rotor is given to take it from", "m")
+        radii.append(p.disk_radius if p.disk_radius is not None else rotor.disk_at(p.node).radius)
+    return radii
+
+
 def plate_parameters(plates: Sequence[RubPlate], speeds: Mapping[str, float], spool_of: Mapping[int, str] | None,
                      rotor, newton_tol: float) -> tuple[np.ndarray, np.ndarray]:
     """The kernel's plate table and Newton's absolute tolerances.
@@ -181,13 +196,7 @@ def plate_parameters(plates: Sequence[RubPlate], speeds: Mapping[str, float], sp
     """
     par = np.zeros((len(plates), kernel.N_PLATE_PAR))
     atol = np.zeros(len(plates))
-    for k, p in enumerate(plates):
-        radius = p.disk_radius
-        if radius is None:
-            if rotor is None:
-                checks.fail(f"plates[{k}].disk_radius", None, "must be given when no rotor is given to take it from",
-                            "m")
-            radius = rotor.disk_at(p.node).radius
+    for k, (p, radius) in enumerate(zip(plates, disk_radii(plates, rotor))):
         s = spool_of.get(p.node)
         if s not in speeds:
             checks.fail(f"plates[{k}].node", p.node, "must be a node of a spool in spool_of")

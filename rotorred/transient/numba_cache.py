@@ -37,7 +37,8 @@ from numba.core import caching
 PACKAGE = Path(__file__).resolve().parent.parent
 #: files (relative to PACKAGE) that numba compiles into rotorred's kernels: every generated
 #: module, and every module of rotorred that defines or wraps an njit function
-KERNEL_SOURCES = ("transient/contact.py", "transient/contact_solve.py", "transient/kernel.py")
+KERNEL_SOURCES = ("transient/contact.py", "transient/contact_solve.py", "transient/kernel.py",
+                  "transient/ramp_kernel.py")
 GENERATED = "_generated"
 
 

@@ -7,12 +7,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred.transient import kernel
+from rotorred.transient.ramp_kernel import PASSES_FAILED
 from rotorred.transient.contact import STATE_NAMES, RubPlate, disk_force
 
 _CAUSES = {
     kernel.NONFINITE: "a non-finite value",
     kernel.NEWTON_FAILED: "the contact Newton iteration failed",
     kernel.LIMIT: "a contact-node displacement beyond `displacement_limit`",
+    PASSES_FAILED: "the step at varying speed did not converge",
 }
 
 
@@ -131,7 +133,8 @@ class TransientResult:
         One per plate, in the order given.
     success : bool
     status : int
-        0 finished; 2 non-finite value; 3 Newton failure; 4 displacement limit.
+        0 finished; 2 non-finite value; 3 Newton failure; 4 displacement limit; 5 the passes of a step at
+        varying speed did not converge.
     message : str
     final : FinalState
     method : str
@@ -154,6 +157,10 @@ class TransientResult:
     kernel_load_time : float
         Time to compile the step kernel (first run after an install) or load it from numba's cache,
         before the loop (s); not in ``run_time`` nor in µs per step.
+    n_passes : int
+        Fixed-point passes of the steps at varying speeds (0 at constant speeds).
+    states : ndarray, shape (n_rec, 2 n), or None
+        With ``record_state``: q and v (model coordinates) at the record times.
     """
 
     t: np.ndarray
@@ -178,6 +185,8 @@ class TransientResult:
     run_time: float
     run_cpu_time: float = 0.0
     kernel_load_time: float = 0.0
+    n_passes: int = 0
+    states: np.ndarray | None = None
 
     @property
     def us_per_step(self) -> float:
