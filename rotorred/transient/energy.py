@@ -1,0 +1,120 @@
+"""Energy balance of a transient, from its recorded state: the work the drive must do to follow the speeds.
+
+With the spin angle ``psi_s`` of each spool as a coordinate whose speed ``Omega_s`` is prescribed,
+the kinetic energy of the lateral motion and its coupling to the spin is
+``T = 1/2 q'^T M q' + sum_s Omega_s q'^T K_G,s q`` (+ the rigid spin ``1/2 J_s Omega_s^2``, whose
+change the drive supplies exactly and which is left out of both sides). Lagrange's equation
+of ``psi_s`` gives the torque the drive applies beyond ``J_s Omega_s'``,
+``tau_s = d/dt (q'^T K_G,s q)``, and the unbalance forces do the work ``q'^T F_u`` that the drive
+supplies through the eccentric masses. The energy ``E = T + 1/2 q^T K q`` then obeys
+(docs/model.md, Eq. R5)
+
+    E(t) - E(0) = W_drive - W_damping + W_gravity + W_contact,
+    W_drive = int q'^T F_u dt + sum_s int Omega_s d(q'^T K_G,s q),
+    W_damping = int q'^T C q' dt,  W_gravity = int q'^T F_g dt,  W_contact = int q'^T B f dt,
+
+every integral evaluated from the records with the trapezoidal rule in ``q`` (``sum f_avg . dq``),
+the rule of the average-acceleration step. The residual is that of the quadrature: second
+order in the record interval.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.model.loads import Unbalance
+from rotorred.model.speeds import SpeedProfile
+from rotorred.transient.matrices import contact_rows, force_columns
+from rotorred.transient.ramp import forces_at, profile_table
+
+
+@dataclass(frozen=True)
+class EnergyBalance:
+    """Energies and works of a transient at its record times (J), each shape (n_rec,), from 0 at t = 0.
+
+    Attributes
+    ----------
+    t : ndarray
+        Record times (s).
+    energy : ndarray
+        ``E(t) - E(0)``: kinetic (with the spin coupling) plus strain energy.
+    drive, damping, gravity, contact : ndarray
+        ``W_drive`` (unbalances and spin coupling), ``W_damping`` (dissipated, >= 0 for C >= 0), the work
+        of gravity and of the contact forces on the rotor.
+    """
+
+    t: np.ndarray
+    energy: np.ndarray
+    drive: np.ndarray
+    damping: np.ndarray
+    gravity: np.ndarray
+    contact: np.ndarray
+
+    @property
+    def residual(self) -> np.ndarray:
+        """``E - E0 - (W_drive - W_damping + W_gravity + W_contact)`` (J)."""
+        return self.energy - (self.drive - self.damping + self.gravity + self.contact)
+
+    @property
+    def relative_residual(self) -> float:
+        """Largest |residual| over the largest of |W_drive|, W_damping and |E - E0| (-)."""
+        scale = max(np.max(np.abs(self.drive)), np.max(np.abs(self.damping)), np.max(np.abs(self.energy)))
+        return float(np.max(np.abs(self.residual)) / scale) if scale > 0 else 0.0
+
+
+def _trapezoid_work(force: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Cumulative ``sum_k (f_k + f_k+1)/2 . (q_k+1 - q_k)`` for rows of ``force`` and ``q``, from 0."""
+    inc = np.einsum("ij,ij->i", 0.5 * (force[1:] + force[:-1]), np.diff(q, axis=0))
+    return np.concatenate([[0.0], np.cumsum(inc)])
+
+
+def energy_balance(model, result, speeds: Mapping[str, float] | SpeedProfile, *, unbalances: Sequence[Unbalance] = (),
+                   spool_of: Mapping[int, str] | None = None, rotor=None, gravity: float | None = None) -> EnergyBalance:
+    """The energy balance (Eq. R5) of ``result``, a :func:`~rotorred.transient.newmark.simulate` run with
+    ``record_state=True`` and the same model, speeds, unbalances and gravity.
+
+    Parameters
+    ----------
+    model : SystemMatrices or ReducedSystem
+    result : TransientResult
+        Recorded with ``record_state=True`` (every step, ``decimate = 1``, for the step's own quadrature).
+    speeds : dict of str to float, or SpeedProfile
+    unbalances, spool_of, rotor, gravity
+        As given to ``simulate``.
+
+    Returns
+    -------
+    EnergyBalance
+    """
+    if result.states is None:
+        checks.fail("result.states", None, "must be recorded: run simulate(..., record_state=True)")
+    profile = speeds if isinstance(speeds, SpeedProfile) else SpeedProfile.constant(speeds)
+    if spool_of is None and rotor is not None:
+        spool_of = rotor.spool_of
+    n = model.M.shape[0]
+    q, v = result.states[:, :n], result.states[:, n:]
+    spools = model.spools
+    unit = force_columns(model, {s: 1.0 for s in spools}, spool_of or {}, unbalances, gravity)
+    F = forces_at(unit, profile_table(profile, spools, unit), result.t)  # (n_rec, n)
+    gravity_columns = [j for j, s in enumerate(unit.spool) if s is None]
+    F_g = unit.F[:, gravity_columns].sum(axis=1) if gravity_columns else np.zeros(n)
+    F_u = F - F_g
+    K_G = {s: np.asarray(model.K_G.get(s, np.zeros((n, n))), float) for s in spools}
+    W = profile.speed(result.t)
+    coupling = {s: np.einsum("ij,ij->i", v, q @ K_G[s].T) for s in spools}  # q'^T K_G,s q
+    energy = (0.5 * np.einsum("ij,ij->i", v @ model.M, v) + 0.5 * np.einsum("ij,ij->i", q @ model.K, q)
+              + sum(W[s] * coupling[s] for s in spools))
+    spin = sum(np.concatenate([[0.0], np.cumsum(0.5 * (W[s][1:] + W[s][:-1]) * np.diff(coupling[s]))])
+               for s in spools)
+    f_contact = np.zeros_like(q)
+    if result.contacts:
+        B = contact_rows(model, [c.plate for c in result.contacts])
+        f_contact = np.column_stack([c.force_xy for c in result.contacts]) @ B.T
+    return EnergyBalance(t=result.t, energy=energy - energy[0], drive=_trapezoid_work(F_u, q) + spin,
+                         damping=_trapezoid_work(v @ model.C.T, q),
+                         gravity=_trapezoid_work(np.broadcast_to(F_g, q.shape), q),
+                         contact=_trapezoid_work(f_contact, q))
