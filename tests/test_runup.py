@@ -13,10 +13,12 @@ from scipy.optimize import minimize_scalar
 from scipy.special import fresnel
 
 from rotorred.checks import InputError
+from rotorred.linear.harmonic import unbalance_response
 from rotorred.model.assembly import DofMap, SystemMatrices
 from rotorred.model.elements import Disk
 from rotorred.model.loads import Unbalance
 from rotorred.model.speeds import SpeedProfile
+from rotorred.signals.orders import angle_blocks, order_tracks
 from rotorred.transient import ramp_kernel
 from rotorred.transient.energy import energy_balance
 from rotorred.transient.newmark import simulate
@@ -241,3 +243,32 @@ def test_energy_balance_needs_the_recorded_state():
     with pytest.raises(InputError) as e:
         energy_balance(model, res, {"shaft": 100.0})
     assert e.value.field == "result.states"
+
+
+def test_slow_ramp_is_the_steady_unbalance_response():
+    """A slow run-up (250 rad/s over 250 s: lambda = Omega'/omega^2 = 1e-5 at the critical speed) tracked
+    by order (1x, angle-domain resampling) equals the steady unbalance response of
+    rotorred.linear.harmonic (frequency domain, another path) at each block's speed.
+
+    Measured (dt = 1e-4 s): the peak (316.1 rad/s) within 0.022 %, the curve 5 % or more from the peak within
+    9.6e-4 (Newmark's period error (omega dt)^2/12 = 8e-5 moves the resonance; at dt = 2e-4 s the error
+    is 5e-3). Asserted: the peak within 0.22 %, the curve within 1e-2 (10x the measured; the issue's
+    bounds are 2 % and 1 %)."""
+    model, T = disk_rotor(), 250.0
+    profile = SpeedProfile.ramp({"shaft": 200.0}, {"shaft": 450.0}, T)
+    loads = dict(unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"})
+    res = simulate(model, profile, T, 1e-4, outputs=[(1, "x"), (1, "y")], decimate=5, progress=False, **loads)
+    blocks = angle_blocks(res.t, [res.outputs[(1, "x")], res.outputs[(1, "y")]], profile.at(res.t)["shaft"][2],
+                          revs_per_block=16)
+    track = order_tracks(blocks, "shaft", [1.0])[0][0]
+    steady = unbalance_response(model, speeds=blocks.speed, outputs=[(1, "x")], **loads)
+    W, a, Q = blocks.speed, track.amplitude, np.abs(steady.phasors["shaft"][(1, "x")])
+    keep = W > 220.0  # the start from rest has rung out
+    W, a, Q = W[keep], a[keep], Q[keep]
+    k = int(np.argmax(Q))
+    assert abs(a[k - 3:k + 4].max() / Q[k] - 1) < 2.2e-3
+    away = np.abs(W - W[k]) > 0.05 * W[k]
+    assert np.max(np.abs(a[away] - Q[away]) / Q[away]) < 1e-2
+    # the phase too: the track is the steady phasor (x ~ Re(Q e^(i phi)))
+    phase_err = np.abs(np.angle(track.amplitude[keep] * np.exp(1j * track.phase[keep]) / steady.phasors["shaft"][(1, "x")][keep]))
+    assert phase_err[away].max() < 3.7e-2  # measured 3.7e-3 rad
