@@ -45,7 +45,7 @@ import scipy.linalg as sla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
-from rotorred.linear.modal import eigen, mac
+from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, assemble
 from rotorred.model.rotor import Rotor
 
@@ -433,7 +433,8 @@ class _Solver:
         self.x_rows, self.y_rows = _xy_rows(sm)
 
     def solve(self, Omega: float):
-        sol = eigen(self.M, self.C + Omega * self.G, self.K, n_modes=self.n_candidates)
+        sol = eigen(self.M, self.C + Omega * self.G, self.K, n_modes=self.n_candidates,
+                    max_damping_ratio=WHIRL_MAX_DAMPING_RATIO)
         return sol.eigenvalues, _canonical_basis(sol.eigenvalues, sol.modes, self.x_rows, self.y_rows)
 
     def local(self, Omega: float, lam0: complex, v0: np.ndarray, max_iter: int = 12):

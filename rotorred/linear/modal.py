@@ -44,8 +44,14 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.block([[np.zeros((n, n)), np.eye(n)], [-sla.lu_solve(lu, K), -sla.lu_solve(lu, D)]])
 
 
+#: eigenvalues with a damping ratio -Re(lambda)/|lambda| at or above this are not whirl modes: an
+#: overdamped pair (mass-proportional Rayleigh damping makes the rig's lowest shaft modes so) splits by
+#: round-off into a complex pair of tiny imaginary part that would read as a mode at ~0 Hz
+WHIRL_MAX_DAMPING_RATIO = 0.5
+
+
 def eigen(M: np.ndarray, D: np.ndarray, K: np.ndarray, n_modes: int | None = None,
-          min_frequency: float = 1e-6) -> EigenSolution:
+          min_frequency: float = 1e-6, max_damping_ratio: float | None = None) -> EigenSolution:
     """Eigenvalues and mode shapes of M q'' + D q' + K q = 0.
 
     Parameters
@@ -56,6 +62,8 @@ def eigen(M: np.ndarray, D: np.ndarray, K: np.ndarray, n_modes: int | None = Non
         Keep the lowest ``n_modes`` frequencies (default all).
     min_frequency : float
         Eigenvalues with Im(lambda) below this (rad/s) are dropped (real, overdamped or rigid-body).
+    max_damping_ratio : float, optional
+        Also drop eigenvalues with a damping ratio at or above this (e.g. :data:`WHIRL_MAX_DAMPING_RATIO`).
 
     Returns
     -------
@@ -64,6 +72,8 @@ def eigen(M: np.ndarray, D: np.ndarray, K: np.ndarray, n_modes: int | None = Non
     n = M.shape[0]
     lam, vec = sla.eig(state_matrix(M, D, K))
     keep = lam.imag > min_frequency
+    if max_damping_ratio is not None:
+        keep &= -lam.real < max_damping_ratio * np.abs(lam)
     lam, vec = lam[keep], vec[:n, keep]
     order = np.argsort(lam.imag, kind="stable")
     if n_modes is not None:

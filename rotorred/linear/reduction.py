@@ -37,7 +37,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
-from rotorred.linear.modal import eigen
+from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
 from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, assemble
 from rotorred.model.dofs import DofMap
 from rotorred.model.rotor import Rotor
@@ -324,9 +324,6 @@ def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndar
             {s: p(KG) for s, KG in system.K_G.items()})
 
 
-#: eigenvalues with a damping ratio -Re(lambda)/|lambda| at or above this are not counted as whirl modes
-WHIRL_MAX_DAMPING_RATIO = 0.5
-
 
 def whirl_frequencies(model, speeds: Mapping[str, float]) -> np.ndarray:
     """Damped whirl frequencies Im(lambda) (rad/s) of ``model`` at spool speeds ``speeds``, ascending.
@@ -335,9 +332,7 @@ def whirl_frequencies(model, speeds: Mapping[str, float]) -> np.ndarray:
     high-frequency shaft modes that stiffness-proportional Rayleigh damping makes
     overdamped) do not whirl visibly and are left out, in the full and reduced model alike.
     """
-    lam = eigen(model.M, model.damping(speeds), model.K).eigenvalues
-    zeta = -lam.real / np.abs(lam)
-    return lam.imag[zeta < WHIRL_MAX_DAMPING_RATIO]
+    return eigen(model.M, model.damping(speeds), model.K, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
 
 
 def whirl_error(reference: Sequence[np.ndarray], model, speeds_list: Sequence[Mapping[str, float]],

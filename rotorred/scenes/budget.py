@@ -102,10 +102,12 @@ def _elements(rotor):
 def scene_estimate(scene) -> Estimate:
     """Steps, record and model size of a scene's run (the run and its no-rub comparison)."""
     s = scene.solver
-    transient = not (scene.is_linear and s.start == "settled")
+    runup = getattr(scene, "runup", None)
+    transient = runup is not None or not (scene.is_linear and s.start == "settled")
     steps = int(round(s.duration / s.dt)) if transient else 0
-    samples = int(round((s.duration - s.record_start) / s.dt)) + 1
-    cases = 2 if scene.plates and scene.output.compare_normal else 1
+    record_dt = runup.record_dt if runup is not None else s.dt
+    samples = int(round((s.duration - s.record_start) / record_dt)) + 1
+    cases = 2 if scene.plates and scene.output.compare_normal and runup is None else 1
     columns = 1 + cases * len(scene.output.dofs) + 8 * len(scene.plates)
     record = samples * columns * (8 * 4 + _CSV_BYTES)  # record, result, NPZ/.mat copies; CSV text
     n_dof, model_bytes = model_estimate(scene.rotor)

@@ -48,10 +48,11 @@ from rotorred.model.dofs import DIRECTIONS, parse_dof
 from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.rotor import Rotor
 from rotorred.model.rotor_file import load_rotor, presets, read_text_file, read_toml
+from rotorred.model.speeds import SpeedProfile
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
-__all__ = ["Scene", "SolverSpec", "OutputSpec", "SceneError", "load_scene", "scene_from_toml", "scene_from_dict",
+__all__ = ["Scene", "SolverSpec", "OutputSpec", "RunupSpec", "SceneError", "load_scene", "scene_from_toml", "scene_from_dict",
            "builtin_scenes", "apply_settings", "parse_setting", "DIRECTIONS", "PLOTS", "FORMATS"]
 
 PLOTS = ("waveforms", "spectra", "orbits", "poincare")
@@ -61,7 +62,9 @@ STARTS = ("settled", "rest")
 METHODS = ("newmark", "hht")
 BENDING = ("navier", "clamped-free", "rigid")
 
-_TOP_KEYS = {"name", "description", "rotor", "speeds", "unbalance", "rub", "solver", "output"}
+_TOP_KEYS = {"name", "description", "rotor", "speeds", "unbalance", "rub", "solver", "output", "runup"}
+_RUNUP_KEYS = {"from", "to", "duration", "hold", "table", "orders", "orbits_hz", "reference", "record_dt",
+               "revs_per_block"}
 _ROTOR_KEYS = {"preset", "file", "rayleigh_alpha", "rayleigh_beta"}
 _UNBALANCE_KEYS = {"node", "m_e", "phase_deg"}  # rotorred.model.loads.UNBALANCE_KEYS
 _RUB_NUMBERS = {"clearance": ("m", 0.0, False), "K_nr": ("N/m^1.5", 0.0, True), "c": ("s/m", 0.0, False),
@@ -180,6 +183,34 @@ class OutputSpec:
 
 
 @dataclass(frozen=True)
+class RunupSpec:
+    """A run-up or coast-down: the speed profile and what to show of it (``[runup]``, docs/scenes.md).
+
+    Attributes
+    ----------
+    profile : SpeedProfile
+        Spool speeds against time (rad/s).
+    reference : str
+        Spool whose speed is the abscissa of the amplitude plots.
+    orders : tuple of float
+        Orders tracked for every spool (cycles per revolution).
+    orbits_hz : tuple of float
+        Speeds of the reference spool (Hz) where orbit snapshots are taken.
+    record_dt : float
+        Record interval (s), a whole number of steps.
+    revs_per_block : int
+        Revolutions per block of the order tracks (rotorred.signals.orders).
+    """
+
+    profile: SpeedProfile
+    reference: str
+    orders: tuple[float, ...] = (1.0,)
+    orbits_hz: tuple[float, ...] = ()
+    record_dt: float = 1e-4
+    revs_per_block: int = 16
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated scene (see the module docstring and ``docs/scenes.md``).
 
@@ -196,6 +227,8 @@ class Scene:
     plates : tuple of RubPlate
     solver : SolverSpec
     output : OutputSpec
+    runup : RunupSpec or None
+        The speed profile of a run-up or coast-down; None for constant ``speeds``.
     source : str
         Where the scene came from (file, built-in name or "<string>").
     data : dict
@@ -211,6 +244,7 @@ class Scene:
     plates: tuple
     solver: SolverSpec
     output: OutputSpec
+    runup: RunupSpec | None = None
     source: str = "<string>"
     data: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -451,6 +485,57 @@ def _speeds(value, rotor: Rotor) -> dict[str, float]:
     return speeds
 
 
+def _runup(value, rotor: Rotor, speeds: dict[str, float]) -> RunupSpec | None:
+    """``[runup]``: a ramp between fractions of ``[speeds]`` (fixed ratio) or a table of every spool's speeds."""
+    if value is None:
+        return None
+    table = checks.table("runup", value)
+    checks.keys("runup", table, _RUNUP_KEYS)
+    spools = [s.name for s in rotor.spools]
+    if "table" in table:
+        for key in ("from", "to", "duration", "hold"):
+            if key in table:
+                fail(f"runup.{key}", table[key], "must not be given with runup.table (the table gives the speeds)")
+        profile = _runup_table(table["table"], spools)
+    else:
+        start = checks.non_negative("runup.from", table.get("from", 0.0), "x [speeds]")
+        end = checks.non_negative("runup.to", table.get("to", 1.2), "x [speeds]")
+        if start == end:
+            fail("runup.to", table.get("to", 1.2), f"must differ from runup.from = {start:g} (a ramp changes the "
+                 "speeds; a constant speed needs no [runup])", "x [speeds]")
+        duration = checks.positive("runup.duration", table.get("duration", 10.0), "s")
+        hold = checks.non_negative("runup.hold", table.get("hold", 0.0), "s")
+        profile = SpeedProfile.ramp({s: start * w for s, w in speeds.items()}, {s: end * w for s, w in speeds.items()},
+                                    duration, hold)
+    reference = checks.choice("runup.reference", table.get("reference", spools[0]), spools)
+    orders = tuple(checks.sequence("runup.orders", table.get("orders", [1.0]),
+                                   lambda f, v: checks.positive(f, v, "-"), min_len=1, unique=True))
+    top = round(float(max(profile.speeds[reference])) / (2 * math.pi), 9)  # Hz, as written
+    orbits = tuple(checks.sequence("runup.orbits_hz", table.get("orbits_hz", []),
+                                   lambda f, v: checks.number(f, v, "Hz", gt=0.0, le=top)))
+    record_dt = checks.positive("runup.record_dt", table.get("record_dt", RunupSpec.record_dt), "s")
+    revs = checks.integer("runup.revs_per_block", table.get("revs_per_block", RunupSpec.revs_per_block), ge=2)
+    return RunupSpec(profile=profile, reference=reference, orders=orders, orbits_hz=orbits, record_dt=record_dt,
+                     revs_per_block=revs)
+
+
+def _runup_table(rows, spools: list[str]) -> SpeedProfile:
+    """``runup.table``: rows [t (s), speed of each spool in the rotor's order (Hz)]."""
+    rows = checks.sequence("runup.table", rows, min_len=2)
+    width = 1 + len(spools)
+    t, columns = [], {s: [] for s in spools}
+    for k, row in enumerate(rows):
+        row = checks.sequence(f"runup.table[{k}]", row, lambda f, v: checks.number(f, v), min_len=width,
+                              max_len=width)
+        t.append(row[0])
+        for s, v in zip(spools, row[1:]):
+            columns[s].append(2 * math.pi * checks.non_negative(f"runup.table[{k}][{1 + spools.index(s)}]", v, "Hz"))
+    try:
+        return SpeedProfile(t, columns)
+    except InputError as exc:
+        raise exc.within("runup.table") from None
+
+
 def _unbalances(entries, rotor: Rotor) -> tuple[Unbalance, ...]:
     return tuple(unbalance_from_table(f"unbalance[{i}]", u, rotor.spool_of)
                  for i, u in enumerate(checks.tables("unbalance", entries)))
@@ -509,10 +594,10 @@ def _plate(where: str, r: dict, rotor: Rotor) -> RubPlate:
         raise exc.within(where) from None
 
 
-def _solver(value, rotor: Rotor, speeds: dict[str, float]) -> SolverSpec:
+def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = SolverSpec()) -> SolverSpec:
+    """``[solver]``, with the defaults ``d`` (a run-up's: its whole profile from t = 0)."""
     table = checks.table("solver", {} if value is None else value)
     checks.keys("solver", table, _SOLVER_KEYS)
-    d = SolverSpec()
     model = checks.choice("solver.model", table.get("model", d.model), MODELS)
     modes, cutoff, boundary = _solver_reduction(table, rotor)
     dt, duration, record_start = _solver_times(table, d)
@@ -625,10 +710,27 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     speeds = _speeds(data.get("speeds"), rotor)
     unbalances = _unbalances(data.get("unbalance", []), rotor)
     plates = _plates(data.get("rub", []), rotor)
-    solver = _solver(data.get("solver"), rotor, speeds)
+    runup = _runup(data.get("runup"), rotor, speeds)
+    defaults = SolverSpec() if runup is None else SolverSpec(duration=runup.profile.duration, record_start=0.0)
+    solver = _solver(data.get("solver"), rotor, speeds, defaults)
+    if runup is not None:
+        _check_runup_solver(runup, solver)
     output = _output(data.get("output"), rotor, solver, plates)
     if not unbalances and solver.gravity == 0:
         fail("unbalance", data.get("unbalance", []), "must hold at least one entry unless solver.gravity is given: "
              "the scene has no load")
     return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source, speeds=speeds,
-                 unbalances=unbalances, plates=plates, solver=solver, output=output, source=source, data=data)
+                 unbalances=unbalances, plates=plates, solver=solver, output=output, runup=runup, source=source,
+                 data=data)
+
+
+def _check_runup_solver(runup: RunupSpec, solver: SolverSpec) -> None:
+    """A run-up steps with average-acceleration Newmark, records from t = 0, at a whole number of steps."""
+    if solver.method != "newmark":
+        fail("solver.method", solver.method, 'must be "newmark" with [runup] (average acceleration at varying speed)')
+    if solver.record_start != 0.0:
+        fail("solver.record_start", solver.record_start, "must be 0 with [runup]: the whole run-up is recorded", "s")
+    ratio = runup.record_dt / solver.dt
+    if ratio < 1 - _RTOL or abs(ratio - round(ratio)) > _RTOL * ratio:
+        fail("runup.record_dt", runup.record_dt, f"must be a whole number (>= 1) of steps of solver.dt = "
+             f"{solver.dt:g}", "s")

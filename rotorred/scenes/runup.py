@@ -1,0 +1,312 @@
+"""Run a run-up (or coast-down) scene: the transient at the ``[runup]`` speeds, and what it shows.
+
+:func:`run_runup` steps the scene's model through its speed profile
+(:mod:`rotorred.transient.ramp`) from rest or from the steady state at the initial speeds, then:
+
+* order tracks of every spool's ``runup.orders`` at every recorded DOF (angle-domain resampling,
+  :mod:`rotorred.signals.orders`), with block lengths that hold whole revolutions of both spools
+  when their speed ratio is a fixed small fraction (9/7: 28 inner = 36 outer revolutions), so the
+  other spool's lines fall on bins the Hann window nulls;
+* the overall amplitude (largest orbit radius) against the reference spool's speed, per node;
+* a waterfall of the table DOF (:mod:`rotorred.signals.waterfall`);
+* orbit snapshots at ``runup.orbits_hz``;
+* rub intervals with their onset and end speeds;
+* the Campbell critical speeds in the swept range (:func:`rotorred.linear.campbell.campbell`, at the
+  profile's final speed ratio), for the amplitude plot.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
+from rotorred.scenes.schema import Scene
+from rotorred.signals.orders import OrderTrack, angle_blocks, order_tracks, overall_amplitude
+from rotorred.signals.waterfall import Waterfall, waterfall
+
+#: a speed ratio counts as a fixed fraction p/q when it is one to this (relative) and q <= RATIO_DENOMINATOR
+RATIO_RTOL, RATIO_DENOMINATOR = 1e-9, 12
+#: speeds of the Campbell diagram behind the critical speeds
+CAMPBELL_SPEEDS = 41
+
+
+@dataclass(frozen=True)
+class RubInterval:
+    """A stretch of a run-up in which a plate touches at least once every two revolutions of the reference spool.
+
+    Attributes
+    ----------
+    plate : int
+    node : int
+    t_start, t_end : float
+        First and last contact (s).
+    speed_start, speed_end : dict of str to float
+        Spool speeds there (Hz).
+    impacts : int
+        Contact onsets in the stretch.
+    """
+
+    plate: int
+    node: int
+    t_start: float
+    t_end: float
+    speed_start: dict
+    speed_end: dict
+    impacts: int
+
+
+@dataclass(frozen=True)
+class OrbitSnapshot:
+    """The orbit of a node over two revolutions of the reference spool around the time it passes ``speed_hz``.
+
+    Attributes
+    ----------
+    speed_hz : float
+        Reference spool speed (Hz).
+    t : float
+        When the reference spool passes it (s).
+    node : int
+    x, y : ndarray
+        Displacements (m) over the snapshot.
+    """
+
+    speed_hz: float
+    t: float
+    node: int
+    x: np.ndarray
+    y: np.ndarray
+
+
+@dataclass(frozen=True)
+class RunupResult:
+    """A run-up scene's record and its analyses (:func:`run_runup`).
+
+    Attributes
+    ----------
+    scene : Scene
+    t : ndarray, shape (n,)
+        Record times (s).
+    speeds : dict of str to ndarray, shape (n,)
+        Spool speeds at the record times (rad/s).
+    outputs : dict of (int, str) to ndarray, shape (n,)
+        Recorded DOFs (m or rad).
+    contacts : tuple of ContactHistory
+    tracks : tuple of OrderTrack
+        Every spool's orders at every recorded DOF (``track.spool``, ``track.order``, ``dof`` in :attr:`track_dofs`).
+    track_dofs : tuple of (int, str)
+        The recorded DOF of each track.
+    overall : dict of int to (ndarray, ndarray)
+        Per node with x and y: (reference spool speed (rad/s), largest orbit radius (m)) per block.
+    waterfall : Waterfall or None
+        Of the table DOF.
+    waterfall_dof : (int, str)
+    orbits : tuple of OrbitSnapshot
+    rubs : tuple of RubInterval
+    critical_speeds : tuple of CriticalSpeed
+        Critical speeds in the swept range of the reference spool (``speed`` in rad/s of the reference).
+    campbell_ratio : dict of str to float
+        Speed ratios of the Campbell diagram (the profile's final ones).
+    model_label : str
+    n_steps : int
+    counters : dict
+    build_time, solve_time, analysis_time : float
+        Wall times (s).
+    incomplete : str or None
+        Why the run stops early (a diverged transient); the analyses cover the record up to then.
+    """
+
+    scene: Scene
+    t: np.ndarray
+    speeds: dict
+    outputs: dict
+    contacts: tuple
+    tracks: tuple
+    track_dofs: tuple
+    overall: dict
+    waterfall: Waterfall | None
+    waterfall_dof: tuple
+    orbits: tuple
+    rubs: tuple
+    critical_speeds: tuple
+    campbell_ratio: dict
+    model_label: str
+    n_steps: int
+    counters: dict
+    build_time: float
+    solve_time: float
+    analysis_time: float
+    incomplete: str | None = None
+
+    @property
+    def reference(self) -> str:
+        return self.scene.runup.reference
+
+
+# --------------------------------------------------------------------------- analyses
+def block_revolutions(ratio: float, base: int) -> int:
+    """Revolutions per order-tracking block: ``base``, raised to a multiple of ``q`` when the other spool turns
+    ``ratio = p/q`` times as fast (q <= RATIO_DENOMINATOR), so the block holds whole revolutions of both."""
+    if not ratio > 0:
+        return base
+    frac = Fraction(ratio).limit_denominator(RATIO_DENOMINATOR)
+    if abs(float(frac) - ratio) > RATIO_RTOL * ratio:
+        return base
+    q = frac.denominator
+    return q * math.ceil(base / q)
+
+
+def _fixed_ratio(speeds: dict, s: str, other: str) -> float:
+    """The ratio Omega_other / Omega_s when it is the same wherever both turn, else 0."""
+    a, b = speeds[s], speeds[other]
+    turning = (a > 0) & (b > 0)
+    if not np.any(turning):
+        return 0.0
+    r = b[turning] / a[turning]
+    return float(r[0]) if np.ptp(r) <= RATIO_RTOL * r[0] else 0.0
+
+
+def tracks_of(scene: Scene, t: np.ndarray, speeds: dict, angles: dict, outputs: dict) -> tuple[tuple, tuple, dict]:
+    """Order tracks of every spool and the overall amplitude against the reference spool's speed."""
+    spec = scene.runup
+    dofs = list(outputs)
+    X = np.array([outputs[d] for d in dofs])
+    tracks, track_dofs, overall = [], [], {}
+    for s in speeds:
+        if not np.any(speeds[s] > 0):
+            continue
+        others = [o for o in speeds if o != s]
+        revs = spec.revs_per_block
+        for o in others:
+            revs = block_revolutions(_fixed_ratio(speeds, s, o), revs)
+        blocks = angle_blocks(t, X, angles[s], revs, samples_per_rev=64)
+        for j, per_order in enumerate(order_tracks(blocks, s, spec.orders)):
+            tracks += per_order
+            track_dofs += [dofs[j]] * len(per_order)
+        if s == spec.reference:
+            for node in sorted({d[0] for d in dofs}):
+                if (node, "x") in dofs and (node, "y") in dofs:
+                    overall[node] = (blocks.speed, overall_amplitude(blocks, dofs.index((node, "x")),
+                                                                     dofs.index((node, "y"))))
+    return tuple(tracks), tuple(track_dofs), overall
+
+
+def rub_intervals(scene: Scene, t: np.ndarray, speeds: dict, contacts) -> tuple[RubInterval, ...]:
+    """Stretches of contact, merged across gaps shorter than two revolutions of the reference spool."""
+    ref = speeds[scene.runup.reference]
+    out = []
+    for k, ch in enumerate(contacts):
+        touching = np.flatnonzero(ch.state != 0)
+        if touching.size == 0:
+            continue
+        onsets = np.flatnonzero((ch.state[1:] != 0) & (ch.state[:-1] == 0)) + 1
+        groups, start = [], touching[0]
+        for a, b in zip(touching[:-1], touching[1:]):
+            rev = 2 * math.pi / ref[a] if ref[a] > 0 else math.inf
+            if t[b] - t[a] > 2 * rev:
+                groups.append((start, a))
+                start = b
+        groups.append((start, touching[-1]))
+        for i, j in groups:
+            hz = {s: w / (2 * math.pi) for s, w in speeds.items()}
+            out.append(RubInterval(plate=k, node=ch.plate.node, t_start=float(t[i]), t_end=float(t[j]),
+                                   speed_start={s: float(v[i]) for s, v in hz.items()},
+                                   speed_end={s: float(v[j]) for s, v in hz.items()},
+                                   impacts=int(np.count_nonzero((onsets >= i) & (onsets <= j))) + int(i == 0)))
+    return tuple(out)
+
+
+def orbit_snapshots(scene: Scene, t: np.ndarray, speeds: dict, outputs: dict) -> tuple[OrbitSnapshot, ...]:
+    """Each node's orbit over two revolutions of the reference spool where it first passes each ``orbits_hz``."""
+    ref = speeds[scene.runup.reference]
+    out = []
+    for f in scene.runup.orbits_hz:
+        target = 2 * math.pi * f
+        side = np.sign(ref - target)
+        crossing = np.flatnonzero(side != side[0])
+        if crossing.size == 0:
+            continue
+        i = int(crossing[0])
+        half = 2 * math.pi / target  # one revolution either side
+        window = (t >= t[i] - half) & (t <= t[i] + half)
+        for node in scene.output.nodes:
+            if (node, "x") in outputs and (node, "y") in outputs:
+                out.append(OrbitSnapshot(speed_hz=f, t=float(t[i]), node=node, x=outputs[(node, "x")][window],
+                                         y=outputs[(node, "y")][window]))
+    return tuple(out)
+
+
+def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
+    """Campbell critical speeds of the reference spool within the swept range, at the profile's final ratios."""
+    from rotorred.linear.campbell import campbell
+
+    ref = scene.runup.reference
+    final = {s: float(v[-1]) for s, v in speeds.items()}
+    if final[ref] <= 0:
+        final = {s: float(np.max(v)) for s, v in speeds.items()}
+    ratio = {s: w / final[ref] for s, w in final.items() if s != ref}
+    top = float(np.max(speeds[ref]))
+    cd = campbell(scene.rotor, np.linspace(0.0, top, CAMPBELL_SPEEDS), ratio=ratio or None, reference=ref)
+    low = float(np.min(speeds[ref]))
+    return tuple(c for c in cd.critical_speeds if low <= c.speed <= top), {ref: 1.0, **ratio}
+
+
+# --------------------------------------------------------------------------- the run
+def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | None = None) -> RunupResult:
+    """Step the scene through its speed profile and analyse the record (see the module docstring).
+
+    A diverged transient does not raise: the result holds the record up to the failure, analysed,
+    with ``incomplete`` saying when, where and why it stopped.
+    """
+    from rotorred.transient.newmark import simulate
+    from rotorred.transient.results import SimulationDiverged
+
+    if scene.runup is None:
+        raise ValueError(f"scene {scene.name!r} has no [runup]")
+    model = model or build_model(scene)
+    s, profile = scene.solver, scene.runup.profile
+    start = dataclasses.replace(scene, speeds=profile.speeds_at(0.0))
+    q0, v0 = settled_state(start, model.model) if s.start == "settled" else (None, None)
+    t0 = time.perf_counter()
+    incomplete = None
+    try:
+        res = simulate(model.model, profile, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
+                       rotor=scene.rotor, outputs=scene.output.dofs, decimate=int(round(scene.runup.record_dt / s.dt)),
+                       gravity=s.gravity or None, q0=q0, v0=v0, progress=progress)
+    except SimulationDiverged as exc:
+        res, incomplete = exc.result, explain_divergence(scene, exc)
+    solve_time = time.perf_counter() - t0
+    return analyse(scene, model, res, solve_time, incomplete)
+
+
+def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete: str | None) -> RunupResult:
+    """Tracks, overall amplitude, waterfall, orbits, rub intervals and critical speeds of a run-up's record."""
+    t0 = time.perf_counter()
+    at = scene.runup.profile.at(res.t)
+    speeds = {sp: v[0] for sp, v in at.items()}
+    angles = {sp: v[2] for sp, v in at.items()}
+    tracks, track_dofs, overall = tracks_of(scene, res.t, speeds, angles, res.outputs) if len(res.t) > 8 else ((), (), {})
+    dof = table_dof(scene)
+    f_top = max(float(np.max(v)) for v in speeds.values()) / (2 * math.pi)
+    f_max = scene.output.f_max_hz or 4.0 * f_top
+    segment = min(0.25, 0.5 * (res.t[-1] - res.t[0])) if len(res.t) > 16 else 0.0
+    fall = waterfall(res.t, res.outputs[dof], segment, f_max) if segment > 0 and len(res.t) >= 32 else None
+    criticals, ratio = critical_speeds_in_range(scene, speeds)
+    counters = {"us_per_step": res.us_per_step, "n_passes": res.n_passes, "n_factorizations": res.n_factorizations,
+                "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
+                "kernel_load_time": res.kernel_load_time}
+    return RunupResult(scene=scene, t=res.t, speeds=speeds, outputs=res.outputs, contacts=res.contacts, tracks=tracks,
+                       track_dofs=track_dofs, overall=overall, waterfall=fall, waterfall_dof=dof,
+                       orbits=orbit_snapshots(scene, res.t, speeds, res.outputs),
+                       rubs=rub_intervals(scene, res.t, speeds, res.contacts), critical_speeds=criticals,
+                       campbell_ratio=ratio, model_label=model.label, n_steps=res.n_steps, counters=counters,
+                       build_time=model.build_time, solve_time=solve_time, analysis_time=time.perf_counter() - t0,
+                       incomplete=incomplete)
+
+
+__all__ = ["RunupResult", "RubInterval", "OrbitSnapshot", "OrderTrack", "run_runup", "block_revolutions"]
