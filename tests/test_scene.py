@@ -87,7 +87,7 @@ def test_rotor_file_relative_to_the_scene(tmp_path):
 # written in the scene's units and what is allowed).
 BAD = [
     ("unknown top-level key", "colour", "red", "colour = 'red': unknown key; allowed keys are description, name, "
-     "output, rotor, rub, solver, speeds, unbalance"),
+     "output, rotor, rub, runup, solver, speeds, unbalance"),
     ("unknown solver key", "solver.step", 1e-5, "solver.step = 1e-05: unknown key; allowed keys are alpha, "
      "boundary_nodes, cutoff_hz, dt, duration, gravity, method, model, modes, record_start, start"),
     ("unknown rub key", "rub[0].gap", 1e-5, "rub[0].gap = 1e-05: unknown key; allowed keys are K_nr, a0, b0, "),

@@ -3,7 +3,11 @@
 With no scene it runs the built-in ``paper-rub`` (Xu et al. 2016: rub at node 18, 70/90 Hz).
 Writes ``waveforms.png``, ``spectra_node<N>.png``, ``orbits.png``, ``result.npz``,
 ``result.mat``, ``timeseries.csv``, ``spectra.csv``, ``lines.csv`` and ``summary.txt``
-(as the scene's ``[output]`` asks), and prints the summary.
+(as the scene's ``[output]`` asks), and prints the summary. A scene with ``[runup]`` (the
+built-in ``runup``, ``runup-rub``, ``coastdown-rub``) writes ``runup_amplitude.png``,
+``order_tracks.png``, ``waterfall.png``, ``runup_orbits.png``, their CSV files
+(``runup_amplitude.csv``, ``order_tracks.csv``, ``rub_intervals.csv``, ``critical_speeds.csv``),
+the record and ``summary.txt``.
 
 Everything is checked before computing (the scene, ``--out``, the size estimate of
 :mod:`rotorred.scenes.budget`); the files are staged and moved into ``--out`` when complete
@@ -77,6 +81,9 @@ def _settings(items: list[str]) -> dict:
 def _compute_and_write(scene, args, folder, out) -> int:
     """Run the scene, stage its files and commit them; a diverged run commits its partial record (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
+
+    if scene.runup is not None:
+        return _runup_and_write(scene, folder, out)
     from rotorred.scenes.outputs import write_outputs
     from rotorred.scenes.run import SceneDiverged, run_scene
     from rotorred.scenes.summary import format_summary
@@ -93,4 +100,22 @@ def _compute_and_write(scene, args, folder, out) -> int:
     files = write_outputs(result, folder.staging, shown=out)
     folder.commit()
     print(format_summary(result, files))
+    return 0
+
+
+def _runup_and_write(scene, folder, out) -> int:
+    """A run-up scene: the transient through its speed profile, its figures, data and summary; a diverged run
+    writes what it computed up to then, analysed, marked INCOMPLETE (exit 3)."""
+    from rotorred.cli import EXIT_DIVERGED
+    from rotorred.scenes.runup import run_runup
+    from rotorred.scenes.runup_outputs import format_runup_summary, write_runup_outputs
+
+    result = run_runup(scene, progress=None)
+    files = write_runup_outputs(result, folder.staging, shown=out)
+    committed = folder.commit(incomplete=result.incomplete)
+    print(format_runup_summary(result, committed))
+    if result.incomplete:
+        print(f"rotorred run: error: {result.incomplete}; partial results written to {out} (marked {INCOMPLETE})",
+              file=sys.stderr)
+        return EXIT_DIVERGED
     return 0

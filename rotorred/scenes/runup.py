@@ -7,7 +7,8 @@
   :mod:`rotorred.signals.orders`), with block lengths that hold whole revolutions of both spools
   when their speed ratio is a fixed small fraction (9/7: 28 inner = 36 outer revolutions), so the
   other spool's lines fall on bins the Hann window nulls;
-* the overall amplitude (largest orbit radius) against the reference spool's speed, per node;
+* the overall amplitude (largest orbit radius over two revolutions, one revolution apart) against the
+  reference spool's speed, per node;
 * a waterfall of the table DOF (:mod:`rotorred.signals.waterfall`);
 * orbit snapshots at ``runup.orbits_hz``;
 * rub intervals with their onset and end speeds;
@@ -32,13 +33,17 @@ from rotorred.signals.waterfall import Waterfall, waterfall
 
 #: a speed ratio counts as a fixed fraction p/q when it is one to this (relative) and q <= RATIO_DENOMINATOR
 RATIO_RTOL, RATIO_DENOMINATOR = 1e-9, 12
+#: contacts fewer than this many revolutions of the reference spool apart belong to one rub interval (impacts
+#: recur every few revolutions in a rub, e.g. once in 2-3 at 70-80 Hz on the rig)
+RUB_GAP_REVS = 10
 #: speeds of the Campbell diagram behind the critical speeds
 CAMPBELL_SPEEDS = 41
 
 
 @dataclass(frozen=True)
 class RubInterval:
-    """A stretch of a run-up in which a plate touches at least once every two revolutions of the reference spool.
+    """A stretch of a run-up in which a plate touches at least once every :data:`RUB_GAP_REVS` revolutions of the
+    reference spool.
 
     Attributes
     ----------
@@ -188,16 +193,17 @@ def tracks_of(scene: Scene, t: np.ndarray, speeds: dict, angles: dict, outputs: 
         for j, per_order in enumerate(order_tracks(blocks, s, spec.orders)):
             tracks += per_order
             track_dofs += [dofs[j]] * len(per_order)
-        if s == spec.reference:
+        if s == spec.reference:  # the overall amplitude revolution by revolution
+            per_rev = angle_blocks(t, X, angles[s], 2, samples_per_rev=64)
             for node in sorted({d[0] for d in dofs}):
                 if (node, "x") in dofs and (node, "y") in dofs:
-                    overall[node] = (blocks.speed, overall_amplitude(blocks, dofs.index((node, "x")),
-                                                                     dofs.index((node, "y"))))
+                    overall[node] = (per_rev.speed, overall_amplitude(per_rev, dofs.index((node, "x")),
+                                                                      dofs.index((node, "y"))))
     return tuple(tracks), tuple(track_dofs), overall
 
 
 def rub_intervals(scene: Scene, t: np.ndarray, speeds: dict, contacts) -> tuple[RubInterval, ...]:
-    """Stretches of contact, merged across gaps shorter than two revolutions of the reference spool."""
+    """Stretches of contact, merged across gaps shorter than :data:`RUB_GAP_REVS` revolutions of the reference spool."""
     ref = speeds[scene.runup.reference]
     out = []
     for k, ch in enumerate(contacts):
@@ -208,7 +214,7 @@ def rub_intervals(scene: Scene, t: np.ndarray, speeds: dict, contacts) -> tuple[
         groups, start = [], touching[0]
         for a, b in zip(touching[:-1], touching[1:]):
             rev = 2 * math.pi / ref[a] if ref[a] > 0 else math.inf
-            if t[b] - t[a] > 2 * rev:
+            if t[b] - t[a] > RUB_GAP_REVS * rev:
                 groups.append((start, a))
                 start = b
         groups.append((start, touching[-1]))

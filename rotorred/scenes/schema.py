@@ -207,7 +207,7 @@ class RunupSpec:
     orders: tuple[float, ...] = (1.0,)
     orbits_hz: tuple[float, ...] = ()
     record_dt: float = 1e-4
-    revs_per_block: int = 16
+    revs_per_block: int = 8
 
 
 @dataclass(frozen=True)
