@@ -156,3 +156,23 @@ def test_rotorred_run_runup_diverged_keeps_the_record(tmp_path):
     assert "Traceback" not in proc.stderr
     assert "diverged at t = 0.7" in proc.stderr and "rub[0] (node 18, x)" in proc.stderr
     assert (out / "INCOMPLETE").exists() and (out / "result.npz").exists()
+
+
+def test_reduced_run_up_equals_full():
+    """The run-up amplitude curves of the Craig-Bampton model (48 DOFs) and of the full FE model (80 DOFs)
+    agree: from rest to 42/54 Hz in 3 s through the 15-18 Hz criticals, orbit radius and 1x tracks at
+    nodes 13, 14, 18. Measured: largest difference 8.6e-6 of each curve's peak; asserted 8.6e-5 (10x; the
+    issue asks 1 %). The 12 s run-up: 2.3e-5 (validation/runup_checks.py)."""
+    results = {m: run_runup(load_scene("runup", {"solver.model": m, "runup.to": 0.6, "runup.duration": 3.0,
+                                                  "runup.orbits_hz": []}), progress=False)
+               for m in ("reduced", "full")}
+    red, full = results["reduced"], results["full"]
+    worst = 0.0
+    for node in full.overall:
+        a, b = red.overall[node][1], full.overall[node][1]
+        worst = max(worst, np.max(np.abs(a - b)) / b.max())
+    for ta, tb, da, db in zip(full.tracks, red.tracks, full.track_dofs, red.track_dofs):
+        assert (ta.spool, ta.order, da) == (tb.spool, tb.order, db)
+        if ta.order == 1.0:
+            worst = max(worst, np.max(np.abs(tb.amplitude - ta.amplitude)) / ta.amplitude.max())
+    assert worst < 8.6e-5
