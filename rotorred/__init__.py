@@ -40,6 +40,7 @@ _EXPORTS = {
     "assemble": "rotorred.model.assembly",
     "SystemMatrices": "rotorred.model.assembly",
     "Unbalance": "rotorred.model.loads",
+    "SpeedProfile": "rotorred.model.speeds",
     # linear analyses
     "campbell": "rotorred.linear.campbell",
     "CampbellResult": "rotorred.linear.campbell",
@@ -60,12 +61,17 @@ _EXPORTS = {
     "simulate": "rotorred.transient.newmark",
     "TransientResult": "rotorred.transient.newmark",
     "SimulationDiverged": "rotorred.transient.newmark",
+    "energy_balance": "rotorred.transient.energy",
+    "EnergyBalance": "rotorred.transient.energy",
     # signals
     "amplitude_spectrum": "rotorred.signals.spectra",
     "settled_spectrum": "rotorred.signals.spectra",
     "Spectrum": "rotorred.signals.spectra",
     "label_lines": "rotorred.signals.lines",
     "SpectralLine": "rotorred.signals.lines",
+    "angle_blocks": "rotorred.signals.orders",
+    "order_tracks": "rotorred.signals.orders",
+    "OrderTrack": "rotorred.signals.orders",
     # scenes
     "load_scene": "rotorred.scenes.schema",
     "builtin_scenes": "rotorred.scenes.schema",
@@ -73,6 +79,8 @@ _EXPORTS = {
     "run_scene": "rotorred.scenes.run",
     "SceneResult": "rotorred.scenes.run",
     "write_outputs": "rotorred.scenes.outputs",
+    "run_runup": "rotorred.scenes.runup",
+    "RunupResult": "rotorred.scenes.runup",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -58,3 +58,18 @@ def test_readme_rotor_file_error_example():
     with pytest.raises(RotorFileError) as info:
         rotor_from_toml(bad, source="rig.toml")
     assert str(info.value) == " ".join(example.split())
+
+
+def test_readme_runup_example_runs(capsys):
+    """The run-up block of the README: the 1x outer track at the rub disk peaks after the outer line's critical
+    speed (Campbell: inner 42.9 Hz, outer 55.2 Hz), as a passage through resonance does."""
+    text = README.read_text()
+    section = text[text.index("## Run-ups and coast-downs"):text.index("## Python\n")]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    namespace: dict = {}
+    exec(compile(code, str(README), "exec"), namespace)
+    out = capsys.readouterr().out.strip().splitlines()
+    assert len(out) == 1 and out[0].startswith("1x outer peak")
+    track = namespace["track"]
+    f_peak = track.speed[track.amplitude.argmax()] / (2 * np.pi)
+    assert 55.2 < f_peak < 60.0
