@@ -408,16 +408,24 @@ def _linear_predictor(level, tb, cur, levels, forcing, plates, w):
 def _condense_contact(l, cur, levels, plates, w):
     """Contact kinematics at zero new contact force (:class:`Condensed` p, pd, v in ``w``); True if any plate touches.
 
-    Fills ``w.rlin``/``w.rdlin`` (contact-DOF displacement and velocity) and ``w.ulin``/``w.udlin``
-    (plate displacement and velocity), then the penetration, its rate and v_rel of each plate.
+    Fills ``w.rlin`` (contact-DOF displacement, ``B^T w.qn``), then :func:`_condense_rlin`.
     """
-    c3, c4, c5, alpha = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5], levels.coef[l, 6]
     for j in range(cur.xc.shape[0]):
         s = 0.0
         for ii in range(w.qn.shape[0]):
             s += plates.BT[j, ii] * w.qn[ii]
         w.rlin[j] = s
-        w.rdlin[j] = c3 * (s - cur.xc[j, 0]) + c4 * cur.xc[j, 1] + c5 * cur.xc[j, 2]
+    return _condense_rlin(l, cur, levels, plates, w)
+
+
+@njit(cache=True, inline="always")
+def _condense_rlin(l, cur, levels, plates, w):
+    """From the contact-DOF displacement ``w.rlin`` at zero new contact force: ``w.rdlin`` (its velocity),
+    ``w.ulin``/``w.udlin`` (plate displacement and velocity), then the penetration, its rate and v_rel of each
+    plate; True if any plate touches."""
+    c3, c4, c5, alpha = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5], levels.coef[l, 6]
+    for j in range(cur.xc.shape[0]):
+        w.rdlin[j] = c3 * (w.rlin[j] - cur.xc[j, 0]) + c4 * cur.xc[j, 1] + c5 * cur.xc[j, 2]
     touching = False
     for k in range(plates.par.shape[0]):
         cs = plates.par[k, P_COS]
@@ -479,10 +487,17 @@ def _update_contact(l, touching, cond, cur, new, levels, plates, w):
     ``w.qn += (1 + alpha) S f``; ``new.xc`` (contact DOFs), ``new.ps`` (plates), ``new.pinfo``
     (v_rel, gap, state); the friction force of an open plate is set to zero.
     """
+    _disk_forces(new.z, plates.par, w.frot)
+    _add_columns(w.qn, w.frot, levels.ST[l], 1.0 + levels.coef[l, 6])
+    _update_contact_dofs(l, touching, cond, cur, new, levels, plates, w)
+
+
+@njit(cache=True, inline="always")
+def _update_contact_dofs(l, touching, cond, cur, new, levels, plates, w):
+    """The Newmark update of the contact DOFs (``r = w.rlin + W f``, f in ``w.frot``) and of the plates, and
+    ``new.pinfo``; the friction force of an open plate is set to zero."""
     c0, c1, c2 = levels.coef[l, 0], levels.coef[l, 1], levels.coef[l, 2]
     c3, c4, c5, alpha = levels.coef[l, 3], levels.coef[l, 4], levels.coef[l, 5], levels.coef[l, 6]
-    _disk_forces(new.z, plates.par, w.frot)
-    _add_columns(w.qn, w.frot, levels.ST[l], 1.0 + alpha)
     for j in range(cur.xc.shape[0]):
         r = w.rlin[j]
         if touching:
@@ -619,11 +634,7 @@ def _beyond_limit(xc, limit):
 def _record(idx, t, s, record):
     """Write the state ``s`` at time ``t`` (s) into record row ``idx``."""
     record.t[idx] = t
-    for r in range(record.rows.shape[0]):
-        acc = 0.0
-        for i in range(record.rows.shape[1]):
-            acc += record.rows[r, i] * s.x[i]
-        record.y[idx, r] = acc
+    _matvec(record.rows, s.x, record.y[idx])  # vectorised sums (a sequential one per row is latency-bound)
     for k in range(s.ps.shape[0]):
         record.plate[idx, k, R_P] = s.z[2 * k]
         record.plate[idx, k, R_T] = s.z[2 * k + 1]

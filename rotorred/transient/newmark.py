@@ -58,7 +58,8 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.loads import Unbalance
 from rotorred.model.speeds import SpeedProfile
-from rotorred.transient import kernel
+from rotorred.transient import eigen_kernel, kernel
+from rotorred.transient.eigenstep import eigen_form, rows_on_y
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate
 from rotorred.transient.matrices import (contact_rows, force_columns, kernel_plates, newmark_coefficients,
                                          plate_parameters, step_levels, step_matrices)
@@ -72,8 +73,10 @@ from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces,
 
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
                record: kernel.Record, settings: kernel.Settings, diag: kernel.Diagnostics, n_steps: int,
-               chunk: int, progress: bool | None) -> tuple[int, float, float, float]:
-    """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar.
+               chunk: int, progress: bool | None, eig=None) -> tuple[int, float, float, float]:
+    """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar:
+    the eigenbasis loop (:mod:`rotorred.transient.eigen_kernel`) when ``eig`` is given (``record.rows`` then act
+    on its state y), else the dense one.
 
     Returns
     -------
@@ -86,12 +89,18 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     """
     spare = kernel.spare_state(state)
     work = kernel.work_arrays(len(state.x) // 3, len(plates.par), len(forcing.kind))
-    load_time = load_kernel((0, 0, levels, forcing, plates, state, spare, work, record, settings, diag))
+    if eig is None:
+        loop, extra = kernel.run_steps, (levels, forcing, plates, state, spare, work, record, settings, diag)
+    else:
+        ework = eigen_kernel.eigen_work(len(state.x) // 3)
+        loop, extra = eigen_kernel.run_eigen_steps, (levels, eig, forcing, plates, state, spare, work, ework, record,
+                                                     settings, diag)
+    load_time = load_kernel((0, 0, *extra), loop)
     t_run, cpu_run = time.perf_counter(), time.process_time()
     status, i, shown = kernel.RUNNING, 0, False
     while i < n_steps:
         i_next = min(n_steps, i + chunk)
-        status = kernel.run_steps(i, i_next, levels, forcing, plates, state, spare, work, record, settings, diag)
+        status = loop(i, i_next, *extra)
         if status != kernel.RUNNING:
             break
         i = i_next
@@ -115,7 +124,7 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
              progress: bool | None = None,
              newton_tol: float = 1e-10, max_newton: int = 50, max_halvings: int = 4,
              displacement_limit: float = 1.0, chunk_steps: int | None = None, record_state: bool = False,
-             **unknown) -> TransientResult:
+             step: str = "auto", **unknown) -> TransientResult:
     """Transient response with unbalance, optional gravity and rub-impact plates.
 
     Parameters
@@ -176,6 +185,12 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     record_state : bool
         Also record the whole state (q, v) in model coordinates (``result.states``), e.g. for
         :func:`rotorred.transient.energy.energy_balance`.
+    step : {"auto", "eigen", "dense"}
+        Constant speeds: ``"eigen"`` steps the linear part in the eigenbasis of the average-acceleration
+        amplification matrix, O(n) per step (:mod:`rotorred.transient.eigen_kernel`), the same recurrence as
+        ``"dense"`` (O(n^2)) to rounding; ``"auto"`` (default) takes it wherever it applies and falls back to
+        the dense step where the scheme is not average acceleration or the matrix is (nearly) defective.
+        ``result.step_form`` says which ran and why.
 
     Returns
     -------
@@ -205,6 +220,7 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     check_start(start, len(loads.plates))
     x0 = initial_vector(n, q0, v0, start)
     record_state = checks.boolean("record_state", record_state)
+    step = checks.choice("step", step, STEPS)
     if profile is not None:
         return run_profile(model, profile, scheme, run, loads, rotor, x0, start, progress, record_state=record_state)
     # 2. prepare the matrices: forces, plates, step matrices (with the condensed contact operator) per level
@@ -216,9 +232,11 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     levels = step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha,
                          run.max_halvings + 1)
     state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
-    # 3. plan the record
+    eig, step_form = choose_step(step, levels, contact, scheme, M, K)
+    # 3. plan the record (on the eigenbasis state y when the step runs there)
     plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
-    record = record_buffers(plan, record_rows(model, loads.outputs, record_state), len(loads.plates))
+    rows = record_rows(model, loads.outputs, record_state)
+    record = record_buffers(plan, rows if eig is None else rows_on_y(rows, eig.P), len(loads.plates))
     setup_time = time.perf_counter() - t_setup
     # 4. run the kernel
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
@@ -226,10 +244,25 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
     status, run_time, run_cpu_time, load_time = run_kernel(
         levels, kernel.Forcing(forces.kind, forces.omega), contact, state, record, settings, diag, plan.n_steps,
-        run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress)
+        run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                          (setup_time, run_time, run_cpu_time, load_time), record_state=record_state)
+                          (setup_time, run_time, run_cpu_time, load_time), record_state=record_state,
+                          step_form=step_form)
+
+
+#: the constant-speed step's forms: "auto" (the eigenbasis where it applies, else dense), "eigen", "dense"
+STEPS = ("auto", "eigen", "dense")
+
+
+def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme, M, K):
+    """(Eigen or None, what was chosen and why) for ``step`` (:data:`STEPS`)."""
+    if step == "dense":
+        return None, "dense (asked)"
+    eig, note = eigen_form(levels, plates, scheme, M, K)
+    if eig is None and step == "eigen":
+        checks.fail("step", step, f"cannot be used here: {note.removeprefix('dense: ')}")
+    return eig, note
 
 
 __all__ = ["simulate", "TransientResult", "ContactHistory", "FinalState", "SimulationDiverged", "METHODS",

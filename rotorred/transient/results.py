@@ -161,6 +161,9 @@ class TransientResult:
         Fixed-point passes of the steps at varying speeds (0 at constant speeds).
     states : ndarray, shape (n_rec, 2 n), or None
         With ``record_state``: q and v (model coordinates) at the record times.
+    step_form : str
+        Which constant-speed step ran and why (``"eigenbasis, cond(P) = ..."``, ``"dense: ..."``); empty at
+        varying speeds.
     """
 
     t: np.ndarray
@@ -187,6 +190,7 @@ class TransientResult:
     kernel_load_time: float = 0.0
     n_passes: int = 0
     states: np.ndarray | None = None
+    step_form: str = ""
 
     @property
     def us_per_step(self) -> float:

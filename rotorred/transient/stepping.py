@@ -312,7 +312,8 @@ def show_progress(frac: float, t: float, elapsed: float) -> None:
 # ----------------------------------------------------------------------------------- 4. result
 def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: RecordPlan, record: kernel.Record,
                    state: kernel.State, diag: kernel.Diagnostics, status: int, times: tuple,
-                   n_factorizations: int | None = None, record_state: bool = False) -> TransientResult:
+                   n_factorizations: int | None = None, record_state: bool = False,
+                   step_form: str = "") -> TransientResult:
     """The :class:`TransientResult` of a run (raises :class:`SimulationDiverged` carrying it if the run failed).
 
     ``times`` is (setup time, loop wall time, loop CPU time, kernel load time) (s); ``n_factorizations``
@@ -338,7 +339,7 @@ def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: R
         n_substeps=int(counters[kernel.C_SUBSTEPS]), n_newton=int(counters[kernel.C_NEWTON]),
         n_contact_steps=int(counters[kernel.C_CONTACT]), max_newton_per_solve=int(counters[kernel.C_MAXNEWTON]),
         n_factorizations=run.max_halvings + 1 if n_factorizations is None else n_factorizations,
-        n_passes=int(counters[C_PASSES]), setup_time=times[0], run_time=times[1], run_cpu_time=times[2],
+        n_passes=int(counters[C_PASSES]), step_form=step_form, setup_time=times[0], run_time=times[1], run_cpu_time=times[2],
         kernel_load_time=times[3])
     if not success:
         raise SimulationDiverged(message, result, float(diag.err[kernel.E_TIME]), dof, cause)

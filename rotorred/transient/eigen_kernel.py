@@ -1,0 +1,211 @@
+"""Compiled step loop of the average-acceleration Newmark transient in the eigenbasis of its amplification matrix.
+
+At constant speeds, a full step of average-acceleration Newmark (gamma = 1/2, beta = 1/4) maps the
+state x = (q, v) linearly, plus the forces:
+
+    q' = H x + sum_j w_j(tb) UF_j + S (f_old + f_new),    v' = (2/h)(q' - q) - v,
+
+so ``x' = A x + b`` with ``A = [[Hq, Hv], [(2/h)(Hq - I), (2/h) Hv - I]]`` and every input entering as
+``[u; (2/h) u]``. With ``A = P D P^-1``, D real block-diagonal (a 1x1 block per real eigenvalue, a
+rotation-scaling 2x2 block ``[[a, b], [-b, a]]`` per complex pair), the state ``y = P^-1 x`` steps in
+O(2n) per step: ``y' = D y + sum_j w_j gF_j + sum_k f_k gS_k`` with the inputs mapped once,
+``gF_j = P^-1 [UF_j; (2/h) UF_j]`` and ``gS_k = P^-1 [S_k; (2/h) S_k]``. The contact stays implicit:
+the contact DOFs' displacement is ``C_r y`` (``C_r = B^T P_q``, 2 rows per plate), and the condensed
+Newton solve, the plates' update and the stick reset are those of :mod:`rotorred.transient.kernel`.
+Only q at the recorded DOFs is formed (``rows @ P_q``) when a record is due.
+
+This is the same discrete recurrence as the dense step, evaluated in another basis: the histories
+agree to rounding (``cond(P)`` times the machine epsilon). A step whose contact solve fails is redone
+by the dense step's halvings from the physical state ``x = P y`` (with no halving allowed, by the dense
+step itself, which then reports the failure), and the state is mapped back.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from rotorred.transient import numba_cache
+from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEWTON_FAILED,
+                                       NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
+                                       _condense_rlin, _disk_forces, _forcing_at_step_end, _matvec, _record,
+                                       _record_step, _solve_contact_forces, _start_forcing, _stick_reset, _substep,
+                                       _update_contact_dofs, _write_state)
+
+numba_cache.register()
+
+
+class Eigen(NamedTuple):
+    """The real block-diagonal form of level 0's amplification matrix and the inputs in its basis (n DOFs).
+
+    Attributes
+    ----------
+    a, b : ndarray, shape (n_c,)
+        The complex pairs' blocks: y is ordered ``[Re-parts (n_c), Im-parts (n_c), real eigenvalues' parts]``,
+        ``yr' = a yr + b yi``, ``yi' = -b yr + a yi`` (contiguous, vectorised).
+    lam : ndarray, shape (2 n - 2 n_c,)
+        The real eigenvalues: ``y' = lam y``.
+    gF : ndarray, shape (nf, 2 n)
+        Forcing vectors in the eigenbasis.
+    gS : ndarray, shape (m, 2 n)
+        Contact-DOF force columns in the eigenbasis (m = 2 n_p).
+    Cr : ndarray, shape (m, 2 n)
+        Contact-DOF displacement rows on y.
+    P, Pinv : ndarray, shape (2 n, 2 n)
+        ``x = P y`` and back.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    lam: np.ndarray
+    gF: np.ndarray
+    gS: np.ndarray
+    Cr: np.ndarray
+    P: np.ndarray
+    Pinv: np.ndarray
+
+
+class EigenWork(NamedTuple):
+    """The eigenbasis state (two buffers), and a physical (q, v) buffer for conversions."""
+
+    y: np.ndarray      # (2 n,) current
+    y_new: np.ndarray  # (2 n,) next
+    x2: np.ndarray     # (2 n,) (q, v)
+
+
+def eigen_work(n: int) -> EigenWork:
+    return EigenWork(y=np.zeros(2 * n), y_new=np.zeros(2 * n), x2=np.zeros(2 * n))
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def _sum(x):
+    """The sum of ``x`` (reassociated: vectorised; a NaN or an infinity still shows)."""
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += x[i]
+    return s
+
+
+@njit(cache=True, inline="always")
+def _to_physical(eig, y, x):
+    """``x[:2n] = P y``: q and v of the state (the acceleration slot is left as it is)."""
+    _matvec(eig.P, y, x)
+
+
+@njit(cache=True, inline="always")
+def _eigen_predictor(y, y_new, eig, cur, plates, w):
+    """``y_new = D y + sum_j w_j gF_j + sum_k f_old,k gS_k``: the step at zero new contact force."""
+    nc = eig.a.shape[0]
+    for k in range(nc):
+        yr = y[k]
+        yi = y[nc + k]
+        y_new[k] = eig.a[k] * yr + eig.b[k] * yi
+        y_new[nc + k] = eig.a[k] * yi - eig.b[k] * yr
+    for k in range(eig.lam.shape[0]):
+        y_new[2 * nc + k] = eig.lam[k] * y[2 * nc + k]
+    _add_columns(y_new, w.fval, eig.gF, 1.0)
+    if plates.par.shape[0] > 0:
+        _disk_forces(cur.z, plates.par, w.frot)
+        _add_columns(y_new, w.frot, eig.gS, 1.0)
+
+
+@njit(cache=True, inline="always")
+def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w):
+    """One main step at level 0 in the eigenbasis, into ``y_new`` and ``new``; RUNNING or a failure code."""
+    _eigen_predictor(y, y_new, eig, cur, plates, w)
+    if plates.par.shape[0] > 0:
+        _matvec(eig.Cr, y_new, w.rlin)
+        touching = _condense_rlin(0, cur, levels, plates, w)
+        cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[0], levels.Jv[0], levels.coef[0, 3])
+        if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
+            for k in range(w.p_lin.shape[0]):
+                if w.p_lin[k] > 0.0:
+                    diag.err[E_PLATE] = k
+                    break
+            return NEWTON_FAILED
+        _disk_forces(new.z, plates.par, w.frot)
+        _add_columns(y_new, w.frot, eig.gS, 1.0)
+        _update_contact_dofs(0, touching, cond, cur, new, levels, plates, w)
+    if not math.isfinite(_sum(y_new)):
+        diag.err[E_DOF] = -1
+        return NONFINITE
+    _stick_reset(new, plates, w)
+    return RUNNING
+
+
+@njit(cache=True)
+def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, work, ework, record, settings, diag):
+    """Advance main steps ``i_begin .. i_end - 1`` as :func:`rotorred.transient.kernel.run_steps` does, level 0 in
+    the eigenbasis (``record.rows`` act on y: the output rows times ``P_q``). ``state.x`` holds q, v on entry
+    and on return."""
+    levels, eig, forcing, plates, record, diag = (_borrowed(levels), _borrowed(eig), _borrowed(forcing),
+                                                  _borrowed(plates), _borrowed(record), _borrowed(diag))
+    cur, new, w, ew = _borrowed(state), _borrowed(spare), _borrowed(work), _borrowed(ework)
+    t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
+    y, y_new = ew.y, ew.y_new
+    _matvec(eig.Pinv, cur.x, y)  # y = P^-1 (q, v)
+    if i_begin == 0 and record.start == 0 and record.count[0] == 0:
+        _record(0, t0, State(y, cur.xc, cur.ps, cur.z, cur.mode, cur.sgn, cur.pinfo), record)
+        record.count[0] = 1
+    units_total = 1 << n_halvings
+    extrapolate = False
+    _start_forcing(forcing, dt, w)
+    for i in range(i_begin, i_end):
+        t_main = t0 + i * dt
+        _forcing_at_step_end(i - i_begin, t0 + (i + 1) * dt, forcing, w)
+        status = _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w)
+        if status == RUNNING:
+            j = _beyond_limit(new.xc, settings.limit)
+            if j >= 0:
+                diag.err[E_TIME] = t0 + (i + 1) * dt
+                diag.err[E_DOF] = -1 - j
+                diag.err[E_STATUS] = LIMIT
+                _to_physical(eig, y, cur.x)
+                _write_state(cur, state)
+                return LIMIT
+            cur, new = new, cur
+            y, y_new = y_new, y
+            extrapolate = True
+        else:  # redo the main step by the dense step's halvings (or, with none allowed, its own level-0 step, which
+            # reports the failure with its DOF or plate), from the physical state
+            _to_physical(eig, y, cur.x)
+            extrapolate = False
+            level = 1 if n_halvings > 0 else 0
+            progress = 0
+            while progress < units_total:
+                h_units = 1 << (n_halvings - level)
+                ta = t_main + progress * (dt / units_total)
+                tb = ta + h_units * (dt / units_total)
+                if progress + h_units == units_total:
+                    tb = t0 + (i + 1) * dt
+                status = _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w)
+                if status == RUNNING:
+                    j = _beyond_limit(new.xc, settings.limit)
+                    if j >= 0:
+                        diag.err[E_TIME] = tb
+                        diag.err[E_DOF] = -1 - j
+                        diag.err[E_STATUS] = LIMIT
+                        _write_state(cur, state)
+                        return LIMIT
+                    cur, new = new, cur
+                    extrapolate = True
+                    progress += h_units
+                    if level > 0:
+                        diag.counters[C_SUBSTEPS] += 1
+                else:
+                    extrapolate = False
+                    level += 1
+                    if level > n_halvings:
+                        diag.err[E_TIME] = tb
+                        diag.err[E_STATUS] = status
+                        _write_state(cur, state)
+                        return status
+            _matvec(eig.Pinv, cur.x, y)
+        diag.counters[C_STEPS] += 1
+        _record_step(i + 1, t0 + (i + 1) * dt, State(y, cur.xc, cur.ps, cur.z, cur.mode, cur.sgn, cur.pinfo), record)
+    _to_physical(eig, y, cur.x)
+    _write_state(cur, state)
+    return RUNNING
