@@ -25,7 +25,10 @@ pairs; each subprocess builds the model, warms up, then times ``--repeats`` runs
 imports the layout of either tree (``rotorred.transient.newmark``, or ``rotorred.newmark`` before
 the layered subpackages).
 
-Run: ``python validation/transient_speed.py [--repeats N] [--t-end S] [--against REV [--rounds N]]``.
+``--step dense`` (or ``eigen``) times that form of the constant-speed step in a tree that has it (from
+issue 15: ``auto`` takes the eigenbasis step), e.g. to compare this tree's dense step against REV's.
+
+Run: ``python validation/transient_speed.py [--repeats N] [--t-end S] [--step FORM] [--against REV [--rounds N]]``.
 """
 
 from __future__ import annotations
@@ -100,9 +103,15 @@ def scene(rr: SimpleNamespace):
     return rig, rr.RubPlate.for_rotor(rig, 18), tuple(rr.Unbalance(*u) for u in UNBALANCES)
 
 
-def measure(rr, model, name: str, rig, plate, unbalances, repeats: int = 3, t_end: float = T_END) -> SpeedRow:
-    """Warm up, then time ``repeats`` runs of the scene on ``model``."""
+def measure(rr, model, name: str, rig, plate, unbalances, repeats: int = 3, t_end: float = T_END,
+            step: str | None = None) -> SpeedRow:
+    """Warm up, then time ``repeats`` runs of the scene on ``model`` (with ``step``, the constant-speed step's form,
+    where the tree's ``simulate`` has that option)."""
+    import inspect
+
     kw = dict(rotor=rig, unbalances=unbalances, plates=[plate], outputs=OUTPUTS, decimate=10, progress=False)
+    if step is not None and "step" in inspect.signature(rr.simulate).parameters:
+        kw["step"] = step
     warm = rr.simulate(model, None, min(t_end, 0.01), DT, **kw)
     runs = [rr.simulate(model, None, t_end, DT, **kw) for _ in range(repeats)]
     r = runs[0]
@@ -116,13 +125,14 @@ def measure(rr, model, name: str, rig, plate, unbalances, repeats: int = 3, t_en
                     n_substeps=r.n_substeps, cpu_us=tuple(cpu))
 
 
-def worker(repeats: int, t_end: float) -> dict:
+def worker(repeats: int, t_end: float, step: str | None = None) -> dict:
     """One subprocess of ``--against``: the reduced model's timed runs (CPU µs per step) with this process's rotorred."""
     import rotorred
 
     rr = api()
     rig, plate, unbalances = scene(rr)
-    row = measure(rr, rr.reduce_rotor(rig, extra_nodes=(18,)), "reduced", rig, plate, unbalances, repeats, t_end)
+    row = measure(rr, rr.reduce_rotor(rig, extra_nodes=(18,)), "reduced", rig, plate, unbalances, repeats, t_end,
+                  step)
     return {"package": str(Path(rotorred.__file__).parent), "n_dof": row.n_dof, "n_steps": row.n_steps,
             "contact_fraction": row.contact_fraction, "cpu_us": list(row.cpu_us)}
 
@@ -136,21 +146,22 @@ def extract(rev: str, into: Path) -> Path:
     return into
 
 
-def run_worker(tree: Path, repeats: int, t_end: float) -> dict:
+def run_worker(tree: Path, repeats: int, t_end: float, step: str | None = None) -> dict:
     env = dict(os.environ, PYTHONPATH=str(tree))
     out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", "--repeats", str(repeats),
-                          "--t-end", str(t_end)], cwd=tree, env=env, capture_output=True, text=True, check=True)
+                          "--t-end", str(t_end)] + (["--step", step] if step else []), cwd=tree, env=env,
+                         capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def against(rev: str, rounds: int, repeats: int, t_end: float) -> int:
+def against(rev: str, rounds: int, repeats: int, t_end: float, step: str | None = None) -> int:
     """Time REV's tree and this one in alternating subprocesses; print min and median CPU µs/step and the ratios."""
     with tempfile.TemporaryDirectory(prefix="rotorred-against-") as tmp:
         trees = {rev: extract(rev, Path(tmp)), "this tree": ROOT}
         samples = {name: [] for name in trees}
         for k in range(rounds):
             for name, tree in trees.items():
-                res = run_worker(tree, repeats, t_end)
+                res = run_worker(tree, repeats, t_end, step)
                 samples[name] += res["cpu_us"]
                 print(f"round {k + 1}/{rounds} {name:>10}: " + " ".join(f"{u:.3f}" for u in res["cpu_us"])
                       + f" µs/step ({res['package']}, {res['n_dof']} DOFs, contact {res['contact_fraction']:.3f})",
@@ -172,13 +183,15 @@ def main(argv=None) -> int:
     parser.add_argument("--t-end", type=float, default=T_END)
     parser.add_argument("--against", metavar="REV", help="also time this git revision, alternating subprocesses")
     parser.add_argument("--rounds", type=int, default=5, help="subprocess pairs with --against (default 5)")
+    parser.add_argument("--step", choices=("auto", "eigen", "dense"), default=None,
+                        help="the constant-speed step's form in a tree that has the option (default: the tree's own)")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        print(json.dumps(worker(args.repeats, args.t_end)))
+        print(json.dumps(worker(args.repeats, args.t_end, args.step)))
         return 0
     if args.against:
-        return against(args.against, args.rounds, args.repeats, args.t_end)
+        return against(args.against, args.rounds, args.repeats, args.t_end, args.step)
     rr = api()
     rig, plate, unbalances = scene(rr)
     t0 = time.perf_counter()
