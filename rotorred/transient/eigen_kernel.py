@@ -7,12 +7,16 @@ state x = (q, v) linearly, plus the forces:
 
 so ``x' = A x + b`` with ``A = [[Hq, Hv], [(2/h)(Hq - I), (2/h) Hv - I]]`` and every input entering as
 ``[u; (2/h) u]``. With ``A = P D P^-1``, D real block-diagonal (a 1x1 block per real eigenvalue, a
-rotation-scaling 2x2 block ``[[a, b], [-b, a]]`` per complex pair), the state ``y = P^-1 x`` steps in
-O(2n) per step: ``y' = D y + sum_j w_j gF_j + sum_k f_k gS_k`` with the inputs mapped once,
-``gF_j = P^-1 [UF_j; (2/h) UF_j]`` and ``gS_k = P^-1 [S_k; (2/h) S_k]``. The contact stays implicit:
-the contact DOFs' displacement is ``C_r y`` (``C_r = B^T P_q``, 2 rows per plate), and the condensed
-Newton solve, the plates' update and the stick reset are those of :mod:`rotorred.transient.kernel`.
-Only q at the recorded DOFs is formed (``rows @ P_q``) when a record is due.
+rotation-scaling 2x2 block ``[[a, b], [-b, a]]`` per complex pair), the state ``y = P^-1 x`` obeys
+``y' = D y + sum_j w_j(t') gF_j + sum_k f_k gS_k`` with the inputs mapped once, ``gF_j = P^-1 [UF_j; (2/h) UF_j]``
+and ``gS_k = P^-1 [S_k; (2/h) S_k]``. The external forces are constants and (cos, sin) pairs at fixed
+frequencies, so the recurrence has an exact periodic particular solution
+``y_p(t) = Y_0 + sum_pairs Re(Y_j e^(i omega_j t))`` with ``(I - e^(-i omega h) D) Y_j = gF_cos - i gF_sin``
+(:func:`rotorred.transient.eigenstep.eigen_form`). The kernel steps ``y_h = y - y_p`` in O(2n):
+``y_h' = D y_h + sum_k f_k gS_k``, and adds ``y_p`` only where q is read: at the contact DOFs
+(``C_r y``, 2 rows per plate) every step and at the recorded outputs when a record is due (both
+precomputed row by pair). The contact stays implicit: the condensed Newton solve, the plates' update and
+the stick reset are those of :mod:`rotorred.transient.kernel`.
 
 This is the same discrete recurrence as the dense step, evaluated in another basis: the histories
 agree to rounding (``cond(P)`` times the machine epsilon). A step whose contact solve fails is redone
@@ -32,7 +36,7 @@ from rotorred.transient import numba_cache
 from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEWTON_FAILED,
                                        NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
                                        _condense_rlin, _disk_forces, _forcing_at_step_end, _matvec, _record,
-                                       _record_step, _solve_contact_forces, _start_forcing, _stick_reset, _substep,
+                                       _solve_contact_forces, _start_forcing, _stick_reset, _substep,
                                        _update_contact_dofs, _write_state)
 
 numba_cache.register()
@@ -48,8 +52,18 @@ class Eigen(NamedTuple):
         ``yr' = a yr + b yi``, ``yi' = -b yr + a yi`` (contiguous, vectorised).
     lam : ndarray, shape (2 n - 2 n_c,)
         The real eigenvalues: ``y' = lam y``.
-    gF : ndarray, shape (nf, 2 n)
-        Forcing vectors in the eigenbasis.
+    pair_col : ndarray of int64, shape (n_f,)
+        Forcing column of the cos member of each (cos, sin) pair (its time functions ``w.fcos``, ``w.fsin``).
+    omega : ndarray, shape (n_f,)
+        Each pair's angular frequency (rad/s).
+    Yr, Yi : ndarray, shape (n_f, 2 n)
+        The particular solution of each pair: ``Re(Y e^(i omega t)) = cos Yr - sin Yi``.
+    Y0 : ndarray, shape (2 n,)
+        That of the constant forces.
+    CYr, CYi : ndarray, shape (n_f, m)
+        ``C_r Yr``, ``C_r Yi``; ``CY0``, shape (m,): ``C_r Y0``.
+    RYr, RYi : ndarray, shape (n_f, n_out)
+        The same for the record rows; ``RY0``, shape (n_out,).
     gS : ndarray, shape (m, 2 n)
         Contact-DOF force columns in the eigenbasis (m = 2 n_p).
     Cr : ndarray, shape (m, 2 n)
@@ -61,7 +75,17 @@ class Eigen(NamedTuple):
     a: np.ndarray
     b: np.ndarray
     lam: np.ndarray
-    gF: np.ndarray
+    pair_col: np.ndarray
+    omega: np.ndarray
+    Yr: np.ndarray
+    Yi: np.ndarray
+    Y0: np.ndarray
+    CYr: np.ndarray
+    CYi: np.ndarray
+    CY0: np.ndarray
+    RYr: np.ndarray
+    RYi: np.ndarray
+    RY0: np.ndarray
     gS: np.ndarray
     Cr: np.ndarray
     P: np.ndarray
@@ -69,15 +93,18 @@ class Eigen(NamedTuple):
 
 
 class EigenWork(NamedTuple):
-    """The eigenbasis state (two buffers), and a physical (q, v) buffer for conversions."""
+    """The eigenbasis state y_h (two buffers), a full y for conversions, and cos, sin of each pair at a time."""
 
-    y: np.ndarray      # (2 n,) current
+    y: np.ndarray      # (2 n,) current y_h
     y_new: np.ndarray  # (2 n,) next
-    x2: np.ndarray     # (2 n,) (q, v)
+    yfull: np.ndarray  # (2 n,) y_h + y_p
+    c: np.ndarray      # (n_f,) cos(omega t)
+    s: np.ndarray      # (n_f,) sin(omega t)
 
 
-def eigen_work(n: int) -> EigenWork:
-    return EigenWork(y=np.zeros(2 * n), y_new=np.zeros(2 * n), x2=np.zeros(2 * n))
+def eigen_work(n: int, n_pairs: int) -> EigenWork:
+    return EigenWork(y=np.zeros(2 * n), y_new=np.zeros(2 * n), yfull=np.zeros(2 * n), c=np.zeros(n_pairs),
+                     s=np.zeros(n_pairs))
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
@@ -90,14 +117,61 @@ def _sum(x):
 
 
 @njit(cache=True, inline="always")
-def _to_physical(eig, y, x):
-    """``x[:2n] = P y``: q and v of the state (the acceleration slot is left as it is)."""
-    _matvec(eig.P, y, x)
+def _phases_at(t, eig, ew):
+    """``ew.c``, ``ew.s``: cos and sin of each pair's omega t."""
+    for j in range(eig.omega.shape[0]):
+        ew.c[j] = math.cos(eig.omega[j] * t)
+        ew.s[j] = math.sin(eig.omega[j] * t)
+
+
+@njit(cache=True, inline="always")
+def _phases_from_forcing(eig, w, ew):
+    """``ew.c``, ``ew.s`` from the forcing's time functions at the end of the main step (``w.fcos``, ``w.fsin``)."""
+    for j in range(eig.omega.shape[0]):
+        ew.c[j] = w.fcos[eig.pair_col[j]]
+        ew.s[j] = w.fsin[eig.pair_col[j]]
+
+
+@njit(cache=True, inline="always")
+def _with_particular(y, eig, ew, out, sign):
+    """``out = y + sign * y_p`` at the phases in ``ew``."""
+    for i in range(y.shape[0]):
+        out[i] = y[i] + sign * eig.Y0[i]
+    for j in range(eig.omega.shape[0]):
+        c = sign * ew.c[j]
+        sn = sign * ew.s[j]
+        for i in range(y.shape[0]):
+            out[i] += c * eig.Yr[j, i] - sn * eig.Yi[j, i]
+
+
+@njit(cache=True, inline="always")
+def _to_physical(y, eig, ew, x):
+    """``x[:2n] = P (y_h + y_p)``: q and v of the state at the phases in ``ew`` (the acceleration is left alone)."""
+    _with_particular(y, eig, ew, ew.yfull, 1.0)
+    _matvec(eig.P, ew.yfull, x)
+
+
+@njit(cache=True, inline="always")
+def _from_physical(x, eig, ew, y):
+    """``y = P^-1 x - y_p`` at the phases in ``ew``."""
+    _matvec(eig.Pinv, x, ew.yfull)
+    _with_particular(ew.yfull, eig, ew, y, -1.0)
+
+
+@njit(cache=True, inline="always")
+def _record_eigen(idx, t, y, cur, eig, ew, record):
+    """Record row ``idx``: the rows on y_h plus the particular solution's rows at the phases in ``ew``."""
+    _record(idx, t, State(y, cur.xc, cur.ps, cur.z, cur.mode, cur.sgn, cur.pinfo), record)
+    for r in range(record.y.shape[1]):
+        v = eig.RY0[r]
+        for j in range(eig.omega.shape[0]):
+            v += ew.c[j] * eig.RYr[j, r] - ew.s[j] * eig.RYi[j, r]
+        record.y[idx, r] += v
 
 
 @njit(cache=True, inline="always")
 def _eigen_predictor(y, y_new, eig, cur, plates, w):
-    """``y_new = D y + sum_j w_j gF_j + sum_k f_old,k gS_k``: the step at zero new contact force."""
+    """``y_new = D y + sum_k f_old,k gS_k``: the homogeneous part at zero new contact force."""
     nc = eig.a.shape[0]
     for k in range(nc):
         yr = y[k]
@@ -106,18 +180,23 @@ def _eigen_predictor(y, y_new, eig, cur, plates, w):
         y_new[nc + k] = eig.a[k] * yi - eig.b[k] * yr
     for k in range(eig.lam.shape[0]):
         y_new[2 * nc + k] = eig.lam[k] * y[2 * nc + k]
-    _add_columns(y_new, w.fval, eig.gF, 1.0)
     if plates.par.shape[0] > 0:
         _disk_forces(cur.z, plates.par, w.frot)
         _add_columns(y_new, w.frot, eig.gS, 1.0)
 
 
 @njit(cache=True, inline="always")
-def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w):
-    """One main step at level 0 in the eigenbasis, into ``y_new`` and ``new``; RUNNING or a failure code."""
+def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w, ew):
+    """One main step at level 0 in the eigenbasis, into ``y_new`` and ``new`` (the phases of the step's end in
+    ``ew``); RUNNING or a failure code."""
     _eigen_predictor(y, y_new, eig, cur, plates, w)
     if plates.par.shape[0] > 0:
         _matvec(eig.Cr, y_new, w.rlin)
+        for k in range(w.rlin.shape[0]):
+            r = eig.CY0[k]
+            for j in range(eig.omega.shape[0]):
+                r += ew.c[j] * eig.CYr[j, k] - ew.s[j] * eig.CYi[j, k]
+            w.rlin[k] += r
         touching = _condense_rlin(0, cur, levels, plates, w)
         cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[0], levels.Jv[0], levels.coef[0, 3])
         if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
@@ -139,16 +218,17 @@ def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, 
 @njit(cache=True)
 def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, work, ework, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` as :func:`rotorred.transient.kernel.run_steps` does, level 0 in
-    the eigenbasis (``record.rows`` act on y: the output rows times ``P_q``). ``state.x`` holds q, v on entry
+    the eigenbasis (``record.rows`` act on y: the output rows times ``P``). ``state.x`` holds q, v on entry
     and on return."""
     levels, eig, forcing, plates, record, diag = (_borrowed(levels), _borrowed(eig), _borrowed(forcing),
                                                   _borrowed(plates), _borrowed(record), _borrowed(diag))
     cur, new, w, ew = _borrowed(state), _borrowed(spare), _borrowed(work), _borrowed(ework)
     t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
     y, y_new = ew.y, ew.y_new
-    _matvec(eig.Pinv, cur.x, y)  # y = P^-1 (q, v)
+    _phases_at(t0 + i_begin * dt, eig, ew)
+    _from_physical(cur.x, eig, ew, y)
     if i_begin == 0 and record.start == 0 and record.count[0] == 0:
-        _record(0, t0, State(y, cur.xc, cur.ps, cur.z, cur.mode, cur.sgn, cur.pinfo), record)
+        _record_eigen(0, t0, y, cur, eig, ew, record)
         record.count[0] = 1
     units_total = 1 << n_halvings
     extrapolate = False
@@ -156,14 +236,16 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
     for i in range(i_begin, i_end):
         t_main = t0 + i * dt
         _forcing_at_step_end(i - i_begin, t0 + (i + 1) * dt, forcing, w)
-        status = _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w)
+        _phases_from_forcing(eig, w, ew)
+        status = _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w, ew)
         if status == RUNNING:
             j = _beyond_limit(new.xc, settings.limit)
             if j >= 0:
                 diag.err[E_TIME] = t0 + (i + 1) * dt
                 diag.err[E_DOF] = -1 - j
                 diag.err[E_STATUS] = LIMIT
-                _to_physical(eig, y, cur.x)
+                _phases_at(t_main, eig, ew)
+                _to_physical(y, eig, ew, cur.x)
                 _write_state(cur, state)
                 return LIMIT
             cur, new = new, cur
@@ -171,7 +253,8 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
             extrapolate = True
         else:  # redo the main step by the dense step's halvings (or, with none allowed, its own level-0 step, which
             # reports the failure with its DOF or plate), from the physical state
-            _to_physical(eig, y, cur.x)
+            _phases_at(t_main, eig, ew)
+            _to_physical(y, eig, ew, cur.x)
             extrapolate = False
             level = 1 if n_halvings > 0 else 0
             progress = 0
@@ -203,9 +286,14 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
                         diag.err[E_STATUS] = status
                         _write_state(cur, state)
                         return status
-            _matvec(eig.Pinv, cur.x, y)
+            _phases_from_forcing(eig, w, ew)
+            _from_physical(cur.x, eig, ew, y)
         diag.counters[C_STEPS] += 1
-        _record_step(i + 1, t0 + (i + 1) * dt, State(y, cur.xc, cur.ps, cur.z, cur.mode, cur.sgn, cur.pinfo), record)
-    _to_physical(eig, y, cur.x)
+        j = i + 1
+        if j >= record.start and (j - record.start) % record.every == 0 and record.count[0] < record.t.shape[0]:
+            _record_eigen(record.count[0], t0 + j * dt, y, cur, eig, ew, record)
+            record.count[0] += 1
+    _phases_at(t0 + i_end * dt, eig, ew)
+    _to_physical(y, eig, ew, cur.x)
     _write_state(cur, state)
     return RUNNING

@@ -69,8 +69,8 @@ def modal_scaling(M: np.ndarray, K: np.ndarray) -> np.ndarray:
     return T
 
 
-def eigen_form(levels: kernel.Levels, plates: kernel.Plates, scheme, M: np.ndarray,
-               K: np.ndarray) -> tuple[Eigen | None, str]:
+def eigen_form(levels: kernel.Levels, plates: kernel.Plates, scheme, M: np.ndarray, K: np.ndarray,
+               forcing: kernel.Forcing) -> tuple[Eigen | None, str]:
     """The eigenbasis step's operators for level 0, or None with the reason the dense step is kept.
 
     The eigenvectors are those of ``T^-1 A T`` (:func:`modal_scaling`): ``P = T P~``; the condition number
@@ -102,12 +102,79 @@ def eigen_form(levels: kernel.Levels, plates: kernel.Plates, scheme, M: np.ndarr
         return np.ascontiguousarray((Pinv @ np.vstack([rows.T, (2.0 / h) * rows.T])).T) if len(rows) else \
             np.zeros((0, 2 * n))
 
-    eig = Eigen(a=a, b=b, lam=lam, gF=mapped(levels.UF[0]), gS=mapped(levels.ST[0]),
-                Cr=np.ascontiguousarray(plates.BT @ P[:n]), P=np.ascontiguousarray(P),
-                Pinv=np.ascontiguousarray(Pinv))
+    gF = mapped(levels.UF[0])
+    particular = particular_solutions(a, b, lam, gF, forcing, h)
+    if isinstance(particular, str):
+        return None, particular
+    pair_col, omega, Yr, Yi, Y0 = particular
+    Cr = np.ascontiguousarray(plates.BT @ P[:n])
+    m = Cr.shape[0]
+    eig = Eigen(a=a, b=b, lam=lam, pair_col=pair_col, omega=omega, Yr=Yr, Yi=Yi, Y0=Y0,
+                CYr=np.ascontiguousarray(Yr @ Cr.T).reshape(len(omega), m),
+                CYi=np.ascontiguousarray(Yi @ Cr.T).reshape(len(omega), m), CY0=Cr @ Y0,
+                RYr=np.zeros((len(omega), 0)), RYi=np.zeros((len(omega), 0)), RY0=np.zeros(0),
+                gS=mapped(levels.ST[0]), Cr=Cr, P=np.ascontiguousarray(P), Pinv=np.ascontiguousarray(Pinv))
     return eig, f"eigenbasis, cond(P) = {cond:.3g}"
+
+
+def particular_solutions(a, b, lam, gF: np.ndarray, forcing: kernel.Forcing, h: float):
+    """The periodic particular solution of ``y' = D y + sum_j w_j(t') gF_j`` for constant columns (kind 0) and
+    (cos, sin) pairs (kinds 1, 2), or a "dense: ..." reason when a pair is at a natural frequency of the step.
+
+    Returns
+    -------
+    pair_col : ndarray of int64, shape (n_f,)
+    omega : ndarray, shape (n_f,)
+    Yr, Yi : ndarray, shape (n_f, 2 n)
+        ``Y = Yr + i Yi`` solves ``(I - e^(-i omega h) D) Y = gF_cos - i gF_sin``.
+    Y0 : ndarray, shape (2 n,)
+        ``(I - D) Y0 = sum of the constant columns``.
+    """
+    nc = len(a)
+    m = 2 * nc + len(lam)
+
+    def solve(g, z):  # (I - z D) Y = g, block by block
+        Y = np.zeros(m, complex)
+        p, q = 1.0 - z * a, z * b
+        det = p * p + q * q
+        gr, gi = g[:nc], g[nc:2 * nc]
+        Y[:nc] = (p * gr + q * gi) / det
+        Y[nc:2 * nc] = (p * gi - q * gr) / det
+        Y[2 * nc:] = g[2 * nc:] / (1.0 - z * lam)
+        smallest = min(np.min(np.abs(det), initial=np.inf), np.min(np.abs(1.0 - z * lam), initial=np.inf))
+        return Y, smallest
+
+    kinds, omegas = np.asarray(forcing.kind), np.asarray(forcing.omega)
+    Y0 = np.zeros(m)
+    cols, oms, Yr, Yi = [], [], [], []
+    for j, kind in enumerate(kinds):
+        if kind == 0:
+            Y, smallest = solve(gF[j].astype(complex), 1.0)
+            Y0 += Y.real
+        elif kind == 1:
+            Y, smallest = solve(gF[j] - 1j * gF[j + 1], np.exp(-1j * omegas[j] * h))
+            cols.append(j)
+            oms.append(omegas[j])
+            Yr.append(Y.real)
+            Yi.append(Y.imag)
+        else:
+            continue
+        if smallest < 1e-12:
+            return (f"dense: a force at {omegas[j]:.6g} rad/s excites an undamped mode of the step at its own "
+                    "frequency (no periodic particular solution)")
+    return (np.array(cols, dtype=np.int64), np.array(oms, dtype=float),
+            np.ascontiguousarray(np.array(Yr).reshape(len(cols), m)),
+            np.ascontiguousarray(np.array(Yi).reshape(len(cols), m)), Y0)
 
 
 def rows_on_y(rows: np.ndarray, P: np.ndarray) -> np.ndarray:
     """Record rows on x = (q[, v]) mapped to rows on y: ``rows @ P[:k]`` with k the rows' width."""
     return np.ascontiguousarray(rows @ P[:rows.shape[1]])
+
+
+def with_record_rows(eig: Eigen, rows_y: np.ndarray) -> Eigen:
+    """``eig`` with the particular solution's contributions to the record rows (on y)."""
+    n_out = rows_y.shape[0]
+    return eig._replace(RYr=np.ascontiguousarray(eig.Yr @ rows_y.T).reshape(len(eig.omega), n_out),
+                        RYi=np.ascontiguousarray(eig.Yi @ rows_y.T).reshape(len(eig.omega), n_out),
+                        RY0=rows_y @ eig.Y0)

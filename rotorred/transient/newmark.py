@@ -59,7 +59,7 @@ from rotorred import checks
 from rotorred.model.loads import Unbalance
 from rotorred.model.speeds import SpeedProfile
 from rotorred.transient import eigen_kernel, kernel
-from rotorred.transient.eigenstep import eigen_form, rows_on_y
+from rotorred.transient.eigenstep import eigen_form, rows_on_y, with_record_rows
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate
 from rotorred.transient.matrices import (contact_rows, force_columns, kernel_plates, newmark_coefficients,
                                          plate_parameters, step_levels, step_matrices)
@@ -92,7 +92,7 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     if eig is None:
         loop, extra = kernel.run_steps, (levels, forcing, plates, state, spare, work, record, settings, diag)
     else:
-        ework = eigen_kernel.eigen_work(len(state.x) // 3)
+        ework = eigen_kernel.eigen_work(len(state.x) // 3, len(eig.omega))
         loop, extra = eigen_kernel.run_eigen_steps, (levels, eig, forcing, plates, state, spare, work, ework, record,
                                                      settings, diag)
     load_time = load_kernel((0, 0, *extra), loop)
@@ -232,18 +232,22 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     levels = step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha,
                          run.max_halvings + 1)
     state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
-    eig, step_form = choose_step(step, levels, contact, scheme, M, K)
+    forcing = kernel.Forcing(forces.kind, forces.omega)
+    eig, step_form = choose_step(step, levels, contact, scheme, M, K, forcing)
     # 3. plan the record (on the eigenbasis state y when the step runs there)
     plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
     rows = record_rows(model, loads.outputs, record_state)
-    record = record_buffers(plan, rows if eig is None else rows_on_y(rows, eig.P), len(loads.plates))
+    if eig is not None:
+        rows = rows_on_y(rows, eig.P)
+        eig = with_record_rows(eig, rows)
+    record = record_buffers(plan, rows, len(loads.plates))
     setup_time = time.perf_counter() - t_setup
     # 4. run the kernel
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
                                max_newton=run.max_newton, limit=run.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
     status, run_time, run_cpu_time, load_time = run_kernel(
-        levels, kernel.Forcing(forces.kind, forces.omega), contact, state, record, settings, diag, plan.n_steps,
+        levels, forcing, contact, state, record, settings, diag, plan.n_steps,
         run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
@@ -255,11 +259,11 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
 STEPS = ("auto", "eigen", "dense")
 
 
-def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme, M, K):
+def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme, M, K, forcing: kernel.Forcing):
     """(Eigen or None, what was chosen and why) for ``step`` (:data:`STEPS`)."""
     if step == "dense":
         return None, "dense (asked)"
-    eig, note = eigen_form(levels, plates, scheme, M, K)
+    eig, note = eigen_form(levels, plates, scheme, M, K, forcing)
     if eig is None and step == "eigen":
         checks.fail("step", step, f"cannot be used here: {note.removeprefix('dense: ')}")
     return eig, note
