@@ -205,6 +205,7 @@ def tracks_of(scene: Scene, t: np.ndarray, speeds: dict, angles: dict, outputs: 
 def rub_intervals(scene: Scene, t: np.ndarray, speeds: dict, contacts) -> tuple[RubInterval, ...]:
     """Stretches of contact, merged across gaps shorter than :data:`RUB_GAP_REVS` revolutions of the reference spool."""
     ref = speeds[scene.runup.reference]
+    hz = {s: w / (2 * math.pi) for s, w in speeds.items()}
     out = []
     for k, ch in enumerate(contacts):
         touching = np.flatnonzero(ch.state != 0)
@@ -219,7 +220,6 @@ def rub_intervals(scene: Scene, t: np.ndarray, speeds: dict, contacts) -> tuple[
                 start = b
         groups.append((start, touching[-1]))
         for i, j in groups:
-            hz = {s: w / (2 * math.pi) for s, w in speeds.items()}
             out.append(RubInterval(plate=k, node=ch.plate.node, t_start=float(t[i]), t_end=float(t[j]),
                                    speed_start={s: float(v[i]) for s, v in hz.items()},
                                    speed_end={s: float(v[j]) for s, v in hz.items()},

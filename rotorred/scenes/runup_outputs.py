@@ -34,10 +34,6 @@ def runup_arrays(result: RunupResult) -> dict[str, np.ndarray]:
     return arrays
 
 
-def _unit(d) -> tuple[float, str]:
-    return (1e6, "urad") if d[1].startswith("theta") else (1e6, "um")
-
-
 def _amplitude_csv(result: RunupResult, path: Path) -> Path:
     """Per block of the reference spool: its speed (Hz, rpm) and each node's largest orbit radius (µm)."""
     nodes = sorted(result.overall)
@@ -51,7 +47,6 @@ def _tracks_csv(result: RunupResult, path: Path) -> Path:
     """One row per track and block: spool, order, DOF, time, the spool's speed, amplitude and phase."""
     cols = [[], [], [], [], [], [], [], []]
     for track, dof in zip(result.tracks, result.track_dofs):
-        scale, _ = _unit(dof)
         n = len(track.t)
         cols[0] += [track.spool] * n
         cols[1] += [track.order] * n
@@ -59,7 +54,7 @@ def _tracks_csv(result: RunupResult, path: Path) -> Path:
         cols[3] += list(track.t)
         cols[4] += list(track.speed * HZ)
         cols[5] += list(60 * track.speed * HZ)
-        cols[6] += list(scale * track.amplitude)
+        cols[6] += list(1e6 * track.amplitude)  # um, or urad for a rotation
         cols[7] += list(np.degrees(track.phase))
     header = ["spool", "order", "dof", "t (s)", "spool speed (Hz)", "spool speed (rpm)", "amplitude (um or urad)",
               "phase (deg)"]

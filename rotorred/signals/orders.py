@@ -136,17 +136,18 @@ def order_tracks(blocks: AngleBlocks, spool: str, orders) -> list[list[OrderTrac
     n_signals, n_blocks, m = blocks.values.shape
     w = window_values("hann", m) if m else np.zeros(0)
     tc = blocks.t.mean(axis=1) if n_blocks else np.zeros(0)
-    out = []
-    for k in range(n_signals):
-        tracks = []
-        for order in orders:
-            rel = blocks.theta - blocks.theta[:, :1]  # the DFT's phase reference: the block's first angle
-            X = (2.0 / w.sum()) * (blocks.values[k] * w * np.exp(-1j * order * rel)).sum(axis=1) if m else np.zeros(0)
-            X = X * np.exp(-1j * order * blocks.theta[:, 0]) if n_blocks else X  # phase against the angle itself
-            tracks.append(OrderTrack(spool=spool, order=float(order), t=tc, speed=blocks.speed, amplitude=np.abs(X),
-                                     phase=np.angle(X), method=blocks.method))
-        out.append(tracks)
-    return out
+    if not (m and n_blocks):
+        empty = np.zeros(0)
+        return [[OrderTrack(spool, float(o), tc, blocks.speed, empty, empty, blocks.method) for o in orders]
+                for _ in range(n_signals)]
+    per_order = []
+    for order in orders:
+        # single-bin DFT of every block and signal at once, phase against the spin angle itself
+        X = (2.0 / w.sum()) * np.einsum("kbm,bm->kb", blocks.values, w * np.exp(-1j * order * blocks.theta))
+        per_order.append(X)
+    return [[OrderTrack(spool=spool, order=float(order), t=tc, speed=blocks.speed, amplitude=np.abs(X[k]),
+                        phase=np.angle(X[k]), method=blocks.method) for order, X in zip(orders, per_order)]
+            for k in range(n_signals)]
 
 
 def overall_amplitude(blocks: AngleBlocks, ix: int, iy: int) -> np.ndarray:

@@ -93,9 +93,10 @@ def speed_intervals(profile: SpeedProfile, spools, n_steps: int, dt: float, widt
         if i_b <= i_a:
             continue
         t = np.unique(np.concatenate([[i_a * dt, i_b * dt], tk[(tk > i_a * dt) & (tk < i_b * dt)]]))
-        speed = np.array([profile.speed(t)[s] for s in spools])
-        mid = 0.5 * (t[1:] + t[:-1])  # one time inside each piece of constant acceleration
-        acc = np.array([profile.at(mid)[s][1] for s in spools])
+        at_t = profile.speed(t)
+        at_mid = profile.at(0.5 * (t[1:] + t[:-1]))  # one time inside each piece of constant acceleration
+        speed = np.array([at_t[s] for s in spools])
+        acc = np.array([at_mid[s][1] for s in spools])
         lo, hi = speed.min(axis=1), speed.max(axis=1)
         a_ref = profile.at(0.5 * (t[0] + t[-1]))
         ref = np.column_stack([0.5 * (lo + hi), [a_ref[s][1] for s in spools]])
