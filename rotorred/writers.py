@@ -84,8 +84,8 @@ def write_csv(path: str | Path, header: Sequence[str], columns: Sequence[Sequenc
     w.writerow(header)
     fmt = _numeric_format(columns, digits)
     if fmt is not None and columns and len(columns[0]):  # numbers only: one %-format per row, the same text
-        rows = np.column_stack([np.asarray(c) for c in columns]).tolist()
-        buf.write("\n".join([fmt % tuple(r) for r in rows]) + "\n")
+        rows = zip(*[c.tolist() for c in columns])  # Python floats and ints, each column its own type
+        buf.write("\n".join([fmt % r for r in rows]) + "\n")
     else:
         for row in zip(*columns):
             w.writerow([_cell(v, digits) for v in row])
@@ -93,13 +93,13 @@ def write_csv(path: str | Path, header: Sequence[str], columns: Sequence[Sequenc
 
 
 def _numeric_format(columns: Sequence[Sequence], digits: int) -> str | None:
-    """The %-format of a row when every column is a float or integer array (``_cell``'s text), else None.
+    """The %-format of a row when every column is a 1-D float or integer array (``_cell``'s text), else None.
 
-    ``"%.9g" % x`` and ``f"{x:.9g}"`` are the same conversion; formatting a whole row at once is about
-    2.5x faster than a cell at a time through the csv module (30 001 x 13: 0.28 against 0.71 s).
+    ``"%.9g" % x`` and ``f"{x:.9g}"`` are the same conversion, as are ``"%d" % i`` and ``str(i)``; formatting a
+    whole row at once is about 2.5x faster than a cell at a time through the csv module (30 001 x 13: 0.28
+    against 0.71 s; paper-rub's timeseries.csv, 30 001 x 17 with an integer column: 0.26 against 1.37 s).
     """
-    kinds = {c.dtype.kind if isinstance(c, np.ndarray) and c.ndim == 1 else "" for c in columns}
-    if not kinds <= set("fiu") or ("f" in kinds and kinds != {"f"}):  # a mixed row would make its integers floats
+    if not all(isinstance(c, np.ndarray) and c.ndim == 1 and c.dtype.kind in "fiu" for c in columns):
         return None
     kinds = [c.dtype.kind for c in columns]
     return ",".join(f"%.{digits}g" if k == "f" else "%d" for k in kinds)

@@ -20,17 +20,18 @@ def test_numeric_rows_are_written_as_cell_by_cell(tmp_path):
     floats[1][[3, 7, 11]] = [np.nan, np.inf, -np.inf]
     floats[2][5] = -0.0
     ints = [np.arange(501), -np.arange(501, dtype=np.int32) * 7, np.arange(501, dtype=np.uint8)]
+    mixed = [floats[0], ints[1], floats[1], ints[2]]  # each column keeps its type: integers stay integers
     for header, columns, digits in ((["t (s)", "x (m)", "F (N)"], floats, 9), (["a", "b", "c"], ints, 9),
-                                    (["t", "x", "F"], floats, 17)):
+                                    (["t", "x", "F"], floats, 17), (["t", "i", "x", "state"], mixed, 9)):
         assert writers._numeric_format(columns, digits) is not None
         path = write_csv(tmp_path / "a.csv", header, columns, digits=digits)
         assert path.read_text() == _cell_by_cell(header, columns, digits)
 
 
-def test_mixed_or_text_columns_take_the_general_path(tmp_path):
-    mixed = [np.arange(3), np.array([0.5, 1.5, 2.5])]  # a row of both would turn the integers into floats
+def test_text_columns_take_the_general_path_and_integers_stay_integers(tmp_path):
+    mixed = [np.arange(3), np.array([0.5, 1.5, 2.5])]
     text = [np.array([1.0, 2.0]), ["ok", "failed: a, b"]]  # quoted by the csv module
-    assert writers._numeric_format(mixed, 9) is None and writers._numeric_format(text, 9) is None
+    assert writers._numeric_format(text, 9) is None and writers._numeric_format([np.zeros((2, 2))], 9) is None
     assert write_csv(tmp_path / "m.csv", ["i", "x"], mixed).read_text() == "i,x\n0,0.5\n1,1.5\n2,2.5\n"
     assert write_csv(tmp_path / "t.csv", ["x", "s"], text).read_text() == 'x,s\n1,ok\n2,"failed: a, b"\n'
     assert write_csv(tmp_path / "e.csv", ["x"], [np.zeros(0)]).read_text() == "x\n"

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
+from matplotlib.transforms import ScaledTranslation
 
 from rotorred import checks
 from rotorred.model.dofs import direction_name
@@ -95,7 +96,7 @@ def _side_by_side(panel_width: float, height: float, n: int) -> tuple[Figure, np
 def _save(fig: Figure, path: Path, title: str | None) -> Path:
     if title:
         fig.suptitle(title)
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, pil_kwargs={"compress_level": 1})  # zlib level 1: PNG encoding 0.13 -> 0.05 s a figure, files 15 % larger
     return path
 
 
@@ -155,7 +156,7 @@ def plot_waveforms(
             ax.plot(t[keep], scale * y[keep], lw=1.0, label=str(label))
         ax.set_ylabel(f"{quantity} ({unit})")
         if panel:
-            ax.set_title(panel)
+            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("Time (s)")
@@ -239,16 +240,9 @@ def plot_spectra(
             lw = 0.9 + 1.6 * (n_series - 1 - i)
             (handle,) = ax.plot(f[show], scale * a[show], lw=lw, label=str(label))
             top = max(top, float(np.max(scale * a[show][f[show] > 0], initial=0.0)))
-            for ln in lines.get(str(label), ()):
-                if not ln.known or (f_max is not None and ln.frequency_hz > f_max):
-                    continue
-                y = scale * ln.amplitude
-                ax.plot(ln.frequency_hz, y, "v", ms=4, color=handle.get_color())
-                ax.annotate(
-                    plot_label(ln.label), (ln.frequency_hz, y), xytext=(0, 6),
-                    textcoords="offset points", rotation=90, ha="center", va="bottom",
-                    fontsize=8, color=handle.get_color(),
-                )
+            shown = [ln for ln in lines.get(str(label), ())
+                     if ln.known and (f_max is None or ln.frequency_hz <= f_max)]
+            _label_lines(ax, shown, scale, handle.get_color())
         if log_y:
             ax.set_yscale("log")
             ax.set_ylim(top / dynamic_range, top * 30)  # headroom for rotated labels
@@ -256,12 +250,25 @@ def plot_spectra(
             ax.set_ylim(0, top * 1.35 if top > 0 else 1)
         ax.set_ylabel(f"Amplitude ({unit})")
         if panel:
-            ax.set_title(panel)
+            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
         ax.grid(True, alpha=0.3, which="both" if not log_y else "major")
         ax.legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("Frequency (Hz)")
     axes[-1].set_xlim(0, f_max if f_max is not None else None)
     return _save(fig, path, title)
+
+
+def _label_lines(ax, lines: Sequence[SpectralLine], scale: float, color) -> None:
+    """Mark ``lines`` (one marker artist for all) and write each one's label above it, rotated."""
+    if not lines:
+        return
+    f = np.array([ln.frequency_hz for ln in lines])
+    y = scale * np.array([ln.amplitude for ln in lines])
+    ax.plot(f, y, "v", ms=4, ls="none", color=color)
+    above = ax.transData + ScaledTranslation(0, 6 / 72, ax.figure.dpi_scale_trans)  # 6 points above the marker
+    for fk, yk, ln in zip(f, y, lines):
+        ax.text(fk, yk, plot_label(ln.label), transform=above, rotation=90, ha="center", va="bottom", fontsize=8,
+                color=color, clip_on=False)
 
 
 def plot_label(label: str) -> str:
@@ -338,7 +345,7 @@ def plot_orbits(
         ax.axhline(0, color="0.8", lw=0.6, zorder=0)
         ax.axvline(0, color="0.8", lw=0.6, zorder=0)
         if panel:
-            ax.set_title(panel)
+            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
     return _save(fig, path, title)

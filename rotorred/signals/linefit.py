@@ -129,7 +129,7 @@ from fractions import Fraction
 
 import numpy as np
 import scipy.linalg
-import scipy.stats
+import scipy.special
 
 from rotorred import checks
 from rotorred.signals.lines import MINUS, combination_label
@@ -799,7 +799,7 @@ def _shortlist(peaks: tuple[UnlabelledPeak, ...], opts: _Options, tol_hz: float,
                 continue
             chance = min(1.0, new.size * 2.0 * tol_hz / max(new.max() - opts.f_lo, 2.0 * tol_hz))
             matched = np.abs(new[:, None] - where[None, :]).min(axis=0) <= tol_hz
-            p_value = float(scipy.stats.binom.sf(int(matched.sum()) - 1, where.size, chance))
+            p_value = float(scipy.special.bdtrc(int(matched.sum()) - 1, where.size, chance))  # binomial survival function
             if matched.any() and p_value <= TORUS_ALPHA:
                 scored.append((p_value, -float(energy[matched].sum()), k * j, k + j, k, (k, j)))
     return [kj for *_, kj in sorted(scored)[:N_TORI]]
