@@ -242,3 +242,30 @@ def test_gravity_settled_state_matches_time_stepping():
     for d in harmonic.outputs:
         amp = np.max(np.abs(harmonic.outputs[d] - np.mean(harmonic.outputs[d])))
         assert np.max(np.abs(stepped.outputs[d] - harmonic.outputs[d])) < tol * amp + 1e-12 * abs(sag)
+
+
+def test_figures_drawn_by_worker_processes_are_the_figures_drawn_here(rub, tmp_path):
+    """The command draws its figures in a FigurePool while it writes the data files: the same files, pixel for
+    pixel, as drawing them here; a failing figure fails the write (its error, not a lost file)."""
+    import pickle
+
+    from matplotlib.image import imread
+
+    from rotorred.plots.pool import FigurePool
+    from rotorred.plots.scene import scene_figures
+
+    sc, res = rub
+    here = write_outputs(res, tmp_path / "here")
+    with FigurePool(workers=1) as pool:
+        there = write_outputs(res, tmp_path / "there", pool=pool)
+    assert [f.name for f in here] == [f.name for f in there]
+    for a, b in zip(here, there):
+        if a.suffix == ".png":
+            np.testing.assert_array_equal(imread(a), imread(b))
+    jobs = scene_figures(res, tmp_path / "jobs")
+    assert len(jobs) == 5 and all(pickle.loads(pickle.dumps(job)).func is job.func for job in jobs)
+    import functools
+
+    bad = functools.partial(jobs[0].func, res.t[:1], *jobs[0].args[1:], **jobs[0].keywords)  # 1 sample: refused
+    with FigurePool(workers=1) as pool, pytest.raises(Exception, match="at least 2 samples"):
+        pool.submit(bad).result()

@@ -59,10 +59,18 @@ def run(args) -> int:
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
     budget.check(budget.scene_estimate(scene), force=args.force)
-    with OutputFolder(out) as folder:
-        status = _compute_and_write(scene, args, folder, out)
+    with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
+        status = _compute_and_write(scene, args, folder, out, pool)
     print(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
+
+
+def _figure_pool(scene):
+    """Workers that import matplotlib now and draw the figures while the data files are written
+    (:class:`rotorred.plots.pool.FigurePool`); none for a scene without figures or a run-up."""
+    from rotorred.plots.pool import FigurePool
+
+    return FigurePool(workers=0 if not scene.output.plots or scene.runup is not None else None)
 
 
 def _settings(items: list[str]) -> dict:
@@ -78,26 +86,27 @@ def _settings(items: list[str]) -> dict:
     return settings
 
 
-def _compute_and_write(scene, args, folder, out) -> int:
+def _compute_and_write(scene, args, folder, out, pool) -> int:
     """Run the scene, stage its files and commit them; a diverged run commits its partial record (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
 
     if scene.runup is not None:
         return _runup_and_write(scene, folder, out)
     from rotorred.scenes.outputs import write_outputs
-    from rotorred.scenes.run import SceneDiverged, run_scene
+    from rotorred.scenes.run import SceneDiverged
     from rotorred.scenes.summary import format_summary
+    from rotorred.scenes.tolerance import run_to_tolerance
 
     try:
-        result = run_scene(scene, compare_normal=False if args.no_normal else None, progress=None)
+        result = run_to_tolerance(scene, compare_normal=False if args.no_normal else None, progress=None)
     except SceneDiverged as exc:
-        write_outputs(exc.partial, folder.staging, shown=out)
+        write_outputs(exc.partial, folder.staging, shown=out, pool=pool)
         files = folder.commit(incomplete=str(exc))
         print(format_summary(exc.partial, files))
         print(f"rotorred run: error: {exc}; partial results written to {out} (marked {INCOMPLETE})",
               file=sys.stderr)
         return EXIT_DIVERGED
-    files = write_outputs(result, folder.staging, shown=out)
+    files = write_outputs(result, folder.staging, shown=out, pool=pool)
     folder.commit()
     print(format_summary(result, files))
     return 0

@@ -165,6 +165,10 @@ class MapSpec:
 
         total = 0
         for scene in self.scenes():
+            if scene.solver.tolerance is not None:
+                checks.fail("solver.tolerance", scene.solver.tolerance, "is not available in maps yet (each point would "
+                            "choose its own model and step): choose the settings with `rotorred run --set "
+                            "solver.tolerance=...` at a representative point and give them to the map")
             budget.check(budget.scene_estimate(scene), force=force)
             total += max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
         if total > budget.MAX_STEPS and not force:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,7 @@ from rotorred.model.dofs import direction_name
 from rotorred.signals.lines import SpectralLine
 from rotorred.signals.spectra import Spectrum
 
-__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene"]
+__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures"]
 
 
 # --------------------------------------------------------------------------- helpers
@@ -408,7 +409,24 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
 # --------------------------------------------------------------------------- a scene's figures
 def plot_scene(result, out: str | Path) -> list[Path]:
     """The figures a scene's ``output.plots`` asks for, written into ``out``: waveforms, spectra, orbits,
-    the Poincare section of the table DOF.
+    the Poincare section of the table DOF (each of :func:`scene_figures` drawn here, one after the other).
+
+    Parameters
+    ----------
+    result : rotorred.scenes.run.SceneResult
+    out : str or Path
+
+    Returns
+    -------
+    list of Path
+    """
+    return [job() for job in scene_figures(result, out)]
+
+
+def scene_figures(result, out: str | Path) -> list[partial]:
+    """The figures of :func:`plot_scene` as jobs: each a ``functools.partial`` of a plot function and plain
+    arrays, which draws and writes one file when called (in this process or, pickled, in a
+    :class:`rotorred.plots.pool.FigurePool` worker) and returns its path.
 
     Parameters
     ----------
@@ -419,14 +437,14 @@ def plot_scene(result, out: str | Path) -> list[Path]:
 
     Returns
     -------
-    list of Path
+    list of functools.partial
     """
     out = Path(out)
     sc = result.scene
     plots = sc.output.plots
     case = "rub" if sc.plates else "response"
     pairs = [("normal", result.normal), (case, result)] if result.normal is not None else [(case, result)]
-    files = []
+    jobs = []
     rub_text = "; ".join(f"rub at node {p.node} ({math.degrees(p.theta):g} deg, clearance {1e6 * p.clearance:.3g} um)"
                          for p in sc.plates) or "no rub"
     speeds = ", ".join(f"{w / (2 * math.pi):.4g} Hz" for w in sc.speeds.values())
@@ -435,7 +453,7 @@ def plot_scene(result, out: str | Path) -> list[Path]:
         window = sc.output.plot_window or (result.t[0], min(result.t[-1], result.t[0] + 0.14))
         signals = {f"node {n} {direction_name(d)}": {label: r.outputs[(n, d)] for label, r in pairs}
                    for n in sc.output.nodes for d in sc.output.directions}
-        files.append(plot_waveforms(result.t, signals, out / "waveforms.png", t_window=window,
+        jobs.append(partial(plot_waveforms, result.t, signals, out / "waveforms.png", t_window=window,
                                     title=f"{sc.name}: time waveforms ({speeds}; {rub_text})",
                                     unit="µm" if translational else "µrad"))
     if "spectra" in plots:
@@ -451,8 +469,8 @@ def plot_scene(result, out: str | Path) -> list[Path]:
                 f_max_n = max(1.1 * max(known, default=0.0), 3.0 * result.f_H)
             else:
                 f_max_n = f_max
-            files.append(plot_spectra(spectra, out / f"spectra_node{n}.png", lines=lines, f_max=f_max_n,
-                                      title=f"{sc.name}: amplitude spectra at node {n} ({rub_text})"))
+            jobs.append(partial(plot_spectra, spectra, out / f"spectra_node{n}.png", lines=lines, f_max=f_max_n,
+                                 title=f"{sc.name}: amplitude spectra at node {n} ({rub_text})"))
     if "orbits" in plots and {"x", "y"} <= set(sc.output.directions):
         orbits = {}
         for n in sc.output.nodes:
@@ -461,19 +479,19 @@ def plot_scene(result, out: str | Path) -> list[Path]:
                 if p.node == n:
                     title += f", plate at {math.degrees(p.theta):g} deg"
             orbits[title] = {label: (r.outputs[(n, "x")], r.outputs[(n, "y")]) for label, r in pairs}
-        files.append(plot_orbits(orbits, out / "orbits.png",
-                                 title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
+        jobs.append(partial(plot_orbits, orbits, out / "orbits.png",
+                             title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
     if "poincare" in plots and result.analysis is not None and result.analysis.classification.poincare.x.size:
-        files.append(_scene_poincare(result, out / "poincare.png", speeds, rub_text))
-    return files
+        jobs.append(_scene_poincare(result, out / "poincare.png", speeds, rub_text))
+    return jobs
 
 
-def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> Path:
-    """The Poincare section of the table DOF, labelled with its class and section frequency."""
+def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> partial:
+    """The Poincare section of the table DOF, labelled with its class and section frequency (a job)."""
     a = result.analysis
     c = a.classification
     rot = a.dof[1].startswith("theta")
-    return plot_poincare(c.poincare.x, c.poincare.velocity, path, scale=1e6, unit="µrad" if rot else "µm",
+    return partial(plot_poincare, c.poincare.x, c.poincare.velocity, path, scale=1e6, unit="µrad" if rot else "µm",
                          label=f"{c.label}, once per {1.0 / c.poincare.frequency_hz:.4g} s "
                                f"({c.poincare.frequency_hz:.6g} Hz)",
                          title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])}\n"

@@ -129,7 +129,18 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
     return files
 
 
-def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None) -> list[Path]:
+def _submit_figures(result: SceneResult, out: Path, pool) -> list:
+    """Futures of the scene's figures, drawn by ``pool`` (None: drawn now, in this process)."""
+    from rotorred.plots.pool import FigurePool  # matplotlib only when figures are written
+    from rotorred.plots.scene import scene_figures
+
+    jobs = scene_figures(result, out)
+    if pool is None:
+        pool = FigurePool(workers=0)
+    return [pool.submit(job) for job in jobs]
+
+
+def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None, pool=None) -> list[Path]:
     """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written.
 
     An incomplete result (a diverged transient, ``result.incomplete``) gets its data files and
@@ -143,14 +154,15 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
     shown : str or Path, optional
         Folder the summary names the files in (the final folder when ``out`` is a staging folder,
         :class:`rotorred.writers.OutputFolder`); default ``out``.
+    pool : rotorred.plots.pool.FigurePool, optional
+        Draws the figures while the data files are written (default: one after the other, here).
     """
-    from rotorred.plots.scene import plot_scene  # matplotlib only when figures are written
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plots = result.scene.output.plots and not result.incomplete
-    files = plot_scene(result, out) if plots else []
-    files += write_data(result, out)
+    figures = [] if not plots else _submit_figures(result, out, pool)
+    data = write_data(result, out)
+    files = [f.result() for f in figures] + data
     summary = out / "summary.txt"
     files.append(summary)
     named = [Path(shown) / f.name for f in files] if shown is not None else files

@@ -144,6 +144,8 @@ class SceneResult:
     final : rotorred.transient.results.FinalState or None
         State at the end of a transient (model coordinates), the start of a continuation; None
         for the harmonic solution.
+    settings : rotorred.scenes.tolerance.Settings or None
+        What ``solver.tolerance`` chose and why (``scene`` is then the scene as run); None without a tolerance.
     """
 
     scene: Scene
@@ -165,6 +167,7 @@ class SceneResult:
     analyses: dict = field(default_factory=dict)
     analysis_errors: dict = field(default_factory=dict)
     final: object = None
+    settings: object = None
 
     @property
     def analysis(self) -> LineAnalysis | None:
@@ -305,7 +308,7 @@ def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- run
 def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: bool | None = None,
-              progress: bool | None = False, analyse: bool = True, initial=None) -> SceneResult:
+              progress: bool | None = False, analyse: bool = True, initial=None, settings=None) -> SceneResult:
     """Compute a scene's response, spectra and labelled lines.
 
     Parameters
@@ -324,6 +327,9 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     initial : rotorred.transient.results.FinalState, optional
         Continue from another run's ``final`` state (model coordinates, the plates' states and
         contact forces) in place of ``solver.start``; the transient is then always stepped.
+    settings : rotorred.scenes.tolerance.Settings, optional
+        What ``solver.tolerance`` chose for ``scene`` (kept in the result for the summary;
+        :func:`rotorred.scenes.tolerance.run_to_tolerance` chooses and runs).
 
     Returns
     -------
@@ -356,7 +362,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
                        spectra=spectra, lines=lines, f_L=f_L, f_H=f_H, method=response.method,
                        model_label=model.label, n_steps=response.n_steps, build_time=model.build_time,
                        solve_time=solve_time, normal=normal, counters=response.counters, analyses=analyses,
-                       analysis_errors=errors, final=response.final)
+                       analysis_errors=errors, final=response.final, settings=settings)
 
 
 def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: int | None = None,

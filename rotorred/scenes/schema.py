@@ -76,7 +76,9 @@ _PLATE_NUMBERS = {"plate_a": ("m", 0.0, True), "plate_b": ("m", 0.0, True), "pla
                   "plate_eta": ("m", 0.0, True), "a0": ("N/m", 0.0, True), "b0": ("N", 0.0, False)}
 _RUB_KEYS = {"node", "theta_deg", "bending", "name"} | set(_RUB_NUMBERS) | set(_PLATE_NUMBERS)
 _SOLVER_KEYS = {"model", "modes", "cutoff_hz", "boundary_nodes", "dt", "duration", "record_start", "start",
-                "method", "alpha", "gravity"}
+                "method", "alpha", "gravity", "tolerance"}
+#: range of ``solver.tolerance``: below 1e-5 the time step needed leaves double precision little room
+TOLERANCE_RANGE = (1e-5, 0.1)
 _OUTPUT_KEYS = {"nodes", "directions", "plots", "formats", "plot_window", "table", "line_threshold", "f_max_hz",
                 "compare_normal"}
 #: relative tolerance of the record-window tests (whole number of steps, of common periods)
@@ -123,6 +125,9 @@ class SolverSpec:
         HHT-alpha parameter (only with method "hht").
     gravity : float
         Gravity along -y (m/s^2); 0 for none.
+    tolerance : float or None
+        Relative error target of the outputs (:mod:`rotorred.scenes.tolerance`): the tool then chooses
+        ``modes``, ``boundary_nodes``, ``dt``, ``record_start`` and ``duration`` (the window's length kept).
     """
 
     model: str = "reduced"
@@ -136,6 +141,7 @@ class SolverSpec:
     method: str = "newmark"
     alpha: float | None = None
     gravity: float = 0.0
+    tolerance: float | None = None
 
 
 @dataclass(frozen=True)
@@ -609,8 +615,15 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = Solve
             fail("solver.alpha", alpha, 'must not be given unless solver.method = "hht"')
         alpha = checks.number("solver.alpha", alpha, "-", ge=-1 / 3, le=0.0)
     gravity = checks.number("solver.gravity", table.get("gravity", d.gravity), "m/s^2")
+    tolerance = table.get("tolerance")
+    if tolerance is not None:
+        tolerance = checks.number("solver.tolerance", tolerance, "-", ge=TOLERANCE_RANGE[0], le=TOLERANCE_RANGE[1])
+        if method != "newmark":
+            fail("solver.tolerance", tolerance, f'needs solver.method = "newmark" (its error estimates are the '
+                 f'average-acceleration step\'s), not {method!r}')
     return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
-                      record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity)
+                      record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity,
+                      tolerance=tolerance)
 
 
 def _solver_reduction(table: dict, rotor: Rotor) -> tuple[int | None, float | None, tuple[int, ...]]:
@@ -728,6 +741,9 @@ def _check_runup_solver(runup: RunupSpec, solver: SolverSpec) -> None:
     """A run-up steps with average-acceleration Newmark, records from t = 0, at a whole number of steps."""
     if solver.method != "newmark":
         fail("solver.method", solver.method, 'must be "newmark" with [runup] (average acceleration at varying speed)')
+    if solver.tolerance is not None:
+        fail("solver.tolerance", solver.tolerance, "is not available with [runup] (its estimates are for constant "
+             "speeds): give solver.dt and solver.modes")
     if solver.record_start != 0.0:
         fail("solver.record_start", solver.record_start, "must be 0 with [runup]: the whole run-up is recorded", "s")
     ratio = runup.record_dt / solver.dt

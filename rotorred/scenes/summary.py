@@ -83,6 +83,8 @@ def _setup(result: SceneResult) -> str:
              "unbalances: " + (", ".join(f"node {u.node} {u.m_e:g} kg m at {math.degrees(u.phase):g} deg"
                                          for u in sc.unbalances) or "none"),
              f"model: {result.model_label}; built in {result.build_time:.2f} s"]
+    if result.settings is not None:
+        lines[3:3] = result.settings.describe()
     if result.method == "harmonic":
         lines.append(f"response: harmonic steady state (linear scene, settled start), {len(result.t)} samples "
                      f"of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")

@@ -1,0 +1,87 @@
+"""Figures drawn in worker processes while the caller goes on: :class:`FigurePool`.
+
+Drawing the six figures of ``paper-rub`` takes about as long as everything else of a warm
+``rotorred run`` (the solve, the line fit, the data files), and matplotlib's import another 0.4 s.
+The pool starts its workers when it is created, so they import matplotlib while the caller
+computes; the caller then submits figure jobs (:func:`rotorred.plots.scene.scene_figures`: a plot
+function and plain arrays) and writes its data files while they are drawn.
+
+Workers are spawned (a fresh interpreter: no fork of a process that holds numba's or BLAS's
+threads) and ignore SIGINT: Ctrl-C is the caller's to handle, and leaving the pool stops them
+before the caller cleans up (:class:`rotorred.writers.OutputFolder` removes its staging folder
+after a worker can no longer write into it). ``workers=0`` draws in the calling process.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import multiprocessing
+import os
+import signal
+
+__all__ = ["FigurePool", "default_workers"]
+
+
+def default_workers() -> int:
+    """Workers of a pool: one per core the process may use, at most 2 (six figures; 0 on one core)."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        cores = os.cpu_count() or 1
+    return 0 if cores < 2 else 2
+
+
+def _start_worker() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import gc
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import rotorred.plots.scene  # noqa: F401 - imported now, while the caller computes
+
+    gc.freeze()  # the imported modules are never garbage: drawing then collects only its own objects
+
+
+def _ready() -> int:
+    return os.getpid()
+
+
+class FigurePool:
+    """A context manager of figure-drawing processes; ``submit(job)`` returns a future of the job's result.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Worker processes (default :func:`default_workers`); 0 draws each job when it is submitted.
+    """
+
+    def __init__(self, workers: int | None = None):
+        self.workers = default_workers() if workers is None else int(workers)
+        self._executor = None
+        if self.workers > 0:
+            self._executor = concurrent.futures.ProcessPoolExecutor(
+                self.workers, mp_context=multiprocessing.get_context("spawn"), initializer=_start_worker)
+            for _ in range(self.workers):  # one job each: every worker starts now
+                self._executor.submit(_ready)
+
+    def submit(self, job) -> concurrent.futures.Future:
+        """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers."""
+        if self._executor is None:
+            future = concurrent.futures.Future()
+            future.set_result(job())
+            return future
+        return self._executor.submit(job)
+
+    def __enter__(self) -> FigurePool:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if self._executor is None:
+            return
+        if exc_type is not None:  # stop drawing now: the caller is about to remove what the workers write into
+            for process in list(getattr(self._executor, "_processes", {}).values()):
+                process.terminate()
+            self._executor.shutdown(wait=True, cancel_futures=True)
+        else:
+            self._executor.shutdown(wait=True)

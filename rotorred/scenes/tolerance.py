@@ -1,0 +1,347 @@
+"""``[solver] tolerance``: the tool chooses the model, the time step and the recorded window to meet a relative
+error target on the scene's outputs, and says what it chose and the error estimate behind each choice.
+
+The error of the outputs is :mod:`rotorred.signals.compare`'s: each recorded DOF's amplitude spectrum up to
+the band's top (relative to its largest line) and its peak. The target ``tol`` is shared out
+(docs/model.md §9):
+
+1. **Band.** ``output.f_max_hz`` when given, else :data:`BAND_FACTOR` x f_H (the rub lines above 0.5 % of
+   the largest reach 6.8 f_H on paper-rub).
+2. **Model** (reduced scenes): the smallest number of fixed-interface modes whose receptance error against
+   the full model (:mod:`rotorred.linear.accuracy`; inputs: the unbalance and rub DOFs, outputs: the
+   recorded DOFs; over the band with a rub plate, whose contact force has every frequency, else at the spool
+   speeds, the only frequencies the unbalances force) is at most ``MODEL_SHARE tol``. A forced node inside the reduced model is tried as a
+   boundary node too (its four DOFs kept physical, the attachment of its force): the smaller model meeting the
+   target wins. When the reduced model would be as large as the full one, the full model is used.
+3. **Time step, a priori**: the largest step of the 1-2-5 ladder whose receptance error (the
+   average-acceleration step's frequency warping, exact for the linear steady state) is at most
+   ``DT_SHARE tol``. A linear scene started settled gets the harmonic solution, exact at any sample: its
+   step is the largest with the band below half the Nyquist frequency whose sampled peak misses the true one
+   by at most ``DT_SHARE tol / 4`` ((Omega dt)^2 / 8 at the fastest spool).
+4. **Window**: the record starts once the slowest mode of the band has decayed to ``WINDOW_SHARE tol``
+   (``ln(1 / (WINDOW_SHARE tol)) / sigma_min``, rounded up to whole common periods); its length is the
+   scene's.
+5. **Time step, measured** (a scene stepped in time: rub plates, or a start from rest): the scene runs at dt
+   and dt/2 and 4/3 of the difference of the outputs (Richardson, order 2) is the step's error estimate on
+   the actual (nonlinear) response; dt is halved until it is at most ``STEP_SHARE tol``, or, when the a-priori
+   step already meets it, doubled while it still does.
+
+The sum of the estimates (model + time step + window) is at most tol.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.linear.accuracy import band_frequencies, receptance, receptance_error
+from rotorred.linear.modal import eigen
+from rotorred.model.assembly import assemble
+from rotorred.scenes.schema import Scene
+from rotorred.signals.compare import outputs_error
+
+__all__ = ["Choice", "Settings", "choose", "run_to_tolerance", "BAND_FACTOR", "MODEL_SHARE", "DT_SHARE", "WINDOW_SHARE",
+           "STEP_SHARE", "DT_LADDER"]
+
+#: the band's top without ``output.f_max_hz``: this many times the higher spool frequency
+BAND_FACTOR = 8.0
+#: shares of the tolerance: model, window, the time step on a stepped response (measured), and the a-priori
+#: time step (the harmonic solution's sampling; the start of the measured step's ladder)
+MODEL_SHARE, WINDOW_SHARE, STEP_SHARE, DT_SHARE = 0.25, 0.25, 0.5, 1.0
+#: time steps tried (s), largest first: a 1-2-5 ladder, each a whole fraction of 0.1 s
+DT_LADDER = tuple(m * 10.0 ** -e for e in range(3, 8) for m in (5, 2, 1))[1:]
+#: most halvings of dt the contact check makes
+MAX_HALVINGS = 6
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One chosen setting: the scene key, its value, the error estimate behind it and why."""
+
+    key: str
+    value: object
+    estimate: float | None
+    reason: str
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What ``[solver] tolerance`` chose for a scene (:func:`choose`).
+
+    Attributes
+    ----------
+    tolerance : float
+    band_hz : float
+        Top of the frequency band of the estimates (Hz).
+    scene : Scene
+        The scene with the chosen ``solver`` settings (tolerance kept).
+    choices : tuple of Choice
+        model, modes, boundary nodes, dt, record_start and duration, each with its estimate and reason.
+    estimate : float
+        Sum of the error estimates (<= tolerance).
+    time : float
+        Wall time of the choice (s), runs of the contact check included.
+    """
+
+    tolerance: float
+    band_hz: float
+    scene: Scene
+    choices: tuple
+    estimate: float
+    time: float
+
+    def describe(self) -> list[str]:
+        """One line per choice, then the total."""
+        lines = [f"solver.tolerance = {self.tolerance:g} (outputs' spectra to {self.band_hz:.4g} Hz and peaks): "
+                 f"chosen in {self.time:.2f} s"]
+        for c in self.choices:
+            est = "" if c.estimate is None else f" (estimate {c.estimate:.2g})"
+            lines.append(f"  {c.key} = {c.value}{est}: {c.reason}")
+        lines.append(f"  estimated error {self.estimate:.2g} <= {self.tolerance:g}")
+        return lines
+
+
+def choose(scene: Scene) -> Settings:
+    """Choose model, dt and window of ``scene`` for its ``solver.tolerance`` (module docstring).
+
+    Returns
+    -------
+    Settings
+        ``settings.scene`` is what to run.
+    """
+    tol = scene.solver.tolerance
+    if tol is None:
+        checks.fail("solver.tolerance", tol, "must be given to choose the settings")
+    t0 = time.perf_counter()
+    f_H = max(w for w in scene.speeds.values()) / (2 * math.pi)
+    band = scene.output.f_max_hz or BAND_FACTOR * f_H
+    system = assemble(scene.rotor)
+    omega = band_frequencies(system, scene.speeds, band)
+    inputs = _input_dofs(scene)
+    # without a plate the forces are the unbalances' alone, at the spool speeds; a contact force has every frequency
+    omega_model = omega if scene.plates else np.array(sorted(_running(scene)))
+    H_full = receptance(system, scene.speeds, omega_model, scene.output.dofs, inputs)
+    model, solver, model_choices, e_model = _choose_model(scene, system, omega_model, inputs, H_full, tol)
+    dt, e_dt = _choose_dt(scene, model, omega, inputs, tol)
+    start, duration, e_window, window_reason = _choose_window(scene, system, omega, dt, tol)
+    chosen = dataclasses.replace(scene, solver=dataclasses.replace(solver, dt=dt, record_start=start,
+                                                                   duration=duration),
+                                 output=_inside(scene.output, start, duration))
+    choices = list(model_choices)
+    dt_reason = (f"a priori: the largest step of the ladder whose receptance error (the step's frequency warping) "
+                 f"over 0-{band:.4g} Hz is <= {DT_SHARE:g} tol ({e_dt:.2g})")
+    e_step = e_dt
+    if scene.plates or scene.solver.start != "settled":  # stepped in time: the step's error is measured
+        chosen, e_step, dt_reason = _measure_dt(chosen, band, tol, dt_reason)
+    choices.append(Choice("solver.dt", f"{chosen.solver.dt:g} s", e_step, dt_reason))
+    choices.append(Choice("solver.record_start", f"{start:g} s", e_window, window_reason))
+    choices.append(Choice("solver.duration", f"{duration:g} s", None,
+                          f"record_start + the scene's window of {scene.solver.duration - scene.solver.record_start:g} s"))
+    estimate = e_model + e_step + e_window
+    return Settings(tol, band, chosen, tuple(choices), estimate, time.perf_counter() - t0)
+
+
+def run_to_tolerance(scene: Scene, **options):
+    """Choose the settings of ``scene`` (:func:`choose`) and run them (:func:`rotorred.scenes.run.run_scene` with
+    ``options``); the result's ``settings`` says what was chosen. A scene without a tolerance runs as it is."""
+    from rotorred.scenes.run import run_scene
+
+    if scene.solver.tolerance is None:
+        return run_scene(scene, **options)
+    settings = choose(scene)
+    return run_scene(settings.scene, settings=settings, **options)
+
+
+def _running(scene: Scene) -> list[float]:
+    """The spool speeds (rad/s) > 0: the frequencies the receptance errors are measured against."""
+    return [w for w in scene.speeds.values() if w > 0]
+
+
+def _input_dofs(scene: Scene) -> list[tuple[int, str]]:
+    """The DOFs forces act on: x and y of every unbalance and rub node."""
+    nodes = sorted({u.node for u in scene.unbalances} | {p.node for p in scene.plates})
+    return [(n, d) for n in nodes for d in ("x", "y")]
+
+
+# --------------------------------------------------------------------------- model
+def _choose_model(scene, system, omega, inputs, H_full, tol):
+    """(model, solver settings, choices, estimate): the smallest reduced model meeting MODEL_SHARE tol, or the full
+    one."""
+    s = scene.solver
+    outputs = scene.output.dofs
+    if s.model == "full":
+        return system, s, [Choice("solver.model", "full", 0.0, "the scene asks for the full model")], 0.0
+    target = MODEL_SHARE * tol
+    options = [_fewest_modes(scene, system, omega, inputs, H_full, target, extra) for extra in _boundary_options(scene)]
+    options = [o for o in options if o is not None]
+    n_full = system.dofs.n_dof
+    best = min(options, key=lambda o: o[0].n_dof) if options else None
+    if best is None or best[0].n_dof >= n_full:
+        why = "no reduced model smaller than the full one meets the target"
+        return system, dataclasses.replace(s, model="full"), [Choice("solver.model", "full", 0.0, why)], 0.0
+    model, err, extra = best
+    solver = dataclasses.replace(s, model="reduced", modes=model.n_modes, cutoff_hz=None,
+                                 boundary_nodes=tuple(sorted(set(s.boundary_nodes) | set(extra))))
+    where = f"worst at {err.output} from a force at {err.input}, {err.frequency_hz:.4g} Hz"
+    choices = [Choice("solver.model", f"reduced, {model.n_dof} of {n_full} DOFs", None,
+                      f"the smallest Craig-Bampton model meeting {MODEL_SHARE:g} tol over the band")]
+    choices.append(Choice("solver.modes", model.n_modes, err.error,
+                          f"fewest fixed-interface modes with a receptance error against the full model <= "
+                          f"{MODEL_SHARE:g} tol ({where})"))
+    if extra:
+        choices.append(Choice("solver.boundary_nodes", list(solver.boundary_nodes), None,
+                              f"forced interior node(s) {list(extra)} kept physical: fewer DOFs than modes alone"))
+    return model, solver, choices, err.error
+
+
+def _boundary_options(scene) -> list[tuple[int, ...]]:
+    """Extra boundary nodes to try: none, and the unbalance nodes that would be interior."""
+    from rotorred.linear.reduction import default_boundary_nodes
+
+    boundary = set(default_boundary_nodes(scene.rotor, tuple(scene.solver.boundary_nodes) +
+                                          tuple(p.node for p in scene.plates)))
+    forced = tuple(sorted({u.node for u in scene.unbalances} - boundary))
+    return [()] + ([forced] if forced else [])
+
+
+def _fewest_modes(scene, system, omega, inputs, H_full, target, extra):
+    """(model, ReceptanceError, extra) of the fewest modes meeting ``target`` with ``extra`` boundary nodes, or
+    None when every mode is needed."""
+    from rotorred.linear.reduction import reduce_rotor
+
+    nodes = tuple(sorted(set(scene.solver.boundary_nodes) | {p.node for p in scene.plates} | set(extra)))
+    largest = reduce_rotor(scene.rotor, nodes, n_modes=0, system=system).selection.n_interior_dofs
+    every = reduce_rotor(scene.rotor, nodes, n_modes=largest, system=system)
+    needed = int(np.count_nonzero(every.interior_frequencies <= omega[-1]))  # every interior mode of the band
+    for n in range(needed, largest + 1):
+        model = reduce_rotor(scene.rotor, nodes, n_modes=n, system=system)
+        err = receptance_error(receptance(model, scene.speeds, omega, scene.output.dofs, inputs), H_full, omega,
+                               scene.output.dofs, inputs, at=_running(scene))
+        if err.error <= target:
+            return model, err, extra
+    return None
+
+
+# --------------------------------------------------------------------------- time step
+def _choose_dt(scene, model, omega, inputs, tol) -> tuple[float, float]:
+    """(dt, estimate): the largest step of :data:`DT_LADDER` whose warping error is <= DT_SHARE tol."""
+    outputs = scene.output.dofs
+    if scene.is_linear and scene.solver.start == "settled":  # the harmonic solution: exact at its samples, whose
+        # peak misses the true one by at most 1 - cos(Omega dt / 2) ~ (Omega dt)^2 / 8 at the fastest spool
+        w = max(_running(scene))
+        dt = next(dt for dt in DT_LADDER
+                  if omega[-1] * dt < 0.5 * math.pi and (w * dt) ** 2 / 8 <= DT_SHARE * tol / 4)
+        return dt, (w * dt) ** 2 / 8
+    H = receptance(model, scene.speeds, omega, outputs, inputs)
+    for dt in DT_LADDER:
+        if omega[-1] * dt >= 0.5 * math.pi:
+            continue  # the band must sit well below the step's Nyquist frequency
+        err = receptance_error(receptance(model, scene.speeds, omega, outputs, inputs, dt=dt), H, omega, outputs,
+                               inputs, at=_running(scene))
+        if err.error <= DT_SHARE * tol:
+            return dt, err.error
+    checks.fail("solver.tolerance", tol, f"is not reachable with a time step of {DT_LADDER[-1]:g} s or more")
+
+
+# --------------------------------------------------------------------------- window
+def _choose_window(scene, system, omega, dt, tol) -> tuple[float, float, float, str]:
+    """(record_start, duration, estimate, reason): the record starts when the slowest mode of the band has decayed
+    to WINDOW_SHARE tol; the scene's window length is kept."""
+    s = scene.solver
+    sol = eigen(system.M, system.damping(scene.speeds), system.K)
+    in_band = sol.eigenvalues[sol.eigenvalues.imag <= omega[-1]]
+    sigma = -in_band.real
+    if not in_band.size or sigma.min() <= 0:
+        checks.fail("solver.tolerance", tol, "cannot be met: a mode of the band is undamped or unstable, so the "
+                    "response does not settle")
+    k = int(np.argmin(sigma))
+    length = s.duration - s.record_start
+    period = _common_period(scene, dt)
+    t_decay = math.log(1.0 / (WINDOW_SHARE * tol)) / sigma[k]
+    start = period * math.ceil(t_decay / period - 1e-9)
+    n_steps = round((start + length) / dt)
+    reason = (f"the slowest mode of the band ({in_band[k].imag / (2 * math.pi):.4g} Hz, decay rate "
+              f"{sigma[k]:.3g} 1/s) decays to {WINDOW_SHARE:g} tol in {t_decay:.3g} s; rounded up to whole "
+              f"{'common periods' if period > dt else 'steps'}")
+    return start, n_steps * dt, WINDOW_SHARE * tol, reason
+
+
+def _common_period(scene, dt) -> float:
+    """The spools' common period when it is a whole number of steps of ``dt`` (at most 1 s), else ``dt``."""
+    from fractions import Fraction
+
+    f = [Fraction(w / (2 * math.pi)).limit_denominator(1000) for w in scene.speeds.values() if w > 0]
+    base = f[0]
+    for x in f[1:]:
+        base = Fraction(math.gcd(base.numerator * x.denominator, x.numerator * base.denominator),
+                        base.denominator * x.denominator)
+    ok = all(abs(float(x) - w / (2 * math.pi)) < 1e-9 * float(x) for x, w in
+             zip(f, [w for w in scene.speeds.values() if w > 0]))
+    period = 1.0 / float(base) if ok and base > 0 else 0.0
+    steps = period / dt
+    if ok and 0 < period <= 1.0 and abs(steps - round(steps)) < 1e-6 * steps:
+        return period
+    return dt
+
+
+def _inside(output, start: float, duration: float):
+    """``output`` with a ``plot_window`` outside the new record dropped (the default window is used)."""
+    w = output.plot_window
+    if w is not None and not (start <= w[0] and w[1] <= duration):
+        return dataclasses.replace(output, plot_window=None)
+    return output
+
+
+# --------------------------------------------------------------------------- time step, measured
+def _measure_dt(scene: Scene, band: float, tol: float, reason: str) -> tuple[Scene, float, str]:
+    """The largest dt of a halving ladder from the a-priori step whose Richardson estimate on the stepped response
+    is at most STEP_SHARE tol: ``4/3 |y(dt) - y(dt/2)|`` (order 2), the step coarsened while it holds, refined
+    until it holds."""
+    from rotorred.scenes.run import build_model, respond, spool_frequencies
+
+    f_L, f_H = spool_frequencies(scene)
+    model = build_model(scene)
+    target = STEP_SHARE * tol
+    runs = {}
+
+    def response(dt):
+        if dt not in runs:
+            runs[dt] = respond(_with_dt(scene, dt), model).outputs
+        return runs[dt]
+
+    def estimate(dt):
+        e = outputs_error(response(dt), dt, response(dt / 2), dt / 2, f_L, f_H, band)
+        return 4.0 / 3.0 * e.error, e
+
+    dt = scene.solver.dt
+    est, diff = estimate(dt)
+    halvings = 0
+    while est > target:
+        if halvings == MAX_HALVINGS:
+            checks.fail("solver.tolerance", tol, f"is not reached after {MAX_HALVINGS} halvings of the time step "
+                        f"(estimate {est:.2g} at dt = {dt:g} s)")
+        dt, halvings = dt / 2, halvings + 1
+        est, diff = estimate(dt)
+    while halvings == 0 and _whole(2 * dt, scene) and 2 * dt <= DT_LADDER[0]:
+        coarse_est = 4.0 / 3.0 * outputs_error(response(2 * dt), 2 * dt, response(dt), dt, f_L, f_H, band).error
+        if coarse_est > target:
+            break
+        dt, est = 2 * dt, coarse_est
+    why = (f"{reason}; measured on the stepped response: 4/3 x the difference to the run at dt/2 (Richardson, "
+           f"order 2) is {est:.2g} <= {STEP_SHARE:g} tol ({len(runs)} runs)")
+    return _with_dt(scene, dt), est, why
+
+
+def _whole(dt: float, scene: Scene) -> bool:
+    """Whether ``record_start`` and ``duration`` are whole numbers of steps of ``dt``."""
+    s = scene.solver
+    return all(abs(t / dt - round(t / dt)) < 1e-6 * max(t / dt, 1.0) for t in (s.record_start, s.duration))
+
+
+def _with_dt(scene: Scene, dt: float) -> Scene:
+    return dataclasses.replace(scene, solver=dataclasses.replace(scene.solver, dt=dt))

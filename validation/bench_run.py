@@ -1,0 +1,96 @@
+"""Wall time of ``rotorred run`` as a user sees it: the first run after a fresh install, a warm run, and where the
+time goes (the solve, the figures).
+
+* **first run**: ``rotorred run --out DIR`` in a subprocess with empty numba and matplotlib caches
+  (``NUMBA_CACHE_DIR``, ``MPLCONFIGDIR`` pointed at new folders): what a fresh install meets, numba's
+  compilation of the step kernel and matplotlib's font cache included;
+* **warm run**: the same command again (caches filled), median of ``--repeats``;
+* **solve**: :func:`rotorred.scenes.run.run_scene` in this process (model, both transients, spectra, line
+  fit, settling, class), median of ``--repeats`` after a warm-up;
+* **figures**: :func:`rotorred.plots.scene.plot_scene` in this process, one after the other, median of
+  ``--repeats`` (the command draws them in worker processes while it writes the data files);
+* **data files**: :func:`rotorred.scenes.outputs.write_data`.
+
+Run: ``python validation/bench_run.py [--scene paper-rub] [--repeats 3]``.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import shutil  # noqa: E402
+import statistics  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+
+def cli_run(scene: str, out: Path, env: dict) -> float:
+    """Wall time (s) of ``rotorred run SCENE --out OUT`` in a subprocess."""
+    t0 = time.perf_counter()
+    command = shutil.which("rotorred", path=str(Path(sys.executable).parent)) or "rotorred"  # the installed script
+    done = subprocess.run([command, "run", scene, "--out", str(out)], env=env, capture_output=True, text=True)
+    seconds = time.perf_counter() - t0
+    if done.returncode != 0:
+        raise SystemExit(f"rotorred run failed:\n{done.stderr}")
+    return seconds
+
+
+def in_process(scene_name: str, repeats: int, folder: Path) -> dict:
+    """Median seconds of the solve, the figures and the data files, in this process."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from rotorred.plots.scene import plot_scene
+    from rotorred.scenes.outputs import write_data
+    from rotorred.scenes.run import run_scene
+    from rotorred.scenes.schema import load_scene
+
+    scene = load_scene(scene_name, {})
+    result = run_scene(scene, progress=None)  # warm-up: the kernel from the cache
+    plot_scene(result, folder)
+    times = {"solve": [], "figures": [], "data files": []}
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = run_scene(scene, progress=None)
+        t1 = time.perf_counter()
+        plot_scene(result, folder)
+        t2 = time.perf_counter()
+        write_data(result, folder)
+        times["solve"].append(t1 - t0)
+        times["figures"].append(t2 - t1)
+        times["data files"].append(time.perf_counter() - t2)
+    return {k: statistics.median(v) for k, v in times.items()}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--scene", default="paper-rub")
+    p.add_argument("--repeats", type=int, default=3)
+    args = p.parse_args(argv)
+    work = Path(tempfile.mkdtemp(prefix="rotorred-bench-run-"))
+    try:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(work / "numba"), MPLCONFIGDIR=str(work / "mpl"))
+        first = cli_run(args.scene, work / "out", env)
+        warm = statistics.median(cli_run(args.scene, work / "out", env) for _ in range(args.repeats))
+        parts = in_process(args.scene, args.repeats, work / "figures")
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print(f"`rotorred run {args.scene}`, {os.cpu_count()} cores, BLAS/numba threads 1")
+    print("| what | seconds |")
+    print("|---|---|")
+    print(f"| first run after a fresh install (empty numba and matplotlib caches) | {first:.1f} |")
+    print(f"| warm run (median of {args.repeats}) | {warm:.2f} |")
+    for k, v in parts.items():
+        print(f"| {k} (in one process, median of {args.repeats}) | {v:.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
