@@ -23,8 +23,9 @@ the band's top (relative to its largest line) and its peak. The target ``tol`` i
    scene's.
 5. **Time step, measured** (a scene stepped in time: rub plates, or a start from rest): the scene runs at dt
    and dt/2 and 4/3 of the difference of the outputs (Richardson, order 2) is the step's error estimate on
-   the actual (nonlinear) response; dt is halved until it is at most ``STEP_SHARE tol``, or, when the a-priori
-   step already meets it, doubled while it still does.
+   the actual (nonlinear) response; dt is halved until it is at most what the model and window estimates
+   leave of tol (at least ``STEP_SHARE tol``), or, when the a-priori step already meets it, doubled while it
+   still does.
 
 The sum of the estimates (model + time step + window) is at most tol.
 """
@@ -137,7 +138,8 @@ def choose(scene: Scene) -> Settings:
                  f"over 0-{band:.4g} Hz is <= {DT_SHARE:g} tol ({e_dt:.2g})")
     e_step = e_dt
     if scene.plates or scene.solver.start != "settled":  # stepped in time: the step's error is measured
-        chosen, e_step, dt_reason = _measure_dt(chosen, band, tol, dt_reason)
+        budget = tol - e_model - e_window  # what the model and the window leave, at least STEP_SHARE tol
+        chosen, e_step, dt_reason = _measure_dt(chosen, band, tol, budget, dt_reason)
     choices.append(Choice("solver.dt", f"{chosen.solver.dt:g} s", e_step, dt_reason))
     choices.append(Choice("solver.record_start", f"{start:g} s", e_window, window_reason))
     choices.append(Choice("solver.duration", f"{duration:g} s", None,
@@ -298,15 +300,15 @@ def _inside(output, start: float, duration: float):
 
 
 # --------------------------------------------------------------------------- time step, measured
-def _measure_dt(scene: Scene, band: float, tol: float, reason: str) -> tuple[Scene, float, str]:
+def _measure_dt(scene: Scene, band: float, tol: float, budget: float, reason: str) -> tuple[Scene, float, str]:
     """The largest dt of a halving ladder from the a-priori step whose Richardson estimate on the stepped response
-    is at most STEP_SHARE tol: ``4/3 |y(dt) - y(dt/2)|`` (order 2), the step coarsened while it holds, refined
-    until it holds."""
+    is at most ``budget``: ``4/3 |y(dt) - y(dt/2)|`` (order 2), the step coarsened while it holds, refined until it
+    holds."""
     from rotorred.scenes.run import build_model, respond, spool_frequencies
 
     f_L, f_H = spool_frequencies(scene)
     model = build_model(scene)
-    target = STEP_SHARE * tol
+    target = max(budget, STEP_SHARE * tol)
     runs = {}
 
     def response(dt):
@@ -333,7 +335,7 @@ def _measure_dt(scene: Scene, band: float, tol: float, reason: str) -> tuple[Sce
             break
         dt, est = 2 * dt, coarse_est
     why = (f"{reason}; measured on the stepped response: 4/3 x the difference to the run at dt/2 (Richardson, "
-           f"order 2) is {est:.2g} <= {STEP_SHARE:g} tol ({len(runs)} runs)")
+           f"order 2) is {est:.2g} <= {target:.2g}, the tolerance left by the model and window ({len(runs)} runs)")
     return _with_dt(scene, dt), est, why
 
 
