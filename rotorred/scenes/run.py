@@ -226,9 +226,13 @@ def build_model(scene: Scene) -> SceneModel:
 
     The reduced model's boundary is every bearing node, both nodes of every inter-shaft
     bearing, every rub node and ``solver.boundary_nodes``
-    (:func:`rotorred.linear.reduction.reduce_rotor`).
+    (:func:`rotorred.linear.reduction.reduce_rotor`). With ``solver.modes = "auto"`` (and no cutoff) the
+    mode count is the fewest whose receptance from the unbalance and rub DOFs to the recorded DOFs is within
+    :data:`rotorred.scenes.modes.AUTO_TARGET` of the full model's (:func:`rotorred.scenes.modes.choose_modes`;
+    an unbalance node may join the boundary, or the full model be used).
     """
-    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
+    from rotorred.linear.reduction import reduce_rotor
+    from rotorred.scenes.modes import AUTO_TARGET, choose_modes
 
     t0 = time.perf_counter()
     system = assemble(scene.rotor)
@@ -236,14 +240,28 @@ def build_model(scene: Scene) -> SceneModel:
     if s.model == "full":
         label = f"full FE model, {system.dofs.n_dof} DOFs"
         model = system
+    elif s.modes is None and s.cutoff_hz is None:  # "auto": for the scene's outputs and forces
+        choice = choose_modes(scene, system, AUTO_TARGET)
+        model = choice.model
+        if choice.full:
+            label = f"full FE model, {system.dofs.n_dof} DOFs ({choice.describe()})"
+        else:
+            extra = tuple(sorted(set(s.boundary_nodes) | {p.node for p in scene.plates} | set(choice.extra_nodes)))
+            label = _reduced_label(scene, model, extra, choice.describe(), system)
     else:
         extra = tuple(sorted(set(s.boundary_nodes) | {p.node for p in scene.plates}))
         cutoff = None if s.cutoff_hz is None else 2 * math.pi * s.cutoff_hz
         model = reduce_rotor(scene.rotor, extra, n_modes=s.modes, cutoff=cutoff, system=system)
-        label = (f"Craig-Bampton model, {model.n_dof} DOFs (boundary nodes "
-                 f"{list(default_boundary_nodes(scene.rotor, extra))} + {model.n_modes} modes; "
-                 f"{model.selection.describe()}) of the {system.dofs.n_dof}-DOF FE model")
+        label = _reduced_label(scene, model, extra, model.selection.describe(), system)
     return SceneModel(model, label, time.perf_counter() - t0, model_key(scene))
+
+
+def _reduced_label(scene: Scene, model, extra: tuple, how: str, system) -> str:
+    from rotorred.linear.reduction import default_boundary_nodes
+
+    return (f"Craig-Bampton model, {model.n_dof} DOFs (boundary nodes "
+            f"{list(default_boundary_nodes(scene.rotor, extra))} + {model.n_modes} modes; {how}) of the "
+            f"{system.dofs.n_dof}-DOF FE model")
 
 
 # --------------------------------------------------------------------------- harmonic solution

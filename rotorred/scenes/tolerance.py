@@ -43,14 +43,13 @@ from rotorred import checks
 from rotorred.linear.accuracy import band_frequencies, receptance, receptance_error
 from rotorred.linear.modal import eigen
 from rotorred.model.assembly import assemble
+from rotorred.scenes.modes import BAND_FACTOR, band_hz, choose_modes, input_dofs, running
 from rotorred.scenes.schema import Scene
 from rotorred.signals.compare import outputs_error
 
 __all__ = ["Choice", "Settings", "choose", "run_to_tolerance", "BAND_FACTOR", "MODEL_SHARE", "DT_SHARE", "WINDOW_SHARE",
            "STEP_SHARE", "DT_LADDER"]
 
-#: the band's top without ``output.f_max_hz``: this many times the higher spool frequency
-BAND_FACTOR = 8.0
 #: shares of the tolerance: model, window, the time step on a stepped response (measured), and the a-priori
 #: time step (the harmonic solution's sampling; the start of the measured step's ladder)
 MODEL_SHARE, WINDOW_SHARE, STEP_SHARE, DT_SHARE = 0.25, 0.25, 0.5, 1.0
@@ -119,15 +118,11 @@ def choose(scene: Scene) -> Settings:
     if tol is None:
         checks.fail("solver.tolerance", tol, "must be given to choose the settings")
     t0 = time.perf_counter()
-    f_H = max(w for w in scene.speeds.values()) / (2 * math.pi)
-    band = scene.output.f_max_hz or BAND_FACTOR * f_H
+    band = band_hz(scene)
     system = assemble(scene.rotor)
     omega = band_frequencies(system, scene.speeds, band)
-    inputs = _input_dofs(scene)
-    # without a plate the forces are the unbalances' alone, at the spool speeds; a contact force has every frequency
-    omega_model = omega if scene.plates else np.array(sorted(_running(scene)))
-    H_full = receptance(system, scene.speeds, omega_model, scene.output.dofs, inputs)
-    model, solver, model_choices, e_model = _choose_model(scene, system, omega_model, inputs, H_full, tol)
+    inputs = input_dofs(scene)
+    model, solver, model_choices, e_model = _choose_model(scene, system, tol)
     dt, e_dt = _choose_dt(scene, model, omega, inputs, tol)
     start, duration, e_window, window_reason = _choose_window(scene, system, omega, dt, tol)
     chosen = dataclasses.replace(scene, solver=dataclasses.replace(solver, dt=dt, record_start=start,
@@ -159,39 +154,23 @@ def run_to_tolerance(scene: Scene, **options):
     return run_scene(settings.scene, settings=settings, **options)
 
 
-def _running(scene: Scene) -> list[float]:
-    """The spool speeds (rad/s) > 0: the frequencies the receptance errors are measured against."""
-    return [w for w in scene.speeds.values() if w > 0]
-
-
-def _input_dofs(scene: Scene) -> list[tuple[int, str]]:
-    """The DOFs forces act on: x and y of every unbalance and rub node."""
-    nodes = sorted({u.node for u in scene.unbalances} | {p.node for p in scene.plates})
-    return [(n, d) for n in nodes for d in ("x", "y")]
-
-
 # --------------------------------------------------------------------------- model
-def _choose_model(scene, system, omega, inputs, H_full, tol):
-    """(model, solver settings, choices, estimate): the smallest reduced model meeting MODEL_SHARE tol, or the full
-    one."""
+def _choose_model(scene, system, tol):
+    """(model, solver settings, choices, estimate): the smallest model meeting MODEL_SHARE tol
+    (:func:`rotorred.scenes.modes.choose_modes`)."""
     s = scene.solver
-    outputs = scene.output.dofs
     if s.model == "full":
         return system, s, [Choice("solver.model", "full", 0.0, "the scene asks for the full model")], 0.0
-    target = MODEL_SHARE * tol
-    options = [_fewest_modes(scene, system, omega, inputs, H_full, target, extra) for extra in _boundary_options(scene)]
-    options = [o for o in options if o is not None]
-    n_full = system.dofs.n_dof
-    best = min(options, key=lambda o: o[0].n_dof) if options else None
-    if best is None or best[0].n_dof >= n_full:
+    choice = choose_modes(scene, system, MODEL_SHARE * tol)
+    if choice.full:
         why = "no reduced model smaller than the full one meets the target"
         return system, dataclasses.replace(s, model="full"), [Choice("solver.model", "full", 0.0, why)], 0.0
-    model, err, extra = best
+    model, err, extra = choice.model, choice.error, choice.extra_nodes
     solver = dataclasses.replace(s, model="reduced", modes=model.n_modes, cutoff_hz=None,
                                  boundary_nodes=tuple(sorted(set(s.boundary_nodes) | set(extra))))
     where = f"worst at {err.output} from a force at {err.input}, {err.frequency_hz:.4g} Hz"
-    choices = [Choice("solver.model", f"reduced, {model.n_dof} of {n_full} DOFs", None,
-                      f"the smallest Craig-Bampton model meeting {MODEL_SHARE:g} tol over the band")]
+    choices = [Choice("solver.model", f"reduced, {model.n_dof} of {system.dofs.n_dof} DOFs", None,
+                      f"the smallest Craig-Bampton model meeting {MODEL_SHARE:g} tol over 0-{choice.band_hz:.4g} Hz")]
     choices.append(Choice("solver.modes", model.n_modes, err.error,
                           f"fewest fixed-interface modes with a receptance error against the full model <= "
                           f"{MODEL_SHARE:g} tol ({where})"))
@@ -201,41 +180,13 @@ def _choose_model(scene, system, omega, inputs, H_full, tol):
     return model, solver, choices, err.error
 
 
-def _boundary_options(scene) -> list[tuple[int, ...]]:
-    """Extra boundary nodes to try: none, and the unbalance nodes that would be interior."""
-    from rotorred.linear.reduction import default_boundary_nodes
-
-    boundary = set(default_boundary_nodes(scene.rotor, tuple(scene.solver.boundary_nodes) +
-                                          tuple(p.node for p in scene.plates)))
-    forced = tuple(sorted({u.node for u in scene.unbalances} - boundary))
-    return [()] + ([forced] if forced else [])
-
-
-def _fewest_modes(scene, system, omega, inputs, H_full, target, extra):
-    """(model, ReceptanceError, extra) of the fewest modes meeting ``target`` with ``extra`` boundary nodes, or
-    None when every mode is needed."""
-    from rotorred.linear.reduction import reduce_rotor
-
-    nodes = tuple(sorted(set(scene.solver.boundary_nodes) | {p.node for p in scene.plates} | set(extra)))
-    largest = reduce_rotor(scene.rotor, nodes, n_modes=0, system=system).selection.n_interior_dofs
-    every = reduce_rotor(scene.rotor, nodes, n_modes=largest, system=system)
-    needed = int(np.count_nonzero(every.interior_frequencies <= omega[-1]))  # every interior mode of the band
-    for n in range(needed, largest + 1):
-        model = reduce_rotor(scene.rotor, nodes, n_modes=n, system=system)
-        err = receptance_error(receptance(model, scene.speeds, omega, scene.output.dofs, inputs), H_full, omega,
-                               scene.output.dofs, inputs, at=_running(scene))
-        if err.error <= target:
-            return model, err, extra
-    return None
-
-
 # --------------------------------------------------------------------------- time step
 def _choose_dt(scene, model, omega, inputs, tol) -> tuple[float, float]:
     """(dt, estimate): the largest step of :data:`DT_LADDER` whose warping error is <= DT_SHARE tol."""
     outputs = scene.output.dofs
     if scene.is_linear and scene.solver.start == "settled":  # the harmonic solution: exact at its samples, whose
         # peak misses the true one by at most 1 - cos(Omega dt / 2) ~ (Omega dt)^2 / 8 at the fastest spool
-        w = max(_running(scene))
+        w = max(running(scene))
         dt = next(dt for dt in DT_LADDER
                   if omega[-1] * dt < 0.5 * math.pi and (w * dt) ** 2 / 8 <= DT_SHARE * tol / 4)
         return dt, (w * dt) ** 2 / 8
@@ -244,7 +195,7 @@ def _choose_dt(scene, model, omega, inputs, tol) -> tuple[float, float]:
         if omega[-1] * dt >= 0.5 * math.pi:
             continue  # the band must sit well below the step's Nyquist frequency
         err = receptance_error(receptance(model, scene.speeds, omega, outputs, inputs, dt=dt), H, omega, outputs,
-                               inputs, at=_running(scene))
+                               inputs, at=running(scene))
         if err.error <= DT_SHARE * tol:
             return dt, err.error
     checks.fail("solver.tolerance", tol, f"is not reachable with a time step of {DT_LADDER[-1]:g} s or more")
