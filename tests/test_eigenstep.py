@@ -85,7 +85,7 @@ def critically_damped() -> SystemMatrices:
 
 def test_defective_amplification_falls_back_to_the_dense_step():
     kw = dict(q0=[1e-5, 0, 0, 0], spool_of={1: "shaft"}, outputs=[(1, "x")], progress=False)
-    res = simulate(critically_damped(), {"shaft": 0.0}, 0.01, 1e-4, **kw)
+    res = simulate(critically_damped(), {"shaft": 0.0}, 1.2, 1e-4, **kw)  # 12 000 steps: long enough for "auto"
     assert res.step_form.startswith("dense: the amplification matrix is defective")
     assert f"> {MAX_COND:.0e}" in res.step_form
     with pytest.raises(InputError) as e:
@@ -93,3 +93,19 @@ def test_defective_amplification_falls_back_to_the_dense_step():
     assert e.value.field == "step"
     hht = simulate(critically_damped(), {"shaft": 0.0}, 0.01, 1e-4, method="hht", **kw)
     assert hht.step_form.startswith("dense: the eigenbasis step is for average acceleration")
+
+
+def test_auto_keeps_the_dense_step_for_runs_too_short_to_repay_the_eigenbasis():
+    """Below EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF n steps "auto" steps densely (the eigen-decomposition would cost
+    more than it saves), from there on in the eigenbasis; "eigen" asks for it at any length."""
+    from rotorred.transient.newmark import EIGEN_MIN_STEPS, EIGEN_STEPS_PER_DOF
+
+    sc = load_scene("paper-rub", {})
+    model = build_model(sc).model
+    n = model.M.shape[0]
+    needed = EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n
+    kw = dict(unbalances=sc.unbalances, plates=sc.plates, rotor=sc.rotor, outputs=[(18, "y")], progress=False)
+    short = simulate(model, sc.speeds, (needed - 1) * 2e-5, 2e-5, **kw)
+    assert short.step_form.startswith("dense:") and f"about {needed} steps" in short.step_form
+    assert simulate(model, sc.speeds, needed * 2e-5, 2e-5, **kw).step_form.startswith("eigenbasis")
+    assert simulate(model, sc.speeds, 0.01, 2e-5, step="eigen", **kw).step_form.startswith("eigenbasis")

@@ -69,6 +69,13 @@ def modal_scaling(M: np.ndarray, K: np.ndarray) -> np.ndarray:
     return T
 
 
+def scheme_excluded(scheme) -> str:
+    """Why the eigenbasis step cannot run ``scheme`` ("dense: ..."), or "" when it can."""
+    if scheme.method != "newmark" or scheme.gamma != 0.5 or scheme.beta != 0.25:
+        return "dense: the eigenbasis step is for average acceleration (gamma = 1/2, beta = 1/4) only"
+    return ""
+
+
 def eigen_form(levels: kernel.Levels, plates: kernel.Plates, scheme, M: np.ndarray, K: np.ndarray,
                forcing: kernel.Forcing) -> tuple[Eigen | None, str]:
     """The eigenbasis step's operators for level 0, or None with the reason the dense step is kept.
@@ -82,8 +89,9 @@ def eigen_form(levels: kernel.Levels, plates: kernel.Plates, scheme, M: np.ndarr
     note : str
         ``"eigenbasis, cond(P) = ..."`` or ``"dense: <why>"``.
     """
-    if scheme.method != "newmark" or scheme.gamma != 0.5 or scheme.beta != 0.25:
-        return None, "dense: the eigenbasis step is for average acceleration (gamma = 1/2, beta = 1/4) only"
+    why = scheme_excluded(scheme)
+    if why:
+        return None, why
     T = modal_scaling(M, K)
     Tinv = np.linalg.inv(T)
     try:

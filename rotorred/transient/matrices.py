@@ -276,22 +276,42 @@ def level_matrices(M, D, K, B, forces: ForceColumns, h: float, gamma: float, bet
     model) the round-off of that difference dominates the error below dt ~ 2.5e-6 s
     (tests/test_roundoff.py).
     """
-    Ainv, Hq, Hv, Ha = step_matrices(M, D, K, h, gamma, beta, alpha)
-    S = Ainv @ B
     c = newmark_coefficients(h, gamma, beta)
     if alpha == 0.0 and c[5] == 0.0:
         # closed form without M^-1 (gamma = 2 beta): Ha M^-1 = c2 A^-1
         # with c0 M = A - c3 D - K, written as identity minus small terms (a solve of A against a
-        # matrix close to A would leave ~cond(A) eps on the identity part)
+        # matrix close to A would leave ~cond(A) eps on the identity part). Built in place from solves with A's
+        # factors (no A^-1, Hq, Hv, Ha of the general form): the refined(16) rig's set-up peaked at 298 MB with them
+        n = len(M)
         lu_A = sla.lu_factor(c[0] * M + c[3] * D + K, check_finite=False)
-        AiK, AiD = sla.lu_solve(lu_A, K, check_finite=False), sla.lu_solve(lu_A, D, check_finite=False)
-        eye = np.eye(len(M))
-        Hq = eye - (1.0 + c[2]) * AiK
-        Hv = (c[1] / c[0]) * (eye - c[3] * AiD - AiK) - (c[4] + c[2]) * AiD
-        H = np.hstack([Hq, Hv])
-        U1, U0 = Ainv @ forces.F, c[2] * (Ainv @ forces.F)
+        H = np.empty((n, 2 * n))
+        Hq, Hv = H[:, :n], H[:, n:]
+        AiK = sla.lu_solve(lu_A, K, check_finite=False)
+        AiD = sla.lu_solve(lu_A, D, check_finite=False)
+        diagonal = np.arange(n)
+        # Hq = I - (1 + c2) A^-1 K and Hv = (c1/c0) (I - c3 A^-1 D - A^-1 K) - (c4 + c2) A^-1 D, in this order
+        np.multiply(AiK, -(1.0 + c[2]), out=Hq)
+        Hq[diagonal, diagonal] += 1.0
+        np.multiply(AiD, -c[3], out=Hv)
+        Hv[diagonal, diagonal] += 1.0
+        Hv -= AiK
+        Hv *= c[1] / c[0]
+        AiD *= c[4] + c[2]
+        Hv -= AiD
+        del AiK, AiD
+        # S and U1 through A^-1 of A = c0 M + (c3 D + K), as the general form has them: the same rounding as
+        # before this form was built in place (a chaotic rub response follows the last bit: tests/test_chaos_rig.py)
+        Ainv = sla.lu_solve(sla.lu_factor(c[0] * M + (c[3] * D + K), check_finite=False), np.eye(n),
+                            check_finite=False)
+        S = Ainv @ B
+        U1 = Ainv @ forces.F
+        U0 = c[2] * U1
+        del Ainv
         S0T = c[2] * S.T
-    elif alpha == 0.0:
+        return _level(H, forces, U1, U0, S, S0T, B, alpha, h, gamma, beta)
+    Ainv, Hq, Hv, Ha = step_matrices(M, D, K, h, gamma, beta, alpha)
+    S = Ainv @ B
+    if alpha == 0.0:
         # a = M^-1 (F + B f - D v - K q) holds at every step: eliminate it
         HaMinv = sla.lu_solve(lu_M, Ha.T, trans=1, check_finite=False).T  # Ha M^-1
         H = np.hstack([Hq - HaMinv @ K, Hv - HaMinv @ D])
@@ -301,6 +321,11 @@ def level_matrices(M, D, K, B, forces: ForceColumns, h: float, gamma: float, bet
         H = np.hstack([Hq, Hv, Ha])
         U1, U0 = (1.0 + alpha) * Ainv @ forces.F, -alpha * Ainv @ forces.F
         S0T = -alpha * S.T
+    return _level(H, forces, U1, U0, S, S0T, B, alpha, h, gamma, beta)
+
+
+def _level(H, forces: ForceColumns, U1, U0, S, S0T, B, alpha: float, h: float, gamma: float, beta: float) -> dict:
+    """The arrays of one level (:func:`level_matrices`) from its step matrix, force and contact maps."""
     coef = np.zeros(8)
     coef[:6] = newmark_coefficients(h, gamma, beta)
     coef[6], coef[7] = alpha, h
@@ -314,15 +339,17 @@ def step_levels(M, D, K, B, forces: ForceColumns, plates: Sequence[RubPlate], dt
     lu_M = sla.lu_factor(M, check_finite=False)
     normals = np.array([p.normal for p in plates]).reshape(-1, 2)
     tangents = np.array([p.tangent for p in plates]).reshape(-1, 2)
-    per_level: dict[str, list] = {name: [] for name in kernel.Levels._fields}
+    stacked: dict[str, np.ndarray] = {}
     for level in range(n_levels):
         h = dt / 2**level
-        for name, value in level_matrices(M, D, K, B, forces, h, gamma, beta, alpha, lu_M).items():
-            per_level[name].append(value)
-        plate = np.array([[scalar_step(p.m_p, p.c_n, p.k_n, h, gamma, beta, alpha),
-                           scalar_step(p.m_p, p.c_t, p.k_t, h, gamma, beta, alpha)] for p in plates]).reshape(-1, 2, 4)
-        Jp, Jv = contact_operator(per_level["W"][-1], normals, tangents, plate[:, :, 3], alpha)
-        per_level["plate"].append(plate)
-        per_level["Jp"].append(Jp)
-        per_level["Jv"].append(Jv)
-    return kernel.Levels(**{name: np.ascontiguousarray(np.array(v, dtype=float)) for name, v in per_level.items()})
+        arrays = level_matrices(M, D, K, B, forces, h, gamma, beta, alpha, lu_M)
+        arrays["plate"] = np.array([[scalar_step(p.m_p, p.c_n, p.k_n, h, gamma, beta, alpha),
+                                     scalar_step(p.m_p, p.c_t, p.k_t, h, gamma, beta, alpha)]
+                                    for p in plates]).reshape(-1, 2, 4)
+        arrays["Jp"], arrays["Jv"] = contact_operator(arrays["W"], normals, tangents, arrays["plate"][:, :, 3], alpha)
+        for name, value in arrays.items():  # each level written into its slot: no second copy of every level
+            if name not in stacked:
+                stacked[name] = np.empty((n_levels,) + np.shape(value))
+            stacked[name][level] = value
+        del arrays
+    return kernel.Levels(**{name: stacked[name] for name in kernel.Levels._fields})

@@ -59,7 +59,7 @@ from rotorred import checks
 from rotorred.model.loads import Unbalance
 from rotorred.model.speeds import SpeedProfile
 from rotorred.transient import eigen_kernel, kernel
-from rotorred.transient.eigenstep import eigen_form, rows_on_y, with_record_rows
+from rotorred.transient.eigenstep import eigen_form, rows_on_y, scheme_excluded, with_record_rows
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate
 from rotorred.transient.matrices import (contact_rows, force_columns, kernel_plates, newmark_coefficients,
                                          plate_parameters, step_levels, step_matrices)
@@ -233,9 +233,9 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
                          run.max_halvings + 1)
     state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
     forcing = kernel.Forcing(forces.kind, forces.omega)
-    eig, step_form = choose_step(step, levels, contact, scheme, M, K, forcing)
-    # 3. plan the record (on the eigenbasis state y when the step runs there)
     plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
+    eig, step_form = choose_step(step, levels, contact, scheme, M, K, forcing, plan.n_steps)
+    # 3. plan the record (on the eigenbasis state y when the step runs there)
     rows = record_rows(model, loads.outputs, record_state)
     if eig is not None:
         rows = rows_on_y(rows, eig.P)
@@ -259,10 +259,22 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
 STEPS = ("auto", "eigen", "dense")
 
 
-def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme, M, K, forcing: kernel.Forcing):
-    """(Eigen or None, what was chosen and why) for ``step`` (:data:`STEPS`)."""
+#: "auto" takes the eigenbasis step for runs of at least EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n steps: below that its
+#: set-up (an eigen-decomposition of the 2n x 2n amplification matrix) costs more than it saves. Measured
+#: (paper-rub on the full refined(k) rig, one thread): break-even at 11 100, 12 300, 23 000 and 23 400 steps for
+#: n = 80, 296, 584 and 1160 (set-up 0.018 / 0.35 / 2.1 / 16.8 s against 0.003 / 0.04 / 0.19 / 1.4 s dense)
+EIGEN_MIN_STEPS, EIGEN_STEPS_PER_DOF = 10_000, 25
+
+
+def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme, M, K, forcing: kernel.Forcing,
+                n_steps: int):
+    """(Eigen or None, what was chosen and why) for ``step`` (:data:`STEPS`) and a run of ``n_steps`` steps."""
     if step == "dense":
         return None, "dense (asked)"
+    n = len(M)
+    if step == "auto" and not scheme_excluded(scheme) and n_steps < EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n:
+        return None, (f"dense: {n_steps} steps are too few to repay the eigenbasis' set-up (it pays from about "
+                      f"{EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n} steps at {n} DOFs)")
     eig, note = eigen_form(levels, plates, scheme, M, K, forcing)
     if eig is None and step == "eigen":
         checks.fail("step", step, f"cannot be used here: {note.removeprefix('dense: ')}")
