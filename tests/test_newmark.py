@@ -432,6 +432,36 @@ def test_newton_failure_is_halved_then_reported():
     assert np.all(np.isfinite(info.value.result.outputs[(1, "x")]))
 
 
+def test_halving_levels_are_built_on_first_need(monkeypatch):
+    """The dense n x 2n matrices of the halving levels are built only when a step first needs halving: the run that
+    halves builds them once and gives the history of a run that had them from the start (bitwise here: no forcing
+    recurrence to restart); a run that never halves builds level 0 only."""
+    import rotorred.transient.newmark as newmark
+
+    system = jeffcott()
+    plate = RubPlate(node=1, theta=0.0, clearance=1e-5, K_nr=1e11, c=0.0, mu_s=0.0, mu_d=0.0, disk_radius=0.1)
+    kw = dict(v0=[0.05, 0, 0, 0], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x")], max_newton=6,
+              step="dense")
+    built = []
+    real = newmark.step_levels
+
+    def counting(*args):
+        built.append(args[-1])
+        return real(*args)
+
+    monkeypatch.setattr(newmark, "step_levels", counting)
+    lazy = simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **kw)
+    assert lazy.n_substeps > 0 and built == [1, 5]
+    monkeypatch.setattr(newmark, "step_levels", lambda *args: real(*args[:-1], 5))  # every level from the start
+    eager = simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **kw)
+    np.testing.assert_array_equal(lazy.outputs[(1, "x")], eager.outputs[(1, "x")])
+    assert lazy.n_substeps == eager.n_substeps
+    built.clear()
+    monkeypatch.setattr(newmark, "step_levels", counting)
+    simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **{**kw, "plates": [], "max_newton": 50})
+    assert built == [1]
+
+
 def test_outputs_decimation_and_start():
     system = jeffcott()
     res = simulate(system, {"shaft": 0.0}, 0.01, 1e-4, q0=[1e-5, 0, 0, 0], outputs=[(1, "x"), (1, "theta_y")],

@@ -33,8 +33,8 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEWTON_FAILED,
-                                       NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
+from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEED_LEVELS,
+                                       NEWTON_FAILED, NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
                                        _condense_rlin, _disk_forces, _forcing_at_step_end, _matvec, _record,
                                        _solve_contact_forces, _start_forcing, _stick_reset, _substep,
                                        _update_contact_dofs, _write_state)
@@ -259,6 +259,9 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
             _to_physical(y, eig, ew, cur.x)
             extrapolate = False
             level = 1 if n_halvings > 0 else 0
+            if level >= levels.H.shape[0]:  # the halving levels are built on first need
+                _write_state(cur, state)
+                return NEED_LEVELS
             progress = 0
             while progress < units_total:
                 h_units = 1 << (n_halvings - level)

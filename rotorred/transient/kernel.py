@@ -105,6 +105,10 @@ def _borrowed(typingctx, container):
 
 # status codes
 RUNNING, DONE, NONFINITE, NEWTON_FAILED, LIMIT = 0, 1, 2, 3, 4
+#: the loop stopped at the start of main step ``diag.counters[C_STEPS]`` (its state in ``state``) because the step
+#: needs halving and ``levels`` holds level 0 only: the caller builds every level and calls again from there (the
+#: halving levels, dense n x 2n matrices each, are built on first need)
+NEED_LEVELS = 5
 # steps between exact re-evaluations of the forcing's cos/sin in the rotation recurrence
 RESYNC = 1024
 
@@ -755,6 +759,9 @@ def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, recor
                     diag.err[E_STATUS] = status
                     _write_state(cur, state)
                     return status
+                if level >= levels.H.shape[0]:  # level 0 failed (progress 0): cur is the main step's start
+                    _write_state(cur, state)
+                    return NEED_LEVELS
         diag.counters[C_STEPS] += 1
         _record_step(i + 1, t0 + (i + 1) * dt, cur, record)
     _write_state(cur, state)

@@ -73,10 +73,13 @@ from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces,
 
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
                record: kernel.Record, settings: kernel.Settings, diag: kernel.Diagnostics, n_steps: int,
-               chunk: int, progress: bool | None, eig=None) -> tuple[int, float, float, float]:
+               chunk: int, progress: bool | None, eig=None, every_level=None) -> tuple[int, float, float, float]:
     """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar:
     the eigenbasis loop (:mod:`rotorred.transient.eigen_kernel`) when ``eig`` is given (``record.rows`` then act
     on its state y), else the dense one.
+
+    ``levels`` may hold level 0 only, with ``every_level()`` building every level: the loop then stops at the
+    first step that needs halving (``kernel.NEED_LEVELS``), and goes on from that step with all of them.
 
     Returns
     -------
@@ -101,6 +104,10 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     while i < n_steps:
         i_next = min(n_steps, i + chunk)
         status = loop(i, i_next, *extra)
+        if status == kernel.NEED_LEVELS and every_level is not None:
+            extra = (every_level(),) + extra[1:]
+            every_level, i = None, int(diag.counters[kernel.C_STEPS])
+            continue
         if status != kernel.RUNNING:
             break
         i = i_next
@@ -229,8 +236,10 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     par, atol = plate_parameters(loads.plates, loads.speeds, loads.spool_of, rotor, run.newton_tol)
     B = contact_rows(model, loads.plates)
     contact = kernel_plates(M, B, par, atol)
-    levels = step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha,
-                         run.max_halvings + 1)
+    def step_levels_up_to(n_levels: int) -> kernel.Levels:
+        return step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha, n_levels)
+
+    levels = step_levels_up_to(1)  # the halving levels (dense n x 2n each) are built when a step first needs them
     state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
     forcing = kernel.Forcing(forces.kind, forces.omega)
     plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
@@ -248,7 +257,8 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
     status, run_time, run_cpu_time, load_time = run_kernel(
         levels, forcing, contact, state, record, settings, diag, plan.n_steps,
-        run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig)
+        run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig,
+        every_level=(lambda: step_levels_up_to(run.max_halvings + 1)) if run.max_halvings > 0 else None)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
                           (setup_time, run_time, run_cpu_time, load_time), record_state=record_state,
