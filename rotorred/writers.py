@@ -114,12 +114,13 @@ def write_npz(path: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
 
 
 def write_mat(path: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
-    """Write ``arrays`` as a compressed MATLAB ``.mat`` file (one variable per key)."""
+    """Write ``arrays`` as an uncompressed MATLAB ``.mat`` file (one variable per key; like the NPZ: compressing
+    paper-rub's took 0.17 s for 27 % less, 3.9 against 5.4 MB)."""
     from scipy.io import savemat
 
     path = Path(path)
     with atomic_path(path, ".mat") as tmp:
-        savemat(tmp, dict(arrays), do_compression=True)
+        savemat(tmp, dict(arrays), do_compression=False)
     return path
 
 

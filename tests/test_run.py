@@ -269,3 +269,20 @@ def test_figures_drawn_by_worker_processes_are_the_figures_drawn_here(rub, tmp_p
     bad = functools.partial(jobs[0].func, res.t[:1], *jobs[0].args[1:], **jobs[0].keywords)  # 1 sample: refused
     with FigurePool(workers=1) as pool, pytest.raises(Exception, match="at least 2 samples"):
         pool.submit(bad).result()
+
+
+def test_a_dead_figure_worker_costs_no_figure(rub, tmp_path):
+    """A worker killed while the figures are drawn (out of memory, a signal): its figures are drawn here instead,
+    and the files are all there."""
+    import os
+    import signal
+
+    from rotorred.plots.pool import FigurePool
+
+    sc, res = rub
+    with FigurePool(workers=1) as pool:
+        pid = pool.submit(os.getpid).result()
+        os.kill(pid, signal.SIGKILL)
+        files = write_outputs(res, tmp_path, pool=pool)
+    assert {"waveforms.png", "orbits.png", "spectra_node14.png"} <= {f.name for f in files}
+    assert all(f.stat().st_size > 0 for f in files)

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import concurrent.futures
 import multiprocessing
+from concurrent.futures.process import BrokenProcessPool
 import os
 import signal
 
-__all__ = ["FigurePool", "default_workers"]
+__all__ = ["FigurePool", "Drawing", "default_workers"]
 
 
 def default_workers() -> int:
@@ -38,7 +39,11 @@ def _start_worker() -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    import rotorred.plots.scene  # noqa: F401 - imported now, while the caller computes
+    import matplotlib.figure  # noqa: F401 - imported now, while the caller computes
+    import matplotlib.patches  # noqa: F401
+    import matplotlib.transforms  # noqa: F401
+
+    import rotorred.plots.scene  # noqa: F401 - light: no signals module, no pyFFTW (the jobs carry plain arrays)
 
     gc.freeze()  # the imported modules are never garbage: drawing then collects only its own objects
 
@@ -47,8 +52,26 @@ def _ready() -> int:
     return os.getpid()
 
 
+class Drawing:
+    """A submitted figure: ``result()`` is its path, drawn in this process when its worker died (killed, out of
+    memory, a script without a ``__main__`` guard that cannot be spawned) or when there is no worker."""
+
+    def __init__(self, job, future: concurrent.futures.Future | None):
+        self._job, self._future = job, future
+        if future is None:
+            self._value = job()
+
+    def result(self):
+        if self._future is None:
+            return self._value
+        try:
+            return self._future.result()
+        except BrokenProcessPool:
+            return self._job()
+
+
 class FigurePool:
-    """A context manager of figure-drawing processes; ``submit(job)`` returns a future of the job's result.
+    """A context manager of figure-drawing processes; ``submit(job)`` returns its :class:`Drawing`.
 
     Parameters
     ----------
@@ -65,13 +88,14 @@ class FigurePool:
             for _ in range(self.workers):  # one job each: every worker starts now
                 self._executor.submit(_ready)
 
-    def submit(self, job) -> concurrent.futures.Future:
+    def submit(self, job) -> Drawing:
         """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers."""
         if self._executor is None:
-            future = concurrent.futures.Future()
-            future.set_result(job())
-            return future
-        return self._executor.submit(job)
+            return Drawing(job, None)
+        try:
+            return Drawing(job, self._executor.submit(job))
+        except BrokenProcessPool:  # a worker died earlier: draw here
+            return Drawing(job, None)
 
     def __enter__(self) -> FigurePool:
         return self

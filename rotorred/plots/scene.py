@@ -17,17 +17,18 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from functools import partial
+from typing import TYPE_CHECKING, NamedTuple
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.patches import Circle
-from matplotlib.transforms import ScaledTranslation
 
 from rotorred import checks
 from rotorred.model.dofs import direction_name
-from rotorred.signals.lines import SpectralLine
-from rotorred.signals.spectra import Spectrum
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from rotorred.signals.lines import SpectralLine
 
 __all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures"]
 
@@ -75,6 +76,8 @@ _MARGINS, _GAP = (0.8, 0.25, 0.6, 0.95), 0.6
 
 def _stacked(width: float, panel_height: float, n: int) -> tuple[Figure, np.ndarray]:
     """A figure of ``n`` panels one above the other sharing x, with fixed margins (:data:`_MARGINS`)."""
+    from matplotlib.figure import Figure
+
     left, right, bottom, top = _MARGINS
     height = panel_height * n + bottom + top - _GAP
     fig = Figure(figsize=(width, height))
@@ -85,6 +88,8 @@ def _stacked(width: float, panel_height: float, n: int) -> tuple[Figure, np.ndar
 
 def _side_by_side(panel_width: float, height: float, n: int) -> tuple[Figure, np.ndarray]:
     """A figure of ``n`` panels in a row, each with its own axis labels, with fixed margins (:data:`_MARGINS`)."""
+    from matplotlib.figure import Figure
+
     left, right, bottom, top = _MARGINS
     gap = left  # the next panel's y label and tick labels
     width = panel_width * n + left + right - gap
@@ -167,7 +172,7 @@ def plot_waveforms(
 
 # --------------------------------------------------------------------------- spectra
 def _spectrum_arrays(name: str, item) -> tuple[np.ndarray, np.ndarray]:
-    if isinstance(item, Spectrum):
+    if hasattr(item, "frequencies") and hasattr(item, "amplitudes"):  # a rotorred.signals.spectra.Spectrum
         return np.asarray(item.frequencies, float), np.asarray(item.amplitudes, float)
     if isinstance(item, Sequence) and len(item) == 2:
         f = _vector(f"{name} frequencies", item[0])
@@ -263,6 +268,8 @@ def _label_lines(ax, lines: Sequence[SpectralLine], scale: float, color) -> None
     """Mark ``lines`` (one marker artist for all) and write each one's label above it, rotated."""
     if not lines:
         return
+    from matplotlib.transforms import ScaledTranslation
+
     f = np.array([ln.frequency_hz for ln in lines])
     y = scale * np.array([ln.amplitude for ln in lines])
     ax.plot(f, y, "v", ms=4, ls="none", color=color)
@@ -336,6 +343,8 @@ def plot_orbits(
             ax.plot(scale * x, scale * y, lw=0.9, label=str(label))
         radius = clearances.get(panel)
         if radius is not None:
+            from matplotlib.patches import Circle
+
             ax.add_patch(
                 Circle((0, 0), scale * radius, fill=False, ls="--", lw=1.0, color="0.4",
                        label=f"clearance {scale * radius:.3g} {unit}")
@@ -394,6 +403,8 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
     x = checks.vector("x", x, min_len=1)
     velocity = checks.vector("velocity", velocity, min_len=x.size, max_len=x.size)
     path = _path(path)
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(5.6, 5.0), layout="constrained")
     ax = fig.subplots()
     ax.plot(scale * x, scale * velocity, ".", ms=4 if x.size < 200 else 2, label=f"{label} ({x.size} samples)".strip())
@@ -421,6 +432,24 @@ def plot_scene(result, out: str | Path) -> list[Path]:
     list of Path
     """
     return [job() for job in scene_figures(result, out)]
+
+
+class LineMark(NamedTuple):
+    """What a spectrum plot shows of a :class:`rotorred.signals.lines.SpectralLine` (a figure job carries these, so
+    a worker needs neither the signals modules nor pyFFTW to draw it)."""
+
+    frequency_hz: float
+    amplitude: float
+    label: str
+    known: bool
+
+
+def _marks(lines) -> list[LineMark]:
+    return [LineMark(float(ln.frequency_hz), float(ln.amplitude), ln.label, bool(ln.known)) for ln in lines]
+
+
+def _pair(spectrum) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(spectrum.frequencies, float), np.asarray(spectrum.amplitudes, float)
 
 
 def scene_figures(result, out: str | Path) -> list[partial]:
@@ -462,8 +491,8 @@ def scene_figures(result, out: str | Path) -> list[partial]:
             spectra, lines = {}, {}
             for d in sc.output.directions:
                 panel = f"node {n} {direction_name(d)}"
-                spectra[panel] = {f"{label} {direction_name(d)}": r.spectra[(n, d)] for label, r in pairs}
-                lines[f"{case} {direction_name(d)}"] = result.lines[(n, d)]
+                spectra[panel] = {f"{label} {direction_name(d)}": _pair(r.spectra[(n, d)]) for label, r in pairs}
+                lines[f"{case} {direction_name(d)}"] = _marks(result.lines[(n, d)])
             if f_max is None:
                 known = [ln.frequency_hz for ls in lines.values() for ln in ls if ln.known]
                 f_max_n = max(1.1 * max(known, default=0.0), 3.0 * result.f_H)

@@ -215,6 +215,16 @@ def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, 
     return RUNNING
 
 
+@njit(cache=True, inline="always")
+def _stop_at_limit(t, j, cur, state, diag):
+    """LIMIT, with the time ``t`` (s) and contact DOF ``j`` in ``diag.err`` and ``cur`` written to ``state``."""
+    diag.err[E_TIME] = t
+    diag.err[E_DOF] = -1 - j
+    diag.err[E_STATUS] = LIMIT
+    _write_state(cur, state)
+    return LIMIT
+
+
 @njit(cache=True)
 def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, work, ework, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` as :func:`rotorred.transient.kernel.run_steps` does, level 0 in
@@ -241,13 +251,9 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
         if status == RUNNING:
             j = _beyond_limit(new.xc, settings.limit)
             if j >= 0:
-                diag.err[E_TIME] = t0 + (i + 1) * dt
-                diag.err[E_DOF] = -1 - j
-                diag.err[E_STATUS] = LIMIT
                 _phases_at(t_main, eig, ew)
                 _to_physical(y, eig, ew, cur.x)
-                _write_state(cur, state)
-                return LIMIT
+                return _stop_at_limit(t0 + (i + 1) * dt, j, cur, state, diag)
             cur, new = new, cur
             y, y_new = y_new, y
             extrapolate = True
@@ -273,11 +279,7 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
                 if status == RUNNING:
                     j = _beyond_limit(new.xc, settings.limit)
                     if j >= 0:
-                        diag.err[E_TIME] = tb
-                        diag.err[E_DOF] = -1 - j
-                        diag.err[E_STATUS] = LIMIT
-                        _write_state(cur, state)
-                        return LIMIT
+                        return _stop_at_limit(tb, j, cur, state, diag)
                     cur, new = new, cur
                     extrapolate = True
                     progress += h_units
