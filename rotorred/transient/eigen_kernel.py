@@ -33,11 +33,11 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEED_LEVELS,
-                                       NEWTON_FAILED, NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
+from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEED_DENSE, NEWTON_FAILED,
+                                       NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
                                        _condense_rlin, _disk_forces, _forcing_at_step_end, _matvec, _record,
-                                       _solve_contact_forces, _start_forcing, _stick_reset, _substep,
-                                       _update_contact_dofs, _write_state)
+                                       _solve_contact_forces, _start_forcing, _stick_reset, _update_contact_dofs,
+                                       _write_state)
 
 numba_cache.register()
 
@@ -229,18 +229,23 @@ def _stop_at_limit(t, j, cur, state, diag):
 def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, work, ework, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` as :func:`rotorred.transient.kernel.run_steps` does, level 0 in
     the eigenbasis (``record.rows`` act on y: the output rows times ``P``). ``state.x`` holds q, v on entry
-    and on return."""
+    and on return.
+
+    A step whose contact solve fails returns NEED_DENSE with that step's start in ``state`` (step index
+    ``diag.counters[C_STEPS]``): the caller redoes it with the dense loop, which halves it (or reports the
+    failure), and calls again from the next step. Inlining the dense step's halvings here took 20 of the
+    kernel's 53 s of compilation, for a path paper-rub never takes.
+    """
     levels, eig, forcing, plates, record, diag = (_borrowed(levels), _borrowed(eig), _borrowed(forcing),
                                                   _borrowed(plates), _borrowed(record), _borrowed(diag))
     cur, new, w, ew = _borrowed(state), _borrowed(spare), _borrowed(work), _borrowed(ework)
-    t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
+    t0, dt = settings.t0, settings.dt
     y, y_new = ew.y, ew.y_new
     _phases_at(t0 + i_begin * dt, eig, ew)
     _from_physical(cur.x, eig, ew, y)
     if i_begin == 0 and record.start == 0 and record.count[0] == 0:
         _record_eigen(0, t0, y, cur, eig, ew, record)
         record.count[0] = 1
-    units_total = 1 << n_halvings
     extrapolate = False
     _start_forcing(forcing, dt, w)
     for i in range(i_begin, i_end):
@@ -257,44 +262,11 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
             cur, new = new, cur
             y, y_new = y_new, y
             extrapolate = True
-        else:  # redo the main step by the dense step's halvings (or, with none allowed, its own level-0 step, which
-            # reports the failure with its DOF or plate), from the physical state. The halving control repeats
-            # kernel.run_steps': shared as an inline function returning the swapped buffers, both loops measured
-            # 15-30 % slower (validation/bench_eigenstep.py)
+        else:  # the dense step redoes this main step (its halvings, or its failure report): the caller runs it
             _phases_at(t_main, eig, ew)
             _to_physical(y, eig, ew, cur.x)
-            extrapolate = False
-            level = 1 if n_halvings > 0 else 0
-            if level >= levels.H.shape[0]:  # the halving levels are built on first need
-                _write_state(cur, state)
-                return NEED_LEVELS
-            progress = 0
-            while progress < units_total:
-                h_units = 1 << (n_halvings - level)
-                ta = t_main + progress * (dt / units_total)
-                tb = ta + h_units * (dt / units_total)
-                if progress + h_units == units_total:
-                    tb = t0 + (i + 1) * dt
-                status = _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w)
-                if status == RUNNING:
-                    j = _beyond_limit(new.xc, settings.limit)
-                    if j >= 0:
-                        return _stop_at_limit(tb, j, cur, state, diag)
-                    cur, new = new, cur
-                    extrapolate = True
-                    progress += h_units
-                    if level > 0:
-                        diag.counters[C_SUBSTEPS] += 1
-                else:
-                    extrapolate = False
-                    level += 1
-                    if level > n_halvings:
-                        diag.err[E_TIME] = tb
-                        diag.err[E_STATUS] = status
-                        _write_state(cur, state)
-                        return status
-            _phases_from_forcing(eig, w, ew)
-            _from_physical(cur.x, eig, ew, y)
+            _write_state(cur, state)
+            return NEED_DENSE
         diag.counters[C_STEPS] += 1
         j = i + 1
         if j >= record.start and (j - record.start) % record.every == 0 and record.count[0] < record.t.shape[0]:

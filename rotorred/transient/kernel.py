@@ -109,6 +109,9 @@ RUNNING, DONE, NONFINITE, NEWTON_FAILED, LIMIT = 0, 1, 2, 3, 4
 #: needs halving and ``levels`` holds level 0 only: the caller builds every level and calls again from there (the
 #: halving levels, dense n x 2n matrices each, are built on first need)
 NEED_LEVELS = 5
+#: the eigenbasis loop stopped at the start of main step ``diag.counters[C_STEPS]`` (its state in ``state``) whose
+#: contact solve failed there: the caller redoes that step with :func:`run_steps` and goes on
+NEED_DENSE = 6
 # steps between exact re-evaluations of the forcing's cos/sin in the rotation recurrence
 RESYNC = 1024
 

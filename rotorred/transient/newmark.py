@@ -73,13 +73,16 @@ from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces,
 
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
                record: kernel.Record, settings: kernel.Settings, diag: kernel.Diagnostics, n_steps: int,
-               chunk: int, progress: bool | None, eig=None, every_level=None) -> tuple[int, float, float, float]:
+               chunk: int, progress: bool | None, eig=None, every_level=None,
+               dense_record: kernel.Record | None = None) -> tuple[int, float, float, float]:
     """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar:
     the eigenbasis loop (:mod:`rotorred.transient.eigen_kernel`) when ``eig`` is given (``record.rows`` then act
-    on its state y), else the dense one.
+    on its state y; ``dense_record`` is the same record with the rows on x), else the dense one.
 
-    ``levels`` may hold level 0 only, with ``every_level()`` building every level: the loop then stops at the
-    first step that needs halving (``kernel.NEED_LEVELS``), and goes on from that step with all of them.
+    ``levels`` may hold level 0 only, with ``every_level()`` building every level: a loop then stops at the
+    first step that needs halving (``kernel.NEED_LEVELS``), and goes on from that step with all of them. A
+    step the eigenbasis loop cannot take (``kernel.NEED_DENSE``) is taken by the dense loop (compiled or loaded
+    when first needed), and the eigenbasis loop goes on from the next step.
 
     Returns
     -------
@@ -88,26 +91,14 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     run_time, run_cpu_time : float
         Wall and CPU time of the loop (s).
     load_time : float
-        Time to compile or load the kernel before the loop (s, :func:`load_kernel`).
+        Time to compile or load the kernels (s, :func:`load_kernel`).
     """
-    spare = kernel.spare_state(state)
-    work = kernel.work_arrays(len(state.x) // 3, len(plates.par), len(forcing.kind))
-    if eig is None:
-        loop, extra = kernel.run_steps, (levels, forcing, plates, state, spare, work, record, settings, diag)
-    else:
-        ework = eigen_kernel.eigen_work(len(state.x) // 3, len(eig.omega))
-        loop, extra = eigen_kernel.run_eigen_steps, (levels, eig, forcing, plates, state, spare, work, ework, record,
-                                                     settings, diag)
-    load_time = load_kernel((0, 0, *extra), loop)
+    loops = _Loops(levels, forcing, plates, state, record, dense_record or record, settings, diag, eig, every_level)
     t_run, cpu_run = time.perf_counter(), time.process_time()
     status, i, shown = kernel.RUNNING, 0, False
     while i < n_steps:
         i_next = min(n_steps, i + chunk)
-        status = loop(i, i_next, *extra)
-        if status == kernel.NEED_LEVELS and every_level is not None:
-            extra = (every_level(),) + extra[1:]
-            every_level, i = None, int(diag.counters[kernel.C_STEPS])
-            continue
+        status = loops.run(i, i_next)
         if status != kernel.RUNNING:
             break
         i = i_next
@@ -117,7 +108,66 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
             show_progress(i / n_steps, i * settings.dt, elapsed)
     if shown:
         print(file=sys.stderr)
-    return status, time.perf_counter() - t_run, time.process_time() - cpu_run, load_time
+    run_time = time.perf_counter() - t_run - loops.dense_load_time
+    return status, run_time, time.process_time() - cpu_run - loops.dense_load_time, loops.load_time
+
+
+class _Loops:
+    """The compiled loops of one run and what they share; :meth:`run` advances main steps ``i .. i_next - 1``,
+    answering the loops' requests (every halving level, a dense step)."""
+
+    def __init__(self, levels, forcing, plates, state, record, dense_record, settings, diag, eig, every_level):
+        self.levels, self.every_level, self.eig, self.diag = levels, every_level, eig, diag
+        spare = kernel.spare_state(state)
+        work = kernel.work_arrays(len(state.x) // 3, len(plates.par), len(forcing.kind))
+        self.shared = (forcing, plates, state, spare, work)
+        self.records, self.settings = (record, dense_record), settings
+        self.ework = None if eig is None else eigen_kernel.eigen_work(len(state.x) // 3, len(eig.omega))
+        self.dense_loaded, self.dense_load_time = eig is None, 0.0
+        self.load_time = load_kernel((0, 0, *self._args()), self._loop())
+
+    def _loop(self):
+        return kernel.run_steps if self.eig is None else eigen_kernel.run_eigen_steps
+
+    def _args(self, dense: bool = False) -> tuple:
+        forcing, plates, state, spare, work = self.shared
+        if dense or self.eig is None:
+            return (self.levels, forcing, plates, state, spare, work, self.records[1 if dense else 0], self.settings,
+                    self.diag)
+        return (self.levels, self.eig, forcing, plates, state, spare, work, self.ework, self.records[0], self.settings,
+                self.diag)
+
+    def _steps_done(self) -> int:
+        return int(self.diag.counters[kernel.C_STEPS])
+
+    def run(self, i: int, i_next: int) -> int:
+        while i < i_next:
+            status = self._loop()(i, i_next, *self._args())
+            if status == kernel.NEED_LEVELS and self.every_level is not None:
+                self._build_levels()
+            elif status == kernel.NEED_DENSE:
+                status = self._dense_step(self._steps_done())
+                if status != kernel.RUNNING:
+                    return status
+            else:
+                return status
+            i = self._steps_done()
+        return kernel.RUNNING
+
+    def _build_levels(self) -> None:
+        self.levels, self.every_level = self.every_level(), None
+
+    def _dense_step(self, i: int) -> int:
+        """Main step ``i`` by the dense loop (its halvings), recorded on x."""
+        if not self.dense_loaded:
+            self.dense_load_time = load_kernel((0, 0, *self._args(dense=True)), kernel.run_steps)
+            self.load_time += self.dense_load_time
+            self.dense_loaded = True
+        while True:
+            status = kernel.run_steps(i, i + 1, *self._args(dense=True))
+            if status != kernel.NEED_LEVELS or self.every_level is None:
+                return status
+            self._build_levels()
 
 
 
@@ -236,6 +286,7 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     par, atol = plate_parameters(loads.plates, loads.speeds, loads.spool_of, rotor, run.newton_tol)
     B = contact_rows(model, loads.plates)
     contact = kernel_plates(M, B, par, atol)
+
     def step_levels_up_to(n_levels: int) -> kernel.Levels:
         return step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha, n_levels)
 
@@ -246,10 +297,11 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     eig, step_form = choose_step(step, levels, contact, scheme, M, K, forcing, plan.n_steps)
     # 3. plan the record (on the eigenbasis state y when the step runs there)
     rows = record_rows(model, loads.outputs, record_state)
+    record = dense_record = record_buffers(plan, rows, len(loads.plates))
     if eig is not None:
         rows = rows_on_y(rows, eig.P)
         eig = with_record_rows(eig, rows)
-    record = record_buffers(plan, rows, len(loads.plates))
+        record = dense_record._replace(rows=np.ascontiguousarray(rows))  # the same buffers, rows on y
     setup_time = time.perf_counter() - t_setup
     # 4. run the kernel
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
@@ -258,7 +310,8 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     status, run_time, run_cpu_time, load_time = run_kernel(
         levels, forcing, contact, state, record, settings, diag, plan.n_steps,
         run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig,
-        every_level=(lambda: step_levels_up_to(run.max_halvings + 1)) if run.max_halvings > 0 else None)
+        every_level=(lambda: step_levels_up_to(run.max_halvings + 1)) if run.max_halvings > 0 else None,
+        dense_record=dense_record)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
                           (setup_time, run_time, run_cpu_time, load_time), record_state=record_state,
