@@ -54,13 +54,18 @@ class ReceptanceError:
     input: tuple
 
 
-def band_frequencies(model, speeds: Mapping[str, float], f_max_hz: float, n_grid: int = N_GRID) -> np.ndarray:
+def band_frequencies(model, speeds: Mapping[str, float], f_max_hz: float, n_grid: int = N_GRID,
+                     eigenvalues: np.ndarray | None = None) -> np.ndarray:
     """Angular frequencies (rad/s) of the band 0..``f_max_hz``: a uniform grid, the damped natural frequencies
-    of ``model`` at ``speeds`` (rad/s) in the band and the spool speeds, ascending, shape (n,)."""
+    of ``model`` at ``speeds`` (rad/s) in the band and the spool speeds, ascending, shape (n,).
+
+    ``eigenvalues``: those of ``model`` at ``speeds`` (:func:`rotorred.linear.modal.eigen`), when already at hand.
+    """
     f_max_hz = checks.positive("f_max_hz", f_max_hz, "Hz")
     w_max = 2 * math.pi * f_max_hz
-    sol = eigen(model.M, model.damping(speeds), model.K)
-    natural = sol.eigenvalues.imag[sol.eigenvalues.imag <= w_max]
+    if eigenvalues is None:
+        eigenvalues = eigen(model.M, model.damping(speeds), model.K).eigenvalues
+    natural = eigenvalues.imag[eigenvalues.imag <= w_max]
     spools = [w for w in speeds.values() if 0 < w <= w_max]
     return np.unique(np.concatenate([np.linspace(0.0, w_max, n_grid), natural, spools]))
 

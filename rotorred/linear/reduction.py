@@ -425,16 +425,15 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
     """
     n_modes, cutoff, band, target, n_check, check_speeds = _checked_options(
         system, n_modes, cutoff, band, target, n_check, check_speeds)
-    nodes, b, i = _boundary(system, boundary_nodes)
-    basis = _basis(system, b, i)
-    n_i = len(i)
+    ladder = ModeLadder(system, boundary_nodes)
+    n_i = ladder.n_interior
 
     if n_modes is not None:
         if n_modes > n_i:
             checks.fail("n_modes", n_modes, f"must be <= {n_i}, the number of interior DOFs")
         selection = ModeSelection("count", n_modes, n_i)
     elif cutoff is not None:
-        n_modes = int(np.count_nonzero(basis.omega <= cutoff))
+        n_modes = int(np.count_nonzero(ladder.frequencies <= cutoff))
         selection = ModeSelection("cutoff", n_modes, n_i, cutoff=float(cutoff), band=band)
     else:
         if check_speeds is None:
@@ -446,8 +445,7 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
         history = []
         resp_err = None
         for n in range(n_i + 1):
-            T = basis.T(n)
-            trial = _make(system, nodes, basis, T, n, ModeSelection("count", n, n_i))
+            trial = ladder.model(n)
             err = whirl_error(reference, trial, check_speeds, band=band, n_check=n_check)
             resp_err = None
             if response is not None and err <= target:
@@ -461,7 +459,7 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
                                   check_speeds=tuple(check_speeds), error=err,
                                   response_target=None if response is None else float(response.target),
                                   response_error=resp_err, history=tuple(history))
-    return _make(system, nodes, basis, basis.T(n_modes), n_modes, selection)
+    return ladder.model(n_modes, selection)
 
 
 def _checked_options(system: SystemMatrices, n_modes, cutoff, band, target, n_check, check_speeds):
@@ -489,6 +487,39 @@ def _checked_options(system: SystemMatrices, n_modes, cutoff, band, target, n_ch
         for k, s in enumerate(check_speeds):
             checks.keys(f"check_speeds[{k}]", s, system.G)
     return n_modes, cutoff, band, target, n_check, check_speeds
+
+
+class ModeLadder:
+    """The Craig–Bampton models of ``system`` with the boundary ``boundary_nodes`` and any number of fixed-interface
+    modes, all from one basis: the constraint modes and the interior eigen-decomposition are computed once (an
+    automatic mode count tries many counts).
+
+    Parameters
+    ----------
+    system : SystemMatrices
+    boundary_nodes : sequence of int
+        Nodes whose four physical DOFs stay as reduced coordinates.
+    """
+
+    def __init__(self, system: SystemMatrices, boundary_nodes: Sequence[int]):
+        self.system = system
+        self.nodes, b, i = _boundary(system, boundary_nodes)
+        self.basis = _basis(system, b, i)
+
+    @property
+    def n_interior(self) -> int:
+        """Interior DOFs: the most fixed-interface modes there are."""
+        return len(self.basis.i)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Fixed-interface natural frequencies (rad/s), ascending, shape (n_interior,)."""
+        return self.basis.omega
+
+    def model(self, n_modes: int, selection: ModeSelection | None = None) -> ReducedSystem:
+        """The model with the lowest ``n_modes`` fixed-interface modes (``selection`` default: a given count)."""
+        selection = selection or ModeSelection("count", n_modes, self.n_interior)
+        return _make(self.system, self.nodes, self.basis, self.basis.T(n_modes), n_modes, selection)
 
 
 def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred.linear.accuracy import ReceptanceError, band_frequencies, receptance, receptance_error
-from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
+from rotorred.linear.reduction import ModeLadder, default_boundary_nodes
 
 __all__ = ["ModeChoice", "choose_modes", "band_hz", "input_dofs", "running", "model_frequencies", "AUTO_TARGET",
            "BAND_FACTOR"]
@@ -92,14 +92,15 @@ def input_dofs(scene) -> list[tuple[int, str]]:
     return [(n, d) for n in nodes for d in ("x", "y")]
 
 
-def model_frequencies(scene, system) -> np.ndarray:
-    """Frequencies (rad/s) a model is compared at: the band with a plate, the spool speeds without."""
+def model_frequencies(scene, system, band: np.ndarray | None = None) -> np.ndarray:
+    """Frequencies (rad/s) a model is compared at: the band with a plate (``band`` when already computed by
+    :func:`rotorred.linear.accuracy.band_frequencies`), the spool speeds without."""
     if scene.plates:
-        return band_frequencies(system, scene.speeds, band_hz(scene))
+        return band if band is not None else band_frequencies(system, scene.speeds, band_hz(scene))
     return np.array(sorted(running(scene)))
 
 
-def choose_modes(scene, system, target: float) -> ModeChoice:
+def choose_modes(scene, system, target: float, band: np.ndarray | None = None) -> ModeChoice:
     """The smallest model of ``scene`` (module docstring) whose receptance error is at most ``target``.
 
     Parameters
@@ -109,8 +110,11 @@ def choose_modes(scene, system, target: float) -> ModeChoice:
         The scene's full model (``assemble(scene.rotor)``).
     target : float
         Relative receptance error (:func:`rotorred.linear.accuracy.receptance_error` at the spool speeds).
+    band : ndarray, optional
+        The band's frequencies (rad/s, :func:`rotorred.linear.accuracy.band_frequencies` of ``system``), when
+        already at hand.
     """
-    omega = model_frequencies(scene, system)
+    omega = model_frequencies(scene, system, band)
     inputs = input_dofs(scene)
     H_full = receptance(system, scene.speeds, omega, scene.output.dofs, inputs)
     options = [_fewest_modes(scene, system, omega, inputs, H_full, target, extra) for extra in _extra_options(scene)]
@@ -134,11 +138,10 @@ def _fewest_modes(scene, system, omega, inputs, H_full, target, extra):
     """(model, ReceptanceError, extra) of the fewest modes meeting ``target`` with ``extra`` boundary nodes, or
     None when every mode is needed."""
     nodes = tuple(sorted(set(scene.solver.boundary_nodes) | {p.node for p in scene.plates} | set(extra)))
-    largest = reduce_rotor(scene.rotor, nodes, n_modes=0, system=system).selection.n_interior_dofs
-    every = reduce_rotor(scene.rotor, nodes, n_modes=largest, system=system)
-    needed = int(np.count_nonzero(every.interior_frequencies <= omega[-1]))  # every interior mode of the range
-    for n in range(needed, largest + 1):
-        model = reduce_rotor(scene.rotor, nodes, n_modes=n, system=system)
+    ladder = ModeLadder(system, default_boundary_nodes(scene.rotor, nodes))
+    needed = int(np.count_nonzero(ladder.frequencies <= omega[-1]))  # every interior mode of the range
+    for n in range(needed, ladder.n_interior + 1):
+        model = ladder.model(n)
         err = receptance_error(receptance(model, scene.speeds, omega, scene.output.dofs, inputs), H_full, omega,
                                scene.output.dofs, inputs, at=running(scene))
         if err.error <= target:

@@ -46,6 +46,7 @@ from rotorred.model.assembly import assemble
 from rotorred.scenes.modes import BAND_FACTOR, band_hz, choose_modes, input_dofs, running
 from rotorred.scenes.schema import Scene
 from rotorred.signals.compare import outputs_error
+from rotorred.signals.spectra import NotCommensurateError, commensurate_record
 
 __all__ = ["Choice", "Settings", "choose", "run_to_tolerance", "BAND_FACTOR", "MODEL_SHARE", "DT_SHARE", "WINDOW_SHARE",
            "STEP_SHARE", "DT_LADDER"]
@@ -57,6 +58,8 @@ MODEL_SHARE, WINDOW_SHARE, STEP_SHARE, DT_SHARE = 0.25, 0.25, 0.5, 1.0
 DT_LADDER = tuple(m * 10.0 ** -e for e in range(3, 8) for m in (5, 2, 1))[1:]
 #: most halvings of dt the contact check makes
 MAX_HALVINGS = 6
+#: longest common period the record start is rounded up to (s); a longer one (or none): whole steps
+MAX_PERIOD = 1.0
 
 
 @dataclass(frozen=True)
@@ -120,11 +123,12 @@ def choose(scene: Scene) -> Settings:
     t0 = time.perf_counter()
     band = band_hz(scene)
     system = assemble(scene.rotor)
-    omega = band_frequencies(system, scene.speeds, band)
+    eigenvalues = eigen(system.M, system.damping(scene.speeds), system.K).eigenvalues  # once: band and window
+    omega = band_frequencies(system, scene.speeds, band, eigenvalues=eigenvalues)
     inputs = input_dofs(scene)
-    model, solver, model_choices, e_model = _choose_model(scene, system, tol)
+    model, solver, model_choices, e_model = _choose_model(scene, system, tol, omega)
     dt, e_dt = _choose_dt(scene, model, omega, inputs, tol)
-    start, duration, e_window, window_reason = _choose_window(scene, system, omega, dt, tol)
+    start, duration, e_window, window_reason = _choose_window(scene, eigenvalues, omega, dt, tol)
     chosen = dataclasses.replace(scene, solver=dataclasses.replace(solver, dt=dt, record_start=start,
                                                                    duration=duration),
                                  output=_inside(scene.output, start, duration))
@@ -155,13 +159,13 @@ def run_to_tolerance(scene: Scene, **options):
 
 
 # --------------------------------------------------------------------------- model
-def _choose_model(scene, system, tol):
+def _choose_model(scene, system, tol, band):
     """(model, solver settings, choices, estimate): the smallest model meeting MODEL_SHARE tol
-    (:func:`rotorred.scenes.modes.choose_modes`)."""
+    (:func:`rotorred.scenes.modes.choose_modes`; ``band``: the band's frequencies, rad/s)."""
     s = scene.solver
     if s.model == "full":
         return system, s, [Choice("solver.model", "full", 0.0, "the scene asks for the full model")], 0.0
-    choice = choose_modes(scene, system, MODEL_SHARE * tol)
+    choice = choose_modes(scene, system, MODEL_SHARE * tol, band)
     if choice.full:
         why = "no reduced model smaller than the full one meets the target"
         return system, dataclasses.replace(s, model="full"), [Choice("solver.model", "full", 0.0, why)], 0.0
@@ -202,12 +206,11 @@ def _choose_dt(scene, model, omega, inputs, tol) -> tuple[float, float]:
 
 
 # --------------------------------------------------------------------------- window
-def _choose_window(scene, system, omega, dt, tol) -> tuple[float, float, float, str]:
-    """(record_start, duration, estimate, reason): the record starts when the slowest mode of the band has decayed
-    to WINDOW_SHARE tol; the scene's window length is kept."""
+def _choose_window(scene, eigenvalues, omega, dt, tol) -> tuple[float, float, float, str]:
+    """(record_start, duration, estimate, reason): the record starts when the slowest mode of the band (of the full
+    model's ``eigenvalues``) has decayed to WINDOW_SHARE tol; the scene's window length is kept."""
     s = scene.solver
-    sol = eigen(system.M, system.damping(scene.speeds), system.K)
-    in_band = sol.eigenvalues[sol.eigenvalues.imag <= omega[-1]]
+    in_band = eigenvalues[eigenvalues.imag <= omega[-1]]
     sigma = -in_band.real
     if not in_band.size or sigma.min() <= 0:
         checks.fail("solver.tolerance", tol, "cannot be met: a mode of the band is undamped or unstable, so the "
@@ -225,21 +228,15 @@ def _choose_window(scene, system, omega, dt, tol) -> tuple[float, float, float, 
 
 
 def _common_period(scene, dt) -> float:
-    """The spools' common period when it is a whole number of steps of ``dt`` (at most 1 s), else ``dt``."""
-    from fractions import Fraction
+    """The spools' common period (:func:`rotorred.signals.spectra.commensurate_record`, the spectrum's own rule) when
+    it is a whole number of steps of ``dt`` and at most :data:`MAX_PERIOD`, else ``dt``."""
+    from rotorred.scenes.run import spool_frequencies
 
-    f = [Fraction(w / (2 * math.pi)).limit_denominator(1000) for w in scene.speeds.values() if w > 0]
-    base = f[0]
-    for x in f[1:]:
-        base = Fraction(math.gcd(base.numerator * x.denominator, x.numerator * base.denominator),
-                        base.denominator * x.denominator)
-    ok = all(abs(float(x) - w / (2 * math.pi)) < 1e-9 * float(x) for x, w in
-             zip(f, [w for w in scene.speeds.values() if w > 0]))
-    period = 1.0 / float(base) if ok and base > 0 else 0.0
-    steps = period / dt
-    if ok and 0 < period <= 1.0 and abs(steps - round(steps)) < 1e-6 * steps:
-        return period
-    return dt
+    try:
+        period = commensurate_record(*spool_frequencies(scene), dt).period
+    except NotCommensurateError:
+        return dt
+    return period if period <= MAX_PERIOD else dt
 
 
 def _inside(output, start: float, duration: float):
@@ -267,21 +264,20 @@ def _measure_dt(scene: Scene, band: float, tol: float, budget: float, reason: st
             runs[dt] = respond(_with_dt(scene, dt), model).outputs
         return runs[dt]
 
-    def estimate(dt):
-        e = outputs_error(response(dt), dt, response(dt / 2), dt / 2, f_L, f_H, band)
-        return 4.0 / 3.0 * e.error, e
+    def estimate(dt):  # Richardson: 4/3 of the difference to the run at dt/2
+        return 4.0 / 3.0 * outputs_error(response(dt), dt, response(dt / 2), dt / 2, f_L, f_H, band).error
 
     dt = scene.solver.dt
-    est, diff = estimate(dt)
+    est = estimate(dt)
     halvings = 0
     while est > target:
         if halvings == MAX_HALVINGS:
             checks.fail("solver.tolerance", tol, f"is not reached after {MAX_HALVINGS} halvings of the time step "
                         f"(estimate {est:.2g} at dt = {dt:g} s)")
         dt, halvings = dt / 2, halvings + 1
-        est, diff = estimate(dt)
+        est = estimate(dt)
     while halvings == 0 and _whole(2 * dt, scene) and 2 * dt <= DT_LADDER[0]:
-        coarse_est = 4.0 / 3.0 * outputs_error(response(2 * dt), 2 * dt, response(dt), dt, f_L, f_H, band).error
+        coarse_est = estimate(2 * dt)
         if coarse_est > target:
             break
         dt, est = 2 * dt, coarse_est
