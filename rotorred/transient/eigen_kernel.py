@@ -33,11 +33,11 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEED_DENSE, NEWTON_FAILED,
-                                       NONFINITE, RUNNING, Condensed, State, _add_columns, _beyond_limit, _borrowed,
-                                       _condense_rlin, _disk_forces, _forcing_at_step_end, _matvec, _record,
-                                       _solve_contact_forces, _start_forcing, _stick_reset, _update_contact_dofs,
-                                       _write_state)
+from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
+                                       Condensed, State, _add_columns, _beyond_limit, _borrowed, _condense_rlin,
+                                       _cos_sin, _disk_forces, _forcing_at_step_end, _matvec, _record,
+                                       _solve_contact_forces, _start_forcing, _stick_reset, _stop_at_limit,
+                                       _update_contact_dofs, _write_state)
 
 numba_cache.register()
 
@@ -119,9 +119,7 @@ def _sum(x):
 @njit(cache=True, inline="always")
 def _phases_at(t, eig, ew):
     """``ew.c``, ``ew.s``: cos and sin of each pair's omega t."""
-    for j in range(eig.omega.shape[0]):
-        ew.c[j] = math.cos(eig.omega[j] * t)
-        ew.s[j] = math.sin(eig.omega[j] * t)
+    _cos_sin(eig.omega, t, ew.c, ew.s)
 
 
 @njit(cache=True, inline="always")
@@ -213,16 +211,6 @@ def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, 
         return NONFINITE
     _stick_reset(new, plates, w)
     return RUNNING
-
-
-@njit(cache=True, inline="always")
-def _stop_at_limit(t, j, cur, state, diag):
-    """LIMIT, with the time ``t`` (s) and contact DOF ``j`` in ``diag.err`` and ``cur`` written to ``state``."""
-    diag.err[E_TIME] = t
-    diag.err[E_DOF] = -1 - j
-    diag.err[E_STATUS] = LIMIT
-    _write_state(cur, state)
-    return LIMIT
 
 
 @njit(cache=True)

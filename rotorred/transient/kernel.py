@@ -366,11 +366,17 @@ def _forcing_value(kind, omega, t):
 # The step functions below are inlined into run_steps (numba inline="always"): a call would pass
 # every array of its containers (a few hundred machine words) per step.
 @njit(cache=True, inline="always")
+def _cos_sin(omega, t, c, s):
+    """``c``, ``s``: cos and sin of each ``omega * t``."""
+    for j in range(omega.shape[0]):
+        c[j] = math.cos(omega[j] * t)
+        s[j] = math.sin(omega[j] * t)
+
+
+@njit(cache=True, inline="always")
 def _start_forcing(forcing, dt, w):
     """The rotation of each sinusoid over one main step: cos and sin of omega dt."""
-    for j in range(forcing.omega.shape[0]):
-        w.rot_c[j] = math.cos(forcing.omega[j] * dt)
-        w.rot_s[j] = math.sin(forcing.omega[j] * dt)
+    _cos_sin(forcing.omega, dt, w.rot_c, w.rot_s)
 
 
 @njit(cache=True, inline="always")
@@ -663,6 +669,16 @@ def _record_step(j, t, s, record):
 
 
 @njit(cache=True, inline="always")
+def _stop_at_limit(t, j, cur, state, diag):
+    """LIMIT, with the time ``t`` (s) and contact DOF ``j`` in ``diag.err`` and ``cur`` written to ``state``."""
+    diag.err[E_TIME] = t
+    diag.err[E_DOF] = -1 - j
+    diag.err[E_STATUS] = LIMIT
+    _write_state(cur, state)
+    return LIMIT
+
+
+@njit(cache=True, inline="always")
 def _write_state(src, dst):
     dst.x[:] = src.x
     dst.xc[:] = src.xc
@@ -744,11 +760,7 @@ def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, recor
             if status == RUNNING:
                 j = _beyond_limit(new.xc, settings.limit)
                 if j >= 0:
-                    diag.err[E_TIME] = tb
-                    diag.err[E_DOF] = -1 - j
-                    diag.err[E_STATUS] = LIMIT
-                    _write_state(cur, state)
-                    return LIMIT
+                    return _stop_at_limit(tb, j, cur, state, diag)
                 cur, new = new, cur
                 extrapolate = True
                 progress += h_units
