@@ -130,7 +130,7 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
 
 
 def _submit_figures(result: SceneResult, out: Path, pool) -> list:
-    """Futures of the scene's figures, drawn by ``pool`` (None: drawn now, in this process)."""
+    """The scene's figures as :class:`rotorred.plots.pool.Drawing` s, drawn by ``pool`` (None: drawn now, here)."""
     from rotorred.plots.pool import FigurePool  # matplotlib only when figures are written
     from rotorred.plots.scene import scene_figures
 
