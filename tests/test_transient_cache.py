@@ -88,3 +88,26 @@ def test_digest_covers_every_module_with_compiled_code():
     compiled.discard((PACKAGE / "transient" / "numba_cache.py").resolve())  # describes njit, compiles nothing
     assert compiled and compiled <= digest, sorted(map(str, compiled - digest))
     assert set((PACKAGE / "_generated").glob("*.py")) <= {p for p in numba_cache.source_files()}
+
+
+def test_a_function_numba_cannot_cache_is_warned_about_not_crashed_on():
+    """numba's check that a compiled result can be cached warns with the locator's ``_py_file``; without it a
+    function numba declines to cache (it happened at NUMBA_OPT=0: "uses dynamic globals") raised AttributeError."""
+    import warnings
+    from types import SimpleNamespace
+
+    from numba.core import caching
+    from numba.core.errors import NumbaWarning
+
+    from rotorred.transient import kernel
+
+    impl = caching.CompileResultCacheImpl(kernel._matvec.py_func)
+    assert isinstance(impl.locator, numba_cache.RotorredCacheLocator)
+    uncachable = SimpleNamespace(lifted=(), library=SimpleNamespace(has_dynamic_globals=True),
+                                 fndesc=SimpleNamespace(qualname="_matvec"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert impl.check_cachable(uncachable) is False
+    assert [w for w in caught if issubclass(w.category, NumbaWarning) and "Cannot cache" in str(w.message)]
+    assert impl.locator._py_file == kernel.__file__
+

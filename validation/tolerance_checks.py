@@ -38,7 +38,7 @@ import math  # noqa: E402
 import time  # noqa: E402
 
 from rotorred.scenes.run import build_model, respond, spool_frequencies  # noqa: E402
-from rotorred.scenes.schema import load_scene  # noqa: E402
+from rotorred.scenes.schema import is_whole_steps, load_scene  # noqa: E402
 from rotorred.scenes.tolerance import choose  # noqa: E402
 from rotorred.signals.compare import outputs_error  # noqa: E402
 
@@ -76,7 +76,7 @@ def run_time(scene) -> float:
 
 
 def divides(dt: float, *times: float) -> bool:
-    return all(abs(t / dt - round(t / dt)) < 1e-6 * max(t / dt, 1.0) for t in times)
+    return all(is_whole_steps(t, dt) for t in times)
 
 
 def grid(chosen):

@@ -83,6 +83,13 @@ _OUTPUT_KEYS = {"nodes", "directions", "plots", "formats", "plot_window", "table
                 "compare_normal"}
 #: relative tolerance of the record-window tests (whole number of steps, of common periods)
 _RTOL = 1e-9
+def is_whole_steps(t: float, dt: float) -> bool:
+    """Whether the time ``t`` (s) is a whole number of steps of ``dt`` (s), up to the relative rounding ``_RTOL``
+    (the rule of a scene's ``record_start`` and ``duration``)."""
+    steps = t / dt
+    return abs(steps - round(steps)) <= _RTOL * max(steps, 1.0)
+
+
 #: tolerance of the Navier series of Eq. 10 (relative); 1e-6 is far below the uncertainty of any plate
 #: dimension and converges within the series' term cap for a centrally loaded plate
 NAVIER_TOL = 1e-6
@@ -661,10 +668,9 @@ def _solver_times(table: dict, d: SolverSpec) -> tuple[float, float, float]:
         fail("solver.duration", duration, f"must exceed solver.record_start = {record_start:g}, the start of the "
              "recorded window record_start..duration", "s")
     for name, value in (("duration", duration), ("record_start", record_start)):
-        steps = value / dt
-        if abs(steps - round(steps)) > _RTOL * max(steps, 1.0):
+        if not is_whole_steps(value, dt):
             fail(f"solver.{name}", value, f"must be a whole number of steps of solver.dt = {dt:g}; it is "
-                 f"{steps:.6g} steps", "s")
+                 f"{value / dt:.6g} steps", "s")
     # Any record length is accepted at any speeds (issue 19): the line fit needs no whole common
     # period, and the spectrum uses a window when the record holds none (signals.spectra.settled_spectrum).
     return dt, duration, record_start

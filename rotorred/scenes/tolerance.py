@@ -44,7 +44,7 @@ from rotorred.linear.accuracy import band_frequencies, receptance, receptance_er
 from rotorred.linear.modal import eigen
 from rotorred.model.assembly import assemble
 from rotorred.scenes.modes import BAND_FACTOR, band_hz, choose_modes, input_dofs, running
-from rotorred.scenes.schema import Scene
+from rotorred.scenes.schema import Scene, is_whole_steps
 from rotorred.signals.compare import outputs_error
 from rotorred.signals.spectra import NotCommensurateError, commensurate_record
 
@@ -288,8 +288,7 @@ def _measure_dt(scene: Scene, band: float, tol: float, budget: float, reason: st
 
 def _whole(dt: float, scene: Scene) -> bool:
     """Whether ``record_start`` and ``duration`` are whole numbers of steps of ``dt``."""
-    s = scene.solver
-    return all(abs(t / dt - round(t / dt)) < 1e-6 * max(t / dt, 1.0) for t in (s.record_start, s.duration))
+    return all(is_whole_steps(t, dt) for t in (scene.solver.record_start, scene.solver.duration))
 
 
 def _with_dt(scene: Scene, dt: float) -> Scene:

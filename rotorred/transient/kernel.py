@@ -679,14 +679,24 @@ def _stop_at_limit(t, j, cur, state, diag):
 
 
 @njit(cache=True, inline="always")
+def _copy_into(src, dst):
+    """``dst[...] = src`` for C-contiguous arrays of one shape, element by element: numba's slice assignment
+    compiles its broadcast error messages (string formatting), which took 6 s of the kernel's compilation."""
+    s = src.reshape(src.size)
+    d = dst.reshape(dst.size)
+    for i in range(s.shape[0]):
+        d[i] = s[i]
+
+
+@njit(cache=True, inline="always")
 def _write_state(src, dst):
-    dst.x[:] = src.x
-    dst.xc[:] = src.xc
-    dst.ps[:] = src.ps
-    dst.z[:] = src.z
-    dst.mode[:] = src.mode
-    dst.sgn[:] = src.sgn
-    dst.pinfo[:] = src.pinfo
+    _copy_into(src.x, dst.x)
+    _copy_into(src.xc, dst.xc)
+    _copy_into(src.ps, dst.ps)
+    _copy_into(src.z, dst.z)
+    _copy_into(src.mode, dst.mode)
+    _copy_into(src.sgn, dst.sgn)
+    _copy_into(src.pinfo, dst.pinfo)
 
 
 def work_arrays(n: int, n_p: int, nf: int) -> Work:

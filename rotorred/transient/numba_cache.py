@@ -121,6 +121,11 @@ class RotorredCacheLocator(caching._CacheLocator):
     def get_disambiguator(self):
         return self._inner.get_disambiguator()
 
+    @property
+    def _py_file(self):
+        """The function's source file (numba reads it to warn that a function cannot be cached)."""
+        return self._inner._py_file
+
     @classmethod
     def from_function(cls, py_func, py_file):
         try:
