@@ -21,6 +21,7 @@ from rotorred.plots.campbell import plot_campbell
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
 from rotorred.linear.modal import eigen
 from rotorred.model.rotor import Rotor, Spool
+from rotorred.model.rotor_file import load_rotor
 
 VALIDATION = Path(__file__).resolve().parents[1] / "validation"
 
@@ -580,3 +581,101 @@ def test_mass_proportional_damping_leaves_no_overdamped_pair_as_a_mode():
         assert (a.spool, a.whirl) == (b.spool, b.whirl)
         assert abs(b.speed / a.speed - 1) < 1.5e-2
         assert b.log_dec < 2 * np.pi * 0.5
+
+
+# --- speed-dependent bearings (issue 18 item 12) ----------------------------------------------------------------
+TABLE_RPM = (0.0, 5000.0, 10000.0, 20000.0)
+
+
+@pytest.fixture(scope="module")
+def tabulated():
+    """Nelson-McVaugh on fluid-film-like bearings: soft at rest, 10x stiffer at 20000 rpm, growing cross-coupling."""
+    from rotorred.model.elements import BearingTable
+
+    rotor = load_rotor("nelson-mcvaugh")
+    speeds = tuple(v * math.pi / 30 for v in TABLE_RPM)
+    tables = tuple(BearingTable(node=b.node, speeds=speeds, k_xx=(2e6, 5e6, 1e7, 2e7), k_yy=(3e6, 6e6, 1.2e7, 2.5e7),
+                                k_xy=(0.0, 1e5, 2e5, 4e5), k_yx=(0.0, -1e5, -2e5, -4e5), c_xx=(200.0, 300.0, 400.0, 500.0),
+                                c_yy=200.0) for b in rotor.bearings)
+    return rotor, dataclasses.replace(rotor, bearings=tables)
+
+
+def _with_bearings_at(rotor, tabulated_rotor, Omega):
+    """The rotor with constant bearings: each table evaluated at ``Omega`` (the path that bypasses the model's tables)."""
+    return dataclasses.replace(rotor, bearings=tuple(t.at(Omega) for t in tabulated_rotor.bearings))
+
+
+def test_speed_dependent_bearings_at_a_speed_equal_the_rotor_rebuilt_with_those_coefficients(tabulated):
+    """``stiffness(speeds)`` and ``damping(speeds)`` of a model with bearing tables are the matrices of the rotor
+    assembled with constant bearings at that speed (two paths: the tables' change added to K, C at the rotor's
+    speed; a fresh assembly). Measured: equal to the last bit; asserted to 1e-15 of the largest entry."""
+    rotor, rt = tabulated
+    sm = assemble(rt)
+    assert sm.speed_dependent and not assemble(rotor).speed_dependent
+    for Omega in (0.0, 300.0, 800.0, 1500.0, 3000.0):  # 3000 rad/s: above the table (held)
+        ref = assemble(_with_bearings_at(rotor, rt, Omega))
+        K, D = sm.stiffness({"shaft": Omega}), sm.damping({"shaft": Omega})
+        assert np.abs(K - ref.K).max() <= 1e-15 * np.abs(ref.K).max()
+        assert np.abs(D - ref.damping({"shaft": Omega})).max() <= 1e-15 * np.abs(ref.K).max() ** 0.5
+
+
+def test_speed_dependent_bearings_critical_speeds_against_an_independent_root_finder(tabulated):
+    """Each critical speed Omega_c of the Campbell diagram with bearing tables solves omega(Omega) = Omega where
+    omega is the mode's whirl speed of the rotor rebuilt with constant bearings at Omega (brentq on that, a path
+    that never sees the tables). Measured: 1.5e-10 and 5e-11 (the diagram's own root tolerance); asserted 2e-9.
+    The tables matter: with the coefficients at rest the lowest crossing is at half the speed."""
+    rotor, rt = tabulated
+    speeds = np.linspace(0.0, 25000 * math.pi / 30, 101)
+    res = campbell(rt, speeds, n_modes=6)
+    assert len(res.critical_speeds) == 2
+    for c in res.critical_speeds:
+        def g(Omega):
+            sm = assemble(_with_bearings_at(rotor, rt, Omega))
+            lam = eigen(sm.M, sm.damping({"shaft": Omega}), sm.K).eigenvalues
+            f = lam.imag[lam.imag > 0]
+            return f[np.argmin(abs(f - c.frequency))] - Omega
+        ref = brentq(g, 0.9 * c.speed, 1.1 * c.speed, xtol=1e-12, rtol=1e-14)
+        assert c.speed == pytest.approx(ref, rel=2e-9)
+    at_rest = campbell(_with_bearings_at(rotor, rt, 0.0), speeds, n_modes=6).critical_speeds
+    assert min(c.speed for c in res.critical_speeds) > 1.4 * min(c.speed for c in at_rest)  # 9331 against 4646 rpm
+
+
+def test_speed_dependent_bearings_in_a_reduced_model(tabulated):
+    """A Craig-Bampton model keeps the bearing nodes physical, so the tables act on it exactly: its critical speeds
+    converge to the full model's with the mode count. Measured: 4.4e-4 with 4 modes, 4.8e-6 with 8; asserted 5e-3
+    and 5e-5."""
+    from rotorred.linear.reduction import reduce_rotor
+
+    _, rt = tabulated
+    speeds = np.linspace(0.0, 25000 * math.pi / 30, 101)
+    full = campbell(rt, speeds, n_modes=6).critical_speeds
+    for n_modes, tol in ((4, 5e-3), (8, 5e-5)):
+        red = campbell(rt, speeds, n_modes=6, model=reduce_rotor(rt, n_modes=n_modes)).critical_speeds
+        assert len(red) == len(full)
+        assert max(abs(a.speed / b.speed - 1) for a, b in zip(red, full)) < tol
+
+
+def test_cli_campbell_of_a_rotor_file_with_bearing_tables(tmp_path, capsys):
+    """End to end: a rotor file's bearings tabulated against speed (speed_rpm lists) give the critical speeds of the
+    tables (those of test_speed_dependent_bearings_... to 1e-6: the same rotor, the same diagram), and the sweep
+    beyond the tables' 20000 rpm is said, bearing by bearing."""
+    from importlib import resources
+
+    from rotorred.cli import main
+
+    text = resources.files("rotorred.model.presets").joinpath("nelson-mcvaugh.toml").read_text()
+    table = ("speed_rpm = [0.0, 5000.0, 10000.0, 20000.0]\nk_xx = [2e6, 5e6, 1e7, 2e7]\nk_yy = [3e6, 6e6, 1.2e7, 2.5e7]\n"
+             "k_xy = [0.0, 1e5, 2e5, 4e5]\nk_yx = [0.0, -1e5, -2e5, -4e5]\nc_xx = [200.0, 300.0, 400.0, 500.0]\n"
+             "c_yy = 200.0")
+    assert text.count("k = 4.3780e+07\nc = 0.0") == 2
+    path = tmp_path / "fluid-film.toml"
+    path.write_text(text.replace("k = 4.3780e+07\nc = 0.0", table))
+    assert main(["campbell", str(path), "--speeds", "0:25000:101", "--modes", "6", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for node in (10, 14):
+        assert (f"bearing at node {node}: coefficients tabulated for 0-20000 rpm of its spool; the sweep leaves that "
+                "range, where the end values are held") in out
+    rows = [line.split() for line in out.splitlines() if re.match(r"\s+\d+\.\d\s+1× shaft", line)]
+    assert [float(r[0]) for r in rows] == pytest.approx([9330.8, 10992.8], abs=0.06)  # printed to 0.1 rpm
+    within = campbell(load_rotor(path), np.linspace(0.0, 20000 * math.pi / 30, 41), n_modes=6)
+    assert within.beyond_tables == ()

@@ -281,3 +281,36 @@ def test_euler_bernoulli_without_rotary_inertia_is_the_textbook_beam():
     e = ShaftElement(0, 1, 0.1, D, 0.0, steel, shear="none", rotary_inertia=False)
     assert not np.any(e.G()) and np.allclose(e.M(), ShaftElement(0, 1, 0.1, D, 0.0, steel, shear="none").M() -
                                              gen.timoshenko_mass_rotary(0.1, steel.rho, I, 0.0), rtol=0, atol=1e-15)
+
+
+def test_bearing_table_interpolates_linearly_and_holds_its_ends():
+    """Between the table's speeds a coefficient is the straight line through its neighbours (a linear table is
+    reproduced at any speed); outside, the end value is held (docs/model.md §10)."""
+    from rotorred.model.elements import BearingTable
+
+    speeds = (0.0, 100.0, 300.0)
+    line = lambda w: 1e6 + 2e4 * w  # noqa: E731 - linear in speed: reproduced exactly by linear interpolation
+    b = BearingTable(node=3, speeds=speeds, k_xx=tuple(line(w) for w in speeds), k_yx=(-1.0, -2.0, -4.0), c_yy=50.0)
+    rng = np.random.default_rng(3)
+    for w in rng.uniform(0.0, 300.0, 20):
+        at = b.at(w)
+        assert at.k_xx == pytest.approx(line(w), rel=1e-14)
+        assert at.c_yy == 50.0 and at.node == 3 and b.covers(w)
+    assert b.at(250.0).k_yx == pytest.approx(-3.5, rel=1e-15)  # a cross-coupled term may be negative
+    assert b.at(1e4).k_xx == line(300.0) and not b.covers(1e4)  # held above the table
+    with pytest.raises(InputError, match=r"^Omega = -1.0: must be >= 0 \(rad/s\)$"):
+        b.at(-1.0)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(speeds=(0.0,)), r"^speeds = \(0.0,\): must be a 1-D array of at least 2 values \(rad/s\)$"),
+    (dict(speeds=(0.0, 10.0), k_xx=(1.0, 2.0, 3.0)), r"^k_xx = \(1.0, 2.0, 3.0\): must be a 1-D array of 2 values \(N/m\)$"),
+    (dict(speeds=(0.0, 10.0), c_xx=-1.0), r"^c_xx = -1.0: must be >= 0 \(N s/m\)$"),
+    (dict(speeds=(5.0, 5.0)), r"^speeds = \(5.0, 5.0\): must be strictly increasing; entry 0 = 5 is followed by 5 "
+                               r"\(rad/s\)$"),
+])
+def test_bearing_table_bad_input(kwargs, message):
+    from rotorred.model.elements import BearingTable
+
+    with pytest.raises(InputError, match=message):
+        BearingTable(node=1, **kwargs)

@@ -1,6 +1,7 @@
 """Rotor TOML files: presets load, and bad files fail before any computation with a message
 that names the field, the value and what is allowed."""
 
+import math
 import re
 
 import pytest
@@ -143,6 +144,15 @@ BAD = [
     ('name = "t"', 'name = "t"\ncolour = "red"', "bad.toml: colour = 'red': unknown key; allowed keys are bearing, "
      "damping, defaults, description, disk, intershaft_bearing, material, name, spool"),
     ("[[bearing]]\nnode = 1\n", "[[bearing]]\n", "bad.toml: bearing[0].node: missing; required"),
+    ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = [1e7, 2e7, 3e7]",
+     "bad.toml: bearing[0].k = [10000000.0, 20000000.0, 30000000.0]: must be a 1-D array of 2 values (N/m)"),
+    ("k = 1e7\nc = 100.0", "speed_rpm = [3000.0, 0.0]\nk = 1e7", "bad.toml: bearing[0].speed_rpm = [3000.0, "
+     "0.0]: must be strictly increasing; entry 0 = 3000 is followed by 0 (rpm)"),
+    ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = 1e7\nc_xx = [100.0, -1.0]",
+     "bad.toml: bearing[0].c_xx = [100.0, -1.0]: must hold values >= 0 only (N s/m)"),
+    ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_rpm = [0.0, 1.0]\nnode_a = 12",
+     "bad.toml: intershaft_bearing[0].speed_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_xx, c_xy, c_yx, "
+     "c_yy, k, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b"),
     ("D_o = 0.2", "D_o = 0.2\nshape = 1", "bad.toml: disk[1].shape = 1: unknown key; allowed keys are D_i, D_o, I_d, "
      "I_p, m, material, name, node, radius, thickness"),
 ]
@@ -197,3 +207,19 @@ def test_invalid_toml_and_missing_file(tmp_path):
         rotor_from_toml("[[spool]\nname=", source="x.toml")
     with pytest.raises(FileNotFoundError, match="neither a preset"):
         load_rotor(tmp_path / "nope.toml")
+
+
+def test_bearing_table_against_speed():
+    """``speed_rpm`` makes a bearing a table against its spool's speed: lists per coefficient, numbers held at every
+    speed, ``k`` setting both direct terms; read in rpm, kept in rad/s."""
+    from rotorred.model.elements import BearingTable
+
+    text = GOOD.replace("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0, 6000.0]\nk = [1e7, 2e7, 4e7]\n"
+                        "c_xx = [100.0, 200.0, 300.0]\nk_xy = 5e5", 1)
+    b = rotor_from_toml(text).bearings[0]
+    assert isinstance(b, BearingTable)
+    assert b.speeds == pytest.approx((0.0, 100 * math.pi, 200 * math.pi), rel=1e-15)
+    assert b.k_xx == b.k_yy == (1e7, 2e7, 4e7) and b.c_xx == (100.0, 200.0, 300.0)
+    assert b.k_xy == (5e5,) * 3 and b.c_yy == (0.0,) * 3
+    at = b.at(150 * math.pi)  # 4500 rpm: half way between the last two speeds
+    assert (at.k_xx, at.k_yy, at.c_xx, at.k_xy) == pytest.approx((3e7, 3e7, 250.0, 5e5), rel=1e-15)

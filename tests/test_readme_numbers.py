@@ -259,6 +259,9 @@ def test_readme_rotor_file_example_loads_and_material_bounds():
     rotor = rotor_from_toml(block, source="README")
     assert [s.name for s in rotor.spools] == ["inner", "outer"] and rotor.defaults.boundary_nodes == (18,)
     assert "E (Pa, <= 1e18), rho (kg/m^3, 1e-9 to 1e6)" in block
+    table = rotor.bearings[1]  # the bearing tabulated against speed
+    assert table.node == 13 and table.c_xx == table.c_yy == (400.0, 300.0, 250.0)
+    assert table.at(4500 * 3.141592653589793 / 30).k_xx == pytest.approx(2.5e7, rel=1e-14)
     Material("m", E=1e18, rho=1e-9)
     Material("m", E=2.1e11, rho=1e6)
     for kw in ({"E": 1.01e18, "rho": 7850.0}, {"E": 2.1e11, "rho": 0.99e-9}, {"E": 2.1e11, "rho": 1.01e6}):

@@ -278,3 +278,18 @@ def test_slow_ramp_is_the_steady_unbalance_response():
     # the phase too: the track is the steady phasor (x ~ Re(Q e^(i phi)))
     phase_err = np.abs(np.angle(track.amplitude[keep] * np.exp(1j * track.phase[keep]) / steady.phasors["shaft"][(1, "x")][keep]))
     assert phase_err[away].max() < 3.7e-2  # measured 3.7e-3 rad
+
+
+def test_runup_refuses_speed_dependent_bearings_on_a_varying_spool():
+    """A run-up steps with constant bearing matrices: a bearing table on a spool whose speed varies is refused
+    before any computation, naming the bearing."""
+    from rotorred.model.assembly import assemble
+    from rotorred.model.elements import BearingTable
+    from rotorred.model.rotor_file import load_rotor
+
+    rotor = load_rotor("nelson-mcvaugh")
+    tables = tuple(BearingTable(node=b.node, speeds=(0.0, 1000.0), k_xx=(1e7, 2e7), k_yy=1e7) for b in rotor.bearings)
+    model = assemble(dataclasses.replace(rotor, bearings=tables))
+    with pytest.raises(InputError, match=r"^bearing at node \d+ = 'speed-dependent': is not supported when the speed "
+                                         r"of spool 'shaft' varies in time"):
+        simulate(model, SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 0.1), 0.1, 1e-4, rotor=rotor)

@@ -64,7 +64,7 @@ def band_frequencies(model, speeds: Mapping[str, float], f_max_hz: float, n_grid
     f_max_hz = checks.positive("f_max_hz", f_max_hz, "Hz")
     w_max = 2 * math.pi * f_max_hz
     if eigenvalues is None:
-        eigenvalues = eigen(model.M, model.damping(speeds), model.K).eigenvalues
+        eigenvalues = eigen(model.M, model.damping(speeds), model.stiffness(speeds)).eigenvalues
     natural = eigenvalues.imag[eigenvalues.imag <= w_max]
     spools = [w for w in speeds.values() if 0 < w <= w_max]
     return np.unique(np.concatenate([np.linspace(0.0, w_max, n_grid), natural, spools]))
@@ -101,7 +101,7 @@ def receptance(model, speeds: Mapping[str, float], omega: np.ndarray, outputs: S
     B = model.output_rows(list(inputs)).T
     s = 1j * warped(omega, dt)
     D = model.damping(speeds)
-    A = s[:, None, None] ** 2 * model.M + s[:, None, None] * D + model.K
+    A = s[:, None, None] ** 2 * model.M + s[:, None, None] * D + model.stiffness(speeds)
     return R @ np.linalg.solve(A, np.broadcast_to(B, (len(s),) + B.shape))
 
 

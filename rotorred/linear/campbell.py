@@ -193,6 +193,9 @@ class CampbellResult:
         Tracked modes that are rigid-body modes of a free or singly supported spool (most of their
         kinetic energy in the null space of K at the first speed, :func:`rigid_body_share`). No
         critical speed is reported where a mode is rigid at either end of a speed interval.
+    beyond_tables : tuple of (int, float, float)
+        Speed-dependent bearings (:class:`rotorred.model.elements.BearingTable`) whose table the sweep leaves:
+        (node, the table's lowest and highest speed, rad/s). Outside the table the end values are held.
     """
 
     speeds: np.ndarray
@@ -207,6 +210,7 @@ class CampbellResult:
     rotor_name: str = ""
     rigid_modes: tuple[int, ...] = ()
     stability_changes: tuple[StabilityChange, ...] = ()
+    beyond_tables: tuple[tuple[int, float, float], ...] = ()
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -424,17 +428,24 @@ def _given_ratios(rotor: Rotor, given: dict, reference: str) -> dict[str, float]
 
 
 class _Solver:
-    """Eigen-solves of one rotor along the speed axis (matrices assembled once)."""
+    """Eigen-solves of one rotor along the speed axis (matrices assembled once; speed-dependent bearings evaluated
+    at each speed)."""
 
     def __init__(self, sm, ratios: Mapping[str, float], n_candidates: int):
-        self.M, self.K, self.C = sm.M, sm.K, sm.C
-        self.G = sm.gyroscopic(ratios)  # sum_s r_s G_s, per unit reference speed
+        self.sm, self.ratios = sm, dict(ratios)
+        self.M = sm.M
         self.n_candidates = n_candidates
         self.x_rows, self.y_rows = _xy_rows(sm)
 
+    def matrices(self, Omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """(D, K) at reference speed ``Omega`` (rad/s): damping with the gyroscopic terms, and stiffness, each with
+        the speed-dependent bearings at their spools' speeds."""
+        speeds = {s: r * Omega for s, r in self.ratios.items()}
+        return self.sm.damping(speeds), self.sm.stiffness(speeds)
+
     def solve(self, Omega: float):
-        sol = eigen(self.M, self.C + Omega * self.G, self.K, n_modes=self.n_candidates,
-                    max_damping_ratio=WHIRL_MAX_DAMPING_RATIO)
+        D, K = self.matrices(Omega)
+        sol = eigen(self.M, D, K, n_modes=self.n_candidates, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO)
         return sol.eigenvalues, _canonical_basis(sol.eigenvalues, sol.modes, self.x_rows, self.y_rows)
 
     def local(self, Omega: float, lam0: complex, v0: np.ndarray, max_iter: int = 12):
@@ -445,7 +456,7 @@ class _Solver:
         Converges quadratically from a close start; returns None if it does not converge (e.g. at a
         multiple eigenvalue, where the bordered matrix is singular).
         """
-        D = self.C + Omega * self.G
+        D, K = self.matrices(Omega)
         n = len(v0)
         lam, v = complex(lam0), v0.astype(complex)
         J = np.zeros((n + 1, n + 1), complex)
@@ -453,7 +464,7 @@ class _Solver:
         rhs = np.zeros(n + 1, complex)
         previous = np.inf
         for _ in range(max_iter):
-            J[:n, :n] = lam * lam * self.M + lam * D + self.K
+            J[:n, :n] = lam * lam * self.M + lam * D + K
             J[:n, n] = (2.0 * lam * self.M + D) @ v
             rhs[:n] = -(J[:n, :n] @ v)
             try:
@@ -568,7 +579,17 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
                           critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
                           harmonics=h, rotor_name=rotor.name,
                           rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])),
-                          stability_changes=changes)
+                          stability_changes=changes, beyond_tables=_beyond_tables(sm, ratios, Omega))
+
+
+def _beyond_tables(sm, ratios: Mapping[str, float], Omega: np.ndarray) -> tuple[tuple[int, float, float], ...]:
+    """The speed-dependent bearings of ``sm`` whose spool's speeds along the sweep leave their table."""
+    out = []
+    for t in sm.tables:
+        spool_speeds = ratios[t.spool] * Omega
+        if not (t.table.covers(float(spool_speeds.min())) and t.table.covers(float(spool_speeds.max()))):
+            out.append((t.table.node, t.table.speeds[0], t.table.speeds[-1]))
+    return tuple(out)
 
 
 #: |log dec| at most this is neutral: an undamped mode, whose computed log dec is round-off (up to 2e-9

@@ -222,14 +222,14 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
     checks.keys("speeds", speeds, spools, required=spools)
     speeds = {s: checks.non_negative(f"speeds.{s}", w, "rad/s") for s, w in speeds.items()}
     forces = _unbalance_forces(model, unbalances, spool_of)
-    D = model.damping(speeds)
+    D, K = model.damping(speeds), model.stiffness(speeds)
     phasors = {}
     for s, f in forces.items():
         w = speeds[s]
         if w == 0.0:
             phasors[s] = np.zeros(model.n_dof, dtype=complex)
             continue
-        phasors[s] = sla.solve(model.K - w * w * model.M + 1j * w * D, w * w * f, check_finite=False)
+        phasors[s] = sla.solve(K - w * w * model.M + 1j * w * D, w * w * f, check_finite=False)
     return SteadyState(speeds=speeds, phasors=phasors)
 
 
@@ -303,9 +303,10 @@ def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: M
     R = model.output_rows(outputs)
     spool_speeds = {s: ratios[s] * speeds for s in spools}
     phasors = {s: np.zeros((len(speeds), len(outputs)), dtype=complex) for s in per_spool}
-    M, K = model.M, model.K
+    M = model.M
     for k in range(len(speeds)):
-        D = model.damping({s: float(spool_speeds[s][k]) for s in spools})
+        at = {s: float(spool_speeds[s][k]) for s in spools}
+        D, K = model.damping(at), model.stiffness(at)
         for s, f in per_spool.items():
             w = float(spool_speeds[s][k])
             if w == 0.0:
@@ -389,12 +390,12 @@ def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output
             checks.fail(name, pairs, "must name at least one (node, direction) pair")
     w_all = _check_speeds(frequencies, "frequencies")
     speeds = dict(speeds or {})
-    D = model.damping(speeds)  # ValueError for unknown spools
+    D, K = model.damping(speeds), model.stiffness(speeds)  # InputError for unknown spools
     B = model.output_rows(inputs).T
     R = model.output_rows(outputs)
     H = np.empty((len(w_all), len(outputs), len(inputs)), dtype=complex)
     for k, w in enumerate(w_all):
-        Z = model.K - w * w * model.M + 1j * w * D
+        Z = K - w * w * model.M + 1j * w * D
         H[k] = R @ sla.solve(Z, B.astype(complex), check_finite=False)
     return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H)
 

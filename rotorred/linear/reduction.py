@@ -38,7 +38,7 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
-from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, assemble
+from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble
 from rotorred.model.dofs import DofMap
 from rotorred.model.rotor import Rotor
 
@@ -184,6 +184,10 @@ class ReducedSystem(SpoolSpeedMixin):
         Record of how ``n_modes`` was chosen.
     K_G : dict of str to ndarray, shape (m, m)
         Reduced spin-acceleration matrix of each spool per unit angular acceleration: ``T^T K_G,s T``.
+    tables : tuple of TabulatedSupport
+        The full model's speed-dependent bearings on the reduced coordinates (rows ``R T``): their change with
+        speed is exact when the bearing's node is a boundary node, as the constraint and fixed-interface modes
+        do not depend on a boundary node's supports.
     """
 
     M: np.ndarray
@@ -198,6 +202,7 @@ class ReducedSystem(SpoolSpeedMixin):
     interior_frequencies: np.ndarray
     selection: ModeSelection
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
+    tables: tuple[TabulatedSupport, ...] = ()
     _bpos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -317,9 +322,17 @@ def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
 def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict, dict]:
     def p(X):
         return T.T @ X @ T
-    Mr, Kr = p(system.M), p(system.K)
-    # symmetrise away round-off so that M_r, K_r stay exactly symmetric
-    Mr, Kr = 0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T)
+
+    def symmetric(X):
+        return 0.5 * (X + X.T)
+
+    # the symmetric parts stay exactly symmetric (round-off symmetrised away); K's skew part, the bearings'
+    # cross-coupled stiffness k_xy != k_yx, is projected on its own and kept
+    Mr, Kr = symmetric(p(system.M)), symmetric(p(symmetric(system.K)))
+    K_skew = 0.5 * (system.K - system.K.T)
+    if np.any(K_skew):
+        X = p(K_skew)
+        Kr = Kr + 0.5 * (X - X.T)
     return (Mr, Kr, p(system.C), {s: p(G) for s, G in system.G.items()},
             {s: p(KG) for s, KG in system.K_G.items()})
 
@@ -332,7 +345,8 @@ def whirl_frequencies(model, speeds: Mapping[str, float]) -> np.ndarray:
     high-frequency shaft modes that stiffness-proportional Rayleigh damping makes
     overdamped) do not whirl visibly and are left out, in the full and reduced model alike.
     """
-    return eigen(model.M, model.damping(speeds), model.K, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
+    return eigen(model.M, model.damping(speeds), model.stiffness(speeds),
+                 max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
 
 
 def whirl_error(reference: Sequence[np.ndarray], model, speeds_list: Sequence[Mapping[str, float]],
@@ -526,7 +540,8 @@ def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
     Mr, Kr, Cr, Gr, KGr = _project(system, T)
     return ReducedSystem(M=Mr, K=Kr, C=Cr, G=Gr, T=T, full_dofs=system.dofs, boundary_nodes=nodes,
                          boundary_dofs=basis.b.copy(), n_modes=n_modes,
-                         interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr)
+                         interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr,
+                         tables=tuple(t.on(T) for t in system.tables))
 
 
 def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,

@@ -25,15 +25,49 @@ from scipy.sparse import coo_matrix
 
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
+from rotorred.model.elements import Bearing, BearingTable
 from rotorred.model.rotor import Rotor
 
-__all__ = ["SystemMatrices", "SpoolSpeedMixin", "assemble", "DofMap", "DIRECTIONS"]
+__all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "DofMap", "DIRECTIONS"]
+
+
+@dataclass(frozen=True)
+class TabulatedSupport:
+    """A bearing whose coefficients depend on speed (:class:`~rotorred.model.elements.BearingTable`), in a model.
+
+    Attributes
+    ----------
+    table : BearingTable
+    spool : str
+        The spool whose speed the table follows (the spool of the bearing's node).
+    rows : ndarray, shape (2, n)
+        The bearing node's x and y displacements as rows on the model's coordinates.
+    nominal : Bearing
+        The coefficients the model's ``K`` and ``C`` hold: the table at the rotor's speed of ``spool``.
+    """
+
+    table: BearingTable
+    spool: str
+    rows: np.ndarray
+    nominal: Bearing
+
+    def on(self, T: np.ndarray) -> TabulatedSupport:
+        """The same bearing in the coordinates ``p`` of ``q = T p`` (a reduced model)."""
+        return TabulatedSupport(self.table, self.spool, self.rows @ T, self.nominal)
+
+    def change(self, speeds: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        """(stiffness, damping) at ``speeds`` (rad/s; a spool left out stands still, as in ``gyroscopic``) minus the
+        nominal ones, on the model's coordinates, (n, n) each."""
+        b = self.table.at(speeds.get(self.spool, 0.0))
+        dK, dC = b.K - self.nominal.K, b.C - self.nominal.C
+        return self.rows.T @ dK @ self.rows, self.rows.T @ dC @ self.rows
 
 
 class SpoolSpeedMixin:
-    """``spools``, ``gyroscopic(speeds)`` and ``damping(speeds)`` of a model with attributes
-    ``M``, ``C`` and ``G`` (dict spool -> gyroscopic matrix per unit speed); shared by the full
-    :class:`SystemMatrices` and the reduced model (:class:`rotorred.linear.reduction.ReducedSystem`)."""
+    """``spools``, ``gyroscopic(speeds)``, ``stiffness(speeds)`` and ``damping(speeds)`` of a model with attributes
+    ``M``, ``K``, ``C``, ``G`` (dict spool -> gyroscopic matrix per unit speed) and ``tables`` (its
+    :class:`TabulatedSupport` s); shared by the full :class:`SystemMatrices` and the reduced model
+    (:class:`rotorred.linear.reduction.ReducedSystem`)."""
 
     @property
     def spools(self) -> tuple[str, ...]:
@@ -50,8 +84,33 @@ class SpoolSpeedMixin:
         return out
 
     def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C + sum_s Omega_s G_s`` (N s/m), shape (n, n)."""
-        return self.C + self.gyroscopic(speeds)
+        """``C(Omega) + sum_s Omega_s G_s`` (N s/m), shape (n, n), at spool speeds ``speeds`` (rad/s)."""
+        return self.dissipation(speeds) + self.gyroscopic(speeds)
+
+    def dissipation(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``C(Omega)`` (N s/m), shape (n, n): ``C`` with the speed-dependent bearings' damping at ``speeds`` (rad/s),
+        without the gyroscopic terms (which do no work)."""
+        if not self.tables:
+            return self.C
+        out = self.C.copy()
+        for t in self.tables:
+            out += t.change(speeds)[1]
+        return out
+
+    def stiffness(self, speeds: Mapping[str, float]) -> np.ndarray:
+        """``K(Omega)`` (N/m), shape (n, n): ``K`` with the speed-dependent bearings' stiffness at ``speeds`` (rad/s)."""
+        if not self.tables:
+            return self.K
+        checks.keys("speeds", speeds, self.G)
+        out = self.K.copy()
+        for t in self.tables:
+            out += t.change(speeds)[0]
+        return out
+
+    @property
+    def speed_dependent(self) -> bool:
+        """Whether the model's stiffness or damping depends on the speeds beyond the gyroscopic terms."""
+        return bool(self.tables)
 
 
 @dataclass(frozen=True)
@@ -72,6 +131,9 @@ class SystemMatrices(SpoolSpeedMixin):
     K_G : dict of str to ndarray, shape (n, n)
         Spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2), ``A_s`` of
         ``G_s = A_s - A_s^T``; needed only when a spool's speed varies (empty for a model built by hand).
+    tables : tuple of TabulatedSupport
+        The bearings whose coefficients depend on speed; ``K`` and ``C`` hold them at the rotor's speeds,
+        :meth:`stiffness` and :meth:`damping` at any speeds.
     """
 
     M: np.ndarray
@@ -80,6 +142,7 @@ class SystemMatrices(SpoolSpeedMixin):
     G: Mapping[str, np.ndarray]
     dofs: DofMap
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
+    tables: tuple[TabulatedSupport, ...] = ()
 
     @property
     def n_dof(self) -> int:
@@ -168,8 +231,15 @@ def assemble(rotor: Rotor) -> SystemMatrices:
         M.add(idx, d.M())
         G[spool_of[d.node]].add(idx, d.G())
         K_G[spool_of[d.node]].add(idx, d.K_G())
+    tables = []
     for b in rotor.bearings:
         idx = dofs.node_dofs(b.node)[:2]
+        if isinstance(b, BearingTable):
+            spool = spool_of[b.node]
+            rows = np.zeros((2, n))
+            rows[[0, 1], idx] = 1.0
+            tables.append(TabulatedSupport(b, spool, rows, b.at(rotor.speeds[spool])))
+            b = tables[-1].nominal
         K.add(idx, b.K)
         C.add(idx, b.C)
     coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
@@ -183,4 +253,4 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     if alpha or beta:
         Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
     return SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
-                          K_G={k: v.dense(n) for k, v in K_G.items()})
+                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables))

@@ -318,7 +318,7 @@ class _Support:
     name: str = ""
 
     def _validate(self):
-        for c in ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"):
+        for c in COEFFICIENTS:
             unit = "N/m" if c[0] == "k" else "N s/m"
             direct = c[-1] == c[-2]  # direct terms are >= 0, cross-coupled terms any sign
             _set(self, c, checks.number(c, getattr(self, c), unit, ge=0.0 if direct else None))
@@ -354,6 +354,69 @@ class Bearing(_Support):
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
         self._validate()
+
+
+#: the coefficients of a support, in the order of :class:`_Support`'s fields
+COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
+
+
+@dataclass(frozen=True)
+class BearingTable:
+    """Bearing from a node to ground whose coefficients are tabulated against the speed of the node's spool
+    (fluid-film bearings, seals).
+
+    Between the table's speeds each coefficient is interpolated linearly; outside them it keeps the
+    value of the nearest end (docs/model.md §10: no extrapolation, which can turn a direct
+    coefficient negative). :meth:`at` gives the :class:`Bearing` at one speed.
+
+    Parameters
+    ----------
+    node : int
+    speeds : sequence of float, shape (p,)
+        Spool speeds of the table (rad/s), >= 0 and strictly increasing, at least 2.
+    k_xx, k_yy, k_xy, k_yx : float or sequence of float, shape (p,)
+        Stiffness (N/m) at each speed; a single number holds at every speed; left out: 0.
+    c_xx, c_yy, c_xy, c_yx : float or sequence of float, shape (p,)
+        Damping (N s/m), the same way.
+    name : str
+    """
+
+    node: int
+    speeds: tuple[float, ...]
+    k_xx: tuple[float, ...] | float = 0.0
+    k_yy: tuple[float, ...] | float = 0.0
+    k_xy: tuple[float, ...] | float = 0.0
+    k_yx: tuple[float, ...] | float = 0.0
+    c_xx: tuple[float, ...] | float = 0.0
+    c_yy: tuple[float, ...] | float = 0.0
+    c_xy: tuple[float, ...] | float = 0.0
+    c_yx: tuple[float, ...] | float = 0.0
+    name: str = ""
+
+    def __post_init__(self):
+        _set(self, "node", checks.integer("node", self.node, ge=0))
+        speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
+        _set(self, "speeds", tuple(float(v) for v in speeds))
+        for c in COEFFICIENTS:
+            unit = "N/m" if c[0] == "k" else "N s/m"
+            ge = 0.0 if c[-1] == c[-2] else None  # direct terms are >= 0, cross-coupled terms any sign
+            value = getattr(self, c)
+            if np.ndim(value) == 0:
+                value = [checks.number(c, value, unit, ge=ge)] * len(speeds)
+            column = checks.vector(c, value, unit, min_len=len(speeds), max_len=len(speeds), ge=ge)
+            _set(self, c, tuple(float(v) for v in column))
+        _set(self, "name", checks.string("name", self.name))
+
+    def at(self, Omega: float) -> Bearing:
+        """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated linearly in speed, held at
+        the table's ends."""
+        Omega = checks.non_negative("Omega", Omega, "rad/s")
+        return Bearing(node=self.node, name=self.name,
+                       **{c: float(np.interp(Omega, self.speeds, getattr(self, c))) for c in COEFFICIENTS})
+
+    def covers(self, Omega: float) -> bool:
+        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, the end values are held)."""
+        return self.speeds[0] <= Omega <= self.speeds[-1]
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import Mapping
 
 from rotorred import checks
 from rotorred.model.dofs import checked_dof
-from rotorred.model.elements import Bearing, Disk, IntershaftBearing, ShaftElement
+from rotorred.model.elements import Bearing, BearingTable, Disk, IntershaftBearing, ShaftElement
 from rotorred.model.loads import Unbalance
 
 
@@ -143,8 +143,8 @@ class Rotor:
     ----------
     spools : tuple of Spool
     disks : tuple of Disk
-    bearings : tuple of Bearing
-        Node-to-ground bearings.
+    bearings : tuple of Bearing or BearingTable
+        Node-to-ground bearings; a :class:`BearingTable`'s coefficients follow the speed of its node's spool.
     intershaft_bearings : tuple of IntershaftBearing
         Bearings between nodes of two different spools.
     rayleigh : tuple of float, optional
@@ -158,14 +158,14 @@ class Rotor:
 
     spools: tuple[Spool, ...]
     disks: tuple[Disk, ...] = ()
-    bearings: tuple[Bearing, ...] = ()
+    bearings: tuple[Bearing | BearingTable, ...] = ()
     intershaft_bearings: tuple[IntershaftBearing, ...] = ()
     rayleigh: tuple[float, float] = (0.0, 0.0)
     name: str = ""
     defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
 
     def __post_init__(self):
-        for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", Bearing),
+        for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", (Bearing, BearingTable)),
                           ("intershaft_bearings", IntershaftBearing)):
             object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
@@ -289,10 +289,12 @@ class Rotor:
 
 
 def _instance(cls):
-    """Item check of :func:`rotorred.checks.sequence`: an instance of ``cls``."""
+    """Item check of :func:`rotorred.checks.sequence`: an instance of ``cls`` (a class or a tuple of classes)."""
+    names = " or ".join(c.__name__ for c in (cls if isinstance(cls, tuple) else (cls,)))
+
     def check(field_: str, value):
         if not isinstance(value, cls):
-            checks.fail(field_, value, f"must be a {cls.__name__}")
+            checks.fail(field_, value, f"must be a {names}")
         return value
     return check
 

@@ -13,6 +13,8 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     node = 3; m = 5.7; I_d = 0.023; I_p = 0.045; radius = 0.125
     [[bearing]]                        # k_* (N/m), c_* (N s/m); k / c set both direct terms
     node = 1; k = 2e7; c = 300.0
+    [[bearing]]                        # against speed: speed_rpm and, per coefficient, a number or a list
+    node = 13; speed_rpm = [0.0, 3000.0, 6000.0]; k = [1e7, 2e7, 3e7]; c_xx = [400.0, 300.0, 250.0]
     [[intershaft_bearing]]
     node_a = 20; node_b = 9; k = 1e7; c = 300.0
     [damping]
@@ -39,8 +41,8 @@ from typing import Any
 from rotorred import checks
 from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
-from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, Disk, IntershaftBearing, Material,
-                                     ShaftElement)
+from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
+                                     Material, ShaftElement)
 from rotorred.model.loads import unbalance_from_table
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 
@@ -258,9 +260,14 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
                   name=d.get("name", ""), radius=d.get("radius", D_o / 2))
 
 
-def _bearing(where: str, b: dict) -> Bearing:
-    checks.keys(where, b, _SUPPORT_KEYS | {"node"}, required={"node"})
-    return _build(where, Bearing, node=b["node"], **_coefficients(where, b))
+def _bearing(where: str, b: dict) -> Bearing | BearingTable:
+    """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm"}, required={"node"})
+    if "speed_rpm" not in b:
+        return _build(where, Bearing, node=b["node"], **_coefficients(where, b))
+    rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
+    return _build(where, BearingTable, node=b["node"], speeds=tuple(rpm * math.pi / 30.0),
+                  **_coefficients(where, b, n_speeds=len(rpm)))
 
 
 def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing:
@@ -268,8 +275,9 @@ def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing:
     return _build(where, IntershaftBearing, node_a=b["node_a"], node_b=b["node_b"], **_coefficients(where, b))
 
 
-def _coefficients(where: str, b: dict) -> dict[str, Any]:
-    """The support coefficients as given; ``k`` / ``c`` (isotropic) set both direct terms."""
+def _coefficients(where: str, b: dict, n_speeds: int = 0) -> dict[str, Any]:
+    """The support coefficients as given; ``k`` / ``c`` (isotropic) set both direct terms. With ``n_speeds`` (a
+    table against speed) each may be a number or a list of ``n_speeds`` values."""
     out: dict[str, Any] = {k: v for k, v in b.items() if k in _SUPPORT_KEYS - {"k", "c"}}
     for kind, unit in (("k", "N/m"), ("c", "N s/m")):
         if kind in b:
@@ -277,7 +285,12 @@ def _coefficients(where: str, b: dict) -> dict[str, Any]:
                 if direct in b:
                     checks.fail(f"{where}.{direct}", b[direct], f"must not be given with {kind}: "
                                 f"give {kind} (isotropic) or {kind}_xx, {kind}_yy")
-            out[f"{kind}_xx"] = out[f"{kind}_yy"] = checks.non_negative(f"{where}.{kind}", b[kind], unit)
+            if n_speeds and isinstance(b[kind], (list, tuple)):
+                value = tuple(checks.vector(f"{where}.{kind}", b[kind], unit, min_len=n_speeds, max_len=n_speeds,
+                                            ge=0.0))
+            else:
+                value = checks.non_negative(f"{where}.{kind}", b[kind], unit)
+            out[f"{kind}_xx"] = out[f"{kind}_yy"] = value
     return out
 
 

@@ -276,7 +276,7 @@ def _static_deflection(scene: Scene, model) -> np.ndarray | None:
     """Gravity's static deflection in model coordinates (None without gravity)."""
     if not scene.solver.gravity:
         return None
-    return np.linalg.solve(model.K, gravity_force(model, scene.solver.gravity))
+    return np.linalg.solve(model.stiffness(scene.speeds), gravity_force(model, scene.solver.gravity))
 
 
 def settled_state(scene: Scene, model) -> tuple[np.ndarray, np.ndarray]:

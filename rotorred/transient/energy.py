@@ -105,8 +105,11 @@ def energy_balance(model, result, speeds: Mapping[str, float] | SpeedProfile, *,
     F_u = F - F_g
     K_G = {s: np.asarray(model.K_G.get(s, np.zeros((n, n))), float) for s in spools}
     W = profile.speed(result.t)
+    # bearing tables sit on spools of constant speed (a run-up of their spool is refused): K, C at the first speeds
+    first = {s: float(W[s][0]) for s in spools}
+    K, C = model.stiffness(first), model.dissipation(first)
     coupling = {s: np.einsum("ij,ij->i", v, q @ K_G[s].T) for s in spools}  # q'^T K_G,s q
-    energy = (0.5 * np.einsum("ij,ij->i", v @ model.M, v) + 0.5 * np.einsum("ij,ij->i", q @ model.K, q)
+    energy = (0.5 * np.einsum("ij,ij->i", v @ model.M, v) + 0.5 * np.einsum("ij,ij->i", q @ K, q)
               + sum(W[s] * coupling[s] for s in spools))
     spin = sum(np.concatenate([[0.0], np.cumsum(0.5 * (W[s][1:] + W[s][:-1]) * np.diff(coupling[s]))])
                for s in spools)
@@ -115,6 +118,6 @@ def energy_balance(model, result, speeds: Mapping[str, float] | SpeedProfile, *,
         B = contact_rows(model, [c.plate for c in result.contacts])
         f_contact = np.column_stack([c.force_xy for c in result.contacts]) @ B.T
     return EnergyBalance(t=result.t, energy=energy - energy[0], drive=_trapezoid_work(F_u, q) + spin,
-                         damping=_trapezoid_work(v @ model.C.T, q),
+                         damping=_trapezoid_work(v @ C.T, q),
                          gravity=_trapezoid_work(np.broadcast_to(F_g, q.shape), q),
                          contact=_trapezoid_work(f_contact, q))

@@ -281,7 +281,8 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     if profile is not None:
         return run_profile(model, profile, scheme, run, loads, rotor, x0, start, progress, record_state=record_state)
     # 2. prepare the matrices: forces, plates, step matrices (with the condensed contact operator) per level
-    M, K, D = np.asarray(model.M, float), np.asarray(model.K, float), np.asarray(model.damping(loads.speeds), float)
+    M, K, D = (np.asarray(model.M, float), np.asarray(model.stiffness(loads.speeds), float),
+               np.asarray(model.damping(loads.speeds), float))
     forces = force_columns(model, loads.speeds, loads.spool_of, loads.unbalances, run.gravity)
     par, atol = plate_parameters(loads.plates, loads.speeds, loads.spool_of, rotor, run.newton_tol)
     B = contact_rows(model, loads.plates)

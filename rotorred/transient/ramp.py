@@ -61,6 +61,11 @@ def check_profile_run(model, profile: SpeedProfile, scheme) -> dict:
         checks.fail("method", scheme.method, "must be 'newmark' with gamma = 1/2, beta = 1/4 (average acceleration) "
                     "when the speeds vary in time")
     acc = profile.accelerations()
+    for t in model.tables:
+        if np.any(acc[t.spool] != 0.0):
+            checks.fail(f"bearing at node {t.table.node}", "speed-dependent", "is not supported when the speed of "
+                        f"spool '{t.spool}' varies in time (a run-up steps with constant bearing matrices); give "
+                        "the bearing constant coefficients, or run at constant speeds")
     K_G = {}
     for s in model.spools:
         if s in model.K_G:
