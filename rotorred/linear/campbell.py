@@ -295,8 +295,9 @@ def _xy_rows(model) -> tuple[np.ndarray, np.ndarray]:
     a full model, the rows of ``T`` (n_nodes, m) for a Craig-Bampton model (its interior nodes recovered)."""
     full = isinstance(model, SystemMatrices)
     dofs = model.dofs if full else model.full_dofs
-    x = np.array([dofs.index(n, "x") for n in dofs.nodes])
-    y = np.array([dofs.index(n, "y") for n in dofs.nodes])
+    moving = [n for n in dofs.nodes if not dofs.is_fixed(n, "x")]  # a supported node does not whirl
+    x = np.array([dofs.index(n, "x") for n in moving])
+    y = np.array([dofs.index(n, "y") for n in moving])
     return (x, y) if full else (model.T[x], model.T[y])
 
 

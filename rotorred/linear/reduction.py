@@ -310,7 +310,7 @@ def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
     try:
         chol = sla.cho_factor(K_ii)
     except np.linalg.LinAlgError:
-        checks.fail("boundary_nodes", [system.dofs.nodes[p] for p in np.unique(b // 4)], "must restrain the "
+        checks.fail("boundary_nodes", sorted({system.dofs.node_of(int(d)) for d in b}), "must restrain the "
                     "interior part of the model when fixed: it is not restrained (K_ii is singular); add a node "
                     "of each free part")
     Psi = -sla.cho_solve(chol, K_ib)

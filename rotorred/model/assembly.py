@@ -252,5 +252,24 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     alpha, beta = rotor.rayleigh
     if alpha or beta:
         Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
-    return SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
+    free = SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
                           K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables))
+    return _supported(free, rotor.supports)
+
+
+def _supported(system: SystemMatrices, supports) -> SystemMatrices:
+    """``system`` without the DOFs the supports fix: their rows and columns removed (a pinned or clamped DOF is
+    zero, exactly; docs/model.md §11)."""
+    if not supports:
+        return system
+    dofs = DofMap(system.dofs.nodes, system.dofs.n_internal,
+                  fixed=frozenset((sp.node, d) for sp in supports for d in sp.fixed))
+    keep = dofs.free_in(system.dofs)
+
+    def cut(X):
+        return X[np.ix_(keep, keep)]
+
+    return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
+                          dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
+                          tables=tuple(TabulatedSupport(t.table, t.spool, t.rows[:, keep], t.nominal)
+                                       for t in system.tables))

@@ -97,9 +97,10 @@ def checked_dof(field: str, value, nodes: Collection[int] | None = None, what: s
 class DofMap:
     """Global DOF numbering.
 
-    4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order, indices
-    ``4 * position + direction``; then the internal (bubble) DOFs of hierarchical shaft
-    elements, ``n_internal`` of them, after all nodal DOFs. Code that needs physical DOFs uses
+    4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order; the DOFs a support fixes
+    (``fixed``) are left out and the others numbered on in that order; then the internal (bubble)
+    DOFs of hierarchical shaft elements, ``n_internal`` of them, after all nodal DOFs. Without fixed
+    DOFs a node's DOFs are ``4 * position + direction``. Code that needs physical DOFs uses
     :meth:`index` or :meth:`node_dofs`, never ``n_dof // 4``.
 
     Parameters
@@ -108,37 +109,66 @@ class DofMap:
         Node numbers in DOF order.
     n_internal : int
         Number of internal DOFs (0 for a model of Nelson elements only).
+    fixed : frozenset of (int, str)
+        (node, direction) pairs held by supports (:class:`rotorred.model.elements.Support`): not DOFs
+        of the model.
     """
 
     nodes: tuple[int, ...]
     n_internal: int = 0
+    fixed: frozenset = frozenset()
     _pos: dict = field(init=False, repr=False, compare=False)
+    _index: dict = field(init=False, repr=False, compare=False)
+    _free: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         object.__setattr__(self, "nodes", checks.sequence("nodes", tuple(self.nodes), checks.integer, unique=True))
         object.__setattr__(self, "n_internal", checks.integer("n_internal", self.n_internal, ge=0))
         object.__setattr__(self, "_pos", {n: i for i, n in enumerate(self.nodes)})
+        fixed = frozenset(checked_dof(f"fixed[{i}]", d, self._pos, "the model")
+                          for i, d in enumerate(sorted(self.fixed, key=str)))
+        object.__setattr__(self, "fixed", fixed)
+        free = tuple((n, d) for n in self.nodes for d in DIRECTIONS if (n, d) not in fixed)
+        object.__setattr__(self, "_free", free)
+        object.__setattr__(self, "_index", {nd: i for i, nd in enumerate(free)})
 
     @property
     def n_dof(self) -> int:
         """Number of DOFs."""
-        return 4 * len(self.nodes) + self.n_internal
+        return len(self._free) + self.n_internal
 
     @property
     def nodal(self) -> np.ndarray:
-        """Indices of all nodal DOFs as an array, shape (n_nodes, 4): row k is node ``nodes[k]``."""
-        return np.arange(4 * len(self.nodes)).reshape(-1, 4)
+        """Indices of all nodal DOFs, shape (n_nodes, 4): row k is node ``nodes[k]``; -1 where a DOF is fixed."""
+        return np.array([[self._index.get((n, d), -1) for d in DIRECTIONS] for n in self.nodes], dtype=int)
 
     def node_dofs(self, node: int) -> np.ndarray:
-        """Global indices of the 4 DOFs of ``node``, shape (4,)."""
-        return 4 * self._node_pos(node) + np.arange(4)
+        """Global indices of the free DOFs of ``node``, in DOF order, shape (4,) (fewer where a support fixes some)."""
+        self._node_pos(node)
+        return np.array([self._index[(node, d)] for d in DIRECTIONS if (node, d) in self._index], dtype=int)
 
     def index(self, node: int, direction: str) -> int:
         """Global index of ``direction`` at ``node``: ``"x"``, ``"y"``, ``"theta_x"`` (``"tx"``) or
         ``"theta_y"`` (``"ty"``)."""
         if not isinstance(direction, str) or direction not in _OFFSET:
             checks.fail("direction", direction, f"must be one of {_DIRECTIONS_TEXT}")
-        return 4 * self._node_pos(node) + _OFFSET[direction]
+        self._node_pos(node)
+        direction = DIRECTION_ALIASES.get(direction, direction)
+        if (node, direction) in self.fixed:
+            checks.fail("node", node, f"must be a node whose {direction} is free; a support fixes {direction} there "
+                        "(its displacement is zero, not a DOF of the model)")
+        return self._index[(node, direction)]
+
+    def is_fixed(self, node: int, direction: str) -> bool:
+        """Whether a support fixes ``direction`` at ``node``."""
+        return (node, DIRECTION_ALIASES.get(direction, direction)) in self.fixed
+
+    def free_in(self, full: DofMap) -> np.ndarray:
+        """This map's DOFs as indices of ``full`` (the same nodes and internal DOFs, nothing fixed), shape (n_dof,):
+        ``X[np.ix_(k, k)]`` takes a matrix assembled on ``full`` to this map."""
+        nodal = [full.index(n, d) for n, d in self._free]
+        start = 4 * len(full.nodes)
+        return np.array(nodal + list(range(start, start + self.n_internal)), dtype=int)
 
     def checked_outputs(self, outputs, name: str = "outputs") -> tuple[tuple[int, str], ...]:
         """Validate (node, direction) pairs (or ``"NODE:DIRECTION"`` texts) naming nodes of this model.
@@ -152,9 +182,14 @@ class DofMap:
     def label(self, dof: int) -> str:
         """Human label of a global DOF, e.g. ``"node 18 y"``."""
         checks.integer("dof", dof, ge=0, le=self.n_dof - 1)
-        if dof >= 4 * len(self.nodes):
-            return f"internal {dof - 4 * len(self.nodes)}"
-        return f"node {self.nodes[dof // 4]} {DIRECTIONS[dof % 4]}"
+        if dof >= len(self._free):
+            return f"internal {dof - len(self._free)}"
+        node, direction = self._free[dof]
+        return f"node {node} {direction}"
+
+    def node_of(self, dof: int) -> int | None:
+        """The node of a global DOF (None for an internal DOF)."""
+        return self._free[dof][0] if dof < len(self._free) else None
 
     def _node_pos(self, node: int) -> int:
         try:

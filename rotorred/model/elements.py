@@ -356,6 +356,38 @@ class Bearing(_Support):
         self._validate()
 
 
+#: the directions each kind of :class:`Support` fixes
+SUPPORT_KINDS = {"pinned": ("x", "y"), "clamped": ("x", "y", "theta_x", "theta_y")}
+
+
+@dataclass(frozen=True)
+class Support:
+    """A rigid support of a node: ``"pinned"`` fixes its x and y (it may still tilt), ``"clamped"`` also
+    theta_x and theta_y. The fixed DOFs are removed from the model (exact), not held by a stiff spring.
+
+    Parameters
+    ----------
+    node : int
+    kind : str
+        ``"pinned"`` or ``"clamped"``.
+    name : str
+    """
+
+    node: int
+    kind: str = "pinned"
+    name: str = ""
+
+    def __post_init__(self):
+        _set(self, "node", checks.integer("node", self.node, ge=0))
+        _set(self, "kind", checks.choice("kind", self.kind, tuple(SUPPORT_KINDS)))
+        _set(self, "name", checks.string("name", self.name))
+
+    @property
+    def fixed(self) -> tuple[str, ...]:
+        """The directions the support fixes."""
+        return SUPPORT_KINDS[self.kind]
+
+
 #: the coefficients of a support, in the order of :class:`_Support`'s fields
 COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
 

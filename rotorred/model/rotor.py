@@ -19,7 +19,7 @@ from typing import Mapping
 
 from rotorred import checks
 from rotorred.model.dofs import checked_dof
-from rotorred.model.elements import Bearing, BearingTable, Disk, IntershaftBearing, ShaftElement
+from rotorred.model.elements import Bearing, BearingTable, Disk, IntershaftBearing, ShaftElement, Support
 from rotorred.model.loads import Unbalance
 
 
@@ -154,6 +154,8 @@ class Rotor:
     defaults : AnalysisDefaults
         Default unbalances, outputs and extra boundary nodes of analyses (empty by default);
         kept by :meth:`refined`, :meth:`with_speeds` and the other copies.
+    supports : tuple of Support
+        Pinned or clamped nodes (at most one support a node): their fixed DOFs are not DOFs of the model.
     """
 
     spools: tuple[Spool, ...]
@@ -163,10 +165,11 @@ class Rotor:
     rayleigh: tuple[float, float] = (0.0, 0.0)
     name: str = ""
     defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
+    supports: tuple[Support, ...] = ()
 
     def __post_init__(self):
         for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", (Bearing, BearingTable)),
-                          ("intershaft_bearings", IntershaftBearing)):
+                          ("intershaft_bearings", IntershaftBearing), ("supports", Support)):
             object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
             checks.fail("spools", self.spools, "must hold at least one spool")
@@ -193,6 +196,17 @@ class Rotor:
             checks.node(f"disks[{i}].node", d.node, owner)
         for i, b in enumerate(self.bearings):
             checks.node(f"bearings[{i}].node", b.node, owner)
+        supported: dict[int, str] = {}
+        for i, sp in enumerate(self.supports):
+            checks.node(f"supports[{i}].node", sp.node, owner)
+            if sp.node in supported:
+                checks.fail(f"supports[{i}].node", sp.node, f"must not carry a second support (node {sp.node} is "
+                            f"already {supported[sp.node]})")
+            supported[sp.node] = sp.kind
+        for i, b in enumerate(self.bearings):
+            if b.node in supported:
+                checks.fail(f"bearings[{i}].node", b.node, f"must not be a {supported[b.node]} node: the support fixes "
+                            "its x and y, so a bearing there would carry no motion")
         for i, b in enumerate(self.intershaft_bearings):
             checks.node(f"intershaft_bearings[{i}].node_a", b.node_a, owner)
             checks.node(f"intershaft_bearings[{i}].node_b", b.node_b, owner)
@@ -284,6 +298,7 @@ class Rotor:
         return dataclasses.replace(
             self, spools=(s,), disks=tuple(d for d in self.disks if d.node in nodes),
             bearings=tuple(b for b in self.bearings if b.node in nodes), intershaft_bearings=(),
+            supports=tuple(sp for sp in self.supports if sp.node in nodes),
             name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes))
 
 

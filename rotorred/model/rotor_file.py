@@ -17,6 +17,8 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     node = 13; speed_rpm = [0.0, 3000.0, 6000.0]; k = [1e7, 2e7, 3e7]; c_xx = [400.0, 300.0, 250.0]
     [[intershaft_bearing]]
     node_a = 20; node_b = 9; k = 1e7; c = 300.0
+    [[support]]                        # a rigid support: "pinned" fixes x, y; "clamped" also theta_x, theta_y
+    node = 1; kind = "pinned"
     [damping]
     rayleigh_alpha = 0.0; rayleigh_beta = 0.0
     [defaults]                         # what analyses use when nothing else is given (all optional)
@@ -42,7 +44,7 @@ from rotorred import checks
 from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
-                                     Material, ShaftElement)
+                                     Material, ShaftElement, Support)
 from rotorred.model.loads import unbalance_from_table
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 
@@ -53,7 +55,7 @@ except ModuleNotFoundError:  # pragma: no cover
 
 __all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_from_dict", "read_toml"]
 
-_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "damping",
+_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "damping",
              "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements"}
@@ -61,9 +63,11 @@ _ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element", "r
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
+_SUPPORT_NODE_KEYS = {"node", "kind", "name"}
 _DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
 #: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
-_FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing"}
+_FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing",
+              "supports": "support"}
 
 
 class RotorFileError(InputError):
@@ -169,11 +173,12 @@ def _rotor(data: dict) -> Rotor:
                      for i, b in enumerate(checks.tables("bearing", data.get("bearing", []))))
     inter = tuple(_intershaft_bearing(f"intershaft_bearing[{i}]", b)
                   for i, b in enumerate(checks.tables("intershaft_bearing", data.get("intershaft_bearing", []))))
+    supports = tuple(_support(f"support[{i}]", sp) for i, sp in enumerate(checks.tables("support", data.get("support", []))))
     rayleigh = _damping(data.get("damping", {}))
     defaults = _defaults(data.get("defaults", {}), nodes)
     try:
         return Rotor(spools=spools, disks=disks, bearings=bearings, intershaft_bearings=inter, rayleigh=rayleigh,
-                     name=name, defaults=defaults)
+                     name=name, defaults=defaults, supports=supports)
     except InputError as exc:  # Rotor names its attributes (disks[0].node); the file's keys are disk[0].node
         head, _, rest = exc.field.partition("[")
         field = f"{_FILE_KEYS[head]}[{rest}" if head in _FILE_KEYS and rest else exc.field
@@ -268,6 +273,11 @@ def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
     return _build(where, BearingTable, node=b["node"], speeds=tuple(rpm * math.pi / 30.0),
                   **_coefficients(where, b, n_speeds=len(rpm)))
+
+
+def _support(where: str, sp: dict) -> Support:
+    checks.keys(where, sp, _SUPPORT_NODE_KEYS, required={"node", "kind"})
+    return _build(where, Support, node=sp["node"], kind=sp["kind"], name=sp.get("name", ""))
 
 
 def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing:
