@@ -142,7 +142,7 @@ BAD = [
      "thickness, material: give either (m, I_d, I_p) or (D_o, D_i, thickness, material)"),
     ("I_p = 0.02", "I_p = -0.02", "bad.toml: disk[0].I_p = -0.02: must be >= 0 (kg m^2)"),
     ('name = "t"', 'name = "t"\ncolour = "red"', "bad.toml: colour = 'red': unknown key; allowed keys are bearing, "
-     "damping, defaults, description, disk, intershaft_bearing, material, name, spool, support"),
+     "damping, defaults, description, disk, intershaft_bearing, material, name, pedestal, spool, support"),
     ("[[bearing]]\nnode = 1\n", "[[bearing]]\n", "bad.toml: bearing[0].node: missing; required"),
     ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = [1e7, 2e7, 3e7]",
      "bad.toml: bearing[0].k = [10000000.0, 20000000.0, 30000000.0]: must be a 1-D array of 2 values (N/m)"),

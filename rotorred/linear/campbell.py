@@ -627,7 +627,7 @@ def _checked_model(model, rotor: Rotor):
 
     if not isinstance(model, ReducedSystem):
         checks.fail("model", type(model).__name__, "must be a ReducedSystem (reduce_rotor) of the rotor, or None")
-    if set(model.G) != {s.name for s in rotor.spools} or tuple(model.full_dofs.nodes) != tuple(rotor.nodes):
+    if set(model.G) != {s.name for s in rotor.spools} or tuple(model.full_dofs.nodes) != tuple(rotor.all_nodes):
         checks.fail("model", "a ReducedSystem", f"must be reduced from rotor {rotor.name!r} (its spools and nodes)")
     return model
 

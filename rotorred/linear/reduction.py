@@ -188,6 +188,8 @@ class ReducedSystem(SpoolSpeedMixin):
         The full model's speed-dependent bearings on the reduced coordinates (rows ``R T``): their change with
         speed is exact when the bearing's node is a boundary node, as the constraint and fixed-interface modes
         do not depend on a boundary node's supports.
+    supported_weight : ndarray, shape (m,), or None
+        ``T^T`` times the full model's ``supported_weight`` (a rotor with pinned or clamped supports).
     """
 
     M: np.ndarray
@@ -203,6 +205,7 @@ class ReducedSystem(SpoolSpeedMixin):
     selection: ModeSelection
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
     tables: tuple[TabulatedSupport, ...] = ()
+    supported_weight: np.ndarray | None = None
     _bpos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -259,13 +262,14 @@ class ReducedSystem(SpoolSpeedMixin):
 
 
 def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:
-    """Bearing nodes, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF order."""
+    """Bearing nodes and their pedestals, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF
+    order."""
     extra = [checks.node(f"extra_nodes[{i}]", n, rotor.spool_of) for i, n in enumerate(extra_nodes)]
-    nodes = {b.node for b in rotor.bearings}
+    nodes = {b.node for b in rotor.bearings} | {b.link for b in rotor.bearings if b.link is not None}
     for b in rotor.intershaft_bearings:
         nodes.update((b.node_a, b.node_b))
     nodes.update(extra)
-    return tuple(n for n in rotor.nodes if n in nodes)
+    return tuple(n for n in rotor.all_nodes if n in nodes)
 
 
 def _boundary(system: SystemMatrices, boundary_nodes) -> tuple[tuple[int, ...], np.ndarray, np.ndarray]:
@@ -541,7 +545,8 @@ def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
     return ReducedSystem(M=Mr, K=Kr, C=Cr, G=Gr, T=T, full_dofs=system.dofs, boundary_nodes=nodes,
                          boundary_dofs=basis.b.copy(), n_modes=n_modes,
                          interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr,
-                         tables=tuple(t.on(T) for t in system.tables))
+                         tables=tuple(t.on(T) for t in system.tables),
+                         supported_weight=None if system.supported_weight is None else T.T @ system.supported_weight)
 
 
 def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,

@@ -134,6 +134,9 @@ class SystemMatrices(SpoolSpeedMixin):
     tables : tuple of TabulatedSupport
         The bearings whose coefficients depend on speed; ``K`` and ``C`` hold them at the rotor's speeds,
         :meth:`stiffness` and :meth:`damping` at any speeds.
+    supported_weight : ndarray, shape (n,), or None
+        With supports: ``M e_y`` of the model before the fixed DOFs were removed (kg), e_y the unit rigid
+        translation in y, on the remaining DOFs; gravity's consistent load is ``-g`` times it. None without supports.
     """
 
     M: np.ndarray
@@ -143,6 +146,7 @@ class SystemMatrices(SpoolSpeedMixin):
     dofs: DofMap
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
     tables: tuple[TabulatedSupport, ...] = ()
+    supported_weight: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
@@ -207,9 +211,9 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     SystemMatrices
     """
     n_internal = sum(e.n_internal for s in rotor.spools for e in s.elements)
-    dofs = DofMap(rotor.nodes, n_internal)
+    dofs = DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals))
     n = dofs.n_dof
-    next_internal = 4 * len(rotor.nodes)
+    next_internal = n - n_internal
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
     G = {s.name: _Triplets() for s in rotor.spools}
     K_G = {s.name: _Triplets() for s in rotor.spools}
@@ -231,18 +235,23 @@ def assemble(rotor: Rotor) -> SystemMatrices:
         M.add(idx, d.M())
         G[spool_of[d.node]].add(idx, d.G())
         K_G[spool_of[d.node]].add(idx, d.K_G())
+    for p in rotor.pedestals:
+        M.add(dofs.node_dofs(p.node), p.M())
+    coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
     tables = []
     for b in rotor.bearings:
         idx = dofs.node_dofs(b.node)[:2]
         if isinstance(b, BearingTable):
             spool = spool_of[b.node]
-            rows = np.zeros((2, n))
-            rows[[0, 1], idx] = 1.0
-            tables.append(TabulatedSupport(b, spool, rows, b.at(rotor.speeds[spool])))
+            tables.append(TabulatedSupport(b, spool, _deflection_rows(dofs, b), b.at(rotor.speeds[spool])))
             b = tables[-1].nominal
-        K.add(idx, b.K)
-        C.add(idx, b.C)
-    coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
+        if b.link is None:
+            K.add(idx, b.K)
+            C.add(idx, b.C)
+        else:
+            both = np.concatenate([idx, dofs.node_dofs(b.link)])
+            K.add(both, np.kron(coupling, b.K))
+            C.add(both, np.kron(coupling, b.C))
     for b in rotor.intershaft_bearings:
         a, c = dofs.node_dofs(b.node_a)[:2], dofs.node_dofs(b.node_b)[:2]
         idx = np.concatenate([a, c])
@@ -257,19 +266,29 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     return _supported(free, rotor.supports)
 
 
+def _deflection_rows(dofs: DofMap, b) -> np.ndarray:
+    """A bearing's deflection, its node's x, y (less its pedestal's), as rows on the DOFs, shape (2, n)."""
+    rows = np.zeros((2, dofs.n_dof))
+    rows[[0, 1], dofs.node_dofs(b.node)[:2]] = 1.0
+    if b.link is not None:
+        rows[[0, 1], dofs.node_dofs(b.link)] = -1.0
+    return rows
+
+
 def _supported(system: SystemMatrices, supports) -> SystemMatrices:
     """``system`` without the DOFs the supports fix: their rows and columns removed (a pinned or clamped DOF is
     zero, exactly; docs/model.md §11)."""
     if not supports:
         return system
-    dofs = DofMap(system.dofs.nodes, system.dofs.n_internal,
+    dofs = DofMap(system.dofs.nodes, system.dofs.n_internal, translational=system.dofs.translational,
                   fixed=frozenset((sp.node, d) for sp in supports for d in sp.fixed))
     keep = dofs.free_in(system.dofs)
 
     def cut(X):
         return X[np.ix_(keep, keep)]
 
+    e_y = system.output_rows([(n, "y") for n in system.dofs.nodes]).sum(axis=0)  # every node moves 1 in y
     return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
                           dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
                           tables=tuple(TabulatedSupport(t.table, t.spool, t.rows[:, keep], t.nominal)
-                                       for t in system.tables))
+                                       for t in system.tables), supported_weight=(system.M @ e_y)[keep])

@@ -97,11 +97,11 @@ def checked_dof(field: str, value, nodes: Collection[int] | None = None, what: s
 class DofMap:
     """Global DOF numbering.
 
-    4 DOFs per node, (x, y, theta_x, theta_y), nodes in ``nodes`` order; the DOFs a support fixes
-    (``fixed``) are left out and the others numbered on in that order; then the internal (bubble)
-    DOFs of hierarchical shaft elements, ``n_internal`` of them, after all nodal DOFs. Without fixed
-    DOFs a node's DOFs are ``4 * position + direction``. Code that needs physical DOFs uses
-    :meth:`index` or :meth:`node_dofs`, never ``n_dof // 4``.
+    4 DOFs per shaft node, (x, y, theta_x, theta_y), 2 per pedestal node (``translational``: x, y), nodes in
+    ``nodes`` order; the DOFs a support fixes (``fixed``) are left out and the others numbered on in that
+    order; then the internal (bubble) DOFs of hierarchical shaft elements, ``n_internal`` of them, after all
+    nodal DOFs. Without fixed DOFs and pedestals a node's DOFs are ``4 * position + direction``. Code that
+    needs physical DOFs uses :meth:`index` or :meth:`node_dofs`, never ``n_dof // 4``.
 
     Parameters
     ----------
@@ -112,11 +112,14 @@ class DofMap:
     fixed : frozenset of (int, str)
         (node, direction) pairs held by supports (:class:`rotorred.model.elements.Support`): not DOFs
         of the model.
+    translational : frozenset of int
+        Nodes with x and y only: pedestals (:class:`rotorred.model.elements.Pedestal`).
     """
 
     nodes: tuple[int, ...]
     n_internal: int = 0
     fixed: frozenset = frozenset()
+    translational: frozenset = frozenset()
     _pos: dict = field(init=False, repr=False, compare=False)
     _index: dict = field(init=False, repr=False, compare=False)
     _free: tuple = field(init=False, repr=False, compare=False)
@@ -128,7 +131,10 @@ class DofMap:
         fixed = frozenset(checked_dof(f"fixed[{i}]", d, self._pos, "the model")
                           for i, d in enumerate(sorted(self.fixed, key=str)))
         object.__setattr__(self, "fixed", fixed)
-        free = tuple((n, d) for n in self.nodes for d in DIRECTIONS if (n, d) not in fixed)
+        translational = frozenset(checks.node(f"translational[{i}]", n, self._pos, "a node of the model")
+                                  for i, n in enumerate(sorted(self.translational)))
+        object.__setattr__(self, "translational", translational)
+        free = tuple((n, d) for n in self.nodes for d in self.directions(n) if (n, d) not in fixed)
         object.__setattr__(self, "_free", free)
         object.__setattr__(self, "_index", {nd: i for i, nd in enumerate(free)})
 
@@ -142,8 +148,18 @@ class DofMap:
         """Indices of all nodal DOFs, shape (n_nodes, 4): row k is node ``nodes[k]``; -1 where a DOF is fixed."""
         return np.array([[self._index.get((n, d), -1) for d in DIRECTIONS] for n in self.nodes], dtype=int)
 
+    @property
+    def pairs(self) -> tuple[tuple[int, str], ...]:
+        """(node, direction) of each nodal DOF, in DOF order (fixed DOFs and pedestals' rotations are not DOFs)."""
+        return self._free
+
+    def directions(self, node: int) -> tuple[str, ...]:
+        """The directions a node has (fixed or not): x, y for a pedestal node, all four for a shaft node."""
+        return DIRECTIONS[:2] if node in self.translational else DIRECTIONS
+
     def node_dofs(self, node: int) -> np.ndarray:
-        """Global indices of the free DOFs of ``node``, in DOF order, shape (4,) (fewer where a support fixes some)."""
+        """Global indices of the free DOFs of ``node``, in DOF order, shape (4,) (2 for a pedestal node; fewer where a
+        support fixes some)."""
         self._node_pos(node)
         return np.array([self._index[(node, d)] for d in DIRECTIONS if (node, d) in self._index], dtype=int)
 
@@ -154,6 +170,9 @@ class DofMap:
             checks.fail("direction", direction, f"must be one of {_DIRECTIONS_TEXT}")
         self._node_pos(node)
         direction = DIRECTION_ALIASES.get(direction, direction)
+        if direction not in self.directions(node):
+            checks.fail("node", node, f"must be a shaft node to have {direction}; node {node} is a pedestal node "
+                        "(x and y only)")
         if (node, direction) in self.fixed:
             checks.fail("node", node, f"must be a node whose {direction} is free; a support fixes {direction} there "
                         "(its displacement is zero, not a DOF of the model)")
@@ -167,7 +186,7 @@ class DofMap:
         """This map's DOFs as indices of ``full`` (the same nodes and internal DOFs, nothing fixed), shape (n_dof,):
         ``X[np.ix_(k, k)]`` takes a matrix assembled on ``full`` to this map."""
         nodal = [full.index(n, d) for n, d in self._free]
-        start = 4 * len(full.nodes)
+        start = full.n_dof - full.n_internal
         return np.array(nodal + list(range(start, start + self.n_internal)), dtype=int)
 
     def checked_outputs(self, outputs, name: str = "outputs") -> tuple[tuple[int, str], ...]:

@@ -337,23 +337,64 @@ class _Support:
 
 @dataclass(frozen=True)
 class Bearing(_Support):
-    """Linear bearing from a node to ground (x and y only).
+    """Linear bearing from a node to ground, or to a pedestal (x and y only).
 
     Parameters
     ----------
     node : int
     k_xx, k_yy, k_xy, k_yx : float
-        Stiffness coefficients (N/m); the force on the shaft is -K [x, y].
+        Stiffness coefficients (N/m); the force on the shaft is -K [x, y] (-K [x - x_link, y - y_link] with a link).
     c_xx, c_yy, c_xy, c_yx : float
         Damping coefficients (N s/m).
     name : str
+    link : int or None
+        The pedestal node (:class:`Pedestal`) the bearing joins ``node`` to; None: ground.
     """
 
     node: int = field(default=-1, kw_only=True)
+    link: int | None = field(default=None, kw_only=True)
 
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
+        _check_link(self)
         self._validate()
+
+
+def _check_link(bearing) -> None:
+    if bearing.link is not None:
+        _set(bearing, "link", checks.integer("link", bearing.link, ge=0))
+        if bearing.link == bearing.node:
+            checks.fail("link", bearing.link, f"must differ from node = {bearing.node}")
+
+
+@dataclass(frozen=True)
+class Pedestal:
+    """An off-shaft node with mass and x, y only: a bearing housing on its own springs, a pedestal, a casing point.
+
+    It is held to ground by the bearings given at its node and joined to the shaft by the bearings that name it as
+    their ``link``.
+
+    Parameters
+    ----------
+    node : int
+        A node number of no spool.
+    m : float
+        Mass (kg), in x and in y.
+    name : str
+    """
+
+    node: int
+    m: float
+    name: str = ""
+
+    def __post_init__(self):
+        _set(self, "node", checks.integer("node", self.node, ge=0))
+        _set(self, "m", checks.positive("m", self.m, "kg"))
+        _set(self, "name", checks.string("name", self.name))
+
+    def M(self) -> np.ndarray:
+        """Mass matrix on (x, y), shape (2, 2) (kg)."""
+        return self.m * np.eye(2)
 
 
 #: the directions each kind of :class:`Support` fixes
@@ -411,6 +452,8 @@ class BearingTable:
     c_xx, c_yy, c_xy, c_yx : float or sequence of float, shape (p,)
         Damping (N s/m), the same way.
     name : str
+    link : int or None
+        The pedestal node the bearing joins ``node`` to; None: ground.
     """
 
     node: int
@@ -424,9 +467,11 @@ class BearingTable:
     c_xy: tuple[float, ...] | float = 0.0
     c_yx: tuple[float, ...] | float = 0.0
     name: str = ""
+    link: int | None = None
 
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
+        _check_link(self)
         speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
         _set(self, "speeds", tuple(float(v) for v in speeds))
         for c in COEFFICIENTS:
@@ -443,7 +488,7 @@ class BearingTable:
         """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated linearly in speed, held at
         the table's ends."""
         Omega = checks.non_negative("Omega", Omega, "rad/s")
-        return Bearing(node=self.node, name=self.name,
+        return Bearing(node=self.node, name=self.name, link=self.link,
                        **{c: float(np.interp(Omega, self.speeds, getattr(self, c))) for c in COEFFICIENTS})
 
     def covers(self, Omega: float) -> bool:

@@ -59,7 +59,8 @@ def gravity_force(model, g: float) -> np.ndarray:
 
     ``e`` is a rigid unit translation in y expressed in the model's coordinates (for a reduced
     model, the least-squares fit of the recovery rows, which is exact when every bearing node is
-    on the boundary).
+    on the boundary). A model with supports carries ``M e`` of the rotor before its fixed DOFs were removed
+    (``supported_weight``): the fixed DOFs' share of the consistent load acts on their free neighbours.
 
     Parameters
     ----------
@@ -72,7 +73,9 @@ def gravity_force(model, g: float) -> np.ndarray:
     ndarray, shape (n,)
     """
     g = checks.number("g", g, "m/s^2")
-    pairs = [(node, d) for node in model.full_dofs.nodes for d in ("x", "y", "theta_x", "theta_y")]
+    if model.supported_weight is not None:  # supports remove DOFs that move with a rigid translation
+        return -g * model.supported_weight
+    pairs = list(model.full_dofs.pairs)
     R = model.output_rows(pairs)
     target = np.array([1.0 if d == "y" else 0.0 for _, d in pairs])
     e, *_ = np.linalg.lstsq(R, target, rcond=None)

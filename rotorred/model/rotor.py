@@ -19,7 +19,8 @@ from typing import Mapping
 
 from rotorred import checks
 from rotorred.model.dofs import checked_dof
-from rotorred.model.elements import Bearing, BearingTable, Disk, IntershaftBearing, ShaftElement, Support
+from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Pedestal, ShaftElement,
+                                     Support)
 from rotorred.model.loads import Unbalance
 
 
@@ -156,6 +157,9 @@ class Rotor:
         kept by :meth:`refined`, :meth:`with_speeds` and the other copies.
     supports : tuple of Support
         Pinned or clamped nodes (at most one support a node): their fixed DOFs are not DOFs of the model.
+    pedestals : tuple of Pedestal
+        Off-shaft nodes (x, y) with mass, numbered apart from the spools' nodes; bearings at them hold them to
+        ground, bearings with ``link`` join a shaft node to them.
     """
 
     spools: tuple[Spool, ...]
@@ -166,10 +170,11 @@ class Rotor:
     name: str = ""
     defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
     supports: tuple[Support, ...] = ()
+    pedestals: tuple[Pedestal, ...] = ()
 
     def __post_init__(self):
         for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", (Bearing, BearingTable)),
-                          ("intershaft_bearings", IntershaftBearing), ("supports", Support)):
+                          ("intershaft_bearings", IntershaftBearing), ("supports", Support), ("pedestals", Pedestal)):
             object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
             checks.fail("spools", self.spools, "must hold at least one spool")
@@ -183,30 +188,19 @@ class Rotor:
 
     def _check_topology(self) -> None:
         """Spool names unique, no node on two spools, every referenced node exists."""
-        owner: dict[int, str] = {}
-        for i, s in enumerate(self.spools):
-            if s.name in [t.name for t in self.spools[:i]]:
-                checks.fail(f"spools[{i}].name", s.name, "must differ from the names of the other spools")
-            for n in s.nodes:
-                if n in owner:
-                    checks.fail(f"spools[{i}].nodes", s.nodes, f"must not include node {n}, which belongs to "
-                                f"spool {owner[n]!r}")
-                owner[n] = s.name
+        owner = self._spool_owners()
         for i, d in enumerate(self.disks):
             checks.node(f"disks[{i}].node", d.node, owner)
+        pedestals = self._checked_pedestals(owner)
         for i, b in enumerate(self.bearings):
-            checks.node(f"bearings[{i}].node", b.node, owner)
-        supported: dict[int, str] = {}
-        for i, sp in enumerate(self.supports):
-            checks.node(f"supports[{i}].node", sp.node, owner)
-            if sp.node in supported:
-                checks.fail(f"supports[{i}].node", sp.node, f"must not carry a second support (node {sp.node} is "
-                            f"already {supported[sp.node]})")
-            supported[sp.node] = sp.kind
-        for i, b in enumerate(self.bearings):
-            if b.node in supported:
-                checks.fail(f"bearings[{i}].node", b.node, f"must not be a {supported[b.node]} node: the support fixes "
-                            "its x and y, so a bearing there would carry no motion")
+            checks.node(f"bearings[{i}].node", b.node, set(owner) | set(pedestals))
+            if b.link is not None and b.link not in pedestals:
+                checks.fail(f"bearings[{i}].link", b.link, f"must be a pedestal node ({checks.ranges_text(pedestals)})"
+                            if pedestals else "must be a pedestal node; the rotor has no [[pedestal]]")
+            if isinstance(b, BearingTable) and b.node in pedestals:
+                checks.fail(f"bearings[{i}].node", b.node, "must be a shaft node for a bearing tabulated against "
+                            "speed (its spool's speed); node {} is a pedestal".format(b.node))
+        self._check_supports(owner)
         for i, b in enumerate(self.intershaft_bearings):
             checks.node(f"intershaft_bearings[{i}].node_a", b.node_a, owner)
             checks.node(f"intershaft_bearings[{i}].node_b", b.node_b, owner)
@@ -219,11 +213,55 @@ class Rotor:
         except checks.InputError as exc:
             raise exc.within("defaults") from None
 
+    def _spool_owners(self) -> dict[int, str]:
+        """The spool of each shaft node; spool names unique, no node on two spools."""
+        owner: dict[int, str] = {}
+        for i, s in enumerate(self.spools):
+            if s.name in [t.name for t in self.spools[:i]]:
+                checks.fail(f"spools[{i}].name", s.name, "must differ from the names of the other spools")
+            for n in s.nodes:
+                if n in owner:
+                    checks.fail(f"spools[{i}].nodes", s.nodes, f"must not include node {n}, which belongs to "
+                                f"spool {owner[n]!r}")
+                owner[n] = s.name
+        return owner
+
+    def _checked_pedestals(self, owner: dict[int, str]) -> set[int]:
+        """The pedestal nodes: each on no spool and not given twice."""
+        pedestals: set[int] = set()
+        for i, p in enumerate(self.pedestals):
+            if p.node in owner:
+                checks.fail(f"pedestals[{i}].node", p.node, f"must be a node of no spool (node {p.node} is on spool "
+                            f"{owner[p.node]!r}); a pedestal is an off-shaft node")
+            if p.node in pedestals:
+                checks.fail(f"pedestals[{i}].node", p.node, "must not be given twice")
+            pedestals.add(p.node)
+        return pedestals
+
+    def _check_supports(self, owner: dict[int, str]) -> None:
+        """Supports on shaft nodes, one a node, and no bearing at a supported node."""
+        supported: dict[int, str] = {}
+        for i, sp in enumerate(self.supports):
+            checks.node(f"supports[{i}].node", sp.node, owner)
+            if sp.node in supported:
+                checks.fail(f"supports[{i}].node", sp.node, f"must not carry a second support (node {sp.node} is "
+                            f"already {supported[sp.node]})")
+            supported[sp.node] = sp.kind
+        for i, b in enumerate(self.bearings):
+            if b.node in supported:
+                checks.fail(f"bearings[{i}].node", b.node, f"must not be a {supported[b.node]} node: the support fixes "
+                            "its x and y, so a bearing there would carry no motion")
+
     # --- topology -----------------------------------------------------------------
     @property
     def nodes(self) -> tuple[int, ...]:
-        """All node numbers in DOF order: spool by spool, axially."""
+        """The shaft nodes in DOF order: spool by spool, axially."""
         return tuple(n for s in self.spools for n in s.nodes)
+
+    @property
+    def all_nodes(self) -> tuple[int, ...]:
+        """Every node in DOF order: the shaft nodes (:attr:`nodes`), then the pedestal nodes."""
+        return self.nodes + tuple(p.node for p in self.pedestals)
 
     @property
     def spool_of(self) -> dict[int, str]:
@@ -270,7 +308,7 @@ class Rotor:
         n = checks.integer("n", n, ge=1)
         if n == 1:
             return self
-        next_node = max(self.nodes) + 1
+        next_node = max(self.all_nodes) + 1
         spools = []
         for s in self.spools:
             elements = []
@@ -295,10 +333,12 @@ class Rotor:
         """Return the spool ``name`` alone, with its disks and ground bearings."""
         s = self.spool(name)
         nodes = set(s.nodes)
+        linked = {b.link for b in self.bearings if b.node in nodes and b.link is not None}  # its pedestals
         return dataclasses.replace(
             self, spools=(s,), disks=tuple(d for d in self.disks if d.node in nodes),
-            bearings=tuple(b for b in self.bearings if b.node in nodes), intershaft_bearings=(),
+            bearings=tuple(b for b in self.bearings if b.node in nodes or b.node in linked), intershaft_bearings=(),
             supports=tuple(sp for sp in self.supports if sp.node in nodes),
+            pedestals=tuple(p for p in self.pedestals if p.node in linked),
             name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes))
 
 

@@ -19,6 +19,8 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     node_a = 20; node_b = 9; k = 1e7; c = 300.0
     [[support]]                        # a rigid support: "pinned" fixes x, y; "clamped" also theta_x, theta_y
     node = 1; kind = "pinned"
+    [[pedestal]]                       # an off-shaft node (x, y) with mass (kg); a [[bearing]] at it holds it to
+    node = 30; m = 20.0                # ground, a [[bearing]] with link = 30 joins a shaft node to it
     [damping]
     rayleigh_alpha = 0.0; rayleigh_beta = 0.0
     [defaults]                         # what analyses use when nothing else is given (all optional)
@@ -44,7 +46,7 @@ from rotorred import checks
 from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
-                                     Material, ShaftElement, Support)
+                                     Material, Pedestal, ShaftElement, Support)
 from rotorred.model.loads import unbalance_from_table
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 
@@ -55,8 +57,8 @@ except ModuleNotFoundError:  # pragma: no cover
 
 __all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_from_dict", "read_toml"]
 
-_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "damping",
-             "defaults"}
+_TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
+             "damping", "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements"}
 _ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element", "rotary_inertia"}
@@ -67,7 +69,7 @@ _SUPPORT_NODE_KEYS = {"node", "kind", "name"}
 _DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
 #: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
 _FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing",
-              "supports": "support"}
+              "supports": "support", "pedestals": "pedestal"}
 
 
 class RotorFileError(InputError):
@@ -174,11 +176,13 @@ def _rotor(data: dict) -> Rotor:
     inter = tuple(_intershaft_bearing(f"intershaft_bearing[{i}]", b)
                   for i, b in enumerate(checks.tables("intershaft_bearing", data.get("intershaft_bearing", []))))
     supports = tuple(_support(f"support[{i}]", sp) for i, sp in enumerate(checks.tables("support", data.get("support", []))))
+    pedestals = tuple(_pedestal(f"pedestal[{i}]", p)
+                      for i, p in enumerate(checks.tables("pedestal", data.get("pedestal", []))))
     rayleigh = _damping(data.get("damping", {}))
     defaults = _defaults(data.get("defaults", {}), nodes)
     try:
         return Rotor(spools=spools, disks=disks, bearings=bearings, intershaft_bearings=inter, rayleigh=rayleigh,
-                     name=name, defaults=defaults, supports=supports)
+                     name=name, defaults=defaults, supports=supports, pedestals=pedestals)
     except InputError as exc:  # Rotor names its attributes (disks[0].node); the file's keys are disk[0].node
         head, _, rest = exc.field.partition("[")
         field = f"{_FILE_KEYS[head]}[{rest}" if head in _FILE_KEYS and rest else exc.field
@@ -267,12 +271,17 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm"}, required={"node"})
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link"}, required={"node"})
     if "speed_rpm" not in b:
-        return _build(where, Bearing, node=b["node"], **_coefficients(where, b))
+        return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
     rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
-    return _build(where, BearingTable, node=b["node"], speeds=tuple(rpm * math.pi / 30.0),
+    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(rpm * math.pi / 30.0),
                   **_coefficients(where, b, n_speeds=len(rpm)))
+
+
+def _pedestal(where: str, p: dict) -> Pedestal:
+    checks.keys(where, p, {"node", "m", "name"}, required={"node", "m"})
+    return _build(where, Pedestal, node=p["node"], m=p["m"], name=p.get("name", ""))
 
 
 def _support(where: str, sp: dict) -> Support:
