@@ -12,6 +12,12 @@ def _timoshenko() -> str:
     return module_text()
 
 
+def _tapered() -> str:
+    from derivations.tapered import module_text
+
+    return module_text()
+
+
 def _contact() -> str:
     from derivations.contact import module_text
 
@@ -22,4 +28,5 @@ def _contact() -> str:
 TARGETS: list[tuple[str, object]] = [
     ("rotorred/_generated/timoshenko.py", _timoshenko),
     ("rotorred/_generated/contact.py", _contact),
+    ("rotorred/_generated/tapered.py", _tapered),
 ]

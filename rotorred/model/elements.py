@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotorred import checks
+from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_translational
+from rotorred._generated.tapered import tapered_spin_acceleration, tapered_stiffness
 from rotorred._generated import timoshenko as _gen
 
 SHEAR_METHODS = ("cowper", "hutchinson", "none")
@@ -128,7 +130,7 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
 
 @dataclass(frozen=True)
 class ShaftElement:
-    """Uniform hollow circular Timoshenko shaft element between two nodes of one spool.
+    """Hollow circular Timoshenko shaft element between two nodes of one spool, uniform or tapered.
 
     Parameters
     ----------
@@ -154,6 +156,10 @@ class ShaftElement:
         Rotary inertia of the cross-section (default True). False leaves out the rotary mass and
         with it the shaft's own gyroscopic matrix (both are rho I): with ``shear = "none"`` this
         is the Euler-Bernoulli beam of the textbooks (no shear, no rotary inertia).
+    D_o_right, D_i_right : float, optional
+        Diameters at the right node (m) of a tapered element, default ``D_o`` and ``D_i``: the
+        diameters vary linearly from left to right and the element is the conical one of
+        derivations/tapered.py (``element = "nelson"`` only). ``D_o``, ``D_i`` are then the left ones.
     """
 
     left: int
@@ -165,6 +171,8 @@ class ShaftElement:
     shear: str = "cowper"
     element: str = "nelson"
     rotary_inertia: bool = True
+    D_o_right: float | None = None
+    D_i_right: float | None = None
 
     def __post_init__(self):
         _set(self, "left", checks.integer("left", self.left, ge=0))
@@ -185,6 +193,23 @@ class ShaftElement:
         if self.element == "hierarchical" and self.shear == "none":
             checks.fail("element", self.element, "must be 'nelson' with shear = 'none' (an Euler-Bernoulli element): "
                         "the hierarchical element needs shear = 'cowper' or 'hutchinson'")
+        _set(self, "D_o_right", self.D_o if self.D_o_right is None else checks.positive("D_o_right", self.D_o_right, "m"))
+        _set(self, "D_i_right", self.D_i if self.D_i_right is None else
+             checks.non_negative("D_i_right", self.D_i_right, "m"))
+        if self.D_i_right >= self.D_o_right:
+            checks.fail("D_i_right", self.D_i_right, f"must be < D_o_right = {self.D_o_right:g}", "m")
+        if self.tapered and self.element != "nelson":
+            checks.fail("element", self.element, "must be 'nelson' for a tapered element (D_o_right, D_i_right given)")
+
+    @property
+    def tapered(self) -> bool:
+        """Whether the diameters differ between the nodes."""
+        return self.D_o_right != self.D_o or self.D_i_right != self.D_i
+
+    @property
+    def _mid(self) -> tuple[float, float]:
+        """Outer and inner diameter at mid-length (m): the section of ``A``, ``I``, ``kappa`` and ``phi``."""
+        return 0.5 * (self.D_o + self.D_o_right), 0.5 * (self.D_i + self.D_i_right)
 
     @property
     def n_internal(self) -> int:
@@ -193,20 +218,22 @@ class ShaftElement:
 
     @property
     def A(self) -> float:
-        """Cross-section area (m^2)."""
-        return math.pi * (self.D_o**2 - self.D_i**2) / 4.0
+        """Cross-section area (m^2) (at mid-length for a tapered element)."""
+        D_o, D_i = self._mid
+        return math.pi * (D_o**2 - D_i**2) / 4.0
 
     @property
     def I(self) -> float:  # noqa: E743 - textbook symbol
-        """Diametral second moment of area (m^4); the polar one is 2 I."""
-        return math.pi * (self.D_o**4 - self.D_i**4) / 64.0
+        """Diametral second moment of area (m^4) (at mid-length for a tapered element); the polar one is 2 I."""
+        D_o, D_i = self._mid
+        return math.pi * (D_o**4 - D_i**4) / 64.0
 
     @property
     def kappa(self) -> float:
-        """Shear coefficient (-); inf for ``shear="none"``."""
+        """Shear coefficient (-) (of the mid-length section for a tapered element); inf for ``shear="none"``."""
         if self.shear == "none":
             return math.inf
-        return shear_coefficient(self.D_o, self.D_i, self.material.nu, self.shear)
+        return shear_coefficient(*self._mid, self.material.nu, self.shear)
 
     @property
     def phi(self) -> float:
@@ -218,12 +245,29 @@ class ShaftElement:
 
     @property
     def mass(self) -> float:
-        """Mass rho A L (kg)."""
-        return self.material.rho * self.A * self.L
+        """Mass rho int A dz (kg)."""
+        A0, A1, A2 = self.taper()[0]
+        return self.material.rho * self.L * (A0 + A1 / 2 + A2 / 3)
+
+    def taper(self) -> tuple[tuple[float, float, float], tuple[float, float, float, float, float]]:
+        """The section along the element, ``xi = z / L``: (A0, A1, A2) of A(xi) = sum A_k xi^k (m^2) and (I0, ..., I4)
+        of I(xi) = sum I_k xi^k (m^4), from the linear diameters ``d(xi) = d_left + (d_right - d_left) xi``."""
+        a, b = self.D_o, self.D_o_right - self.D_o
+        c, e = self.D_i, self.D_i_right - self.D_i
+        A = tuple(math.pi / 4 * math.comb(2, k) * (a ** (2 - k) * b**k - c ** (2 - k) * e**k) for k in range(3))
+        I = tuple(math.pi / 64 * math.comb(4, k) * (a ** (4 - k) * b**k - c ** (4 - k) * e**k) for k in range(5))  # noqa: E741
+        return A, I
+
+    def _tapered_rotary(self) -> tuple[float, ...]:
+        """I(xi)'s coefficients as the rotary inertia sees them (zeros without rotary inertia)."""
+        return self.taper()[1] if self.rotary_inertia else (0.0,) * 5
 
     def M(self) -> np.ndarray:
         """Mass matrix (translational + rotary), shape (8 + n_internal,) * 2 (kg, kg m, kg m^2)."""
         rho, phi = self.material.rho, self.phi
+        if self.tapered:
+            return (tapered_mass_translational(self.L, rho, *self.taper()[0], phi)
+                    + tapered_mass_rotary(self.L, rho, *self._tapered_rotary(), phi))
         I_r = self.I if self.rotary_inertia else 0.0  # no rotary mass: the generated term at I = 0
         if self.element == "hierarchical":
             return (_gen.hierarchical_mass_translational(self.L, rho, self.A, phi)
@@ -233,12 +277,19 @@ class ShaftElement:
 
     def K(self) -> np.ndarray:
         """Stiffness matrix, shape (8 + n_internal,) * 2 (N/m, N, N m)."""
+        if self.tapered:  # Euler-Bernoulli (phi = 0): no shear strain, kappa G does not enter
+            kG = 0.0 if self.shear == "none" else self.kappa * self.material.G_s
+            A, I = self.taper()  # noqa: E741
+            return tapered_stiffness(self.L, self.material.E, *I, kG, *A, self.phi)
         if self.element == "hierarchical":
             return _gen.hierarchical_stiffness(self.L, self.material.E, self.I, self.phi)
         return _gen.timoshenko_stiffness(self.L, self.material.E, self.I, self.phi)
 
     def G(self) -> np.ndarray:
         """Gyroscopic matrix per unit spin speed, shape (8 + n_internal,) * 2 (kg m^2 per rad)."""
+        if self.tapered:
+            A_g = self.K_G()
+            return A_g - A_g.T
         I_r = self.I if self.rotary_inertia else 0.0  # the gyroscopic matrix is rotary inertia spun
         if self.element == "hierarchical":
             return _gen.hierarchical_gyroscopic(self.L, self.material.rho, I_r, self.phi)
@@ -247,16 +298,24 @@ class ShaftElement:
     def K_G(self) -> np.ndarray:
         """Spin-acceleration matrix per unit angular acceleration, shape (8 + n_internal,) * 2 (kg m^2 per rad):
         the ``A`` of ``G = A - A^T`` (docs/model.md, Eq. R2)."""
+        if self.tapered:
+            return tapered_spin_acceleration(self.L, self.material.rho, *self._tapered_rotary(), self.phi)
         I_r = self.I if self.rotary_inertia else 0.0
         if self.element == "hierarchical":
             return _gen.hierarchical_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
         return _gen.timoshenko_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
 
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
-        """Split into ``n`` equal elements through ``new_nodes`` (length n - 1)."""
+        """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line."""
         chain = [self.left, *new_nodes, self.right]
-        return [ShaftElement(chain[i], chain[i + 1], self.L / n, self.D_o, self.D_i, self.material, self.shear,
-                             self.element, self.rotary_inertia) for i in range(n)]
+
+        def at(d_left, d_right, xi):
+            return d_left + (d_right - d_left) * xi
+
+        return [ShaftElement(chain[i], chain[i + 1], self.L / n, at(self.D_o, self.D_o_right, i / n),
+                             at(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
+                             self.rotary_inertia, at(self.D_o, self.D_o_right, (i + 1) / n),
+                             at(self.D_i, self.D_i_right, (i + 1) / n)) for i in range(n)]
 
 
 @dataclass(frozen=True)

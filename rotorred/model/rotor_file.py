@@ -60,8 +60,10 @@ __all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
-_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements"}
-_ELEMENT_KEYS = {"L", "D_o", "D_i", "material", "repeat", "shear", "element", "rotary_inertia"}
+_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements", "stations",
+               "material"}
+_STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
+_ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
@@ -222,26 +224,97 @@ def _spools(value, materials: dict[str, Material]) -> tuple[Spool, ...]:
 
 
 def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
-    checks.keys(where, s, _SPOOL_KEYS, required={"name", "first_node", "elements"})
+    checks.keys(where, s, _SPOOL_KEYS, required={"name", "first_node"})
+    if ("elements" in s) == ("stations" in s):
+        checks.fail(where, sorted(k for k in ("elements", "stations") if k in s) or "neither",
+                    "must give the shaft either as elements (a list of L, D_o, D_i, ...) or as stations (a list of z, D_o, "
+                    "D_i, ...), one of the two")
     name = checks.string(f"{where}.name", s["name"], empty=False)
     node = checks.integer(f"{where}.first_node", s["first_node"], ge=0)
-    shear = checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS)
-    element = checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS)
-    rotary = s.get("rotary_inertia", True)
+    defaults = dict(shear=checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS),
+                    element=checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS),
+                    rotary_inertia=s.get("rotary_inertia", True))
+    if "stations" in s:
+        if "z0" in s:
+            checks.fail(f"{where}.z0", s["z0"], "must not be given with stations: the first station's z is the start")
+        sections = _sections_of_stations(where, s, materials)
+        z0 = sections[0]["z"]
+    else:
+        sections = _sections_of_elements(where, s, materials)
+        z0 = s.get("z0", 0.0)
     elements = []
-    for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
-        ew = f"{where}.elements[{j}]"
-        checks.keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o", "material"})
-        mat = _material(f"{ew}.material", e["material"], materials)
-        for _ in range(checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1)):
-            elements.append(_build(ew, ShaftElement, left=node, right=node + 1, L=e["L"], D_o=e["D_o"],
-                                   D_i=e.get("D_i", 0.0), material=mat, shear=e.get("shear", shear),
-                                   element=e.get("element", element),
-                                   rotary_inertia=e.get("rotary_inertia", rotary)))
+    for ew, section in ((sec.pop("where"), sec) for sec in sections):
+        section.pop("z", None)
+        for _ in range(section.pop("count")):
+            elements.append(_build(ew, ShaftElement, left=node, right=node + 1,
+                                   **{k: section.get(k, v) for k, v in defaults.items()},
+                                   **{k: v for k, v in section.items() if k not in defaults}))
             node += 1
     speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0,
-                  z0=s.get("z0", 0.0))
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0)
+
+
+def _sections_of_elements(where: str, s: dict, materials: dict[str, Material]) -> list[dict]:
+    """The ``elements`` list: one section per entry, ``repeat`` elements of length L each."""
+    out = []
+    for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
+        ew = f"{where}.elements[{j}]"
+        checks.keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o"})
+        section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia")
+                   if k in e}
+        out.append(dict(section, where=ew, D_i=e.get("D_i", 0.0), material=_section_material(ew, e, s, where, materials),
+                        count=checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1)))
+    return out
+
+
+def _sections_of_stations(where: str, s: dict, materials: dict[str, Material]) -> list[dict]:
+    """The ``stations`` list (drawings' and ROSS tables' form): station k starts the section to station k + 1 with
+    its D_o, D_i, tapering to D_o_end, D_i_end if given; the last station gives only z, the shaft's end. A section is
+    split into ``n`` equal elements (default 1)."""
+    stations = checks.tables(f"{where}.stations", s["stations"], min_len=2)
+    z = []
+    for k, st in enumerate(stations):
+        if "z" not in st:
+            raise InputError(f"{where}.stations[{k}].z", checks.MISSING, "required")
+        z.append(checks.number(f"{where}.stations[{k}].z", st["z"], "m"))
+    for k in range(1, len(z)):
+        if z[k] <= z[k - 1]:
+            checks.fail(f"{where}.stations[{k}].z", z[k], f"must be > the previous station's z = {z[k - 1]:g}", "m")
+    checks.keys(f"{where}.stations[{len(z) - 1}]", stations[-1], {"z"})  # the shaft's end
+    out = []
+    for k, st in enumerate(stations[:-1]):
+        sw = f"{where}.stations[{k}]"
+        checks.keys(sw, st, _STATION_KEYS, required={"z", "D_o"})
+        n = checks.integer(f"{sw}.n", st.get("n", 1), ge=1)
+        D_o = checks.positive(f"{sw}.D_o", st["D_o"], "m")
+        D_i = checks.non_negative(f"{sw}.D_i", st.get("D_i", 0.0), "m")
+        D_o_end = checks.positive(f"{sw}.D_o_end", st.get("D_o_end", D_o), "m")
+        D_i_end = checks.non_negative(f"{sw}.D_i_end", st.get("D_i_end", D_i), "m")
+        section = dict(where=sw, z=z[k], L=(z[k + 1] - z[k]) / n, count=1,
+                       material=_section_material(sw, st, s, where, materials))
+        section.update({k2: st[k2] for k2 in ("shear", "element", "rotary_inertia") if k2 in st})
+        for i in range(n):  # a taper split along its line
+            out.append(dict(section, D_o=_along(D_o, D_o_end, i / n), D_i=_along(D_i, D_i_end, i / n),
+                            D_o_right=_along(D_o, D_o_end, (i + 1) / n), D_i_right=_along(D_i, D_i_end, (i + 1) / n)))
+    return out
+
+
+def _section_material(here: str, entry: dict, spool: dict, where: str, materials: dict[str, Material]) -> Material:
+    """The entry's ``material``, else the spool's."""
+    if "material" in entry:
+        return _material(f"{here}.material", entry["material"], materials)
+    if "material" in spool:
+        return _material(f"{where}.material", spool["material"], materials)
+    raise InputError(f"{here}.material", checks.MISSING, f"required (or {where}.material for every section)")
+
+
+def _along(left, right, xi: float):
+    """The diameter at ``xi`` of a linear taper from ``left`` to ``right`` (left itself at 0, right itself at 1)."""
+    if xi == 0.0:
+        return left
+    if xi == 1.0:
+        return right
+    return left + (right - left) * xi
 
 
 def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
