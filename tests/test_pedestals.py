@@ -128,3 +128,18 @@ def test_rotor_file_pedestal():
 ])
 def test_rotor_file_bad_pedestals(old, new, message):
     assert_refused(FILE, old, new, message)
+
+
+def test_ross_coaxial_example_gives_its_published_whirl_speeds():
+    """ROSS's coaxial example (``ross.rotor_assembly.coaxrotor_example``), written as the preset ``ross-coaxial``
+    with its pedestals and the bearing linking the shafts, no workaround. ROSS's docstring publishes
+    ``np.round(rotor.run_modal(speed=0).wd[:4]) = [39, 39, 99, 99]`` rad/s; rotorred: 39.053, 39.053, 98.631,
+    98.631."""
+    from rotorred.linear.modal import eigen
+
+    rotor = load_rotor("ross-coaxial")
+    assert [p.node for p in rotor.pedestals] == [18, 19] and {b.link for b in rotor.bearings} == {None, 18, 19}
+    sm = assemble(rotor)
+    lam = eigen(sm.M, sm.damping({"inner": 0.0, "outer": 0.0}), sm.K).eigenvalues
+    wd = np.sort(lam.imag[lam.imag > 0])[:4]
+    assert list(np.round(wd)) == [39.0, 39.0, 99.0, 99.0]

@@ -98,9 +98,9 @@ BAD = [
      "rub[0].clearance = True: must be a finite number >= 0 (m)"),
     ("missing rotor table", "rotor", None, "rotor: missing; required"),
     ("both preset and file", "rotor.file", "x.toml", "rotor = {'preset': 'seed-rig', 'file': 'x.toml'}: must hold "
-     "exactly one of preset (nelson-mcvaugh, seed-rig) or file (a rotor TOML path)"),
+     "exactly one of preset (nelson-mcvaugh, ross-coaxial, seed-rig) or file (a rotor TOML path)"),
     ("unknown preset", "rotor.preset", "jet-engine",
-     "rotor.preset = 'jet-engine': must be one of 'nelson-mcvaugh', 'seed-rig'"),
+     "rotor.preset = 'jet-engine': must be one of 'nelson-mcvaugh', 'ross-coaxial', 'seed-rig'"),
     ("missing rotor file", "rotor", {"file": "/nonexistent/rig.toml"},
      "rotor.file = '/nonexistent/rig.toml': must be an existing rotor TOML file"),
     ("negative Rayleigh damping", "rotor.rayleigh_alpha", -1.0, "rotor.rayleigh_alpha = -1.0: must be >= 0 (1/s)"),

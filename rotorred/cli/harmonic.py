@@ -44,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "frequency; the per-spool phasors are reported, and their 'peak bound' is the sum of "
                     "magnitudes (an upper bound of the two-frequency signal's peak).")
     p.add_argument("rotor", metavar="ROTOR_OR_SCENE",
-                   help="rotor preset (seed-rig, nelson-mcvaugh) or rotor TOML file, or a scene (built-in name "
+                   help="rotor preset (e.g. seed-rig, ross-coaxial) or rotor TOML file, or a scene (built-in name "
                         "or scene TOML file), whose unbalances, speeds, outputs and model are then the defaults")
     p.add_argument("--speeds", default=None,
                    help="reference spool speeds in rpm: START:STOP:N or a comma list "
