@@ -375,3 +375,22 @@ def test_conical_shaft_converges_to_the_limit_of_fine_stepped_meshes(shear, orde
     assert errors[1] < errors[0] and errors[1] < tol16
     if order:
         assert order[0] < math.log2(errors[0] / errors[1]) < order[1]
+
+
+def test_bearing_table_extrapolates_linearly_when_asked():
+    """``extrapolate = "linear"`` (ROSS's behaviour) continues the end segments: a linear table is reproduced beyond
+    both ends; a direct coefficient extrapolated below zero is refused, naming the bearing and the speed."""
+    from rotorred.model.elements import BearingTable
+
+    line = lambda w: 1e6 + 2e4 * w  # noqa: E731
+    speeds = (100.0, 200.0, 300.0)
+    b = BearingTable(node=3, speeds=speeds, k_xx=tuple(line(w) for w in speeds), c_xx=(10.0, 20.0, 30.0),
+                     extrapolate="linear")
+    for w in (0.0, 50.0, 350.0, 1000.0):
+        assert b.at(w).k_xx == pytest.approx(line(w), rel=1e-14)
+    assert BearingTable(node=3, speeds=speeds, k_xx=tuple(line(w) for w in speeds)).at(0.0).k_xx == line(100.0)
+    with pytest.raises(InputError, match=r"^extrapolate = 'linear': gives c_xx = -10 at 0 rad/s for the bearing at "
+                                         r"node 3, below 0"):
+        BearingTable(node=3, speeds=speeds, c_xx=(10.0, 30.0, 40.0), extrapolate="linear").at(0.0)
+    with pytest.raises(InputError, match=r"^extrapolate = 'cubic': must be one of 'hold', 'linear'$"):
+        BearingTable(node=3, speeds=speeds, extrapolate="cubic")

@@ -151,6 +151,8 @@ BAD = [
      "0.0]: must be strictly increasing; entry 0 = 3000 is followed by 0 (rpm)"),
     ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = 1e7\nc_xx = [100.0, -1.0]",
      "bad.toml: bearing[0].c_xx = [100.0, -1.0]: must hold values >= 0 only (N s/m)"),
+    ("k = 1e7\nc = 100.0", "k = 1e7\nextrapolate = \"linear\"",
+     "bad.toml: bearing[0].extrapolate = 'linear': needs speed_rpm: only a table against speed extrapolates"),
     ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_rpm = [0.0, 1.0]\nnode_a = 12",
      "bad.toml: intershaft_bearing[0].speed_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_xx, c_xy, c_yx, "
      "c_yy, k, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b"),
@@ -215,7 +217,9 @@ def test_bearing_table_against_speed():
     text = GOOD.replace("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0, 6000.0]\nk = [1e7, 2e7, 4e7]\n"
                         "c_xx = [100.0, 200.0, 300.0]\nk_xy = 5e5", 1)
     b = rotor_from_toml(text).bearings[0]
-    assert isinstance(b, BearingTable)
+    assert isinstance(b, BearingTable) and b.extrapolate == "hold"
+    linear = rotor_from_toml(text.replace("k_xy = 5e5", 'k_xy = 5e5\nextrapolate = "linear"')).bearings[0]
+    assert linear.at(300 * math.pi).k_xx == pytest.approx(6e7, rel=1e-14) and b.at(300 * math.pi).k_xx == 4e7
     assert b.speeds == pytest.approx((0.0, 100 * math.pi, 200 * math.pi), rel=1e-15)
     assert b.k_xx == b.k_yy == (1e7, 2e7, 4e7) and b.c_xx == (100.0, 200.0, 300.0)
     assert b.k_xy == (5e5,) * 3 and b.c_yy == (0.0,) * 3

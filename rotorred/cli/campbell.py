@@ -156,9 +156,10 @@ def format_critical_speeds(result) -> str:
         f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
         lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "
                      f"{', '.join(str(j) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
-    for node, lo, hi in result.beyond_tables:
+    for node, lo, hi, rule in result.beyond_tables:
+        beyond = "the end values are held" if rule == "hold" else "the end segments are extrapolated linearly"
         lines.append(f"bearing at node {node}: coefficients tabulated for {lo * 30 / math.pi:.6g}-{hi * 30 / math.pi:.6g} "
-                     f"rpm of its spool; the sweep leaves that range, where the end values are held")
+                     f"rpm of its spool; the sweep leaves that range, where {beyond}")
     for c in result.critical_speeds:
         lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")

@@ -193,9 +193,9 @@ class CampbellResult:
         Tracked modes that are rigid-body modes of a free or singly supported spool (most of their
         kinetic energy in the null space of K at the first speed, :func:`rigid_body_share`). No
         critical speed is reported where a mode is rigid at either end of a speed interval.
-    beyond_tables : tuple of (int, float, float)
+    beyond_tables : tuple of (int, float, float, str)
         Speed-dependent bearings (:class:`rotorred.model.elements.BearingTable`) whose table the sweep leaves:
-        (node, the table's lowest and highest speed, rad/s). Outside the table the end values are held.
+        (node, the table's lowest and highest speed (rad/s), its ``extrapolate``: "hold" or "linear").
     """
 
     speeds: np.ndarray
@@ -210,7 +210,7 @@ class CampbellResult:
     rotor_name: str = ""
     rigid_modes: tuple[int, ...] = ()
     stability_changes: tuple[StabilityChange, ...] = ()
-    beyond_tables: tuple[tuple[int, float, float], ...] = ()
+    beyond_tables: tuple[tuple[int, float, float, str], ...] = ()
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -583,13 +583,13 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
                           stability_changes=changes, beyond_tables=_beyond_tables(sm, ratios, Omega))
 
 
-def _beyond_tables(sm, ratios: Mapping[str, float], Omega: np.ndarray) -> tuple[tuple[int, float, float], ...]:
+def _beyond_tables(sm, ratios: Mapping[str, float], Omega: np.ndarray) -> tuple[tuple[int, float, float, str], ...]:
     """The speed-dependent bearings of ``sm`` whose spool's speeds along the sweep leave their table."""
     out = []
     for t in sm.tables:
         spool_speeds = ratios[t.spool] * Omega
         if not (t.table.covers(float(spool_speeds.min())) and t.table.covers(float(spool_speeds.max()))):
-            out.append((t.table.node, t.table.speeds[0], t.table.speeds[-1]))
+            out.append((t.table.node, t.table.speeds[0], t.table.speeds[-1], t.table.extrapolate))
     return tuple(out)
 
 

@@ -488,6 +488,9 @@ class Support:
         return SUPPORT_KINDS[self.kind]
 
 
+#: what a :class:`BearingTable` does outside its speeds
+EXTRAPOLATIONS = ("hold", "linear")
+
 #: the coefficients of a support, in the order of :class:`_Support`'s fields
 COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
 
@@ -498,8 +501,9 @@ class BearingTable:
     (fluid-film bearings, seals).
 
     Between the table's speeds each coefficient is interpolated linearly; outside them it keeps the
-    value of the nearest end (docs/model.md §10: no extrapolation, which can turn a direct
-    coefficient negative). :meth:`at` gives the :class:`Bearing` at one speed.
+    value of the nearest end (``extrapolate = "hold"``, the default: docs/model.md §10), or follows the
+    end segment's line (``"linear"``, what ROSS does; a direct coefficient extrapolated below zero is
+    refused). :meth:`at` gives the :class:`Bearing` at one speed.
 
     Parameters
     ----------
@@ -513,6 +517,8 @@ class BearingTable:
     name : str
     link : int or None
         The pedestal node the bearing joins ``node`` to; None: ground.
+    extrapolate : {"hold", "linear"}
+        Outside the table's speeds: the end values held, or the end segments' lines.
     """
 
     node: int
@@ -527,10 +533,12 @@ class BearingTable:
     c_yx: tuple[float, ...] | float = 0.0
     name: str = ""
     link: int | None = None
+    extrapolate: str = "hold"
 
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
         _check_link(self)
+        _set(self, "extrapolate", checks.choice("extrapolate", self.extrapolate, EXTRAPOLATIONS))
         speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
         _set(self, "speeds", tuple(float(v) for v in speeds))
         for c in COEFFICIENTS:
@@ -544,14 +552,26 @@ class BearingTable:
         _set(self, "name", checks.string("name", self.name))
 
     def at(self, Omega: float) -> Bearing:
-        """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated linearly in speed, held at
-        the table's ends."""
+        """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated linearly in speed; outside the
+        table held at its ends or extrapolated along its end segments (:attr:`extrapolate`)."""
         Omega = checks.non_negative("Omega", Omega, "rad/s")
-        return Bearing(node=self.node, name=self.name, link=self.link,
-                       **{c: float(np.interp(Omega, self.speeds, getattr(self, c))) for c in COEFFICIENTS})
+        values = {c: self._value(c, Omega) for c in COEFFICIENTS}
+        for c in ("k_xx", "k_yy", "c_xx", "c_yy"):
+            if values[c] < 0.0:
+                checks.fail("extrapolate", self.extrapolate, f"gives {c} = {values[c]:.6g} at {Omega:.6g} rad/s for "
+                            f"the bearing at node {self.node}, below 0 (its table covers {self.speeds[0]:.6g}-"
+                            f"{self.speeds[-1]:.6g} rad/s); extend the table or hold its ends (extrapolate = 'hold')")
+        return Bearing(node=self.node, name=self.name, link=self.link, **values)
+
+    def _value(self, c: str, Omega: float) -> float:
+        W, v = self.speeds, getattr(self, c)
+        if self.extrapolate == "linear" and not self.covers(Omega):
+            i = 0 if Omega < W[0] else len(W) - 2  # the end segment on that side
+            return float(v[i] + (v[i + 1] - v[i]) * (Omega - W[i]) / (W[i + 1] - W[i]))
+        return float(np.interp(Omega, W, v))
 
     def covers(self, Omega: float) -> bool:
-        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, the end values are held)."""
+        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies)."""
         return self.speeds[0] <= Omega <= self.speeds[-1]
 
 

@@ -344,12 +344,14 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link"}, required={"node"})
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link", "extrapolate"}, required={"node"})
     if "speed_rpm" not in b:
+        if "extrapolate" in b:
+            checks.fail(f"{where}.extrapolate", b["extrapolate"], "needs speed_rpm: only a table against speed extrapolates")
         return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
     rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
     return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(rpm * math.pi / 30.0),
-                  **_coefficients(where, b, n_speeds=len(rpm)))
+                  extrapolate=b.get("extrapolate", "hold"), **_coefficients(where, b, n_speeds=len(rpm)))
 
 
 def _pedestal(where: str, p: dict) -> Pedestal:
