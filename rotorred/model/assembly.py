@@ -17,6 +17,7 @@ triplets in one pass.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -52,15 +53,16 @@ class TabulatedSupport:
     nominal: Bearing
 
     def on(self, T: np.ndarray) -> TabulatedSupport:
-        """The same bearing in the coordinates ``p`` of ``q = T p`` (a reduced model)."""
-        return TabulatedSupport(self.table, self.spool, self.rows @ T, self.nominal)
+        """The same bearing in the coordinates ``p`` of ``q = T p`` (a reduced model; a column selection for
+        supports)."""
+        return dataclasses.replace(self, rows=self.rows @ T)
 
-    def change(self, speeds: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
-        """(stiffness, damping) at ``speeds`` (rad/s; a spool left out stands still, as in ``gyroscopic``) minus the
-        nominal ones, on the model's coordinates, (n, n) each."""
+    def change(self, speeds: Mapping[str, float], matrix: str) -> np.ndarray:
+        """The bearing's ``matrix`` (``"K"``: stiffness, ``"C"``: damping) at ``speeds`` (rad/s; a spool left out stands
+        still, as in ``gyroscopic``) minus the nominal one, on the model's coordinates, shape (n, n)."""
         b = self.table.at(speeds.get(self.spool, 0.0))
-        dK, dC = b.K - self.nominal.K, b.C - self.nominal.C
-        return self.rows.T @ dK @ self.rows, self.rows.T @ dC @ self.rows
+        delta = getattr(b, matrix) - getattr(self.nominal, matrix)
+        return self.rows.T @ delta @ self.rows
 
 
 class SpoolSpeedMixin:
@@ -94,7 +96,7 @@ class SpoolSpeedMixin:
             return self.C
         out = self.C.copy()
         for t in self.tables:
-            out += t.change(speeds)[1]
+            out += t.change(speeds, "C")
         return out
 
     def stiffness(self, speeds: Mapping[str, float]) -> np.ndarray:
@@ -104,7 +106,7 @@ class SpoolSpeedMixin:
         checks.keys("speeds", speeds, self.G)
         out = self.K.copy()
         for t in self.tables:
-            out += t.change(speeds)[0]
+            out += t.change(speeds, "K")
         return out
 
     @property
@@ -290,5 +292,5 @@ def _supported(system: SystemMatrices, supports) -> SystemMatrices:
     e_y = system.output_rows([(n, "y") for n in system.dofs.nodes]).sum(axis=0)  # every node moves 1 in y
     return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
                           dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
-                          tables=tuple(TabulatedSupport(t.table, t.spool, t.rows[:, keep], t.nominal)
-                                       for t in system.tables), supported_weight=(system.M @ e_y)[keep])
+                          tables=tuple(dataclasses.replace(t, rows=t.rows[:, keep]) for t in system.tables),
+                          supported_weight=(system.M @ e_y)[keep])

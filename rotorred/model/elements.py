@@ -308,14 +308,19 @@ class ShaftElement:
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line."""
         chain = [self.left, *new_nodes, self.right]
+        return [ShaftElement(chain[i], chain[i + 1], self.L / n, along(self.D_o, self.D_o_right, i / n),
+                             along(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
+                             self.rotary_inertia, along(self.D_o, self.D_o_right, (i + 1) / n),
+                             along(self.D_i, self.D_i_right, (i + 1) / n)) for i in range(n)]
 
-        def at(d_left, d_right, xi):
-            return d_left + (d_right - d_left) * xi
 
-        return [ShaftElement(chain[i], chain[i + 1], self.L / n, at(self.D_o, self.D_o_right, i / n),
-                             at(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
-                             self.rotary_inertia, at(self.D_o, self.D_o_right, (i + 1) / n),
-                             at(self.D_i, self.D_i_right, (i + 1) / n)) for i in range(n)]
+def along(left: float, right: float, xi: float) -> float:
+    """The diameter at ``xi`` (0..1) of a linear taper from ``left`` to ``right`` (m), the ends exactly."""
+    if xi == 0.0:
+        return left
+    if xi == 1.0:
+        return right
+    return left + (right - left) * xi
 
 
 @dataclass(frozen=True)

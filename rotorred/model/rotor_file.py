@@ -245,11 +245,13 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
     elements = []
     for ew, section in ((sec.pop("where"), sec) for sec in sections):
         section.pop("z", None)
-        for _ in range(section.pop("count")):
-            elements.append(_build(ew, ShaftElement, left=node, right=node + 1,
-                                   **{k: section.get(k, v) for k, v in defaults.items()},
-                                   **{k: v for k, v in section.items() if k not in defaults}))
-            node += 1
+        count, n = section.pop("count"), section.pop("split")
+        for _ in range(count):  # each repeat one element, split into n along its taper
+            whole = _build(ew, ShaftElement, left=node, right=node + n,
+                           **{k: section.get(k, v) for k, v in defaults.items()},
+                           **{k: v for k, v in section.items() if k not in defaults})
+            elements.extend(whole.split(n, list(range(node + 1, node + n))))
+            node += n
     speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
     return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0)
 
@@ -263,7 +265,7 @@ def _sections_of_elements(where: str, s: dict, materials: dict[str, Material]) -
         section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia")
                    if k in e}
         out.append(dict(section, where=ew, D_i=e.get("D_i", 0.0), material=_section_material(ew, e, s, where, materials),
-                        count=checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1)))
+                        count=checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1), split=1))
     return out
 
 
@@ -290,12 +292,9 @@ def _sections_of_stations(where: str, s: dict, materials: dict[str, Material]) -
         D_i = checks.non_negative(f"{sw}.D_i", st.get("D_i", 0.0), "m")
         D_o_end = checks.positive(f"{sw}.D_o_end", st.get("D_o_end", D_o), "m")
         D_i_end = checks.non_negative(f"{sw}.D_i_end", st.get("D_i_end", D_i), "m")
-        section = dict(where=sw, z=z[k], L=(z[k + 1] - z[k]) / n, count=1,
-                       material=_section_material(sw, st, s, where, materials))
-        section.update({k2: st[k2] for k2 in ("shear", "element", "rotary_inertia") if k2 in st})
-        for i in range(n):  # a taper split along its line
-            out.append(dict(section, D_o=_along(D_o, D_o_end, i / n), D_i=_along(D_i, D_i_end, i / n),
-                            D_o_right=_along(D_o, D_o_end, (i + 1) / n), D_i_right=_along(D_i, D_i_end, (i + 1) / n)))
+        section = dict(where=sw, z=z[k], L=z[k + 1] - z[k], D_o=D_o, D_i=D_i, D_o_right=D_o_end, D_i_right=D_i_end,
+                       count=1, split=n, material=_section_material(sw, st, s, where, materials))
+        out.append(dict(section, **{k2: st[k2] for k2 in ("shear", "element", "rotary_inertia") if k2 in st}))
     return out
 
 
@@ -306,15 +305,6 @@ def _section_material(here: str, entry: dict, spool: dict, where: str, materials
     if "material" in spool:
         return _material(f"{where}.material", spool["material"], materials)
     raise InputError(f"{here}.material", checks.MISSING, f"required (or {where}.material for every section)")
-
-
-def _along(left, right, xi: float):
-    """The diameter at ``xi`` of a linear taper from ``left`` to ``right`` (left itself at 0, right itself at 1)."""
-    if xi == 0.0:
-        return left
-    if xi == 1.0:
-        return right
-    return left + (right - left) * xi
 
 
 def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:

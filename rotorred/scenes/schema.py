@@ -83,6 +83,8 @@ _OUTPUT_KEYS = {"nodes", "directions", "plots", "formats", "plot_window", "table
                 "compare_normal"}
 #: relative tolerance of the record-window tests (whole number of steps, of common periods)
 _RTOL = 1e-9
+
+
 def is_whole_steps(t: float, dt: float) -> bool:
     """Whether the time ``t`` (s) is a whole number of steps of ``dt`` (s), up to the relative rounding ``_RTOL``
     (the rule of a scene's ``record_start`` and ``duration``)."""

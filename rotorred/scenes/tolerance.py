@@ -123,7 +123,8 @@ def choose(scene: Scene) -> Settings:
     t0 = time.perf_counter()
     band = band_hz(scene)
     system = assemble(scene.rotor)
-    eigenvalues = eigen(system.M, system.damping(scene.speeds), system.stiffness(scene.speeds)).eigenvalues  # once: band and window
+    # the full model's eigenvalues, once: for the band and for the window
+    eigenvalues = eigen(system.M, system.damping(scene.speeds), system.stiffness(scene.speeds)).eigenvalues
     omega = band_frequencies(system, scene.speeds, band, eigenvalues=eigenvalues)
     inputs = input_dofs(scene)
     model, solver, model_choices, e_model = _choose_model(scene, system, tol, omega)
