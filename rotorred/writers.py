@@ -1,4 +1,4 @@
-"""One writer per output format: CSV, NPZ, MATLAB .mat, NetCDF and text.
+"""One writer per output format: CSV, NPZ, MATLAB .mat, NetCDF, TOML and text.
 
 Every file rotorred writes goes through this module. Each writer writes to a temporary file
 beside the target and renames it into place (``os.replace``), so a reader never sees a
@@ -6,12 +6,16 @@ half-written file, and an interrupted write leaves the earlier file (or none) be
 
 CSV: a header row, then one row per sample; floats with ``digits`` significant digits,
 integers and strings as they are. Units belong in the header (``"amplitude (um)"``).
+
+TOML (rotor files written by ``rotorred convert``): floats with ``repr``, so a file read back holds
+the same numbers to the last bit.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 import tempfile
 from collections.abc import Mapping, Sequence
@@ -20,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "atomic_path", "render_table", "OutputFolder",
+__all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "write_toml", "toml_text", "atomic_path",
+           "render_table", "OutputFolder",
            "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
 
 
@@ -138,6 +143,74 @@ def write_text(path: str | Path, text: str) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return path
+
+
+def write_toml(path: str | Path, document: Mapping, header: str = "") -> Path:
+    """Write a TOML document (:func:`toml_text`), ``header`` as comment lines on top."""
+    comments = "".join(f"# {line}".rstrip() + "\n" for line in header.splitlines())
+    return write_text(path, comments + ("\n" if comments else "") + toml_text(document))
+
+
+def toml_text(document: Mapping) -> str:
+    """A TOML text of ``document``: its plain keys first, then a ``[name]`` block per table and a ``[[name]]`` block
+    per item of an array of tables; tables inside those are inline, an array of them one a line. Floats are
+    written with ``repr``, so reading the text back gives the same numbers to the last bit."""
+    plain = {k: v for k, v in document.items() if not _is_table(v) and not _is_tables(v)}
+    blocks = [_toml_lines(plain)] if plain else []
+    for key, value in document.items():
+        if _is_table(value):
+            blocks.append(f"[{_toml_key(key)}]\n" + _toml_lines(value))
+        elif _is_tables(value):
+            blocks.extend(f"[[{_toml_key(key)}]]\n" + _toml_lines(item) for item in value)
+    return "\n".join(blocks)
+
+
+def _is_table(value) -> bool:
+    return isinstance(value, Mapping)
+
+
+def _is_tables(value) -> bool:
+    return isinstance(value, (list, tuple)) and len(value) > 0 and all(isinstance(v, Mapping) for v in value)
+
+
+def _toml_lines(table: Mapping) -> str:
+    lines = []
+    for key, value in table.items():
+        if _is_tables(value):  # an array of inline tables, one a line
+            items = "".join(f"  {_toml_value(v)},\n" for v in value)
+            lines.append(f"{_toml_key(key)} = [\n{items}]")
+        else:
+            lines.append(f"{_toml_key(key)} = {_toml_value(value)}")
+    return "".join(line + "\n" for line in lines)
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() and key.isascii() else _toml_string(key)
+
+
+def _toml_string(text: str) -> str:
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    return f'"{escaped}"'
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ValueError(f"TOML value {value!r}: must be finite")
+        return repr(value)
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, Mapping):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"TOML value {value!r}: a {type(value).__name__} has no TOML form")
 
 
 def render_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

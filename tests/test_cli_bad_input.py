@@ -27,7 +27,7 @@ R = {
     "L_neg": ("L = 0.08", "L = -0.08"), "repeat0": ("repeat = 12", "repeat = 0"),
     "brass": ('material = "steel", repeat = 6', 'material = "brass", repeat = 6'),
     "first_node": ("first_node = 1", "first_node = -1"), "disk_node": ("node = 3", "node = 99"),
-    "thickness": ("thickness = 0.015", "thickness = -0.015"), "k_neg": ("k = 2.0e7", "k = -1.0"),
+    "thickness": ("thickness = 0.015", "thickness = -0.015"), "c_neg": ("c = 1000.0", "c = -1.0"),
     "rpm_str": ("speed_rpm = 4200.0", 'speed_rpm = "fast"'),
     "shear": ('name = "inner"', 'name = "inner"\nshear = "bogus"'),
     "huge": ("repeat = 6 }", "repeat = 100000 }"),
@@ -56,7 +56,7 @@ CASES = [
     (["campbell", "{d}/r_rho_tiny.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material[0].rho", "1e-300"]),
     (["campbell", "{d}/r_brass.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["material", "brass"]),
     (["campbell", "{d}/r_huge.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["ROTOR", "DOFs", "--force"]),
-    (["harmonic", "{d}/r_k_neg.toml", "--out", "{d}/o"], ["r_k_neg.toml", "k", "-1.0"]),
+    (["harmonic", "{d}/r_c_neg.toml", "--out", "{d}/o"], ["r_c_neg.toml", "c", "-1.0"]),  # k < 0: a seal's
     (["campbell", "{d}/missing.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["missing.toml"]),
     # a binary or Latin-1 file, and a key given twice (reliability findings, section 9)
     (["campbell", "{d}/binary.toml", "--speeds", "0:6000:3", "--out", "{d}/o"], ["binary.toml", "UTF-8"]),

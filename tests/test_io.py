@@ -131,7 +131,7 @@ BAD = [
      "bad.toml: spool[0].elements[0].material = 'titanium': must be one of 'steel'"),
     ("k = 1e7\nc = 100.0", "k = 1e7\nk_xx = 2e7",
      "bad.toml: bearing[0].k_xx = 20000000.0: must not be given with k: give k (isotropic) or k_xx, k_yy"),
-    ("k = 1e7\nc = 100.0", "k = -1e7", "bad.toml: bearing[0].k = -10000000.0: must be >= 0 (N/m)"),
+    ("k = 1e7\nc = 100.0", "k = 1e7\nc = -100.0", "bad.toml: bearing[0].c = -100.0: must be >= 0 (N s/m)"),
     ("speed_rpm = 4200.0", "speed_rpm = -10.0", "bad.toml: spool[0].speed_rpm = -10.0: must be >= 0 (rpm)"),
     ("first_node = 10", "first_node = 3",
      "bad.toml: spool[1].nodes = (3, 4, 5): must not include node 3, which belongs to spool 'inner'"),
@@ -152,7 +152,10 @@ BAD = [
     ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = 1e7\nc_xx = [100.0, -1.0]",
      "bad.toml: bearing[0].c_xx = [100.0, -1.0]: must hold values >= 0 only (N s/m)"),
     ("k = 1e7\nc = 100.0", "k = 1e7\nextrapolate = \"linear\"",
-     "bad.toml: bearing[0].extrapolate = 'linear': needs speed_rpm: only a table against speed extrapolates"),
+     "bad.toml: bearing[0].extrapolate = 'linear': needs speed_rpm: only a table against speed interpolates and "
+     "extrapolates"),
+    ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = 1e7\ninterpolation = \"cubic\"",
+     "bad.toml: bearing[0].interpolation = 'cubic': must be one of 'linear', 'pchip'"),
     ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_rpm = [0.0, 1.0]\nnode_a = 12",
      "bad.toml: intershaft_bearing[0].speed_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_xx, c_xy, c_yx, "
      "c_yy, k, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b"),

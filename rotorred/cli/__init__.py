@@ -24,6 +24,7 @@ from pathlib import Path
 #: command modules, in the order ``rotorred --help`` lists them
 COMMANDS = [
     "campbell",
+    "convert",
     "harmonic",
     "map",
     "run",

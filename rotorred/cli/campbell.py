@@ -137,7 +137,7 @@ def format_whirl_table(result, i: int = 0) -> str:
     for j in range(result.n_modes):
         lines.append(f"{j:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
                      f"{result.damping_ratio[i, j]:14.6f} {result.log_dec[i, j]:10.5f}")
-    return "\n".join(lines)
+    return "\n".join(lines + _beyond_tables(result))
 
 
 def format_critical_speeds(result) -> str:
@@ -156,11 +156,17 @@ def format_critical_speeds(result) -> str:
         f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
         lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "
                      f"{', '.join(str(j) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
-    for node, lo, hi, rule in result.beyond_tables:
-        beyond = "the end values are held" if rule == "hold" else "the end segments are extrapolated linearly"
-        lines.append(f"bearing at node {node}: coefficients tabulated for {lo * 30 / math.pi:.6g}-{hi * 30 / math.pi:.6g} "
-                     f"rpm of its spool; the sweep leaves that range, where {beyond}")
     for c in result.critical_speeds:
         lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")
-    return "\n".join(lines)
+    return "\n".join(lines + _beyond_tables(result))
+
+
+def _beyond_tables(result) -> list[str]:
+    """A line for each bearing table the speeds leave, with the rule that applies there."""
+    lines = []
+    for node, lo, hi, rule in result.beyond_tables:
+        beyond = "the end values are held" if rule == "hold" else "the coefficients follow their end tangents (linear)"
+        lines.append(f"bearing at node {node}: coefficients tabulated for {lo * 30 / math.pi:.6g}-{hi * 30 / math.pi:.6g} "
+                     f"rpm of its spool; the speeds leave that range, where {beyond}")
+    return lines

@@ -47,7 +47,7 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
 #: eigenvalues with a damping ratio -Re(lambda)/|lambda| at or above this are not whirl modes: an
 #: overdamped pair (mass-proportional Rayleigh damping makes the rig's lowest shaft modes so) splits by
 #: round-off into a complex pair of tiny imaginary part that would read as a mode at ~0 Hz
-WHIRL_MAX_DAMPING_RATIO = 0.5
+WHIRL_MAX_DAMPING_RATIO = 0.99
 
 
 def eigen(M: np.ndarray, D: np.ndarray, K: np.ndarray, n_modes: int | None = None,

@@ -212,7 +212,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     -------
     SystemMatrices
     """
-    n_internal = sum(e.n_internal for s in rotor.spools for e in s.elements)
+    n_internal = sum(e.n_internal for s in rotor.spools for e in s.all_elements)
     dofs = DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals))
     n = dofs.n_dof
     next_internal = n - n_internal
@@ -220,7 +220,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     G = {s.name: _Triplets() for s in rotor.spools}
     K_G = {s.name: _Triplets() for s in rotor.spools}
     for s in rotor.spools:
-        for e in s.elements:
+        for e in s.all_elements:
             internal = np.arange(next_internal, next_internal + e.n_internal)
             next_internal += e.n_internal
             idx = np.concatenate([dofs.node_dofs(e.left), dofs.node_dofs(e.right), internal])

@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from rotorred import checks
 from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_translational
@@ -384,8 +385,7 @@ class _Support:
     def _validate(self):
         for c in COEFFICIENTS:
             unit = "N/m" if c[0] == "k" else "N s/m"
-            direct = c[-1] == c[-2]  # direct terms are >= 0, cross-coupled terms any sign
-            _set(self, c, checks.number(c, getattr(self, c), unit, ge=0.0 if direct else None))
+            _set(self, c, checks.number(c, getattr(self, c), unit, ge=_least(c)))
         _set(self, "name", checks.string("name", self.name))
 
     @property
@@ -407,9 +407,10 @@ class Bearing(_Support):
     ----------
     node : int
     k_xx, k_yy, k_xy, k_yx : float
-        Stiffness coefficients (N/m); the force on the shaft is -K [x, y] (-K [x - x_link, y - y_link] with a link).
+        Stiffness coefficients (N/m), any sign (a seal's direct stiffness may be negative); the force on the shaft is
+        -K [x, y] (-K [x - x_link, y - y_link] with a link).
     c_xx, c_yy, c_xy, c_yx : float
-        Damping coefficients (N s/m).
+        Damping coefficients (N s/m); the direct ones (c_xx, c_yy) >= 0.
     name : str
     link : int or None
         The pedestal node (:class:`Pedestal`) the bearing joins ``node`` to; None: ground.
@@ -495,9 +496,19 @@ class Support:
 
 #: what a :class:`BearingTable` does outside its speeds
 EXTRAPOLATIONS = ("hold", "linear")
+#: how a :class:`BearingTable` interpolates between its speeds
+INTERPOLATIONS = ("linear", "pchip")
 
 #: the coefficients of a support, in the order of :class:`_Support`'s fields
 COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
+#: the coefficients that must be >= 0: a passive support's direct damping. Direct stiffness may be negative (annular
+#: and labyrinth seals have it: Childs 1993, Turbomachinery Rotordynamics, ch. 4), cross-coupled terms have any sign.
+DIRECT_DAMPING = ("c_xx", "c_yy")
+
+
+def _least(c: str) -> float | None:
+    """The lower bound of coefficient ``c``: 0 for direct damping, none for the others."""
+    return 0.0 if c in DIRECT_DAMPING else None
 
 
 @dataclass(frozen=True)
@@ -505,10 +516,12 @@ class BearingTable:
     """Bearing from a node to ground whose coefficients are tabulated against the speed of the node's spool
     (fluid-film bearings, seals).
 
-    Between the table's speeds each coefficient is interpolated linearly; outside them it keeps the
-    value of the nearest end (``extrapolate = "hold"``, the default: docs/model.md §10), or follows the
-    end segment's line (``"linear"``, what ROSS does; a direct coefficient extrapolated below zero is
-    refused). :meth:`at` gives the :class:`Bearing` at one speed.
+    Between the table's speeds each coefficient is interpolated linearly (``interpolation = "linear"``,
+    the default) or by the shape-preserving piecewise cubic Hermite interpolant (``"pchip"``, Fritsch &
+    Carlson; ROSS 3's default): neither overshoots the tabulated values. Outside them it keeps the value
+    of the nearest end (``extrapolate = "hold"``, the default: docs/model.md §10), or follows the
+    interpolant's tangent line at that end (``"linear"``, what ROSS does; a direct damping coefficient
+    extrapolated below zero is refused). :meth:`at` gives the :class:`Bearing` at one speed.
 
     Parameters
     ----------
@@ -516,14 +529,19 @@ class BearingTable:
     speeds : sequence of float, shape (p,)
         Spool speeds of the table (rad/s), >= 0 and strictly increasing, at least 2.
     k_xx, k_yy, k_xy, k_yx : float or sequence of float, shape (p,)
-        Stiffness (N/m) at each speed; a single number holds at every speed; left out: 0.
+        Stiffness (N/m) at each speed, any sign (a seal's direct stiffness may be negative); a single number holds
+        at every speed; left out: 0.
     c_xx, c_yy, c_xy, c_yx : float or sequence of float, shape (p,)
-        Damping (N s/m), the same way.
+        Damping (N s/m), the same way; the direct terms >= 0.
     name : str
     link : int or None
         The pedestal node the bearing joins ``node`` to; None: ground.
     extrapolate : {"hold", "linear"}
-        Outside the table's speeds: the end values held, or the end segments' lines.
+        Outside the table's speeds: the end values held, or the interpolant's tangent lines at the ends (the end
+        segments with linear interpolation).
+    interpolation : {"linear", "pchip"}
+        Between the table's speeds: straight segments, or scipy's ``PchipInterpolator`` (C1, monotone between
+        monotone data; with 2 speeds it is the straight line).
     """
 
     node: int
@@ -539,29 +557,33 @@ class BearingTable:
     name: str = ""
     link: int | None = None
     extrapolate: str = "hold"
+    interpolation: str = "linear"
 
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
         _check_link(self)
         _set(self, "extrapolate", checks.choice("extrapolate", self.extrapolate, EXTRAPOLATIONS))
+        _set(self, "interpolation", checks.choice("interpolation", self.interpolation, INTERPOLATIONS))
         speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
         _set(self, "speeds", tuple(float(v) for v in speeds))
         for c in COEFFICIENTS:
             unit = "N/m" if c[0] == "k" else "N s/m"
-            ge = 0.0 if c[-1] == c[-2] else None  # direct terms are >= 0, cross-coupled terms any sign
+            ge = _least(c)
             value = getattr(self, c)
             if np.ndim(value) == 0:
                 value = [checks.number(c, value, unit, ge=ge)] * len(speeds)
             column = checks.vector(c, value, unit, min_len=len(speeds), max_len=len(speeds), ge=ge)
             _set(self, c, tuple(float(v) for v in column))
         _set(self, "name", checks.string("name", self.name))
+        if self.interpolation == "pchip" and len(speeds) > 2:
+            _set(self, "_curves", {c: _pchip(speeds, getattr(self, c)) for c in COEFFICIENTS})
 
     def at(self, Omega: float) -> Bearing:
-        """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated linearly in speed; outside the
-        table held at its ends or extrapolated along its end segments (:attr:`extrapolate`)."""
+        """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated in speed (:attr:`interpolation`);
+        outside the table held at its ends or extrapolated along the interpolant's end tangents (:attr:`extrapolate`)."""
         Omega = checks.non_negative("Omega", Omega, "rad/s")
         values = {c: self._value(c, Omega) for c in COEFFICIENTS}
-        for c in ("k_xx", "k_yy", "c_xx", "c_yy"):
+        for c in DIRECT_DAMPING:
             if values[c] < 0.0:
                 checks.fail("extrapolate", self.extrapolate, f"gives {c} = {values[c]:.6g} at {Omega:.6g} rad/s for "
                             f"the bearing at node {self.node}, below 0 (its table covers {self.speeds[0]:.6g}-"
@@ -570,14 +592,29 @@ class BearingTable:
 
     def _value(self, c: str, Omega: float) -> float:
         W, v = self.speeds, getattr(self, c)
-        if self.extrapolate == "linear" and not self.covers(Omega):
-            i = 0 if Omega < W[0] else len(W) - 2  # the end segment on that side
-            return float(v[i] + (v[i + 1] - v[i]) * (Omega - W[i]) / (W[i + 1] - W[i]))
-        return float(np.interp(Omega, W, v))
+        curves = getattr(self, "_curves", None)
+        end = 0 if Omega < W[0] else -1  # the table's end on Omega's side, where it lies outside the table
+        if curves is None:  # straight segments
+            if self.extrapolate == "linear" and not self.covers(Omega):
+                i = 0 if end == 0 else len(W) - 2  # the end segment on that side
+                return float(v[i] + (v[i + 1] - v[i]) * (Omega - W[i]) / (W[i + 1] - W[i]))
+            return float(np.interp(Omega, W, v))
+        value, slope = curves[c]
+        if self.covers(Omega):
+            return float(value(Omega))
+        tangent = slope[end] if self.extrapolate == "linear" else 0.0
+        return float(v[end] + tangent * (Omega - W[end]))
 
     def covers(self, Omega: float) -> bool:
         """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies)."""
         return self.speeds[0] <= Omega <= self.speeds[-1]
+
+
+def _pchip(speeds: np.ndarray, values: tuple[float, ...]):
+    """The shape-preserving cubic through ``(speeds, values)`` and its slopes at the two ends."""
+    curve = PchipInterpolator(speeds, values, extrapolate=False)
+    d = curve.derivative()
+    return curve, (float(d(speeds[0])), float(d(speeds[-1])))
 
 
 @dataclass(frozen=True)

@@ -99,12 +99,17 @@ class Spool:
         Nominal operating speed (rad/s), >= 0.
     z0 : float
         Axial position of the first node (m).
+    sleeves : tuple of ShaftElement, optional
+        Concentric elements over spans of the chain (a sleeve shrunk on the shaft, ROSS's layered
+        elements): each joins the two nodes of an element of the chain, has its length, and adds its
+        matrices to that element's (the two act in parallel). They add no node.
     """
 
     name: str
     elements: tuple[ShaftElement, ...]
     speed: float = 0.0
     z0: float = 0.0
+    sleeves: tuple[ShaftElement, ...] = ()
 
     def __post_init__(self):
         checks.string("name", self.name, empty=False)
@@ -121,6 +126,25 @@ class Spool:
             seen.add(e.right)
         object.__setattr__(self, "speed", checks.non_negative("speed", self.speed, "rad/s"))
         object.__setattr__(self, "z0", checks.number("z0", self.z0, "m"))
+        object.__setattr__(self, "sleeves", checks.sequence("sleeves", _tuple(self.sleeves), _shaft_element))
+        self._check_sleeves()
+
+    def _check_sleeves(self) -> None:
+        """Each sleeve lies on an element of the chain: the same two nodes and the same length."""
+        spans = {(e.left, e.right): e for e in self.elements}
+        for i, sleeve in enumerate(self.sleeves):
+            under = spans.get((sleeve.left, sleeve.right))
+            if under is None:
+                checks.fail(f"sleeves[{i}].left", sleeve.left, f"must be the left node of an element of the chain, "
+                            f"with right = {sleeve.right} its right node: a sleeve lies on one element")
+            if abs(sleeve.L - under.L) > 1e-9 * under.L:
+                checks.fail(f"sleeves[{i}].L", sleeve.L, f"must equal the length {under.L!r} of the element "
+                            f"{sleeve.left}-{sleeve.right} it lies on", "m")
+
+    @property
+    def all_elements(self) -> tuple[ShaftElement, ...]:
+        """The chain's elements and the sleeves on them: every element the assembly adds."""
+        return self.elements + self.sleeves
 
     @property
     def nodes(self) -> tuple[int, ...]:
@@ -296,7 +320,7 @@ class Rotor:
     @property
     def mass(self) -> float:
         """Total mass of shafts and disks (kg)."""
-        return sum(e.mass for s in self.spools for e in s.elements) + sum(d.m for d in self.disks)
+        return sum(e.mass for s in self.spools for e in s.all_elements) + sum(d.m for d in self.disks)
 
     # --- derived models -------------------------------------------------------------
     def refined(self, n: int) -> Rotor:
@@ -311,12 +335,13 @@ class Rotor:
         next_node = max(self.all_nodes) + 1
         spools = []
         for s in self.spools:
-            elements = []
+            elements, new_nodes = [], {}
             for e in s.elements:
-                new = list(range(next_node, next_node + n - 1))
+                new = new_nodes[e.left, e.right] = list(range(next_node, next_node + n - 1))
                 next_node += n - 1
                 elements.extend(e.split(n, new))
-            spools.append(dataclasses.replace(s, elements=tuple(elements)))
+            sleeves = [part for e in s.sleeves for part in e.split(n, new_nodes[e.left, e.right])]
+            spools.append(dataclasses.replace(s, elements=tuple(elements), sleeves=tuple(sleeves)))
         return dataclasses.replace(self, spools=tuple(spools), name=f"{self.name} refined({n})")
 
     def with_speeds(self, speeds: Mapping[str, float]) -> Rotor:

@@ -48,6 +48,7 @@ from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
                                      Material, Pedestal, ShaftElement, Support)
 from rotorred.model.loads import unbalance_from_table
+from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 
 try:  # Python >= 3.11
@@ -55,19 +56,21 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["RotorFileError", "presets", "load_rotor", "rotor_from_toml", "rotor_from_dict", "read_toml"]
+__all__ = ["RotorFileError", "presets", "load_rotor", "rotor_document", "rotor_from_toml", "rotor_from_dict", "read_toml"]
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements", "stations",
-               "material"}
+               "material", "sleeves"}
+_SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
 _STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
 _ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
 _SUPPORT_NODE_KEYS = {"node", "kind", "name"}
+_TABLE_KEYS = {"extrapolate", "interpolation"}  # a bearing table's rules, with speed_rpm only
 _DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
 #: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
 _FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing",
@@ -109,7 +112,23 @@ def load_rotor(spec: str | Path) -> Rotor:
     path = Path(spec)
     if not path.exists():
         raise FileNotFoundError(f"rotor {spec_str!r} is neither a preset ({', '.join(presets())}) nor an existing file")
-    return rotor_from_toml(read_text_file(path, RotorFileError), source=str(path))
+    return rotor_from_toml(read_text_file(path, RotorFileError), source=str(path), name=path.stem)
+
+
+def rotor_document(text: str, source: str = "<string>", name: str = "ross-rotor") -> dict[str, Any]:
+    """The rotor-file document of a TOML text: a rotorred rotor file as parsed, a rotor saved by ROSS 3 converted
+    (:func:`rotorred.model.ross_file.ross_document`, named ``name``).
+
+    Raises
+    ------
+    RotorFileError
+        For text that is not TOML, or a ROSS rotor rotorred cannot represent, naming ``source`` and the key.
+    """
+    try:
+        data = read_toml(text, RotorFileError)
+        return ross_document(data, name) if is_ross_document(data) else data
+    except InputError as exc:
+        raise RotorFileError(exc.field, exc.value, exc.requirement, exc.unit).from_source(source) from None
 
 
 def read_text_file(path: Path, error: type[InputError] = InputError) -> str:
@@ -141,16 +160,18 @@ def read_toml(text: str, error: type[InputError] = InputError) -> dict[str, Any]
         raise error(f"line {line}", value, f"must be valid TOML: {reason[:at.start()]} at column {column}") from None
 
 
-def rotor_from_toml(text: str, source: str = "<string>") -> Rotor:
-    """Parse and validate a rotor TOML document; see the module docstring for the format.
+def rotor_from_toml(text: str, source: str = "<string>", name: str = "ross-rotor") -> Rotor:
+    """Parse and validate a rotor TOML document; see the module docstring for the format. A rotor saved by ROSS 3
+    is read too (:func:`rotor_document`), and named ``name``.
 
     Raises
     ------
     RotorFileError
         Naming ``source``, the key path, the value and what is allowed.
     """
+    document = rotor_document(text, source, name)
     try:
-        return rotor_from_dict(read_toml(text, RotorFileError))
+        return rotor_from_dict(document)
     except RotorFileError as exc:
         raise exc.from_source(source) from None
 
@@ -253,7 +274,33 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
             elements.extend(whole.split(n, list(range(node + 1, node + n))))
             node += n
     speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0)
+    sleeves = _sleeves(where, s, elements, defaults, materials)
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0,
+                  sleeves=sleeves)
+
+
+def _sleeves(where: str, s: dict, chain: list[ShaftElement], defaults: dict, materials: dict[str, Material]):
+    """The ``sleeves`` list: each entry lies on ``repeat`` consecutive elements of the chain from node ``left``,
+    with their lengths."""
+    starting = {e.left: k for k, e in enumerate(chain)}
+    out = []
+    for j, entry in enumerate(checks.tables(f"{where}.sleeves", s.get("sleeves", []))):
+        sw = f"{where}.sleeves[{j}]"
+        checks.keys(sw, entry, _SLEEVE_KEYS, required={"left", "D_o"})
+        first = starting.get(checks.integer(f"{sw}.left", entry["left"], ge=0))
+        if first is None:
+            checks.fail(f"{sw}.left", entry["left"], f"must be the left node of an element of the spool "
+                        f"({checks.ranges_text(starting)})")
+        repeat = checks.integer(f"{sw}.repeat", entry.get("repeat", 1), ge=1)
+        if first + repeat > len(chain):
+            checks.fail(f"{sw}.repeat", repeat, f"must be <= {len(chain) - first}, the elements from node "
+                        f"{entry['left']} to the spool's end")
+        section = {"D_i": 0.0, **{k: entry[k] for k in ("D_o", "D_i", "D_o_right", "D_i_right") if k in entry}}
+        material = _section_material(sw, entry, s, where, materials)
+        options = {k: entry.get(k, v) for k, v in defaults.items()}
+        out.extend(_build(sw, ShaftElement, left=e.left, right=e.right, L=e.L, material=material,
+                          **section, **options) for e in chain[first:first + repeat])
+    return tuple(out)
 
 
 def _sections_of_elements(where: str, s: dict, materials: dict[str, Material]) -> list[dict]:
@@ -334,14 +381,15 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link", "extrapolate"}, required={"node"})
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link"} | _TABLE_KEYS, required={"node"})
     if "speed_rpm" not in b:
-        if "extrapolate" in b:
-            checks.fail(f"{where}.extrapolate", b["extrapolate"], "needs speed_rpm: only a table against speed extrapolates")
+        for key in sorted(_TABLE_KEYS & set(b)):
+            checks.fail(f"{where}.{key}", b[key], "needs speed_rpm: only a table against speed interpolates and "
+                        "extrapolates")
         return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
     rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
     return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(rpm * math.pi / 30.0),
-                  extrapolate=b.get("extrapolate", "hold"), **_coefficients(where, b, n_speeds=len(rpm)))
+                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(rpm)))
 
 
 def _pedestal(where: str, p: dict) -> Pedestal:
@@ -369,11 +417,12 @@ def _coefficients(where: str, b: dict, n_speeds: int = 0) -> dict[str, Any]:
                 if direct in b:
                     checks.fail(f"{where}.{direct}", b[direct], f"must not be given with {kind}: "
                                 f"give {kind} (isotropic) or {kind}_xx, {kind}_yy")
+            ge = 0.0 if kind == "c" else None  # direct damping >= 0; direct stiffness any sign (seals)
             if n_speeds and isinstance(b[kind], (list, tuple)):
                 value = tuple(checks.vector(f"{where}.{kind}", b[kind], unit, min_len=n_speeds, max_len=n_speeds,
-                                            ge=0.0))
+                                            ge=ge))
             else:
-                value = checks.non_negative(f"{where}.{kind}", b[kind], unit)
+                value = checks.number(f"{where}.{kind}", b[kind], unit, ge=ge)
             out[f"{kind}_xx"] = out[f"{kind}_yy"] = value
     return out
 

@@ -1,0 +1,70 @@
+"""``rotorred convert ROSS_FILE OUT``: a rotor saved by ROSS 3 written as a rotorred rotor file."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from rotorred import checks
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "convert", help="write a rotor saved by ROSS as a rotorred rotor file",
+        description="Read a rotor saved by ROSS 3 (Rotor.save, TOML), check it as rotorred reads it, and write the "
+                    "equivalent rotorred rotor file (README, 'Rotor files'): the same nodes, elements, disks and "
+                    "bearings, the tables against speed in rpm. rotorred reads the ROSS file directly too "
+                    "(rotorred campbell my_ross_rotor.toml ...); the rotorred file is for going on in its format.")
+    p.add_argument("source", metavar="ROSS_FILE", help="rotor TOML file saved by ROSS 3 (ross.Rotor.save)")
+    p.add_argument("target", metavar="OUT", help="rotorred rotor file to write (.toml)")
+    return p
+
+
+def run(args) -> int:
+    from rotorred.model.rotor_file import RotorFileError, read_text_file, rotor_document, rotor_from_dict
+    from rotorred.model.ross_file import is_ross_document
+    from rotorred.writers import write_toml
+
+    source, target = Path(args.source), _target(args.target, args.source)
+    if not source.is_file():
+        checks.fail("ROSS_FILE", args.source, "must be an existing file (a rotor saved by ROSS 3)")
+    text = read_text_file(source, RotorFileError)
+    document = rotor_document(text, str(source), name=source.stem)
+    if not is_ross_document(_parsed(text)):
+        checks.fail("ROSS_FILE", args.source, "must be a rotor saved by ROSS (it has no ross_version line); it reads "
+                    "as a rotorred rotor file already")
+    try:
+        rotor = rotor_from_dict(document)
+    except RotorFileError as exc:
+        raise exc.from_source(str(source)) from None
+    write_toml(target, document, header=f"rotorred rotor file converted from {source.name} by `rotorred convert`\n"
+                                        "(axial and torsional coefficients of ROSS's 6-DOF model are not read: "
+                                        "docs/model.md §14)")
+    spool = rotor.spools[0]
+    tables = sum(1 for b in document["bearing"] if "speed_rpm" in b)
+    print(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"
+          + (f", {len(spool.sleeves)} sleeves (ROSS layered elements)" if spool.sleeves else "")
+          + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({tables} tabulated against speed)"
+          + (f", {len(rotor.pedestals)} pedestals" if rotor.pedestals else ""))
+    print(f"wrote {target}")
+    return 0
+
+
+def _target(text: str, source: str) -> Path:
+    """The output file ``text``: not empty, not a folder, not the source."""
+    if not str(text).strip():
+        checks.fail("OUT", text, "must be a file path, not empty")
+    path = Path(text).expanduser()
+    if path.is_dir():
+        checks.fail("OUT", text, "must be a file path; this is a folder")
+    if path.exists() and path.resolve() == Path(source).expanduser().resolve():
+        checks.fail("OUT", text, "must differ from ROSS_FILE: the ROSS file is kept")
+    if not path.parent.exists():
+        checks.fail("OUT", text, f"must be in an existing folder; {str(path.parent)!r} does not exist")
+    return path
+
+
+def _parsed(text: str) -> dict:
+    from rotorred.model.rotor_file import RotorFileError, read_toml
+
+    return read_toml(text, RotorFileError)
