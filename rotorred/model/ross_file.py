@@ -139,15 +139,22 @@ def _sections(data: dict[str, Any]) -> dict[str, list[tuple[str, dict]]]:
         kind = key.split("_", 1)[0]
         where = f"[{key!r}]" if "_" in key else key
         if kind not in READ_KINDS:
-            why = _WHY_NOT.get(kind, "not a lateral element rotorred knows")
-            checks.fail(where, kind, f"is a ROSS {kind} ({why}), which rotorred cannot represent; it reads "
-                        f"{', '.join(READ_KINDS)}. Replace it in ROSS (a bearing by a BearingElement with its "
-                        "coefficients) and save again")
-        out[kind].append((where, checks.table(where, value)))
+            _refuse(where, kind)
+        table = checks.table(where, value)
+        if kind == "BearingElement" and "kp_pid" in table:  # ROSS 3.1 saves a magnetic bearing as a BearingElement
+            _refuse(where, "MagneticBearingElement")
+        out[kind].append((where, table))
     if not out["ShaftElement"]:
         raise checks.InputError("ShaftElement", checks.MISSING, "required: a ROSS rotor holds at least one "
                                 "ShaftElement table")
     return out
+
+
+def _refuse(where: str, kind: str) -> None:
+    why = _WHY_NOT.get(kind, "not a lateral element rotorred knows")
+    checks.fail(where, kind, f"is a ROSS {kind} ({why}), which rotorred cannot represent; it reads "
+                f"{', '.join(READ_KINDS)}. Replace it in ROSS (a bearing by a BearingElement with its coefficients) "
+                "and save again")
 
 
 def _spool(shafts: list[tuple[str, dict]], materials: dict[str, dict]) -> dict[str, Any]:
