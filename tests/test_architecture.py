@@ -21,11 +21,12 @@ LAYERS = {
     "rotorred.model": 1,
     "rotorred.linear": 2, "rotorred.signals": 2,
     "rotorred.transient": 3,
-    "rotorred.plots": 4,
-    "rotorred.scenes": 5,
-    "rotorred.maps": 6,
-    "rotorred.cli": 7,
-    "rotorred": 8,
+    "rotorred.nonlinear": 4,
+    "rotorred.plots": 5,
+    "rotorred.scenes": 6,
+    "rotorred.maps": 7,
+    "rotorred.cli": 8,
+    "rotorred": 9,
 }
 #: where matplotlib may be imported
 MATPLOTLIB_ALLOWED = ("rotorred.plots", "rotorred.cli")

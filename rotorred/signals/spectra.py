@@ -100,6 +100,7 @@ __all__ = [
     "settled_spectrum",
     "window_values",
     "rfft_plan",
+    "rfft",
     "plan_cache_info",
     "plan_cache_clear",
 ]
@@ -274,7 +275,9 @@ def plan_cache_clear() -> None:
         _PLAN_STATS["misses"] = 0
 
 
-def _rfft(x: np.ndarray) -> np.ndarray:
+def rfft(x: np.ndarray) -> np.ndarray:
+    """The real FFT of a 1-D record ``x`` (float64 or float32) on its cached plan (thread-safe), shape
+    (x.size // 2 + 1,), complex, unnormalised (numpy's ``rfft`` convention)."""
     plan, lock = _plan_entry(x.size, x.dtype)
     with lock:  # the plan owns its input/output arrays; one caller at a time
         # Copy into the plan's own aligned input: calling ``plan(input_array=x)`` would let the
@@ -371,7 +374,7 @@ def amplitude_spectrum(x, dt: float, window: str = "rectangular") -> Spectrum:
     n = x.size
     w = window_values(window, n)
     xw = x if window == "rectangular" else (x * w).astype(x.dtype, copy=False)
-    X = _rfft(np.ascontiguousarray(xw))
+    X = rfft(np.ascontiguousarray(xw))
     amplitudes = np.abs(X).astype(np.float64) * (2.0 / w.sum())
     amplitudes[0] *= 0.5
     if n % 2 == 0:

@@ -1,0 +1,203 @@
+"""Pseudo-arclength continuation of periodic solutions in the response frequency omega, with folds located.
+
+The branch is a curve ``y(s) = (z(s), omega(s))`` with ``R(z, omega) = 0`` (:mod:`rotorred.nonlinear.hb`).
+From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the
+previous one), the predictor steps ``ds`` along ``t``; the corrector is Newton's method on ``R = 0`` together
+with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent). Step control:
+``ds`` grows by 1.5 after a correction of at most 4 iterations, up to ``ds_max``; a failed correction halves
+it and retries from the same point, down to ``ds_min``, where the branch stops and says where and why.
+
+A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
+located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
+point, to ``1e-10`` of the step. Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import brentq
+
+from rotorred import checks
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.stability import floquet
+
+__all__ = ["Fold", "Branch", "continue_branch"]
+
+
+@dataclass(frozen=True)
+class Fold:
+    """A located fold: the solution there and its frequency (rad/s)."""
+
+    omega: float
+    z: np.ndarray
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A branch of periodic solutions.
+
+    Attributes
+    ----------
+    omega : ndarray, shape (p,)
+        Response frequency of each point (rad/s).
+    z : ndarray, shape (p, (2H + 1) n)
+        Fourier coefficients of each point (harmonic-major).
+    max_real : ndarray, shape (p,)
+        Largest real part of the Floquet exponents (1/s), NaN where stability was not asked.
+    folds : tuple of Fold
+    stopped : str
+        Why the continuation ended: "reached omega_end", or where and why it stopped early.
+    iterations : ndarray, shape (p,)
+        Corrector iterations of each point.
+    slope : ndarray, shape (p,)
+        d omega / ds of the unit tangent at each point: its sign says which way the branch runs in omega (it
+        changes at the folds).
+    """
+
+    omega: np.ndarray
+    z: np.ndarray
+    max_real: np.ndarray
+    folds: tuple[Fold, ...]
+    stopped: str
+    iterations: np.ndarray
+    slope: np.ndarray
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Whether each point is stable (False where stability was not computed)."""
+        return self.max_real < 0.0
+
+    def amplitude(self, problem: PeriodicProblem, dof: int, order: int = 1) -> np.ndarray:
+        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of ``dof`` at each point."""
+        n = problem.n
+        if order == 0:
+            return np.abs(self.z[:, dof])
+        a, b = self.z[:, (2 * order - 1) * n + dof], self.z[:, 2 * order * n + dof]
+        return np.hypot(a, b)
+
+
+@dataclass
+class _Point:
+    y: np.ndarray  # (z, omega)
+    t: np.ndarray  # unit tangent
+    iterations: int
+
+
+def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
+                    ds: float = 0.05, ds_min: float = 1e-6, ds_max: float = 0.2, max_points: int = 5000,
+                    tol: float = 1e-10, stability: bool = True) -> Branch:
+    """Follow the branch through ``z0`` at ``omega_start`` until omega passes ``omega_end`` (either direction).
+
+    Parameters
+    ----------
+    problem : PeriodicProblem
+    z0 : ndarray
+        A start for the first point (e.g. the linear response).
+    omega_start, omega_end : float
+        Response frequencies (rad/s), > 0.
+    ds, ds_min, ds_max : float
+        Initial, least and largest arclength step (in the units of (z, omega)).
+    max_points : int
+    tol : float
+        Relative residual of every point (:func:`rotorred.nonlinear.hb.solve`).
+    stability : bool
+        Compute each point's Floquet exponents (Hill's method).
+
+    Returns
+    -------
+    Branch
+    """
+    checks.positive("omega_start", omega_start, "rad/s")
+    checks.positive("omega_end", omega_end, "rad/s")
+    direction = 1.0 if omega_end > omega_start else -1.0
+    z, _, it = solve(problem, z0, omega_start, tol=tol)
+    first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
+    points, folds, stopped = [first], [], f"reached omega_end = {omega_end:.9g} rad/s"
+    while len(points) < max_points:
+        nxt, ds, why = _step(problem, points[-1], ds, ds_min, ds_max, tol)
+        if nxt is None:
+            stopped = why
+            break
+        if nxt.t[-1] * points[-1].t[-1] < 0.0:
+            folds.append(_locate_fold(problem, points[-1], nxt, tol))
+        points.append(nxt)
+        if direction * (nxt.y[-1] - omega_end) >= 0.0:
+            break
+        if direction * (nxt.y[-1] - omega_start) < 0.0:
+            stopped = (f"the branch turned back past omega_start = {omega_start:.9g} rad/s (at omega = "
+                       f"{nxt.y[-1]:.9g} rad/s, after {len(folds)} fold{'s' * (len(folds) != 1)})")
+            break
+    else:
+        stopped = f"stopped at max_points = {max_points} (omega = {points[-1].y[-1]:.9g} rad/s)"
+    return _branch(problem, points, folds, stopped, stability)
+
+
+def _branch(problem, points, folds, stopped, stability) -> Branch:
+    y = np.array([p.y for p in points])
+    omega, z = y[:, -1], y[:, :-1]
+    max_real = np.array([floquet(problem, zi, wi).max_real for zi, wi in zip(z, omega)]) if stability \
+        else np.full(len(points), np.nan)
+    return Branch(omega, z, max_real, tuple(folds), stopped, np.array([p.iterations for p in points]),
+                  np.array([p.t[-1] for p in points]))
+
+
+def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarray:
+    """The unit null vector of ``[dR/dz, dR/domega]`` at ``y`` (``ev``: its evaluation, if at hand), oriented along
+    ``previous`` (or with omega growing in ``direction`` at the start)."""
+    ev = ev if ev is not None else problem.evaluate(y[:-1], y[-1])
+    J = np.column_stack([ev.dR_dz, ev.dR_domega])
+    guide = previous if previous is not None else np.append(np.zeros(len(y) - 1), direction)
+    t = sla.solve(np.vstack([J, guide]), np.append(np.zeros(len(y) - 1), 1.0))
+    t /= np.linalg.norm(t)
+    return t if t @ guide > 0 else -t
+
+
+def _correct(problem, y_pred, t, tol, max_iter: int = 20):
+    """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``: the corrected point, its iterations and its evaluation,
+    or None."""
+    y = y_pred.copy()
+    for it in range(max_iter + 1):
+        ev = problem.evaluate(y[:-1], y[-1])
+        if ev.relative <= tol and it > 0:
+            return y, it, ev
+        if it == max_iter or y[-1] <= 0.0:
+            return None
+        J = np.vstack([np.column_stack([ev.dR_dz, ev.dR_domega]), t])
+        try:
+            y = y + sla.solve(J, -np.append(ev.R, t @ (y - y_pred)))
+        except (sla.LinAlgError, ValueError):
+            return None
+    return None
+
+
+def _step(problem, point: _Point, ds, ds_min, ds_max, tol):
+    """The next point from ``point`` with step control: (point, next ds, "") or (None, ds, why)."""
+    while ds >= ds_min:
+        done = _correct(problem, point.y + ds * point.t, point.t, tol)
+        if done is not None:
+            y, it, ev = done
+            grown = min(ds * 1.5, ds_max) if it <= 4 else ds
+            return _Point(y, _tangent(problem, y, point.t, ev=ev), it), grown, ""
+        ds *= 0.5
+    return None, ds, (f"the step fell below ds_min = {ds_min:g} at omega = {point.y[-1]:.9g} rad/s: the corrector did "
+                      f"not converge to a relative residual of {tol:g}")
+
+
+def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
+    """The fold between points ``a`` and ``b``: d omega/ds = 0, by Brent on the arclength from ``a``."""
+    span = float((b.y - a.y) @ a.t)
+
+    def domega(s: float) -> float:
+        if s == 0.0:
+            return a.t[-1]
+        done = _correct(problem, a.y + s * a.t, a.t, tol)
+        if done is None:
+            raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")
+        return _tangent(problem, done[0], a.t, ev=done[2])[-1]
+
+    s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
+    y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]
+    return Fold(float(y[-1]), y[:-1].copy())

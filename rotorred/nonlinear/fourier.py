@@ -1,0 +1,152 @@
+"""Truncated real Fourier series of a periodic response and the alternating frequency-time (AFT) transforms.
+
+A periodic vector ``q(t)`` of period ``T = 2 pi / omega`` with ``H`` harmonics is
+
+    q(t) = a_0 + sum_{k=1..H} (a_k cos(k omega t) + b_k sin(k omega t)),
+
+stored *harmonic-major*: ``z = [a_0, a_1, b_1, ..., a_H, b_H]``, each block the ``n`` DOFs, shape
+``((2H + 1) n,)``. The AFT evaluates ``q`` and ``q'`` at ``N`` equally spaced instants of one period
+(``theta_j = 2 pi j / N``), a nonlinear force there, and its Fourier coefficients back by the DFT: a matrix
+product at the harmonic counts of harmonic balance, where it is the cheaper, the FFT (pyFFTW,
+:func:`rotorred.signals.spectra.rfft`) beyond (:data:`MATRIX_US`). The coefficients are exact (no aliasing)
+for a force that is a polynomial of degree ``p`` in ``q`` when ``N >= (p + 1) H + 1``
+(:func:`alias_free_samples`); a contact force is not a polynomial, and its sample count is a
+convergence parameter (docs/model.md §15).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.signals.spectra import rfft
+
+__all__ = ["Harmonics", "alias_free_samples"]
+
+#: the cost model that picks the DFT's method, in microseconds for 2 DOFs: the matrix product ``MATRIX_US`` per
+#: term and sample, a pyFFTW plan call ``FFT_US[0] + FFT_US[1] N``. Measured here (2 DOFs): at N = 128 the matrix
+#: takes 2.7-10 us for H = 5-60 and the FFT 38 us; at N = 1024 they cross near H = 30, at N = 4096 near H = 15.
+MATRIX_US = 1.4e-3
+FFT_US = (38.0, 0.018)
+
+
+def alias_free_samples(H: int, degree: int) -> int:
+    """The least even sample count that transforms a degree-``degree`` polynomial of an ``H``-harmonic signal
+    without aliasing: ``N >= (degree + 1) H + 1``."""
+    n = (degree + 1) * H + 1
+    return n + n % 2
+
+
+@dataclass(frozen=True)
+class Harmonics:
+    """The harmonic basis: ``H`` harmonics sampled at ``N`` instants a period.
+
+    Parameters
+    ----------
+    H : int
+        Highest harmonic, >= 1.
+    N : int
+        Time samples a period for the AFT, even and > 2 H (so the basis itself is not aliased).
+    """
+
+    H: int
+    N: int
+
+    def __post_init__(self):
+        checks.integer("H", self.H, ge=1)
+        checks.integer("N", self.N, ge=2 * self.H + 2)
+        if self.N % 2:
+            checks.fail("N", self.N, "must be even")
+        theta = 2.0 * math.pi * np.arange(self.N) / self.N
+        k = np.arange(1, self.H + 1)
+        E = np.empty((self.N, 2 * self.H + 1))
+        E[:, 0] = 1.0
+        E[:, 1::2] = np.cos(np.outer(theta, k))
+        E[:, 2::2] = np.sin(np.outer(theta, k))
+        nabla = np.zeros((2 * self.H + 1, 2 * self.H + 1))
+        for j in k:  # d/dtheta (a cos j theta + b sin j theta) = j b cos - j a sin
+            nabla[2 * j - 1, 2 * j] = j
+            nabla[2 * j, 2 * j - 1] = -j
+        forward = E.T * (2.0 / self.N)
+        forward[0] *= 0.5
+        object.__setattr__(self, "E", E)  # (N, 2H + 1): coefficients -> samples
+        object.__setattr__(self, "nabla", nabla)  # d/dtheta on the coefficients of one DOF
+        object.__setattr__(self, "forward", forward)  # (2H + 1, N): samples -> coefficients (least squares)
+        self._complex_basis()
+
+    def _complex_basis(self) -> None:
+        """Q: real coefficients -> complex ones c_m (m = -H..H, index m + H), with c_0 = a_0, c_{+-k} = (a_k -+ i b_k)/2;
+        and where each c_m of a real signal sits in its rfft (index |m| mod N, conjugated for m < 0)."""
+        H, m = self.H, 2 * self.H + 1
+        Q = np.zeros((m, m), complex)
+        Q[H, 0] = 1.0
+        for k in range(1, H + 1):
+            Q[H + k, 2 * k - 1], Q[H + k, 2 * k] = 0.5, -0.5j
+            Q[H - k, 2 * k - 1], Q[H - k, 2 * k] = 0.5, 0.5j
+        orders = np.arange(-2 * H, 2 * H + 1) % self.N  # the DFT index of each difference h - j = -2H..2H
+        upper = orders > self.N // 2
+        object.__setattr__(self, "_Q", Q)
+        object.__setattr__(self, "_Q_inv", np.linalg.inv(Q))
+        object.__setattr__(self, "_rfft_index", np.where(upper, self.N - orders, orders))
+        object.__setattr__(self, "_conjugate", upper)
+        hj = np.arange(m)
+        object.__setattr__(self, "_difference", hj[:, None] - hj[None, :] + 2 * H)  # (h - j) + 2H
+
+    @property
+    def size(self) -> int:
+        """Coefficients a DOF: 2 H + 1."""
+        return 2 * self.H + 1
+
+    @property
+    def orders(self) -> np.ndarray:
+        """The harmonic order of each coefficient: 0, 1, 1, 2, 2, ..., H, H."""
+        return np.concatenate([[0], np.repeat(np.arange(1, self.H + 1), 2)])
+
+    def samples(self, z: np.ndarray, n: int) -> np.ndarray:
+        """``q(theta_j)``, shape (N, n), of the harmonic-major coefficients ``z`` of ``n`` DOFs."""
+        return self.E @ z.reshape(self.size, n)
+
+    def rates(self, z: np.ndarray, n: int) -> np.ndarray:
+        """``dq/dtheta (theta_j)``, shape (N, n): multiply by omega for dq/dt."""
+        return self.E @ (self.nabla @ z.reshape(self.size, n))
+
+    def coefficients(self, f: np.ndarray) -> np.ndarray:
+        """The harmonic-major coefficients of samples ``f`` (N, n): the first H + 1 terms of the DFT, as the matrix
+        product ``forward @ f`` where that is the cheaper (:data:`MATRIX_US`), else by the FFT (pyFFTW). Both are
+        the same DFT (test: equal to 1.7e-14 on unit coefficients)."""
+        if MATRIX_US * (self.H + 1) * self.N < FFT_US[0] + FFT_US[1] * self.N:
+            return (self.forward @ f).reshape(-1)
+        return self.coefficients_fft(f)
+
+    def coefficients_fft(self, f: np.ndarray) -> np.ndarray:
+        """:meth:`coefficients` by the FFT (pyFFTW plans of :func:`rotorred.signals.spectra.rfft`)."""
+        n = f.shape[1]
+        out = np.empty((self.size, n))
+        for i in range(n):
+            X = rfft(np.ascontiguousarray(f[:, i]))
+            out[0, i] = X[0].real / self.N
+            out[1::2, i] = 2.0 * X[1:self.H + 1].real / self.N
+            out[2::2, i] = -2.0 * X[1:self.H + 1].imag / self.N
+        return out.reshape(-1)
+
+    def toeplitz(self, d: np.ndarray) -> np.ndarray:
+        """The coefficients of ``d(theta) p(theta)`` as a matrix acting on those of ``p``, for samples ``d`` of a
+        Jacobian, shape (N, n, n): ``forward diag(d) E`` per DOF pair, harmonic-major, shape ((2H+1) n,) * 2. It is
+        the chain rule through the AFT (and the Hill matrix of ``d``)."""
+        n, m = d.shape[1], self.size
+        spectrum = np.fft.rfft(d.reshape(self.N, n * n), axis=0) / self.N  # d's complex coefficients, m >= 0
+        c = spectrum[self._rfft_index]  # orders -2H..2H
+        c[self._conjugate] = c[self._conjugate].conj()
+        toeplitz = c[self._difference].transpose(2, 0, 1)  # (n n, 2H + 1, 2H + 1): c_{h - j} in the complex basis
+        blocks = (self._Q_inv @ toeplitz @ self._Q).real
+        return blocks.reshape(n, n, m, m).transpose(2, 0, 3, 1).reshape(m * n, m * n)
+
+    def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
+        """:meth:`toeplitz` as the product ``forward diag(d) E`` written out (the definition; for tests)."""
+        n, m = d.shape[1], self.size
+        weighted = d.reshape(self.N, n * n).T[:, :, None] * self.E
+        blocks = np.matmul(self.forward, weighted)
+        return blocks.reshape(n, n, m, m).transpose(2, 0, 3, 1).reshape(m * n, m * n)

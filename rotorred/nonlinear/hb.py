@@ -1,0 +1,206 @@
+"""Harmonic balance of ``M q'' + D q' + K q + f(q, q') = F(t)`` for periodic responses of frequency ``omega``.
+
+The unknowns are the harmonic-major Fourier coefficients ``z`` (:mod:`rotorred.nonlinear.fourier`). The
+residual is
+
+    R(z, omega) = L(omega) z + F_nl(z, omega) - F_ex(omega),
+    L(omega) = I (x) K + omega^2 nabla^2 (x) M + omega nabla (x) D(omega),
+
+with ``nabla`` the d/dtheta operator on one DOF's coefficients and ``(x)`` the Kronecker product; ``F_nl`` is
+the AFT of the nonlinear forces (:mod:`rotorred.nonlinear.forces`). The Jacobian is analytic: the chain rule
+through the AFT, ``dF_nl/dz = T(df/dq) + omega T(df/dv) (nabla (x) I)``, with ``T(d)`` the coefficient matrix
+of multiplying by the sampled derivative ``d`` (:meth:`Harmonics.toeplitz`), and ``dR/domega`` likewise.
+:func:`solve` is Newton's method with a backtracking line search; a point that does not converge raises
+:class:`NotConverged` with its residual and is never returned as a solution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.linalg as sla
+
+from rotorred import checks
+from rotorred.nonlinear.fourier import Harmonics
+
+__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve"]
+
+
+class NotConverged(RuntimeError):
+    """Newton's method did not meet the tolerance: where, how far, after how many iterations."""
+
+    def __init__(self, omega: float, residual: float, tol: float, iterations: int, why: str):
+        self.omega, self.residual, self.tol, self.iterations = omega, residual, tol, iterations
+        super().__init__(f"harmonic balance did not converge at omega = {omega:.9g} rad/s: relative residual "
+                         f"{residual:.3g} > {tol:.3g} after {iterations} Newton iterations ({why})")
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The residual at ``(z, omega)`` and its derivatives."""
+
+    R: np.ndarray
+    dR_dz: np.ndarray
+    dR_domega: np.ndarray
+    scale: float  # ||F_ex|| (or ||L z|| when there is no forcing): what the residual is relative to
+
+    @property
+    def relative(self) -> float:
+        return float(np.linalg.norm(self.R) / self.scale)
+
+
+@dataclass(frozen=True)
+class PeriodicProblem:
+    """A forced system whose periodic response is sought by harmonic balance.
+
+    Parameters
+    ----------
+    M, D, K : ndarray, shape (n, n)
+        Mass, velocity (damping plus gyroscopic) and stiffness matrices (SI).
+    harmonics : Harmonics
+    forcing : callable
+        ``forcing(omega) -> (F, dF_domega)``: the harmonic-major coefficients of the external force, shape
+        ((2H + 1) n,), and their derivative with respect to omega.
+    forces : tuple
+        Nonlinear forces (:mod:`rotorred.nonlinear.forces`).
+    D1 : ndarray, shape (n, n), optional
+        A velocity matrix proportional to omega, ``D(omega) = D + omega D1`` (a gyroscopic matrix per unit speed
+        when the spin follows omega, as in a synchronous unbalance response).
+    """
+
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    harmonics: Harmonics
+    forcing: Callable[[float], tuple[np.ndarray, np.ndarray]]
+    forces: tuple = ()
+    D1: np.ndarray | None = None
+    _ops: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        n = np.shape(self.M)[0] if np.ndim(self.M) == 2 else 0
+        for name in ("M", "D", "K") + (("D1",) if self.D1 is not None else ()):
+            object.__setattr__(self, name, checks.array(name, getattr(self, name), (n, n)))
+        if not isinstance(self.harmonics, Harmonics):
+            checks.fail("harmonics", self.harmonics, "must be a Harmonics")
+        for i, force in enumerate(self.forces):
+            for d in force.dofs:
+                if d >= n:
+                    checks.fail(f"forces[{i}].dofs", force.dofs, f"must be DOFs of the system (0-{n - 1})")
+        h = self.harmonics
+        eye_h, nabla = np.eye(h.size), h.nabla
+        self._ops.update(IK=np.kron(eye_h, self.K), N2M=np.kron(nabla @ nabla, self.M), N1=np.kron(nabla, np.eye(n)),
+                         NM=np.kron(nabla, self.M), ND=np.kron(nabla, self.D),
+                         ND1=None if self.D1 is None else np.kron(nabla, self.D1))
+
+    @property
+    def n(self) -> int:
+        """DOFs of the system."""
+        return self.M.shape[0]
+
+    @property
+    def size(self) -> int:
+        """Unknowns: (2 H + 1) n."""
+        return self.harmonics.size * self.n
+
+    def linear(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """``L(omega)`` and ``dL/domega``, shape (size, size)."""
+        o = self._ops
+        L = o["IK"] + omega**2 * o["N2M"] + omega * o["ND"]
+        dL = 2.0 * omega * o["N2M"] + o["ND"]
+        if o["ND1"] is not None:
+            L = L + omega**2 * o["ND1"]
+            dL = dL + 2.0 * omega * o["ND1"]
+        return L, dL
+
+    def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements and velocities at the AFT instants, shape (N, n) each."""
+        h = self.harmonics
+        return h.samples(z, self.n), omega * h.rates(z, self.n)
+
+    def nonlinear(self, z: np.ndarray, omega: float):
+        """The nonlinear force's coefficients and the Toeplitz matrices of its derivatives, T(df/dq) and
+        T(df/dv)."""
+        h, n = self.harmonics, self.n
+        q, v = self.samples(z, omega)
+        f = np.zeros((h.N, n))
+        dq = np.zeros((h.N, n, n))
+        dv = np.zeros((h.N, n, n))
+        for force in self.forces:
+            idx = list(force.dofs)
+            fi, dqi, dvi = force.evaluate(q[:, idx], v[:, idx])
+            f[:, idx] += fi
+            for a, ia in enumerate(idx):
+                for b, ib in enumerate(idx):
+                    dq[:, ia, ib] += dqi[:, a, b]
+                    dv[:, ia, ib] += dvi[:, a, b]
+        zero = np.zeros((self.size, self.size))
+        return h.coefficients(f), h.toeplitz(dq), (h.toeplitz(dv) if dv.any() else zero)
+
+    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
+        """The residual and its analytic derivatives at ``(z, omega)``."""
+        L, dL = self.linear(omega)
+        F, dF = self.forcing(omega)
+        F_nl, Tq, Tv = self.nonlinear(z, omega)
+        Lz = L @ z
+        R = Lz + F_nl - F
+        rate = self._ops["N1"] @ z  # coefficients of dq/dtheta
+        J = L + Tq + omega * (Tv @ self._ops["N1"])
+        dR_domega = dL @ z + Tv @ rate - dF
+        scale = float(np.linalg.norm(F)) or float(np.linalg.norm(Lz)) or 1.0
+        return Evaluation(R, J, dR_domega, scale)
+
+    def hill_matrices(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A2, A1, A0)`` of the Hill quadratic eigenproblem ``(lambda^2 A2 + lambda A1 + A0) p = 0`` of the
+        perturbation ``e^{lambda t} p(t)`` about the solution ``z`` (``A0`` is ``dR/dz``)."""
+        _, _, Tv = self.nonlinear(z, omega)
+        D = self.D if self.D1 is None else self.D + omega * self.D1
+        A2 = np.kron(np.eye(self.harmonics.size), self.M)
+        A1 = 2.0 * omega * self._ops["NM"] + np.kron(np.eye(self.harmonics.size), D) + Tv
+        return A2, A1, self.evaluate(z, omega).dR_dz
+
+
+def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40):
+    """The periodic solution near ``z0`` at ``omega`` by Newton's method with a backtracking line search.
+
+    Returns
+    -------
+    (z, Evaluation, iterations)
+
+    Raises
+    ------
+    NotConverged
+        If the relative residual ``||R|| / ||F||`` is not below ``tol`` after ``max_iter`` iterations, or a step
+        cannot reduce it.
+    """
+    z = np.array(z0, float)
+    ev = problem.evaluate(z, omega)
+    for it in range(max_iter):
+        if ev.relative <= tol:
+            return z, ev, it
+        try:
+            step = sla.solve(ev.dR_dz, -ev.R)
+        except (sla.LinAlgError, ValueError):
+            raise NotConverged(omega, ev.relative, tol, it, "singular Jacobian") from None
+        z, ev = _line_search(problem, z, step, omega, ev)
+        if ev is None:
+            raise NotConverged(omega, float(np.linalg.norm(problem.evaluate(z, omega).R)) /
+                               problem.evaluate(z, omega).scale, tol, it, "no step reduces the residual")
+    if ev.relative <= tol:
+        return z, ev, max_iter
+    raise NotConverged(omega, ev.relative, tol, max_iter, "iteration limit")
+
+
+def _line_search(problem, z, step, omega, ev, shrink: float = 0.5, tries: int = 30):
+    """``z + a step`` for the largest ``a`` in 1, 1/2, 1/4, ... that lowers ``||R||`` (Armijo with a small slope)."""
+    r0 = np.linalg.norm(ev.R)
+    a = 1.0
+    for _ in range(tries):
+        trial = z + a * step
+        ev_t = problem.evaluate(trial, omega)
+        if np.linalg.norm(ev_t.R) <= (1.0 - 1e-4 * a) * r0:
+            return trial, ev_t
+        a *= shrink
+    return z, None
