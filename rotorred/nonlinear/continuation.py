@@ -3,9 +3,10 @@
 The branch is a curve ``y(s) = (z(s), omega(s))`` with ``R(z, omega) = 0`` (:mod:`rotorred.nonlinear.hb`).
 From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the
 previous one), the predictor steps ``ds`` along ``t``; the corrector is Newton's method on ``R = 0`` together
-with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent). Step control:
-``ds`` grows by 1.5 after a correction of at most 4 iterations, up to ``ds_max``; a failed correction halves
-it and retries from the same point, down to ``ds_min``, where the branch stops and says where and why.
+with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent), each step shortened
+until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at most 4 iterations, up
+to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it and retries
+from the same point, down to ``ds_min``, where the branch stops and says where and why.
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
@@ -26,13 +27,20 @@ from rotorred.nonlinear.stability import floquet
 
 __all__ = ["Fold", "Branch", "continue_branch"]
 
+#: a corrected point farther than this many steps ds from the last has left the branch for another part of the
+#: curve: the step is halved instead
+MAX_JUMP = 2.0
+
 
 @dataclass(frozen=True)
 class Fold:
-    """A located fold: the solution there and its frequency (rad/s)."""
+    """Where the branch turns back in omega: a smooth fold (saddle-node, located by Brent on d omega / ds) or, with
+    ``smooth`` False, a corner (a kink where a contact starts or ends), at the last point before the turn (the steps
+    shrink onto a corner). The solution there and its frequency (rad/s)."""
 
     omega: float
     z: np.ndarray
+    smooth: bool = True
 
 
 @dataclass(frozen=True)
@@ -117,7 +125,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
     points, folds, stopped = [first], [], f"reached omega_end = {omega_end:.9g} rad/s"
     while len(points) < max_points:
-        nxt, ds, why = _step(problem, points[-1], ds, ds_min, ds_max, tol)
+        nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
         if nxt is None:
             stopped = why
             break
@@ -156,34 +164,108 @@ def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarra
 
 
 def _correct(problem, y_pred, t, tol, max_iter: int = 20):
-    """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``: the corrected point, its iterations and its evaluation,
-    or None."""
+    """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``, each step shortened until it lowers the residual (a
+    contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its evaluation, or
+    None."""
     y = y_pred.copy()
+    ev = problem.evaluate(y[:-1], y[-1])
     for it in range(max_iter + 1):
-        ev = problem.evaluate(y[:-1], y[-1])
         if ev.relative <= tol and it > 0:
             return y, it, ev
-        if it == max_iter or y[-1] <= 0.0:
+        if it == max_iter:
             return None
         J = np.vstack([np.column_stack([ev.dR_dz, ev.dR_domega]), t])
         try:
-            y = y + sla.solve(J, -np.append(ev.R, t @ (y - y_pred)))
+            step = sla.solve(J, -np.append(ev.R, t @ (y - y_pred)))
         except (sla.LinAlgError, ValueError):
+            return None
+        y, ev = _shortened(problem, y, step, ev)
+        if ev is None:
             return None
     return None
 
 
-def _step(problem, point: _Point, ds, ds_min, ds_max, tol):
-    """The next point from ``point`` with step control: (point, next ds, "") or (None, ds, why)."""
+def _shortened(problem, y, step, ev, tries: int = 12):
+    """``y + a step`` for the largest ``a`` in 1, 1/2, ... that lowers ``||R||`` (omega kept > 0), and its
+    evaluation; (y, None) if none does."""
+    r0, a = np.linalg.norm(ev.R), 1.0
+    for _ in range(tries):
+        trial = y + a * step
+        if trial[-1] > 0.0:
+            ev_t = problem.evaluate(trial[:-1], trial[-1])
+            if np.linalg.norm(ev_t.R) < r0 or ev_t.relative <= 1e-3 * ev.relative:
+                return trial, ev_t
+        a *= 0.5
+    return y, None
+
+
+def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, tol):
+    """The next point from ``point`` with step control: (point, next ds, "") or (None, ds, why). After six
+    halvings (or at ``ds_min``), a corner is tried once (:func:`_past_a_corner`), then the halving goes on down to
+    ``ds_min``. (Trying a corner at the first failure was tried and taken back: in smooth stretches its steps in
+    omega land on other parts of the branch.)"""
+    first, cornered = ds, False
     while ds >= ds_min:
-        done = _correct(problem, point.y + ds * point.t, point.t, tol)
+        done = _arclength(problem, point, ds, tol)
         if done is not None:
-            y, it, ev = done
-            grown = min(ds * 1.5, ds_max) if it <= 4 else ds
-            return _Point(y, _tangent(problem, y, point.t, ev=ev), it), grown, ""
+            return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""
+        if not cornered and (ds <= first / 64 or ds / 2 < ds_min):
+            cornered = True
+            corner = _past_a_corner(problem, point, previous, max(first, 64 * ds_min), tol)
+            if corner is not None:
+                return corner, first, ""
         ds *= 0.5
     return None, ds, (f"the step fell below ds_min = {ds_min:g} at omega = {point.y[-1]:.9g} rad/s: the corrector did "
-                      f"not converge to a relative residual of {tol:g}")
+                      f"not converge to a relative residual of {tol:g}, nor a step in omega alone")
+
+
+def _arclength(problem, point: _Point, ds, tol):
+    """The corrected point ``ds`` along the tangent, and its iterations, or None (not converged, or a jump)."""
+    done = _correct(problem, point.y + ds * point.t, point.t, tol)
+    if done is None:
+        return None
+    y, it, ev = done
+    if np.linalg.norm(y - point.y) > MAX_JUMP * ds:
+        return None
+    return _Point(y, _tangent(problem, y, point.t, ev=ev), it), it
+
+
+def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
+    """The next point past a corner of the branch, or None. Where a contact starts (grazing) the branch has a kink:
+    it may turn by about a right angle, so the plane normal to the old tangent meets the new part far away, and the
+    arclength corrector fails at every step. A step in omega alone (``ds``, ``ds``/4, ... down to ``ds`` 4^-8, the first
+    that lands within ``MAX_JUMP ds``), in the direction omega was going, then the other, solved by Newton at that
+    omega, gets past it, started from the corner's solution and from the linear response (the side without contact);
+    the new tangent is oriented along the secant. A candidate back along the tangent (its
+    secant within 26 degrees of the reversed tangent), or nearer to the previous point than the corner is, lies on
+    the part just traced, and is passed over."""
+    heading = np.sign(point.t[-1]) or 1.0
+    for sign in (heading, -heading):
+        for delta in ds * 0.25 ** np.arange(9):  # a steep branch moves far for a small change of omega
+            omega = point.y[-1] + sign * delta
+            if omega <= 0.0:
+                continue
+            for start in (point.y[:-1], problem.linear_response(omega)):
+                found = _candidate(problem, point, previous, start, omega, ds, tol)
+                if found is not None:
+                    return found
+    return None
+
+
+def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds, tol):
+    """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
+    just traced."""
+    try:
+        z, ev, it = solve(problem, start, omega, tol=tol)
+    except NotConverged:
+        return None
+    y = np.append(z, omega)
+    secant = y - point.y
+    traced = secant @ point.t < -0.9 * np.linalg.norm(secant) or (  # back along the tangent, or nearer to
+        previous is not None and np.linalg.norm(y - previous.y) < np.linalg.norm(point.y - previous.y))
+    if np.linalg.norm(secant) > MAX_JUMP * ds or traced:
+        return None
+    return _Point(y, _tangent(problem, y, secant, ev=ev), it)
 
 
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
@@ -198,6 +280,9 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
             raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")
         return _tangent(problem, done[0], a.t, ev=done[2])[-1]
 
-    s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
+    try:
+        s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
+    except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
+        return Fold(float(a.y[-1]), a.y[:-1].copy(), smooth=False)
     y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]
     return Fold(float(y[-1]), y[:-1].copy())

@@ -25,7 +25,7 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
 
-__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve"]
+__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "transformed_forces"]
 
 
 class NotConverged(RuntimeError):
@@ -80,11 +80,7 @@ class PeriodicProblem:
     _ops: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        n = np.shape(self.M)[0] if np.ndim(self.M) == 2 else 0
-        for name in ("M", "D", "K") + (("D1",) if self.D1 is not None else ()):
-            object.__setattr__(self, name, checks.array(name, getattr(self, name), (n, n)))
-        if not isinstance(self.harmonics, Harmonics):
-            checks.fail("harmonics", self.harmonics, "must be a Harmonics")
+        n = checked_matrices(self)
         for i, force in enumerate(self.forces):
             for d in force.dofs:
                 if d >= n:
@@ -115,6 +111,10 @@ class PeriodicProblem:
             dL = dL + 2.0 * omega * o["ND1"]
         return L, dL
 
+    def linear_response(self, omega: float) -> np.ndarray:
+        """The coefficients of the response without the nonlinear forces, ``L(omega)^-1 F_ex(omega)``."""
+        return sla.solve(self.linear(omega)[0], self.forcing(omega)[0])
+
     def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and velocities at the AFT instants, shape (N, n) each."""
         h = self.harmonics
@@ -123,21 +123,8 @@ class PeriodicProblem:
     def nonlinear(self, z: np.ndarray, omega: float):
         """The nonlinear force's coefficients and the Toeplitz matrices of its derivatives, T(df/dq) and
         T(df/dv)."""
-        h, n = self.harmonics, self.n
         q, v = self.samples(z, omega)
-        f = np.zeros((h.N, n))
-        dq = np.zeros((h.N, n, n))
-        dv = np.zeros((h.N, n, n))
-        for force in self.forces:
-            idx = list(force.dofs)
-            fi, dqi, dvi = force.evaluate(q[:, idx], v[:, idx])
-            f[:, idx] += fi
-            for a, ia in enumerate(idx):
-                for b, ib in enumerate(idx):
-                    dq[:, ia, ib] += dqi[:, a, b]
-                    dv[:, ia, ib] += dvi[:, a, b]
-        zero = np.zeros((self.size, self.size))
-        return h.coefficients(f), h.toeplitz(dq), (h.toeplitz(dv) if dv.any() else zero)
+        return transformed_forces(self.harmonics, [(force, list(force.dofs)) for force in self.forces], q, v)
 
     def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
         """The residual and its analytic derivatives at ``(z, omega)``."""
@@ -160,6 +147,34 @@ class PeriodicProblem:
         A2 = np.kron(np.eye(self.harmonics.size), self.M)
         A1 = 2.0 * omega * self._ops["NM"] + np.kron(np.eye(self.harmonics.size), D) + Tv
         return A2, A1, self.evaluate(z, omega).dR_dz
+
+
+def checked_matrices(problem) -> int:
+    """Check a problem's M, D, K (and D1) as square matrices of one size, and its harmonics; the size n."""
+    n = np.shape(problem.M)[0] if np.ndim(problem.M) == 2 else 0
+    for name in ("M", "D", "K") + (("D1",) if problem.D1 is not None else ()):
+        object.__setattr__(problem, name, checks.array(name, getattr(problem, name), (n, n)))
+    if not isinstance(problem.harmonics, Harmonics):
+        checks.fail("harmonics", problem.harmonics, "must be a Harmonics")
+    return n
+
+
+def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
+    """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients, and the Toeplitz matrices
+    of their derivatives, T(df/dq) and T(df/dv). ``forces`` pairs each force with the columns of its DOFs."""
+    m = q.shape[1]
+    f = np.zeros((h.N, m))
+    dq = np.zeros((h.N, m, m))
+    dv = np.zeros((h.N, m, m))
+    for force, idx in forces:
+        fi, dqi, dvi = force.evaluate(q[:, idx], v[:, idx])
+        f[:, idx] += fi
+        for a, ia in enumerate(idx):
+            for b, ib in enumerate(idx):
+                dq[:, ia, ib] += dqi[:, a, b]
+                dv[:, ia, ib] += dvi[:, a, b]
+    Tv = h.toeplitz(dv) if dv.any() else np.zeros((h.size * m, h.size * m))
+    return h.coefficients(f), h.toeplitz(dq), Tv
 
 
 def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40):

@@ -1,0 +1,183 @@
+"""Harmonic balance condensed onto the DOFs where the nonlinear forces act.
+
+For ``M q'' + D(omega) q' + K q + f(q_c, q_c') = F(t)`` with ``f`` acting on a few DOFs ``c`` (a rub disk's x and y,
+the plate's DOFs), the linear rest is eliminated harmonic by harmonic through the dynamic compliance: with
+``Z_k = K - (k omega)^2 M + i k omega D(omega)`` and the complex amplitudes ``Q = a - i b`` of
+``a cos(k omega t) + b sin(k omega t)``,
+
+    Q_c = (Z_k^-1 F_k)_c - (Z_k^-1)_cc F_nl,k ,
+
+so the unknowns are the coefficients of the ``c`` DOFs only and the residual is
+
+    R(z_c, omega) = z_c - z_lin(omega) + G(omega) F_nl(z_c, omega),
+
+with ``G`` the block-diagonal real form of ``(Z_k^-1)_cc`` (per harmonic ``[[Re H, Im H], [-Im H, Re H]]``).
+Its Jacobian is analytic: ``I + G (T(df/dq) + omega T(df/dv)(nabla (x) I))``, and ``dR/domega`` uses
+``dZ^-1/domega = -Z^-1 (dZ/domega) Z^-1``. The response of every DOF is recovered from the solution
+(:meth:`CondensedProblem.recover`). The interface is :class:`rotorred.nonlinear.hb.PeriodicProblem`'s, so
+:func:`rotorred.nonlinear.hb.solve` and :func:`rotorred.nonlinear.continuation.continue_branch` take it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.linalg as sla
+
+from rotorred import checks
+from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.hb import Evaluation, checked_matrices, transformed_forces
+
+__all__ = ["CondensedProblem"]
+
+
+@dataclass(frozen=True)
+class _Harmonic:
+    """One harmonic's compliance data at one omega: (Z^-1)_cc, its omega-derivative, the linear response's ``c``
+    rows and their omega-derivative, and the full linear response with the compliance columns (for recovery)."""
+
+    H_cc: np.ndarray
+    dH_cc: np.ndarray
+    q_lin: np.ndarray
+    dq_lin: np.ndarray
+    Q_full: np.ndarray
+    X: np.ndarray
+
+
+@dataclass(frozen=True)
+class CondensedProblem:
+    """A forced system with nonlinear forces on a few DOFs, solved by harmonic balance on those DOFs.
+
+    Parameters
+    ----------
+    M, D, K : ndarray, shape (n, n)
+        Mass, velocity and stiffness matrices of the whole (linear) system (SI).
+    harmonics : Harmonics
+    dofs : tuple of int
+        The DOFs ``c`` the nonlinear forces act on: the unknowns.
+    forcing : callable
+        ``forcing(omega) -> (F, dF_domega)``: harmonic-major coefficients of the external force on all n DOFs,
+        shape ((2H + 1) n,).
+    forces : tuple
+        Nonlinear forces (:mod:`rotorred.nonlinear.forces`), their ``dofs`` numbered in the whole system and among
+        ``dofs``.
+    D1 : ndarray, shape (n, n), optional
+        ``D(omega) = D + omega D1``.
+    """
+
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    harmonics: Harmonics
+    dofs: tuple[int, ...]
+    forcing: Callable[[float], tuple[np.ndarray, np.ndarray]]
+    forces: tuple = ()
+    D1: np.ndarray | None = None
+    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        n = checked_matrices(self)
+        dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
+                               min_len=1, unique=True)
+        object.__setattr__(self, "dofs", dofs)
+        local = {d: i for i, d in enumerate(dofs)}
+        for i, force in enumerate(self.forces):
+            if not set(force.dofs) <= set(local):
+                checks.fail(f"forces[{i}].dofs", force.dofs, f"must be among dofs = {dofs}")
+        # the forces renumbered on the unknowns, for the AFT
+        object.__setattr__(self, "_local_forces", tuple((force, [local[d] for d in force.dofs])
+                                                        for force in self.forces))
+        m, h = len(dofs), self.harmonics
+        object.__setattr__(self, "_N1", np.kron(h.nabla, np.eye(m)))
+
+    @property
+    def n(self) -> int:
+        """The unknown DOFs a harmonic: len(dofs)."""
+        return len(self.dofs)
+
+    @property
+    def size(self) -> int:
+        return self.harmonics.size * self.n
+
+    def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements and velocities of the ``dofs`` at the AFT instants, shape (N, len(dofs)) each."""
+        h = self.harmonics
+        return h.samples(z, self.n), omega * h.rates(z, self.n)
+
+    def _compliance(self, omega: float) -> list[_Harmonic]:
+        """Each harmonic's compliance data at ``omega`` (kept for the last omega asked: Newton iterates there)."""
+        if self._cache.get("omega") == omega:
+            return self._cache["harmonics"]
+        F, dF = self.forcing(omega)
+        N = self.M.shape[0]
+        F, dF = F.reshape(self.harmonics.size, N), dF.reshape(self.harmonics.size, N)
+        out = [self._harmonic(k, omega, F, dF) for k in range(self.harmonics.H + 1)]
+        self._cache.update(omega=omega, harmonics=out)
+        return out
+
+    def _harmonic(self, k: int, omega: float, F: np.ndarray, dF: np.ndarray) -> _Harmonic:
+        D = self.D if self.D1 is None else self.D + omega * self.D1
+        Z = self.K - (k * omega) ** 2 * self.M + 1j * k * omega * D
+        dZ = -2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
+        f, df = (F[0], dF[0]) if k == 0 else (F[2 * k - 1] - 1j * F[2 * k], dF[2 * k - 1] - 1j * dF[2 * k])
+        lu = sla.lu_factor(Z)
+        c = list(self.dofs)
+        unit = np.zeros((Z.shape[0], len(c)))
+        unit[c, range(len(c))] = 1.0
+        X = sla.lu_solve(lu, unit)  # (Z^-1)[:, c]
+        Y = sla.lu_solve(lu, unit, trans=1).T  # (Z^-1)[c, :]
+        Q = sla.lu_solve(lu, f.astype(complex))
+        return _Harmonic(H_cc=X[c], dH_cc=-Y @ dZ @ X, q_lin=Q[c], dq_lin=Y @ (df - dZ @ Q), Q_full=Q, X=X)
+
+    def linear_response(self, omega: float) -> np.ndarray:
+        """The coefficients of the ``dofs`` without the nonlinear forces."""
+        return self._real_blocks(self._compliance(omega))[2]
+
+    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
+        """The condensed residual and its analytic derivatives at ``(z, omega)``."""
+        parts = self._compliance(omega)
+        F_nl, Tq, Tv = self._nonlinear(z, omega)
+        G, dG, z_lin, dz_lin = self._real_blocks(parts)
+        J = np.eye(self.size) + G @ (Tq + omega * (Tv @ self._N1))
+        R = z - z_lin + G @ F_nl
+        dR = -dz_lin + dG @ F_nl + G @ (Tv @ (self._N1 @ z))
+        return Evaluation(R, J, dR, float(np.linalg.norm(z_lin)) or 1.0)
+
+    def _real_blocks(self, parts: list[_Harmonic]):
+        """G, dG/domega (block-diagonal, real) and z_lin, dz_lin/domega (harmonic-major) from the harmonics."""
+        m = self.n
+        G, dG = np.zeros((self.size, self.size)), np.zeros((self.size, self.size))
+        z_lin, dz_lin = np.zeros(self.size), np.zeros(self.size)
+        for k, p in enumerate(parts):
+            if k == 0:
+                G[:m, :m], dG[:m, :m] = p.H_cc.real, p.dH_cc.real
+                z_lin[:m], dz_lin[:m] = p.q_lin.real, p.dq_lin.real
+                continue
+            a, b = slice((2 * k - 1) * m, 2 * k * m), slice(2 * k * m, (2 * k + 1) * m)
+            for target, H in ((G, p.H_cc), (dG, p.dH_cc)):
+                target[a, a], target[a, b] = H.real, H.imag
+                target[b, a], target[b, b] = -H.imag, H.real
+            z_lin[a], z_lin[b] = p.q_lin.real, -p.q_lin.imag
+            dz_lin[a], dz_lin[b] = p.dq_lin.real, -p.dq_lin.imag
+        return G, dG, z_lin, dz_lin
+
+    def _nonlinear(self, z: np.ndarray, omega: float):
+        q, v = self.samples(z, omega)
+        return transformed_forces(self.harmonics, self._local_forces, q, v)
+
+    def recover(self, z: np.ndarray, omega: float) -> np.ndarray:
+        """The harmonic-major coefficients of every DOF, shape ((2H + 1) n_all,), from the solution ``z``."""
+        parts = self._compliance(omega)
+        F_nl = self._nonlinear(z, omega)[0].reshape(self.harmonics.size, self.n)
+        N = self.M.shape[0]
+        out = np.zeros((self.harmonics.size, N))
+        for k, p in enumerate(parts):
+            f = F_nl[0] if k == 0 else F_nl[2 * k - 1] - 1j * F_nl[2 * k]
+            Q = p.Q_full - p.X @ f
+            if k == 0:
+                out[0] = Q.real
+            else:
+                out[2 * k - 1], out[2 * k] = Q.real, -Q.imag
+        return out.reshape(-1)
