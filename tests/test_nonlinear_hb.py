@@ -13,35 +13,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from rotorred.nonlinear.continuation import continue_branch
-from rotorred.nonlinear.forces import CircularClearance, CubicSpring
+from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott
+from rotorred.nonlinear.forces import CircularClearance
 from rotorred.nonlinear.fourier import Harmonics
 from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
-from rotorred.nonlinear.stability import floquet
-
-C, K3, F = 0.02, 0.1, 0.1  # the Duffing oscillator's damping, cubic stiffness, forcing
-E_UNB, GAP, K_C = 0.05, 1.0, 100.0  # the Jeffcott rotor's unbalance, clearance, contact stiffness
-
-
-def duffing(H: int, N: int = 128) -> PeriodicProblem:
-    h = Harmonics(H, N)
-
-    def forcing(omega):
-        f = np.zeros(h.size)
-        f[1] = F
-        return f, np.zeros(h.size)
-    return PeriodicProblem(np.eye(1), C * np.eye(1), np.eye(1), h, forcing, (CubicSpring(0, K3),))
-
-
-def jeffcott(H: int, N: int) -> PeriodicProblem:
-    h = Harmonics(H, N)
-
-    def forcing(omega):  # e m omega^2 (cos, sin): the a_1 of x and the b_1 of y
-        f, df = np.zeros(2 * h.size), np.zeros(2 * h.size)
-        f[2], f[5] = E_UNB * omega**2, E_UNB * omega**2
-        df[2], df[5] = 2 * E_UNB * omega, 2 * E_UNB * omega
-        return f, df
-    return PeriodicProblem(np.eye(2), C * np.eye(2), np.eye(2), h, forcing, (CircularClearance((0, 1), GAP, K_C),))
-
 
 def duffing_branch(H: int):
     problem = duffing(H)
@@ -69,7 +44,7 @@ def duffing_folds_closed_form() -> list[float]:
 
 def test_duffing_with_one_harmonic_is_the_closed_form_folds_included():
     """With H = 1 every point of the branch satisfies the closed-form single-term balance
-    ((1 - w^2 + 3/4 k3 A^2)^2 + (c w)^2) A^2 = F^2 (measured: 4.0e-13 of F^2), and the two located folds are the
+    ((1 - w^2 + 3/4 k3 A^2)^2 + (c w)^2) A^2 = F^2 (measured: 4.0e-13, with F^2 = 0.01), and the two folds are the
     roots of its discriminant (measured 3.2e-14 relative; the issue asks 0.5 %)."""
     problem, branch = duffing_branch(1)
     assert branch.stopped.startswith("reached omega_end")

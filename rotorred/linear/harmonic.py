@@ -221,7 +221,7 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
     spools = tuple(model.spools)
     checks.keys("speeds", speeds, spools, required=spools)
     speeds = {s: checks.non_negative(f"speeds.{s}", w, "rad/s") for s, w in speeds.items()}
-    forces = _unbalance_forces(model, unbalances, spool_of)
+    forces = unbalance_forces(model, unbalances, spool_of)
     D, K = model.damping(speeds), model.stiffness(speeds)
     phasors = {}
     for s, f in forces.items():
@@ -233,8 +233,9 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
     return SteadyState(speeds=speeds, phasors=phasors)
 
 
-def _unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
-    """Force phasor per unit Omega² of each spool's unbalances, in model coordinates."""
+def unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
+    """Force phasor per unit Omega² of each spool's unbalances, in model coordinates: ``F(t) = Re(Omega^2 F e^{i Omega t})``
+    with Omega the spool's speed; shape (n,), complex, per spool."""
     spools = tuple(model.spools)
     dofs = model.full_dofs
     if spool_of is None:
@@ -299,7 +300,7 @@ def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: M
     reference_spool = checks.choice("reference_spool", spools[0] if reference_spool is None else reference_spool,
                                     spools)
     ratios = _ratios(ratios, spools, reference_spool)
-    per_spool = _unbalance_forces(model, unbalances, spool_of)
+    per_spool = unbalance_forces(model, unbalances, spool_of)
     R = model.output_rows(outputs)
     spool_speeds = {s: ratios[s] * speeds for s in spools}
     phasors = {s: np.zeros((len(speeds), len(outputs)), dtype=complex) for s in per_spool}

@@ -106,6 +106,11 @@ class CondensedProblem:
         h = self.harmonics
         return h.samples(z, self.n), omega * h.rates(z, self.n)
 
+    def _compliance_cache(self, omega: float) -> dict:
+        """The compliance data at ``omega``, as the cache holds it (to share with a copy of the problem)."""
+        self._compliance(omega)
+        return dict(self._cache)
+
     def _compliance(self, omega: float) -> list[_Harmonic]:
         """Each harmonic's compliance data at ``omega`` (kept for the last omega asked: Newton iterates there)."""
         if self._cache.get("omega") == omega:
@@ -130,6 +135,10 @@ class CondensedProblem:
         Y = sla.lu_solve(lu, unit, trans=1).T  # (Z^-1)[c, :]
         Q = sla.lu_solve(lu, f.astype(complex))
         return _Harmonic(H_cc=X[c], dH_cc=-Y @ dZ @ X, q_lin=Q[c], dq_lin=Y @ (df - dZ @ Q), Q_full=Q, X=X)
+
+    def compliance_blocks(self, omega: float) -> np.ndarray:
+        """G(omega): the real block-diagonal form of (Z_k^-1)_cc over the harmonics, shape (size, size)."""
+        return self._real_blocks(self._compliance(omega))[0]
 
     def linear_response(self, omega: float) -> np.ndarray:
         """The coefficients of the ``dofs`` without the nonlinear forces."""
@@ -181,3 +190,59 @@ class CondensedProblem:
             else:
                 out[2 * k - 1], out[2 * k] = Q.real, -Q.imag
         return out.reshape(-1)
+
+
+@dataclass(frozen=True)
+class ClearanceFamily:
+    """A :class:`CondensedProblem` at a fixed frequency, parameterised by the clearance of one of its rubs: the
+    problem :func:`rotorred.nonlinear.continuation.continue_branch` follows in the clearance (the parameter takes the
+    place of omega; ``dR/dclearance = G dF_nl/dclearance`` from the rub's own derivative).
+
+    Parameters
+    ----------
+    base : CondensedProblem
+    omega : float
+        The base frequency (rad/s).
+    rub : int
+        Index in ``base.forces`` of the rub (a force with ``with_clearance`` and ``d_clearance``).
+    """
+
+    base: CondensedProblem
+    omega: float
+    rub: int = 0
+
+    @property
+    def n(self) -> int:
+        return self.base.n
+
+    @property
+    def size(self) -> int:
+        return self.base.size
+
+    @property
+    def harmonics(self) -> Harmonics:
+        return self.base.harmonics
+
+    def at(self, clearance: float) -> CondensedProblem:
+        """The problem at ``clearance`` (m)."""
+        forces = list(self.base.forces)
+        forces[self.rub] = forces[self.rub].with_clearance(clearance)
+        return CondensedProblem(self.base.M, self.base.D, self.base.K, self.base.harmonics, self.base.dofs,
+                                self.base.forcing, tuple(forces), self.base.D1)
+
+    def samples(self, z: np.ndarray, clearance: float):
+        return self.base.samples(z, self.omega)
+
+    def linear_response(self, clearance: float) -> np.ndarray:
+        return self.base.linear_response(self.omega)
+
+    def evaluate(self, z: np.ndarray, clearance: float) -> Evaluation:
+        problem = self.at(clearance)
+        problem._cache.update(self.base._compliance_cache(self.omega))
+        ev = problem.evaluate(z, self.omega)
+        rub, idx = problem._local_forces[self.rub]
+        q, v = problem.samples(z, self.omega)
+        d = np.zeros((self.harmonics.N, self.n))
+        d[:, idx] = rub.d_clearance(q[:, idx], v[:, idx])
+        dR = self.base.compliance_blocks(self.omega) @ self.harmonics.coefficients(d)
+        return Evaluation(ev.R, ev.dR_dz, dR, ev.scale)

@@ -11,13 +11,15 @@ with ``m = len(dofs)``. The force is the one the structure feels, on the left-ha
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from rotorred import checks
+from rotorred.transient.contact import RubPlate, normal_force_samples
 
-__all__ = ["CubicSpring", "CircularClearance"]
+__all__ = ["CubicSpring", "CircularClearance", "PlateRub"]
 
 
 @dataclass(frozen=True)
@@ -81,3 +83,63 @@ class CircularClearance:
         outer = np.einsum("ti,tj->tij", q, q) * np.where(touching, self.gap / safe**3, 0.0)[:, None, None]
         df_dq = self.k_c * (share[:, None, None] * np.eye(2) + outer)
         return f, df_dq, np.zeros_like(df_dq)
+
+
+@dataclass(frozen=True)
+class PlateRub:
+    """The paper's rub-impact (Xu et al. 2016, section 2.3; :mod:`rotorred.transient.contact`): the disk at DOFs
+    (x, y) against a plate whose rigid motion (u_n, u_t) is two more DOFs, the normal law in series with the plate's
+    bending (the generated law), and Coulomb friction sliding at the disk's surface speed.
+
+    With the gap ``g = clearance + u_n - (x, y) . n`` and the penetration ``p = -g``, the normal force ``P(p, p')``
+    is the law's root at each sample; friction is ``T = -mu_d P sign(v_rel)``,
+    ``v_rel = Omega r + (x', y') . t - u_t'``. The forces on the left-hand side are ``P n - T t`` on the disk and
+    ``(-P, +T)`` on (u_n, u_t) (Eq. 12 and Eq. 7 moved to the left). Harmonic balance sees sliding only: a sample
+    where ``v_rel`` changes sign would stick, which this force does not model (the rig's rim runs at tens of m/s
+    against whirl velocities of cm/s).
+
+    Parameters
+    ----------
+    dofs : (int, int, int, int)
+        The disk's x and y DOFs and the plate's normal and tangential DOFs.
+    plate : RubPlate
+    surface_speed : float
+        Omega r of the disk's rim (m/s): its spool's speed times ``plate.disk_radius``.
+    """
+
+    dofs: tuple[int, int, int, int]
+    plate: RubPlate
+    surface_speed: float
+
+    def __post_init__(self):
+        dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0), min_len=4, max_len=4)
+        object.__setattr__(self, "dofs", dofs)
+        if not isinstance(self.plate, RubPlate):
+            checks.fail("plate", self.plate, "must be a RubPlate")
+        object.__setattr__(self, "surface_speed", checks.number("surface_speed", self.surface_speed, "m/s"))
+
+    def evaluate(self, q: np.ndarray, v: np.ndarray):
+        plate = self.plate
+        c, s = math.cos(plate.theta), math.sin(plate.theta)
+        grad = np.array([c, s, -1.0, 0.0])  # d p / d(x, y, u_n, u_t), and of p' on the velocities
+        P, dP_dp, dP_drate = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
+        sign = np.sign(self.surface_speed - v[:, 0] * s + v[:, 1] * c - v[:, 3])
+        mu = plate.mu_d * sign
+        dF_dP = np.column_stack([c - mu * s, s + mu * c, -np.ones_like(mu), -mu])  # (N, 4): the forces per unit P
+        f = dF_dP * P[:, None]
+        return f, dF_dP[:, :, None] * (dP_dp[:, None] * grad)[:, None, :], \
+            dF_dP[:, :, None] * (dP_drate[:, None] * grad)[:, None, :]
+
+    def with_clearance(self, clearance: float) -> PlateRub:
+        """The same rub at another clearance (m)."""
+        return PlateRub(self.dofs, self.plate.with_(clearance=clearance), self.surface_speed)
+
+    def d_clearance(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """d f / d clearance at the samples, shape (N, 4) (N/m): the penetration falls as the clearance grows."""
+        plate = self.plate
+        c, s = math.cos(plate.theta), math.sin(plate.theta)
+        grad = np.array([c, s, -1.0, 0.0])
+        _, dP_dp, _ = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
+        mu = plate.mu_d * np.sign(self.surface_speed - v[:, 0] * s + v[:, 1] * c - v[:, 3])
+        dF_dP = np.column_stack([c - mu * s, s + mu * c, -np.ones_like(mu), -mu])
+        return -dF_dP * dP_dp[:, None]

@@ -269,6 +269,43 @@ def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 
     return max(float(P), 0.0), float(-dR_dp / dR_dF)
 
 
+def normal_force_samples(penetration: np.ndarray, rate: np.ndarray, plate: RubPlate, tol: float = 1e-14):
+    """:func:`normal_force` at many samples at once, with both tangents: the roots of the generated residual
+    (``normal_residual_samples``, the same law) by Newton from P = 0 at every sample, the clamp of :func:`normal_law`
+    applied sample by sample.
+
+    Parameters
+    ----------
+    penetration, rate : ndarray, shape (N,)
+        Penetration p = -g (m) and its rate p' (m/s) at each sample.
+    plate : RubPlate
+
+    Returns
+    -------
+    P, dP_dp, dP_drate : ndarray, shape (N,)
+        Normal force (N, >= 0) and its derivatives (N/m, N s/m); zero out of contact.
+    """
+    lam, w0 = plate.compliance, plate.offset
+    P = np.zeros_like(penetration)
+    out = None
+    for _ in range(200):
+        out = _residual_samples(P, penetration - w0 - lam * P, rate, plate)
+        step = out[0] / out[1]
+        P = P - step
+        if np.all(np.abs(step) <= tol * np.maximum(np.abs(P), 1e-300)):
+            break
+    out = _residual_samples(P, penetration - w0 - lam * P, rate, plate)
+    return np.maximum(P, 0.0), -out[2] / out[1], -out[3] / out[1]
+
+
+def _residual_samples(P, delta, rate, plate):
+    """The law's residual and tangent at each sample, clamped as :func:`normal_law` clamps it (s = 0 where
+    ``delta <= 0`` or ``1 + c rate <= 0``)."""
+    active = (delta > 0.0) & (1.0 + plate.c * rate > 0.0)
+    s = np.sqrt(np.where(active, delta, 0.0))
+    return _gen.normal_residual_samples(P, s, rate, plate.K_nr, plate.c, plate.compliance)
+
+
 def contact_energy(P: float, plate: RubPlate) -> float:
     """Elastic energy stored in bending and Hertz contact at the normal force ``P`` (J).
 

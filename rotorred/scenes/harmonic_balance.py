@@ -1,0 +1,163 @@
+"""Harmonic balance of a rub scene: the periodic response of the (reduced) rotor with its rub plates at commensurate
+spool speeds (issue 20; docs/model.md §15).
+
+The base frequency is ``f_0 = gcd(f_L, f_H)`` (10 Hz at the paper's 70/90 Hz): every spool's unbalance force is a
+harmonic ``k_s = f_s / f_0`` of it, and so is every combination line ``m f_H + n f_L``. The linear system is the
+scene's model (M, K at the speeds, C + sum_s Omega_s G_s) with two DOFs per plate (its rigid motion, ``m_p``,
+``c_n``, ``c_t``, ``k_n``, ``k_t``); the unknowns are the Fourier coefficients of each rub disk's x, y and its plate's
+u_n, u_t (:class:`rotorred.nonlinear.condensed.CondensedProblem`), the forces the paper's law
+(:class:`rotorred.nonlinear.forces.PlateRub`). Every DOF's response is recovered from the solution.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.linear.harmonic import unbalance_forces
+from rotorred.nonlinear.condensed import CondensedProblem
+from rotorred.nonlinear.forces import PlateRub
+from rotorred.nonlinear.fourier import Harmonics
+
+__all__ = ["RubProblem", "rub_problem", "base_frequency"]
+
+
+def base_frequency(frequencies_hz) -> float:
+    """The greatest common divisor f_0 of the spool frequencies (Hz): each read as a fraction with a denominator of at
+    most 1000 (within 1e-9 relative), f_0 at least 0.1 Hz (a common period of at most 10 s); else refused."""
+    fractions = [Fraction(f).limit_denominator(1000) for f in frequencies_hz]
+    if any(abs(float(fr) - f) > 1e-9 * abs(f) for f, fr in zip(frequencies_hz, fractions)):
+        checks.fail("speeds", tuple(frequencies_hz), "must be commensurate for a periodic harmonic balance (a "
+                    "quasi-periodic one is not implemented yet)", "Hz")
+    common = math.lcm(*(fr.denominator for fr in fractions))
+    f0 = math.gcd(*(int(fr * common) for fr in fractions)) / common
+    if f0 < 0.1:
+        checks.fail("speeds", tuple(frequencies_hz), f"must share a period of at most 10 s (their greatest common "
+                    f"divisor is {f0:.6g} Hz)", "Hz")
+    return f0
+
+
+@dataclass(frozen=True)
+class RubProblem:
+    """The harmonic-balance problem of a rub scene.
+
+    Attributes
+    ----------
+    problem : CondensedProblem
+    omega : float
+        Base frequency 2 pi f_0 (rad/s).
+    f0 : float
+        Base frequency (Hz).
+    n_model : int
+        DOFs of the scene's model (the plates' DOFs follow them).
+    model : SystemMatrices or ReducedSystem
+    """
+
+    problem: CondensedProblem
+    omega: float
+    f0: float
+    n_model: int
+    model: object
+
+    def lines(self, z: np.ndarray, dof: tuple[int, str]) -> dict[float, float]:
+        """Amplitude (m) of every harmonic k f_0 (Hz) of the model DOF ``dof`` = (node, direction) in the solution."""
+        h = self.problem.harmonics
+        coefficients = self.problem.recover(z, self.omega).reshape(h.size, -1)[:, :self.n_model]
+        y = coefficients @ self.model.output_rows([dof])[0]
+        out = {0.0: abs(y[0])}
+        out.update({k * self.f0: math.hypot(y[2 * k - 1], y[2 * k]) for k in range(1, h.H + 1)})
+        return out
+
+    def start_from_record(self, t: np.ndarray, records: dict) -> np.ndarray:
+        """Coefficients of the unknowns fitted to a transient's settled record: ``records`` maps each unknown's
+        position (0, 1, ... : disk x, disk y, plate u_n, plate u_t per plate) to its samples at ``t``, which must span
+        whole periods 1 / f_0 at a constant step (the phase origin is t = 0, as the solution's)."""
+        h, m = self.problem.harmonics, self.problem.n
+        theta = self.omega * np.asarray(t)
+        z = np.zeros((h.size, m))
+        for j, x in records.items():
+            z[0, j] = np.mean(x)
+            for k in range(1, h.H + 1):
+                z[2 * k - 1, j] = 2.0 * np.mean(x * np.cos(k * theta))
+                z[2 * k, j] = 2.0 * np.mean(x * np.sin(k * theta))
+        return z.reshape(-1)
+
+
+def rub_problem(scene, model, H: int, N: int) -> RubProblem:
+    """The harmonic-balance problem of ``scene`` (with rub plates) on ``model`` with ``H`` harmonics of the base
+    frequency and ``N`` AFT samples a period.
+
+    Parameters
+    ----------
+    scene : rotorred.scenes.schema.Scene
+    model : SystemMatrices or ReducedSystem
+        The scene's model (:func:`rotorred.scenes.run.build_model`); each rub node's x and y must be its own
+        coordinates (a boundary node of a reduced model).
+    H, N : int
+
+    Returns
+    -------
+    RubProblem
+    """
+    if not scene.plates:
+        checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
+    f = scene.frequencies_hz
+    f0 = base_frequency(tuple(f.values()))
+    h = Harmonics(H, N)
+    n = model.n_dof
+    M, D, K = _augmented(model, scene)
+    dofs, forces = [], []
+    for i, plate in enumerate(scene.plates):
+        x, y = (_own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
+        spool = scene.rotor.spool_of[plate.node]
+        rub = PlateRub((x, y, n + 2 * i, n + 2 * i + 1), plate, scene.speeds[spool] * (plate.disk_radius or 0.0))
+        dofs += list(rub.dofs)
+        forces.append(rub)
+    orders = {s: int(round(fs / f0)) for s, fs in f.items()}
+    if any(k > H for k in orders.values()):
+        checks.fail("H", H, f"must reach the spools' harmonics of f0 = {f0:g} Hz ({max(orders.values())})")
+    phasors = unbalance_forces(model, scene.unbalances, scene.rotor.spool_of) if scene.unbalances else {}
+    forcing = _forcing(h, n + 2 * len(scene.plates), phasors, orders)
+    problem = CondensedProblem(M, D, K, h, tuple(dofs), forcing, tuple(forces))
+    return RubProblem(problem, 2 * math.pi * f0, f0, n, model)
+
+
+def _augmented(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """M, D, K of the model at the scene's speeds with two DOFs (u_n, u_t) for each plate."""
+    n, p = model.n_dof, 2 * len(scene.plates)
+    M, D, K = (np.zeros((n + p, n + p)) for _ in range(3))
+    M[:n, :n], D[:n, :n], K[:n, :n] = model.M, model.damping(scene.speeds), model.stiffness(scene.speeds)
+    for i, plate in enumerate(scene.plates):
+        j = n + 2 * i
+        M[j, j] = M[j + 1, j + 1] = plate.m_p
+        D[j, j], D[j + 1, j + 1] = plate.c_n, plate.c_t
+        K[j, j], K[j + 1, j + 1] = plate.k_n, plate.k_t
+    return M, D, K
+
+
+def _own_coordinate(model, dof) -> int:
+    """The model coordinate that is ``dof`` itself (a unit output row), or an error naming the node."""
+    row = model.output_rows([dof])[0]
+    i = int(np.argmax(np.abs(row)))
+    if row[i] != 1.0 or np.count_nonzero(row) != 1:
+        checks.fail("rub.node", dof[0], "must be a node of the model's own coordinates (a boundary node of a "
+                    "reduced model)")
+    return i
+
+
+def _forcing(h: Harmonics, n: int, phasors: dict, orders: dict):
+    """forcing(omega): each spool's unbalance at its harmonic k_s of omega, F = Re((k_s omega)^2 F_s e^{i k_s omega t})."""
+    def forcing(omega: float):
+        F, dF = np.zeros((h.size, n)), np.zeros((h.size, n))
+        for s, phasor in phasors.items():
+            k = orders[s]
+            F[2 * k - 1, :len(phasor)] = (k * omega) ** 2 * phasor.real
+            F[2 * k, :len(phasor)] = -(k * omega) ** 2 * phasor.imag
+            dF[2 * k - 1, :len(phasor)] = 2 * k * k * omega * phasor.real
+            dF[2 * k, :len(phasor)] = -2 * k * k * omega * phasor.imag
+        return F.reshape(-1), dF.reshape(-1)
+    return forcing
