@@ -222,7 +222,7 @@ def run_rotorred(case: Case, repeats: int, stability: bool) -> Run:
     except Exception as exc:  # a failure of the continuation is a result to report, not a crash
         return Run(error=f"{type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}")
     run = Run(time=t, points=len(branch.omega), stopped=branch.stopped,
-              complete=branch.stopped.startswith("reached omega_end"),
+              complete=branch.stopped.startswith("reached the end"),
               folds=[(f.omega, getattr(f, "smooth", True)) for f in branch.folds])
     if not stability:
         run.__dict__.update(accuracy(case, problem, branch.z, branch.omega))
@@ -342,7 +342,7 @@ def run_pyharm(pyHarm, case: Case, repeats: int, xtol: float, timeout_s: int) ->
     eps = 0.5 * (w0 + w1) * 1e-5  # pyHarm's bound tolerance
     complete = bool(len(omega)) and omega[-1] >= w1 + eps
     if complete:
-        stopped = f"reached omega_end (last point at {omega[-1]:.6g})"
+        stopped = f"reached the end (last point at {omega[-1]:.6g})"
     elif len(sols) >= MAX_POINTS:
         stopped = f"hit the cap of {MAX_POINTS} solutions at omega = {omega[-1]:.6g}"
     else:

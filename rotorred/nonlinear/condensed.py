@@ -172,6 +172,15 @@ class CondensedProblem:
             dz_lin[a], dz_lin[b] = p.dq_lin.real, -p.dq_lin.imag
         return G, dG, z_lin, dz_lin
 
+    @property
+    def force_columns(self) -> list:
+        """Each nonlinear force with the columns of its DOFs among the unknowns."""
+        return list(self._local_forces)
+
+    def velocity_matrix(self, omega: float) -> np.ndarray:
+        """D(omega) = D + omega D1 (N s/m)."""
+        return self.D if self.D1 is None else self.D + omega * self.D1
+
     def _nonlinear(self, z: np.ndarray, omega: float):
         q, v = self.samples(z, omega)
         return transformed_forces(self.harmonics, self._local_forces, q, v)
@@ -210,6 +219,8 @@ class ClearanceFamily:
     base: CondensedProblem
     omega: float
     rub: int = 0
+    #: the continuation parameter's name and unit, for messages
+    parameter = ("clearance", "m")
 
     @property
     def n(self) -> int:

@@ -57,7 +57,8 @@ class Branch:
         Largest real part of the Floquet exponents (1/s), NaN where stability was not asked.
     folds : tuple of Fold
     stopped : str
-        Why the continuation ended: "reached omega_end", or where and why it stopped early.
+        Why the continuation ended: "reached the end, omega = ...", or where and why it stopped early (in the
+        problem's parameter: omega, or ``problem.parameter``).
     iterations : ndarray, shape (p,)
         Corrector iterations of each point.
     slope : ndarray, shape (p,)
@@ -123,7 +124,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     direction = 1.0 if omega_end > omega_start else -1.0
     z, _, it = solve(problem, z0, omega_start, tol=tol)
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
-    points, folds, stopped = [first], [], f"reached omega_end = {omega_end:.9g} rad/s"
+    points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     while len(points) < max_points:
         nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
         if nxt is None:
@@ -135,12 +136,18 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
             break
         if direction * (nxt.y[-1] - omega_start) < 0.0:
-            stopped = (f"the branch turned back past omega_start = {omega_start:.9g} rad/s (at omega = "
-                       f"{nxt.y[-1]:.9g} rad/s, after {len(folds)} fold{'s' * (len(folds) != 1)})")
+            stopped = (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
+                       f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
             break
     else:
-        stopped = f"stopped at max_points = {max_points} (omega = {points[-1].y[-1]:.9g} rad/s)"
+        stopped = f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
     return _branch(problem, points, folds, stopped, stability)
+
+
+def _at(problem, value: float) -> str:
+    """``omega = 62.8 rad/s``, or the problem's own parameter (``problem.parameter``: its name and unit)."""
+    name, unit = getattr(problem, "parameter", ("omega", "rad/s"))
+    return f"{name} = {value:.9g} {unit}"
 
 
 def _branch(problem, points, folds, stopped, stability) -> Branch:
@@ -215,7 +222,7 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
             if corner is not None:
                 return corner, first, ""
         ds *= 0.5
-    return None, ds, (f"the step fell below ds_min = {ds_min:g} at omega = {point.y[-1]:.9g} rad/s: the corrector did "
+    return None, ds, (f"the step fell below ds_min = {ds_min:g} at {_at(problem, point.y[-1])}: the corrector did "
                       f"not converge to a relative residual of {tol:g}, nor a step in omega alone")
 
 

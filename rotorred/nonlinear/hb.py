@@ -25,7 +25,8 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
 
-__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "transformed_forces"]
+__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "sampled_forces",
+           "transformed_forces"]
 
 
 class NotConverged(RuntimeError):
@@ -124,7 +125,21 @@ class PeriodicProblem:
         """The nonlinear force's coefficients and the Toeplitz matrices of its derivatives, T(df/dq) and
         T(df/dv)."""
         q, v = self.samples(z, omega)
-        return transformed_forces(self.harmonics, [(force, list(force.dofs)) for force in self.forces], q, v)
+        return transformed_forces(self.harmonics, self.force_columns, q, v)
+
+    @property
+    def dofs(self) -> tuple[int, ...]:
+        """The DOFs of the unknowns: all of them."""
+        return tuple(range(self.n))
+
+    @property
+    def force_columns(self) -> list:
+        """Each nonlinear force with the columns of its DOFs among the unknowns."""
+        return [(force, list(force.dofs)) for force in self.forces]
+
+    def velocity_matrix(self, omega: float) -> np.ndarray:
+        """D(omega) = D + omega D1 (N s/m)."""
+        return self.D if self.D1 is None else self.D + omega * self.D1
 
     def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
         """The residual and its analytic derivatives at ``(z, omega)``."""
@@ -159,13 +174,13 @@ def checked_matrices(problem) -> int:
     return n
 
 
-def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
-    """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients, and the Toeplitz matrices
-    of their derivatives, T(df/dq) and T(df/dv). ``forces`` pairs each force with the columns of its DOFs."""
-    m = q.shape[1]
-    f = np.zeros((h.N, m))
-    dq = np.zeros((h.N, m, m))
-    dv = np.zeros((h.N, m, m))
+def sampled_forces(forces, q: np.ndarray, v: np.ndarray):
+    """The nonlinear forces and their derivatives at the samples ``q``, ``v`` (N, m): f (N, m), df/dq and df/dv
+    (N, m, m). ``forces`` pairs each force with the columns of its DOFs."""
+    N, m = q.shape
+    f = np.zeros((N, m))
+    dq = np.zeros((N, m, m))
+    dv = np.zeros((N, m, m))
     for force, idx in forces:
         fi, dqi, dvi = force.evaluate(q[:, idx], v[:, idx])
         f[:, idx] += fi
@@ -173,6 +188,14 @@ def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
             for b, ib in enumerate(idx):
                 dq[:, ia, ib] += dqi[:, a, b]
                 dv[:, ia, ib] += dvi[:, a, b]
+    return f, dq, dv
+
+
+def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
+    """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients, and the Toeplitz matrices
+    of their derivatives, T(df/dq) and T(df/dv). ``forces`` pairs each force with the columns of its DOFs."""
+    f, dq, dv = sampled_forces(forces, q, v)
+    m = q.shape[1]
     Tv = h.toeplitz(dv) if dv.any() else np.zeros((h.size * m, h.size * m))
     return h.coefficients(f), h.toeplitz(dq), Tv
 
