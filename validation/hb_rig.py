@@ -13,7 +13,9 @@ Prints:
 2. a continuation in the clearance from 50 um (no contact) to 13 um with 30 harmonics (points, folds, time), the
    orbit it ends on refined to 100 harmonics, its distance from the transient's orbit and its lines;
 3. the stability of both orbits from the monodromy matrix of the whole linearised system (largest Floquet
-   multiplier modulus; < 1 stable).
+   multiplier modulus; < 1 stable);
+4. transients started on each orbit (its state at t = 0, ``RubProblem.final_state``) and run for 2 s: the distance of
+   their last period from each orbit (relative, in the Fourier coefficients of the unknowns).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.run import build_model, run_scene
 from rotorred.scenes.schema import load_scene
+from rotorred.transient.newmark import simulate
 
 OUTPUT = (14, "y")
 
@@ -96,6 +99,21 @@ def main() -> None:
         fl = floquet_by_monodromy(rp100.problem, z, rp100.omega, substeps=1)
         print(f"  {name}: largest |multiplier| {np.abs(fl.multipliers).max():.4f} "
               f"({'stable' if fl.stable else 'unstable'}), {time.perf_counter() - t0:.1f} s")
+    print("transients started on each orbit, 2 s later (last period):")
+    for name, z in (("from the transient's orbit", zA), ("from the continuation's orbit", zB)):
+        zt = settled_from(scene, sm, rp100, z)
+        print(f"  {name}: distance {np.linalg.norm(zt - zA) / np.linalg.norm(zA):.4f} from the transient's orbit, "
+              f"{np.linalg.norm(zt - zB) / np.linalg.norm(zB):.4f} from the continuation's")
+
+
+def settled_from(scene, sm, rp, z):
+    """The coefficients of the last period of a 2 s transient started on the orbit ``z``."""
+    res = simulate(sm.model, scene.speeds, 2.0, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
+                   rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=1.9, start=rp.final_state(z))
+    window = res.t >= res.t[-1] - 1.0 / rp.f0 + 1e-9
+    contact = res.contacts[0]
+    records = {0: res.outputs[(18, "x")], 1: res.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    return rp.start_from_record(res.t[window], {j: x[window] for j, x in records.items()})
 
 
 if __name__ == "__main__":

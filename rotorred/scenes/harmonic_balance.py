@@ -72,6 +72,29 @@ class RubProblem:
         out.update({k * self.f0: math.hypot(y[2 * k - 1], y[2 * k]) for k in range(1, h.H + 1)})
         return out
 
+    def final_state(self, z: np.ndarray):
+        """The solution's state at t = 0 as a transient's start (:class:`rotorred.transient.results.FinalState`): the
+        model's and the plates' displacements, velocities and accelerations from the Fourier series, the contact
+        forces and slip directions of the law there. ``simulate(..., start=...)`` then runs on from the orbit."""
+        from rotorred.transient.results import FinalState
+
+        h, w = self.problem.harmonics, self.omega
+        c = self.problem.recover(z, w).reshape(h.size, -1)
+        k = np.arange(1, h.H + 1)[:, None]
+        q = c[0] + c[1::2].sum(axis=0)
+        v = w * (k * c[2::2]).sum(axis=0)
+        a = -w * w * (k * k * c[1::2]).sum(axis=0)
+        n, plates = self.n_model, len(self.problem.forces)
+        plate = np.array([[[q[n + 2 * i + j], v[n + 2 * i + j], a[n + 2 * i + j]] for j in range(2)]
+                          for i in range(plates)])
+        forces, sgn = np.zeros((plates, 2)), np.zeros(plates)
+        for i, rub in enumerate(self.problem.forces):
+            f, _, _ = rub.evaluate(q[list(rub.dofs)][None, :], v[list(rub.dofs)][None, :])
+            forces[i] = (-f[0, 2], f[0, 3])  # the force on (u_n, u_t) is (-P, T)
+            sgn[i] = np.sign(rub.surface_speed - v[rub.dofs[0]] * math.sin(rub.plate.theta)
+                             + v[rub.dofs[1]] * math.cos(rub.plate.theta) - v[rub.dofs[3]]) or 1.0
+        return FinalState(0.0, q[:n], v[:n], a[:n], plate, forces, np.ones(plates, dtype=np.int64), sgn)
+
     def start_from_record(self, t: np.ndarray, records: dict) -> np.ndarray:
         """Coefficients of the unknowns fitted to a transient's settled record: ``records`` maps each unknown's
         position (0, 1, ... : disk x, disk y, plate u_n, plate u_t per plate) to its samples at ``t``, which must span
