@@ -299,3 +299,16 @@ def test_the_monodromy_of_a_condensed_problem_is_the_full_systems(four_dof):
     b = floquet_by_monodromy(condensed, z, omega, 4)
     assert abs(a.max_real - b.max_real) < 1e-14
     assert abs(a.max_real - floquet(full, z_full, omega).max_real) < 7e-5
+
+
+def test_toeplitz_blocks_shared_by_proportional_entries():
+    """A rank-1 Jacobian (a rub's: entry (i, j) = a_i g_j s(theta)) with zero entries, at H = 100 and N = 2048 (the
+    spectral path): its Toeplitz matrix, built from one shared block, equals the product written out for every pair
+    (measured 6.2e-15 of the largest entry; two distinct shapes among the 16 entries)."""
+    h = Harmonics(100, 2048)
+    rng = np.random.default_rng(7)
+    shape = np.maximum(rng.standard_normal(2048), 0.0)  # a force that is zero over part of the period
+    d = np.einsum("i,j,t->tij", [1.0, -0.15, -1.0, 0.15], [0.0, 1.0, -1.0, 0.0], shape)
+    d[:, 0, 0] += 0.3 * np.cos(2 * np.pi * np.arange(2048) / 2048)  # and one entry of another shape
+    exact = h.toeplitz_by_samples(d)
+    assert np.max(np.abs(h.toeplitz(d) - exact)) < 6.2e-14 * np.max(np.abs(exact))

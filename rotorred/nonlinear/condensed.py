@@ -91,6 +91,13 @@ class CondensedProblem:
                                                         for force in self.forces))
         m, h = len(dofs), self.harmonics
         object.__setattr__(self, "_N1", np.kron(h.nabla, np.eye(m)))
+        # X @ (nabla (x) I) is a permutation and scaling of X's columns: (a_k, b_k) <- (-k b_k, k a_k)
+        source, scale = np.arange(self.size), np.zeros(self.size)
+        for k in range(1, h.H + 1):
+            a, b = slice((2 * k - 1) * m, 2 * k * m), slice(2 * k * m, (2 * k + 1) * m)
+            source[a], source[b] = np.arange(b.start, b.stop), np.arange(a.start, a.stop)
+            scale[a], scale[b] = -k, k
+        object.__setattr__(self, "_nabla_columns", (source, scale))
 
     @property
     def n(self) -> int:
@@ -119,6 +126,7 @@ class CondensedProblem:
         N = self.M.shape[0]
         F, dF = F.reshape(self.harmonics.size, N), dF.reshape(self.harmonics.size, N)
         out = [self._harmonic(k, omega, F, dF) for k in range(self.harmonics.H + 1)]
+        self._cache.clear()
         self._cache.update(omega=omega, harmonics=out)
         return out
 
@@ -136,41 +144,57 @@ class CondensedProblem:
         Q = sla.lu_solve(lu, f.astype(complex))
         return _Harmonic(H_cc=X[c], dH_cc=-Y @ dZ @ X, q_lin=Q[c], dq_lin=Y @ (df - dZ @ Q), Q_full=Q, X=X)
 
-    def compliance_blocks(self, omega: float) -> np.ndarray:
-        """G(omega): the real block-diagonal form of (Z_k^-1)_cc over the harmonics, shape (size, size)."""
-        return self._real_blocks(self._compliance(omega))[0]
+    def compliance_blocks(self, omega: float):
+        """G(omega): the real block-diagonal form of (Z_k^-1)_cc over the harmonics, as blocks (:meth:`apply`)."""
+        return self._blocks(omega)[0]
 
     def linear_response(self, omega: float) -> np.ndarray:
         """The coefficients of the ``dofs`` without the nonlinear forces."""
-        return self._real_blocks(self._compliance(omega))[2]
+        return self._blocks(omega)[2]
 
     def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
-        """The condensed residual and its analytic derivatives at ``(z, omega)``."""
-        parts = self._compliance(omega)
+        """The condensed residual and its analytic derivatives at ``(z, omega)``. G is applied block by block (one
+        block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a permutation of columns: no dense product of size^3."""
+        G, dG, z_lin, dz_lin = self._blocks(omega)
         F_nl, Tq, Tv = self._nonlinear(z, omega)
-        G, dG, z_lin, dz_lin = self._real_blocks(parts)
-        J = np.eye(self.size) + G @ (Tq + omega * (Tv @ self._N1))
-        R = z - z_lin + G @ F_nl
-        dR = -dz_lin + dG @ F_nl + G @ (Tv @ (self._N1 @ z))
+        source, scale = self._nabla_columns
+        J = np.eye(self.size) + self.apply(G, Tq + omega * (Tv[:, source] * scale))
+        R = z - z_lin + self.apply(G, F_nl)
+        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, Tv @ (self._N1 @ z))
         return Evaluation(R, J, dR, float(np.linalg.norm(z_lin)) or 1.0)
 
+    def apply(self, blocks, X: np.ndarray) -> np.ndarray:
+        """``G X`` for G given by its blocks (:meth:`_blocks`): the m x m block of harmonic 0 and the (2m x 2m) ones of
+        harmonics 1..H, on the harmonic-major rows of X (a vector or a matrix)."""
+        G0, Gk = blocks
+        m, H = self.n, self.harmonics.H
+        X2 = X.reshape(self.size, -1)
+        out = np.empty_like(X2)
+        out[:m] = G0 @ X2[:m]
+        out[m:] = np.matmul(Gk, X2[m:].reshape(H, 2 * m, -1)).reshape(H * 2 * m, -1)
+        return out.reshape(X.shape)
+
+    def _blocks(self, omega: float):
+        """G and dG/domega as blocks, z_lin and dz_lin/domega, at ``omega`` (cached with the compliance)."""
+        parts = self._compliance(omega)
+        if "blocks" not in self._cache:
+            self._cache["blocks"] = self._real_blocks(parts)
+        return self._cache["blocks"]
+
     def _real_blocks(self, parts: list[_Harmonic]):
-        """G, dG/domega (block-diagonal, real) and z_lin, dz_lin/domega (harmonic-major) from the harmonics."""
-        m = self.n
-        G, dG = np.zeros((self.size, self.size)), np.zeros((self.size, self.size))
+        """G, dG/domega as blocks (the real form [[Re H, Im H], [-Im H, Re H]] per harmonic) and z_lin, dz_lin/domega
+        (harmonic-major) from the harmonics."""
+        m, H = self.n, self.harmonics.H
+        Gk, dGk = np.zeros((H, 2 * m, 2 * m)), np.zeros((H, 2 * m, 2 * m))
         z_lin, dz_lin = np.zeros(self.size), np.zeros(self.size)
-        for k, p in enumerate(parts):
-            if k == 0:
-                G[:m, :m], dG[:m, :m] = p.H_cc.real, p.dH_cc.real
-                z_lin[:m], dz_lin[:m] = p.q_lin.real, p.dq_lin.real
-                continue
+        z_lin[:m], dz_lin[:m] = parts[0].q_lin.real, parts[0].dq_lin.real
+        for k, p in enumerate(parts[1:], start=1):
+            for target, Hc in ((Gk, p.H_cc), (dGk, p.dH_cc)):
+                target[k - 1] = np.block([[Hc.real, Hc.imag], [-Hc.imag, Hc.real]])
             a, b = slice((2 * k - 1) * m, 2 * k * m), slice(2 * k * m, (2 * k + 1) * m)
-            for target, H in ((G, p.H_cc), (dG, p.dH_cc)):
-                target[a, a], target[a, b] = H.real, H.imag
-                target[b, a], target[b, b] = -H.imag, H.real
             z_lin[a], z_lin[b] = p.q_lin.real, -p.q_lin.imag
             dz_lin[a], dz_lin[b] = p.dq_lin.real, -p.dq_lin.imag
-        return G, dG, z_lin, dz_lin
+        return (parts[0].H_cc.real, Gk), (parts[0].dH_cc.real, dGk), z_lin, dz_lin
 
     @property
     def force_columns(self) -> list:
@@ -255,5 +279,5 @@ class ClearanceFamily:
         q, v = problem.samples(z, self.omega)
         d = np.zeros((self.harmonics.N, self.n))
         d[:, idx] = rub.d_clearance(q[:, idx], v[:, idx])
-        dR = self.base.compliance_blocks(self.omega) @ self.harmonics.coefficients(d)
+        dR = self.base.apply(self.base.compliance_blocks(self.omega), self.harmonics.coefficients(d))
         return Evaluation(ev.R, ev.dR_dz, dR, ev.scale)
