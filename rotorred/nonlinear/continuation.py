@@ -30,6 +30,10 @@ __all__ = ["Fold", "Branch", "continue_branch"]
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
 MAX_JUMP = 2.0
+#: Newton iterations, and step halvings in each, that a step in omega alone gets at a corner: one that lands near
+#: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
+CORNER_ITERATIONS = 12
+CORNER_HALVINGS = 4
 
 
 @dataclass(frozen=True)
@@ -263,7 +267,7 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
     """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
     just traced."""
     try:
-        z, ev, it = solve(problem, start, omega, tol=tol)
+        z, ev, it = solve(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
     except NotConverged:
         return None
     y = np.append(z, omega)

@@ -200,8 +200,12 @@ def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
     return h.coefficients(f), h.toeplitz(dq), Tv
 
 
-def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40):
+def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
+          max_halvings: int = 30):
     """The periodic solution near ``z0`` at ``omega`` by Newton's method with a backtracking line search.
+
+    max_halvings : int
+        How often the line search may halve a step before giving up.
 
     Returns
     -------
@@ -222,7 +226,7 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
             step = sla.solve(ev.dR_dz, -ev.R)
         except (sla.LinAlgError, ValueError):
             raise NotConverged(omega, ev.relative, tol, it, "singular Jacobian") from None
-        z, ev = _line_search(problem, z, step, omega, ev)
+        z, ev = _line_search(problem, z, step, omega, ev, tries=max_halvings)
         if ev is None:
             raise NotConverged(omega, float(np.linalg.norm(problem.evaluate(z, omega).R)) /
                                problem.evaluate(z, omega).scale, tol, it, "no step reduces the residual")
