@@ -210,6 +210,9 @@ def test_the_aft_transforms_are_the_dft(H, N):
     assert np.max(np.abs(np.linalg.pinv(h.E) @ f - z.reshape(h.size, 2))) < 1e-13
     d = rng.standard_normal((N, 2, 2))
     assert np.max(np.abs(h._toeplitz_by_spectrum(d) - h.toeplitz_by_samples(d))) < 3.7e-14
+    N1 = np.kron(h.nabla, np.eye(2))  # the derivative on the coefficients, as a permutation: exactly the product
+    X = rng.standard_normal((3, h.size * 2))
+    assert np.array_equal(h.times_derivative(X, 2), X @ N1) and np.array_equal(h.derivative(z, 2), N1 @ z)
 
 
 @pytest.fixture(scope="module")

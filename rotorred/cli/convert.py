@@ -21,18 +21,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from rotorred.model.rotor_file import RotorFileError, read_text_file, rotor_document, rotor_from_dict
+    from rotorred.model.rotor_file import (RotorFileError, read_rotor_toml, read_text_file, rotor_document,
+                                           rotor_from_dict)
     from rotorred.model.ross_file import is_ross_document
     from rotorred.writers import write_toml
 
     source, target = Path(args.source), _target(args.target, args.source)
     if not source.is_file():
         checks.fail("ROSS_FILE", args.source, "must be an existing file (a rotor saved by ROSS 3)")
-    text = read_text_file(source, RotorFileError)
-    document = rotor_document(text, str(source), name=source.stem)
-    if not is_ross_document(_parsed(text)):
+    data = read_rotor_toml(read_text_file(source, RotorFileError), str(source))
+    if not is_ross_document(data):
         checks.fail("ROSS_FILE", args.source, "must be a rotor saved by ROSS (it has no ross_version line); it reads "
                     "as a rotorred rotor file already")
+    document = rotor_document(data, str(source), name=source.stem)
     try:
         rotor = rotor_from_dict(document)
     except RotorFileError as exc:
@@ -63,8 +64,3 @@ def _target(text: str, source: str) -> Path:
         checks.fail("OUT", text, f"must be in an existing folder; {str(path.parent)!r} does not exist")
     return path
 
-
-def _parsed(text: str) -> dict:
-    from rotorred.model.rotor_file import RotorFileError, read_toml
-
-    return read_toml(text, RotorFileError)

@@ -56,7 +56,8 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["RotorFileError", "presets", "load_rotor", "rotor_document", "rotor_from_toml", "rotor_from_dict", "read_toml"]
+__all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor_toml", "rotor_document", "rotor_from_toml",
+           "rotor_from_dict", "read_toml"]
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}
@@ -115,17 +116,25 @@ def load_rotor(spec: str | Path) -> Rotor:
     return rotor_from_toml(read_text_file(path, RotorFileError), source=str(path), name=path.stem)
 
 
-def rotor_document(text: str, source: str = "<string>", name: str = "ross-rotor") -> dict[str, Any]:
-    """The rotor-file document of a TOML text: a rotorred rotor file as parsed, a rotor saved by ROSS 3 converted
+def read_rotor_toml(text: str, source: str = "<string>") -> dict[str, Any]:
+    """The parsed TOML of a rotor file (rotorred's or ROSS's); a syntax error is a :class:`RotorFileError` naming
+    ``source``."""
+    try:
+        return read_toml(text, RotorFileError)
+    except RotorFileError as exc:
+        raise exc.from_source(source) from None
+
+
+def rotor_document(data: dict[str, Any], source: str = "<string>", name: str = "ross-rotor") -> dict[str, Any]:
+    """The rotor-file document of parsed TOML: a rotorred rotor file as it is, a rotor saved by ROSS 3 converted
     (:func:`rotorred.model.ross_file.ross_document`, named ``name``).
 
     Raises
     ------
     RotorFileError
-        For text that is not TOML, or a ROSS rotor rotorred cannot represent, naming ``source`` and the key.
+        For a ROSS rotor rotorred cannot represent, naming ``source`` and the key.
     """
     try:
-        data = read_toml(text, RotorFileError)
         return ross_document(data, name) if is_ross_document(data) else data
     except InputError as exc:
         raise RotorFileError(exc.field, exc.value, exc.requirement, exc.unit).from_source(source) from None
@@ -169,7 +178,7 @@ def rotor_from_toml(text: str, source: str = "<string>", name: str = "ross-rotor
     RotorFileError
         Naming ``source``, the key path, the value and what is allowed.
     """
-    document = rotor_document(text, source, name)
+    document = rotor_document(read_rotor_toml(text, source), source, name)
     try:
         return rotor_from_dict(document)
     except RotorFileError as exc:

@@ -28,7 +28,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
-from rotorred.nonlinear.hb import Evaluation, checked_matrices, transformed_forces
+from rotorred.nonlinear.hb import Evaluation, checked_matrices, sampled_forces, transformed_forces
 
 __all__ = ["CondensedProblem"]
 
@@ -89,15 +89,6 @@ class CondensedProblem:
         # the forces renumbered on the unknowns, for the AFT
         object.__setattr__(self, "_local_forces", tuple((force, [local[d] for d in force.dofs])
                                                         for force in self.forces))
-        m, h = len(dofs), self.harmonics
-        object.__setattr__(self, "_N1", np.kron(h.nabla, np.eye(m)))
-        # X @ (nabla (x) I) is a permutation and scaling of X's columns: (a_k, b_k) <- (-k b_k, k a_k)
-        source, scale = np.arange(self.size), np.zeros(self.size)
-        for k in range(1, h.H + 1):
-            a, b = slice((2 * k - 1) * m, 2 * k * m), slice(2 * k * m, (2 * k + 1) * m)
-            source[a], source[b] = np.arange(b.start, b.stop), np.arange(a.start, a.stop)
-            scale[a], scale[b] = -k, k
-        object.__setattr__(self, "_nabla_columns", (source, scale))
 
     @property
     def n(self) -> int:
@@ -157,10 +148,10 @@ class CondensedProblem:
         block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a permutation of columns: no dense product of size^3."""
         G, dG, z_lin, dz_lin = self._blocks(omega)
         F_nl, Tq, Tv = self._nonlinear(z, omega)
-        source, scale = self._nabla_columns
-        J = np.eye(self.size) + self.apply(G, Tq + omega * (Tv[:, source] * scale))
+        h, m = self.harmonics, self.n
+        J = np.eye(self.size) + self.apply(G, Tq + omega * h.times_derivative(Tv, m))
         R = z - z_lin + self.apply(G, F_nl)
-        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, Tv @ (self._N1 @ z))
+        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, Tv @ h.derivative(z, m))
         return Evaluation(R, J, dR, float(np.linalg.norm(z_lin)) or 1.0)
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
@@ -212,7 +203,9 @@ class CondensedProblem:
     def recover(self, z: np.ndarray, omega: float) -> np.ndarray:
         """The harmonic-major coefficients of every DOF, shape ((2H + 1) n_all,), from the solution ``z``."""
         parts = self._compliance(omega)
-        F_nl = self._nonlinear(z, omega)[0].reshape(self.harmonics.size, self.n)
+        q, v = self.samples(z, omega)  # the forces only: no Toeplitz matrices
+        F_nl = self.harmonics.coefficients(sampled_forces(self.force_columns, q, v)[0]).reshape(self.harmonics.size,
+                                                                                                 self.n)
         N = self.M.shape[0]
         out = np.zeros((self.harmonics.size, N))
         for k, p in enumerate(parts):

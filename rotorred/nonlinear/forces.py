@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred import checks
-from rotorred.transient.contact import RubPlate, normal_force_samples
+from rotorred.transient.contact import RubPlate, disk_force, normal_force_samples, sliding_velocity
 
 __all__ = ["CubicSpring", "CircularClearance", "PlateRub"]
 
@@ -119,16 +119,27 @@ class PlateRub:
         object.__setattr__(self, "surface_speed", checks.number("surface_speed", self.surface_speed, "m/s"))
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
+        grad, P, dP_dp, dP_drate, per_P = self._law(q, v)
+        return per_P * P[:, None], per_P[:, :, None] * (dP_dp[:, None] * grad)[:, None, :], \
+            per_P[:, :, None] * (dP_drate[:, None] * grad)[:, None, :]
+
+    def slip_sign(self, v: np.ndarray) -> np.ndarray:
+        """sign(v_rel) at the samples of the velocities ``v`` (N, 4) (:func:`rotorred.transient.contact.sliding_velocity`,
+        the rim speed given as Omega r)."""
+        return np.sign(sliding_velocity(self.plate, self.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]))
+
+    def _law(self, q: np.ndarray, v: np.ndarray):
+        """d p / d(x, y, u_n, u_t) (also of p' on the velocities), P and its tangents at the samples, and the forces
+        per unit P, shape (N, 4): ``P n - T t`` on the disk (:func:`rotorred.transient.contact.disk_force` turned to
+        the left-hand side), ``(-P, T)`` on the plate, with ``T = -mu_d sign(v_rel) P``."""
         plate = self.plate
         c, s = math.cos(plate.theta), math.sin(plate.theta)
-        grad = np.array([c, s, -1.0, 0.0])  # d p / d(x, y, u_n, u_t), and of p' on the velocities
+        grad = np.array([c, s, -1.0, 0.0])
         P, dP_dp, dP_drate = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
-        sign = np.sign(self.surface_speed - v[:, 0] * s + v[:, 1] * c - v[:, 3])
-        mu = plate.mu_d * sign
-        dF_dP = np.column_stack([c - mu * s, s + mu * c, -np.ones_like(mu), -mu])  # (N, 4): the forces per unit P
-        f = dF_dP * P[:, None]
-        return f, dF_dP[:, :, None] * (dP_dp[:, None] * grad)[:, None, :], \
-            dF_dP[:, :, None] * (dP_drate[:, None] * grad)[:, None, :]
+        T_per_P = -plate.mu_d * self.slip_sign(v)
+        fx, fy = disk_force(1.0, T_per_P, c, s)
+        per_P = np.column_stack([-fx, -fy, -np.ones_like(T_per_P), T_per_P])
+        return grad, P, dP_dp, dP_drate, per_P
 
     def with_clearance(self, clearance: float) -> PlateRub:
         """The same rub at another clearance (m)."""
@@ -136,10 +147,5 @@ class PlateRub:
 
     def d_clearance(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """d f / d clearance at the samples, shape (N, 4) (N/m): the penetration falls as the clearance grows."""
-        plate = self.plate
-        c, s = math.cos(plate.theta), math.sin(plate.theta)
-        grad = np.array([c, s, -1.0, 0.0])
-        _, dP_dp, _ = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
-        mu = plate.mu_d * np.sign(self.surface_speed - v[:, 0] * s + v[:, 1] * c - v[:, 3])
-        dF_dP = np.column_stack([c - mu * s, s + mu * c, -np.ones_like(mu), -mu])
-        return -dF_dP * dP_dp[:, None]
+        _, _, dP_dp, _, per_P = self._law(q, v)
+        return -per_P * dP_dp[:, None]

@@ -152,6 +152,21 @@ class Harmonics:
         """``dq/dtheta (theta_j)``, shape (N, n): multiply by omega for dq/dt."""
         return self.E @ (self.nabla @ z.reshape(self.size, n))
 
+    def derivative(self, z: np.ndarray, n: int) -> np.ndarray:
+        """The harmonic-major coefficients of dq/dtheta, ``(nabla (x) I_n) z``, shape ((2H + 1) n,)."""
+        return (self.nabla @ z.reshape(self.size, n)).reshape(-1)
+
+    def times_derivative(self, X: np.ndarray, n: int) -> np.ndarray:
+        """``X (nabla (x) I_n)`` for X of shape (p, (2H + 1) n): a permutation and scaling of X's columns,
+        (a_k, b_k) <- (-k b_k, k a_k), not a dense product."""
+        H = self.H
+        X3 = X.reshape(X.shape[0], self.size, n)
+        out = np.zeros_like(X3)
+        k = np.arange(1, H + 1)[None, :, None]
+        out[:, 1::2] = -k * X3[:, 2::2]
+        out[:, 2::2] = k * X3[:, 1::2]
+        return out.reshape(X.shape)
+
     def coefficients(self, f: np.ndarray) -> np.ndarray:
         """The harmonic-major coefficients of samples ``f`` (N, n): the first H + 1 terms of the DFT, as the matrix
         product ``forward @ f`` where that is the cheaper (:data:`MATRIX_US`), else by the FFT (pyFFTW). Both are

@@ -88,8 +88,7 @@ class PeriodicProblem:
                     checks.fail(f"forces[{i}].dofs", force.dofs, f"must be DOFs of the system (0-{n - 1})")
         h = self.harmonics
         eye_h, nabla = np.eye(h.size), h.nabla
-        self._ops.update(IK=np.kron(eye_h, self.K), N2M=np.kron(nabla @ nabla, self.M), N1=np.kron(nabla, np.eye(n)),
-                         NM=np.kron(nabla, self.M), ND=np.kron(nabla, self.D),
+        self._ops.update(IK=np.kron(eye_h, self.K), N2M=np.kron(nabla @ nabla, self.M), NM=np.kron(nabla, self.M), ND=np.kron(nabla, self.D),
                          ND1=None if self.D1 is None else np.kron(nabla, self.D1))
 
     @property
@@ -148,20 +147,22 @@ class PeriodicProblem:
         F_nl, Tq, Tv = self.nonlinear(z, omega)
         Lz = L @ z
         R = Lz + F_nl - F
-        rate = self._ops["N1"] @ z  # coefficients of dq/dtheta
-        J = L + Tq + omega * (Tv @ self._ops["N1"])
-        dR_domega = dL @ z + Tv @ rate - dF
+        dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
         scale = float(np.linalg.norm(F)) or float(np.linalg.norm(Lz)) or 1.0
-        return Evaluation(R, J, dR_domega, scale)
+        return Evaluation(R, self._jacobian(L, Tq, Tv, omega), dR_domega, scale)
+
+    def _jacobian(self, L: np.ndarray, Tq: np.ndarray, Tv: np.ndarray, omega: float) -> np.ndarray:
+        """dR/dz = L + T(df/dq) + omega T(df/dv) (nabla (x) I)."""
+        return L + Tq + omega * self.harmonics.times_derivative(Tv, self.n)
 
     def hill_matrices(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(A2, A1, A0)`` of the Hill quadratic eigenproblem ``(lambda^2 A2 + lambda A1 + A0) p = 0`` of the
         perturbation ``e^{lambda t} p(t)`` about the solution ``z`` (``A0`` is ``dR/dz``)."""
-        _, _, Tv = self.nonlinear(z, omega)
-        D = self.D if self.D1 is None else self.D + omega * self.D1
-        A2 = np.kron(np.eye(self.harmonics.size), self.M)
-        A1 = 2.0 * omega * self._ops["NM"] + np.kron(np.eye(self.harmonics.size), D) + Tv
-        return A2, A1, self.evaluate(z, omega).dR_dz
+        _, Tq, Tv = self.nonlinear(z, omega)
+        eye = np.eye(self.harmonics.size)
+        A2 = np.kron(eye, self.M)
+        A1 = 2.0 * omega * self._ops["NM"] + np.kron(eye, self.velocity_matrix(omega)) + Tv
+        return A2, A1, self._jacobian(self.linear(omega)[0], Tq, Tv, omega)
 
 
 def checked_matrices(problem) -> int:

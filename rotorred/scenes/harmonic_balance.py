@@ -91,8 +91,7 @@ class RubProblem:
         for i, rub in enumerate(self.problem.forces):
             f, _, _ = rub.evaluate(q[list(rub.dofs)][None, :], v[list(rub.dofs)][None, :])
             forces[i] = (-f[0, 2], f[0, 3])  # the force on (u_n, u_t) is (-P, T)
-            sgn[i] = np.sign(rub.surface_speed - v[rub.dofs[0]] * math.sin(rub.plate.theta)
-                             + v[rub.dofs[1]] * math.cos(rub.plate.theta) - v[rub.dofs[3]]) or 1.0
+            sgn[i] = rub.slip_sign(v[list(rub.dofs)][None, :])[0] or 1.0
         return FinalState(0.0, q[:n], v[:n], a[:n], plate, forces, np.ones(plates, dtype=np.int64), sgn)
 
     def start_from_record(self, t: np.ndarray, records: dict) -> np.ndarray:
