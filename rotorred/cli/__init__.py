@@ -23,6 +23,7 @@ from pathlib import Path
 
 #: command modules, in the order ``rotorred --help`` lists them
 COMMANDS = [
+    "branch",  # rotorred continue
     "campbell",
     "convert",
     "harmonic",

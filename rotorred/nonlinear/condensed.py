@@ -28,7 +28,8 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
-from rotorred.nonlinear.hb import Evaluation, checked_matrices, sampled_forces, transformed_forces
+from rotorred.nonlinear.hb import Evaluation, checked_matrices, force_coefficients, sampled_forces
+from rotorred.nonlinear.lowrank import IdentityPlusLowRank
 
 __all__ = ["CondensedProblem"]
 
@@ -143,15 +144,26 @@ class CondensedProblem:
         """The coefficients of the ``dofs`` without the nonlinear forces."""
         return self._blocks(omega)[2]
 
-    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
-        """The condensed residual and its analytic derivatives at ``(z, omega)``. G is applied block by block (one
-        block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a permutation of columns: no dense product of size^3."""
+    def evaluate(self, z: np.ndarray, omega: float, jacobian: bool = True) -> Evaluation:
+        """The condensed residual and (unless ``jacobian`` is False: then None) its analytic derivatives at
+        ``(z, omega)``. G is applied block by block (one block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a
+        permutation of columns: no dense product of size^3."""
         G, dG, z_lin, dz_lin = self._blocks(omega)
-        F_nl, Tq, Tv = self._nonlinear(z, omega)
+        q, v = self.samples(z, omega)
         h, m = self.harmonics, self.n
-        J = np.eye(self.size) + self.apply(G, Tq + omega * h.times_derivative(Tv, m))
+        if not jacobian:
+            F_nl = force_coefficients(h, self._local_forces, q, v)
+            return Evaluation(z - z_lin + self.apply(G, F_nl), None, None, float(np.linalg.norm(z_lin)) or 1.0)
+        f, dq, dv = sampled_forces(self._local_forces, q, v)
+        F_nl = h.coefficients(f)
+        factors = h.low_rank(dq, dv, omega, max_rank=self.size // 2)
+        if factors is not None:  # I + G U V^T, solved by Woodbury
+            J = IdentityPlusLowRank(self.apply(G, factors[0]), factors[1])
+        else:
+            J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
         R = z - z_lin + self.apply(G, F_nl)
-        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, Tv @ h.derivative(z, m))
+        dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
+        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
         return Evaluation(R, J, dR, float(np.linalg.norm(z_lin)) or 1.0)
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
@@ -196,16 +208,11 @@ class CondensedProblem:
         """D(omega) = D + omega D1 (N s/m)."""
         return self.D if self.D1 is None else self.D + omega * self.D1
 
-    def _nonlinear(self, z: np.ndarray, omega: float):
-        q, v = self.samples(z, omega)
-        return transformed_forces(self.harmonics, self._local_forces, q, v)
-
     def recover(self, z: np.ndarray, omega: float) -> np.ndarray:
         """The harmonic-major coefficients of every DOF, shape ((2H + 1) n_all,), from the solution ``z``."""
         parts = self._compliance(omega)
         q, v = self.samples(z, omega)  # the forces only: no Toeplitz matrices
-        F_nl = self.harmonics.coefficients(sampled_forces(self.force_columns, q, v)[0]).reshape(self.harmonics.size,
-                                                                                                 self.n)
+        F_nl = force_coefficients(self.harmonics, self._local_forces, q, v).reshape(self.harmonics.size, self.n)
         N = self.M.shape[0]
         out = np.zeros((self.harmonics.size, N))
         for k, p in enumerate(parts):
@@ -252,11 +259,13 @@ class ClearanceFamily:
         return self.base.harmonics
 
     def at(self, clearance: float) -> CondensedProblem:
-        """The problem at ``clearance`` (m)."""
+        """The problem at ``clearance`` (m), sharing the base's compliance at ``omega`` (the clearance leaves it)."""
         forces = list(self.base.forces)
         forces[self.rub] = forces[self.rub].with_clearance(clearance)
-        return CondensedProblem(self.base.M, self.base.D, self.base.K, self.base.harmonics, self.base.dofs,
-                                self.base.forcing, tuple(forces), self.base.D1)
+        problem = CondensedProblem(self.base.M, self.base.D, self.base.K, self.base.harmonics, self.base.dofs,
+                                   self.base.forcing, tuple(forces), self.base.D1)
+        problem._cache.update(self.base._compliance_cache(self.omega))
+        return problem
 
     def samples(self, z: np.ndarray, clearance: float):
         return self.base.samples(z, self.omega)
@@ -264,10 +273,11 @@ class ClearanceFamily:
     def linear_response(self, clearance: float) -> np.ndarray:
         return self.base.linear_response(self.omega)
 
-    def evaluate(self, z: np.ndarray, clearance: float) -> Evaluation:
+    def evaluate(self, z: np.ndarray, clearance: float, jacobian: bool = True) -> Evaluation:
         problem = self.at(clearance)
-        problem._cache.update(self.base._compliance_cache(self.omega))
-        ev = problem.evaluate(z, self.omega)
+        ev = problem.evaluate(z, self.omega, jacobian)
+        if not jacobian:
+            return ev
         rub, idx = problem._local_forces[self.rub]
         q, v = problem.samples(z, self.omega)
         d = np.zeros((self.harmonics.N, self.n))

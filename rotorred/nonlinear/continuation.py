@@ -23,6 +23,7 @@ from scipy.optimize import brentq
 
 from rotorred import checks
 from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
 
 __all__ = ["Fold", "Branch", "continue_branch"]
@@ -101,7 +102,7 @@ class _Point:
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
                     ds: float = 0.05, ds_min: float = 1e-6, ds_max: float = 0.2, max_points: int = 5000,
-                    tol: float = 1e-10, stability: bool = True) -> Branch:
+                    tol: float = 1e-10, stability: bool = True, progress=None) -> Branch:
     """Follow the branch through ``z0`` at ``omega_start`` until omega passes ``omega_end`` (either direction).
 
     Parameters
@@ -118,6 +119,9 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         Relative residual of every point (:func:`rotorred.nonlinear.hb.solve`).
     stability : bool
         Compute each point's Floquet exponents (Hill's method).
+    progress : callable, optional
+        ``progress(points, omega)`` after each point. An interrupt (SIGINT) ends the branch where it is: the points
+        so far are returned, ``stopped`` saying so.
 
     Returns
     -------
@@ -130,12 +134,18 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     while len(points) < max_points:
-        nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
+        if progress is not None:
+            progress(len(points), points[-1].y[-1])
+        try:
+            nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
+            if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
+                folds.append(_locate_fold(problem, points[-1], nxt, tol))
+        except KeyboardInterrupt:
+            stopped = f"interrupted (SIGINT) at {_at(problem, points[-1].y[-1])}, after {len(points)} points"
+            break
         if nxt is None:
             stopped = why
             break
-        if nxt.t[-1] * points[-1].t[-1] < 0.0:
-            folds.append(_locate_fold(problem, points[-1], nxt, tol))
         points.append(nxt)
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
             break
@@ -149,8 +159,10 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
 
 
 def _at(problem, value: float) -> str:
-    """``omega = 62.8 rad/s``, or the problem's own parameter (``problem.parameter``: its name and unit)."""
+    """``omega = 62.8 rad/s``, or the problem's own parameter (``problem.parameter``: its name and unit; a scaled
+    parameter is shown in its own unit by ``problem.parameter_value``)."""
     name, unit = getattr(problem, "parameter", ("omega", "rad/s"))
+    value = getattr(problem, "parameter_value", lambda v: v)(value)
     return f"{name} = {value:.9g} {unit}"
 
 
@@ -167,43 +179,49 @@ def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarra
     """The unit null vector of ``[dR/dz, dR/domega]`` at ``y`` (``ev``: its evaluation, if at hand), oriented along
     ``previous`` (or with omega growing in ``direction`` at the start)."""
     ev = ev if ev is not None else problem.evaluate(y[:-1], y[-1])
-    J = np.column_stack([ev.dR_dz, ev.dR_domega])
     guide = previous if previous is not None else np.append(np.zeros(len(y) - 1), direction)
-    t = sla.solve(np.vstack([J, guide]), np.append(np.zeros(len(y) - 1), 1.0))
+    return _unit_along(bordered(ev.dR_dz, ev.dR_domega, guide), guide)
+
+
+def _unit_along(matrix, guide: np.ndarray) -> np.ndarray:
+    """The unit vector t solving ``matrix t = e_last`` for the factored bordered Jacobian ``[[dR/dz, dR/domega],
+    [guide]]``, oriented along ``guide``: the tangent."""
+    t = matrix.solve(np.append(np.zeros(len(guide) - 1), 1.0))
     t /= np.linalg.norm(t)
     return t if t @ guide > 0 else -t
 
 
 def _correct(problem, y_pred, t, tol, max_iter: int = 20):
     """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``, each step shortened until it lowers the residual (a
-    contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its evaluation, or
-    None."""
+    contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its unit tangent, or
+    None. Each new iterate's residual is evaluated first, its Jacobian only if it has not converged: the tangent
+    is the one of the last Jacobian (the iterate a Newton step before, solved with its factors)."""
     y = y_pred.copy()
     ev = problem.evaluate(y[:-1], y[-1])
-    for it in range(max_iter + 1):
-        if ev.relative <= tol and it > 0:
-            return y, it, ev
-        if it == max_iter:
-            return None
-        J = np.vstack([np.column_stack([ev.dR_dz, ev.dR_domega]), t])
+    for it in range(max_iter):
         try:
-            step = sla.solve(J, -np.append(ev.R, t @ (y - y_pred)))
+            matrix = bordered(ev.dR_dz, ev.dR_domega, t)
+            step = matrix.solve(-np.append(ev.R, t @ (y - y_pred)))
         except (sla.LinAlgError, ValueError):
             return None
         y, ev = _shortened(problem, y, step, ev)
         if ev is None:
             return None
+        if ev.relative <= tol:
+            return y, it + 1, _unit_along(matrix, t)
+        if ev.dR_dz is None:
+            ev = problem.evaluate(y[:-1], y[-1])
     return None
 
 
 def _shortened(problem, y, step, ev, tries: int = 12):
     """``y + a step`` for the largest ``a`` in 1, 1/2, ... that lowers ``||R||`` (omega kept > 0), and its
-    evaluation; (y, None) if none does."""
+    evaluation, without its derivatives; (y, None) if none does."""
     r0, a = np.linalg.norm(ev.R), 1.0
     for _ in range(tries):
         trial = y + a * step
         if trial[-1] > 0.0:
-            ev_t = problem.evaluate(trial[:-1], trial[-1])
+            ev_t = problem.evaluate(trial[:-1], trial[-1], jacobian=False)
             if np.linalg.norm(ev_t.R) < r0 or ev_t.relative <= 1e-3 * ev.relative:
                 return trial, ev_t
         a *= 0.5
@@ -235,10 +253,10 @@ def _arclength(problem, point: _Point, ds, tol):
     done = _correct(problem, point.y + ds * point.t, point.t, tol)
     if done is None:
         return None
-    y, it, ev = done
+    y, it, t = done
     if np.linalg.norm(y - point.y) > MAX_JUMP * ds:
         return None
-    return _Point(y, _tangent(problem, y, point.t, ev=ev), it), it
+    return _Point(y, t, it), it
 
 
 def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
@@ -289,7 +307,7 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
         done = _correct(problem, a.y + s * a.t, a.t, tol)
         if done is None:
             raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")
-        return _tangent(problem, done[0], a.t, ev=done[2])[-1]
+        return _tangent(problem, done[0], a.t)[-1]  # at the point itself: the fold's position rests on it
 
     try:
         s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)

@@ -16,6 +16,7 @@ convergence parameter (docs/model.md §15).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -24,7 +25,7 @@ import numpy as np
 from rotorred import checks
 from rotorred.signals.spectra import rfft
 
-__all__ = ["Harmonics", "alias_free_samples"]
+__all__ = ["Harmonics", "basis", "alias_free_samples", "proportional_columns"]
 
 #: the cost model that picks the DFT's method, in microseconds for 2 DOFs: the matrix product ``MATRIX_US`` per
 #: term and sample, a pyFFTW plan call ``FFT_US[0] + FFT_US[1] N``. Measured here (2 DOFs): at N = 128 the matrix
@@ -37,7 +38,7 @@ FFT_US = (38.0, 0.018)
 TOEPLITZ_BY_SAMPLES = 8000
 
 
-def _proportional_columns(flat: np.ndarray, rtol: float = 1e-13):
+def proportional_columns(flat: np.ndarray, rtol: float = 1e-13):
     """Columns of ``flat`` (N, p) as multiples of a few base columns: ``base`` (indices of the distinct shapes) and
     ``factor`` (p, 2): each column's multiplier and the position of its base in ``base`` (-1 for a zero column).
     Two columns share a base when one is the other times a constant, to ``rtol`` of their largest entry."""
@@ -104,6 +105,7 @@ class Harmonics:
         object.__setattr__(self, "E", E)  # (N, 2H + 1): coefficients -> samples
         object.__setattr__(self, "nabla", nabla)  # d/dtheta on the coefficients of one DOF
         object.__setattr__(self, "forward", forward)  # (2H + 1, N): samples -> coefficients (least squares)
+        object.__setattr__(self, "rate_rows", E @ nabla)  # (N, 2H + 1): coefficients -> samples of d/dtheta
         self._complex_basis()
 
     def _complex_basis(self) -> None:
@@ -198,12 +200,40 @@ class Harmonics:
             return self._assembled(self._blocks_by_samples(flat), n)
         if n < 3:  # a few pairs: finding shared shapes costs more than it saves (0.58 against 0.32 ms, n = 2)
             return self._assembled(self._blocks_by_spectrum(flat), n)
-        base, factor = _proportional_columns(flat)
+        base, factor = proportional_columns(flat)
         distinct = self._blocks_by_spectrum(flat[:, base]) if base else np.zeros((0, self.size, self.size))
         blocks = np.zeros((n * n, self.size, self.size))
         used = factor[:, 1] >= 0
         blocks[used] = distinct[factor[used, 1].astype(int)] * factor[used, 0][:, None, None]
         return self._assembled(blocks, n)
+
+    def low_rank(self, dq: np.ndarray, dv: np.ndarray, omega: float, max_rank: int, rtol: float = 1e-12):
+        """The chain rule through the AFT as a sum of outer products: ``T(dq) + omega T(dv) (nabla (x) I) = U V^T``,
+        one term for each rank of each sample's ``[dq, omega dv]`` (m x 2m, its singular values above ``rtol`` of the
+        largest): none out of contact, one a contact sample for a rub (its Jacobian is rank one). (U, V), each of
+        shape ((2H + 1) m, r), or None if r would pass ``max_rank`` (then the Toeplitz form is the cheaper).
+
+        Parameters
+        ----------
+        dq, dv : ndarray, shape (N, m, m)
+            The sampled derivatives of the forces on the displacements and on the velocities (v = omega dq/dtheta).
+        omega : float
+        max_rank : int
+        rtol : float
+        """
+        N, m, _ = dq.shape
+        M = np.concatenate([dq, omega * dv], axis=2)
+        active = np.flatnonzero(np.abs(M).reshape(N, -1).max(axis=1) > 0.0)
+        if len(active) > max_rank:
+            return None
+        u, s, vh = np.linalg.svd(M[active], full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
+        j, i = np.nonzero(s > rtol * s[:, :1])
+        if len(j) > max_rank:
+            return None
+        L, R, at = u[j, :, i] * s[j, i][:, None], vh[j, i, :], active[j]  # (r, m), (r, 2m), (r,)
+        U = (self.forward[:, at][:, None, :] * L.T[None, :, :]).reshape(self.size * m, len(j))
+        V = (self.E[at][:, :, None] * R[:, None, :m] + self.rate_rows[at][:, :, None] * R[:, None, m:])
+        return U, V.reshape(len(j), self.size * m).T
 
     def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
         """:meth:`toeplitz` as the product ``forward diag(d) E`` written out for every pair (the definition)."""
@@ -233,3 +263,10 @@ class Harmonics:
         """:meth:`toeplitz` from the spectrum for every pair (for tests)."""
         n = d.shape[1]
         return self._assembled(self._blocks_by_spectrum(d.reshape(self.N, n * n)), n)
+
+
+@functools.lru_cache(maxsize=16)
+def basis(H: int, N: int) -> Harmonics:
+    """``Harmonics(H, N)``, built once for each (H, N) (its complex-basis tables take 0.17 s at H = 50): for the
+    problems built again and again along a branch."""
+    return Harmonics(H, N)

@@ -24,9 +24,10 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.lowrank import factored
 
 __all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "sampled_forces",
-           "transformed_forces"]
+           "force_coefficients", "transformed_forces"]
 
 
 class NotConverged(RuntimeError):
@@ -40,11 +41,11 @@ class NotConverged(RuntimeError):
 
 @dataclass(frozen=True)
 class Evaluation:
-    """The residual at ``(z, omega)`` and its derivatives."""
+    """The residual at ``(z, omega)`` and its derivatives (None when only the residual was asked)."""
 
     R: np.ndarray
-    dR_dz: np.ndarray
-    dR_domega: np.ndarray
+    dR_dz: np.ndarray | None
+    dR_domega: np.ndarray | None
     scale: float  # ||F_ex|| (or ||L z|| when there is no forcing): what the residual is relative to
 
     @property
@@ -140,15 +141,21 @@ class PeriodicProblem:
         """D(omega) = D + omega D1 (N s/m)."""
         return self.D if self.D1 is None else self.D + omega * self.D1
 
-    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
-        """The residual and its analytic derivatives at ``(z, omega)``."""
+    def evaluate(self, z: np.ndarray, omega: float, jacobian: bool = True) -> Evaluation:
+        """The residual and (unless ``jacobian`` is False: then None) its analytic derivatives at ``(z, omega)``."""
         L, dL = self.linear(omega)
         F, dF = self.forcing(omega)
-        F_nl, Tq, Tv = self.nonlinear(z, omega)
+        q, v = self.samples(z, omega)
+        if jacobian:
+            F_nl, Tq, Tv = transformed_forces(self.harmonics, self.force_columns, q, v)
+        else:
+            F_nl = force_coefficients(self.harmonics, self.force_columns, q, v)
         Lz = L @ z
         R = Lz + F_nl - F
-        dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
         scale = float(np.linalg.norm(F)) or float(np.linalg.norm(Lz)) or 1.0
+        if not jacobian:
+            return Evaluation(R, None, None, scale)
+        dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
         return Evaluation(R, self._jacobian(L, Tq, Tv, omega), dR_domega, scale)
 
     def _jacobian(self, L: np.ndarray, Tq: np.ndarray, Tv: np.ndarray, omega: float) -> np.ndarray:
@@ -192,6 +199,12 @@ def sampled_forces(forces, q: np.ndarray, v: np.ndarray):
     return f, dq, dv
 
 
+def force_coefficients(h: Harmonics, forces, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients only (no Toeplitz
+    matrices: a residual without its Jacobian). ``forces`` pairs each force with the columns of its DOFs."""
+    return h.coefficients(sampled_forces(forces, q, v)[0])
+
+
 def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
     """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients, and the Toeplitz matrices
     of their derivatives, T(df/dq) and T(df/dv). ``forces`` pairs each force with the columns of its DOFs."""
@@ -224,26 +237,28 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
         if ev.relative <= tol:
             return z, ev, it
         try:
-            step = sla.solve(ev.dR_dz, -ev.R)
+            step = factored(ev.dR_dz).solve(-ev.R)
         except (sla.LinAlgError, ValueError):
             raise NotConverged(omega, ev.relative, tol, it, "singular Jacobian") from None
         z, ev = _line_search(problem, z, step, omega, ev, tries=max_halvings)
         if ev is None:
-            raise NotConverged(omega, float(np.linalg.norm(problem.evaluate(z, omega).R)) /
-                               problem.evaluate(z, omega).scale, tol, it, "no step reduces the residual")
+            raise NotConverged(omega, problem.evaluate(z, omega, jacobian=False).relative, tol, it,
+                               "no step reduces the residual")
     if ev.relative <= tol:
         return z, ev, max_iter
     raise NotConverged(omega, ev.relative, tol, max_iter, "iteration limit")
 
 
 def _line_search(problem, z, step, omega, ev, shrink: float = 0.5, tries: int = 30):
-    """``z + a step`` for the largest ``a`` in 1, 1/2, 1/4, ... that lowers ``||R||`` (Armijo with a small slope)."""
+    """``z + a step`` for the largest ``a`` in 1, 1/2, 1/4, ... that lowers ``||R||`` (Armijo with a small slope), and
+    its evaluation. The full step is evaluated with its Jacobian (it is taken most often), the shortened ones by their
+    residual only until one is taken."""
     r0 = np.linalg.norm(ev.R)
     a = 1.0
-    for _ in range(tries):
+    for i in range(tries):
         trial = z + a * step
-        ev_t = problem.evaluate(trial, omega)
+        ev_t = problem.evaluate(trial, omega, jacobian=i == 0)
         if np.linalg.norm(ev_t.R) <= (1.0 - 1e-4 * a) * r0:
-            return trial, ev_t
+            return trial, (ev_t if i == 0 else problem.evaluate(trial, omega))
         a *= shrink
     return z, None

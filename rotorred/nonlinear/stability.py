@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.fourier import Harmonics, basis
 from rotorred.nonlinear.hb import sampled_forces
 
 __all__ = ["Floquet", "floquet", "floquet_by_monodromy"]
@@ -99,7 +99,7 @@ def floquet_by_monodromy(problem, z: np.ndarray, omega: float, substeps: int = 4
     Floquet
     """
     h = problem.harmonics
-    fine = Harmonics(h.H, h.N * substeps)
+    fine = basis(h.H, h.N * substeps)
     T = 2.0 * np.pi / omega
     dt = T / fine.N
     shift = _half_interval_shift(fine)  # the state matrix midway through each interval

@@ -21,9 +21,9 @@ from rotorred import checks
 from rotorred.linear.harmonic import unbalance_forces
 from rotorred.nonlinear.condensed import CondensedProblem
 from rotorred.nonlinear.forces import PlateRub
-from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.fourier import Harmonics, basis
 
-__all__ = ["RubProblem", "rub_problem", "base_frequency"]
+__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate"]
 
 
 def base_frequency(frequencies_hz) -> float:
@@ -32,7 +32,7 @@ def base_frequency(frequencies_hz) -> float:
     fractions = [Fraction(f).limit_denominator(1000) for f in frequencies_hz]
     if any(abs(float(fr) - f) > 1e-9 * abs(f) for f, fr in zip(frequencies_hz, fractions)):
         checks.fail("speeds", tuple(frequencies_hz), "must be commensurate for a periodic harmonic balance (a "
-                    "quasi-periodic one is not implemented yet)", "Hz")
+                    "quasi-periodic response: rotorred.scenes.torus_balance.torus_rub_problem)", "Hz")
     common = math.lcm(*(fr.denominator for fr in fractions))
     f0 = math.gcd(*(int(fr * common) for fr in fractions)) / common
     if f0 < 0.1:
@@ -66,11 +66,20 @@ class RubProblem:
     def lines(self, z: np.ndarray, dof: tuple[int, str]) -> dict[float, float]:
         """Amplitude (m) of every harmonic k f_0 (Hz) of the model DOF ``dof`` = (node, direction) in the solution."""
         h = self.problem.harmonics
-        coefficients = self.problem.recover(z, self.omega).reshape(h.size, -1)[:, :self.n_model]
-        y = coefficients @ self.model.output_rows([dof])[0]
+        y = self.coefficients(z, dof)
         out = {0.0: abs(y[0])}
         out.update({k * self.f0: math.hypot(y[2 * k - 1], y[2 * k]) for k in range(1, h.H + 1)})
         return out
+
+    def coefficients(self, z: np.ndarray, dof: tuple[int, str]) -> np.ndarray:
+        """The Fourier coefficients [a_0, a_1, b_1, ...] (m) of the model DOF ``dof`` = (node, direction)."""
+        h = self.problem.harmonics
+        coefficients = self.problem.recover(z, self.omega).reshape(h.size, -1)[:, :self.n_model]
+        return coefficients @ self.model.output_rows([dof])[0]
+
+    def waveform(self, z: np.ndarray, dof: tuple[int, str]) -> np.ndarray:
+        """The model DOF ``dof`` over one period at the N AFT instants (m)."""
+        return self.problem.harmonics.E @ self.coefficients(z, dof)
 
     def final_state(self, z: np.ndarray):
         """The solution's state at t = 0 as a transient's start (:class:`rotorred.transient.results.FinalState`): the
@@ -109,7 +118,7 @@ class RubProblem:
         return z.reshape(-1)
 
 
-def rub_problem(scene, model, H: int, N: int) -> RubProblem:
+def rub_problem(scene, model, H: int, N: int, f0: float | None = None) -> RubProblem:
     """The harmonic-balance problem of ``scene`` (with rub plates) on ``model`` with ``H`` harmonics of the base
     frequency and ``N`` AFT samples a period.
 
@@ -120,6 +129,9 @@ def rub_problem(scene, model, H: int, N: int) -> RubProblem:
         The scene's model (:func:`rotorred.scenes.run.build_model`); each rub node's x and y must be its own
         coordinates (a boundary node of a reduced model).
     H, N : int
+    f0 : float, optional
+        The base frequency (Hz), of which every spool frequency must be a whole multiple (to 1e-9); default their
+        greatest common divisor (:func:`base_frequency`). A branch in speed at a fixed speed ratio keeps the orders.
 
     Returns
     -------
@@ -128,13 +140,15 @@ def rub_problem(scene, model, H: int, N: int) -> RubProblem:
     if not scene.plates:
         checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
     f = scene.frequencies_hz
-    f0 = base_frequency(tuple(f.values()))
-    h = Harmonics(H, N)
+    f0 = base_frequency(tuple(f.values())) if f0 is None else f0
+    if any(abs(fs / f0 - round(fs / f0)) > 1e-9 * fs / f0 for fs in f.values()):
+        checks.fail("f0", f0, f"must divide every spool frequency ({', '.join(f'{v:g}' for v in f.values())} Hz)", "Hz")
+    h = basis(H, N)
     n = model.n_dof
-    M, D, K = _augmented(model, scene)
+    M, D, K = augmented_matrices(model, scene)
     dofs, forces = [], []
     for i, plate in enumerate(scene.plates):
-        x, y = (_own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
+        x, y = (own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
         spool = scene.rotor.spool_of[plate.node]
         rub = PlateRub((x, y, n + 2 * i, n + 2 * i + 1), plate, scene.speeds[spool] * (plate.disk_radius or 0.0))
         dofs += list(rub.dofs)
@@ -148,7 +162,7 @@ def rub_problem(scene, model, H: int, N: int) -> RubProblem:
     return RubProblem(problem, 2 * math.pi * f0, f0, n, model)
 
 
-def _augmented(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def augmented_matrices(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """M, D, K of the model at the scene's speeds with two DOFs (u_n, u_t) for each plate."""
     n, p = model.n_dof, 2 * len(scene.plates)
     M, D, K = (np.zeros((n + p, n + p)) for _ in range(3))
@@ -161,7 +175,7 @@ def _augmented(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return M, D, K
 
 
-def _own_coordinate(model, dof) -> int:
+def own_coordinate(model, dof) -> int:
     """The model coordinate that is ``dof`` itself (a unit output row), or an error naming the node."""
     row = model.output_rows([dof])[0]
     i = int(np.argmax(np.abs(row)))

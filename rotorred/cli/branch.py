@@ -1,0 +1,95 @@
+"""``rotorred continue SCENE --param KEY=START:STOP --out DIR``: a branch of the rub response by harmonic balance.
+
+Follows the periodic response of the scene (commensurate speeds, rub plates) by pseudo-arclength continuation in
+``rub.clearance`` (m) or a spool speed ``speeds.<spool>`` (Hz, the speed ratio kept), through its folds, with each
+point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key,
+the peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of
+each harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png``
+(peak against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``. An interrupt
+keeps the points so far (written, marked INCOMPLETE; exit 130).
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rotorred import checks
+from rotorred.cli.options import out_dir
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "continue", help="follow the rub response by harmonic balance in a key (clearance, speed): folds, stability",
+        description="Follow a rub scene's periodic response by harmonic balance with pseudo-arclength continuation in "
+                    "rub.clearance (m) or speeds.<spool> (Hz, the speed ratio kept), through its folds, with each "
+                    "point's stability; write the branch as CSV and NetCDF and plot it. Example: rotorred continue "
+                    "paper-rub --param rub.clearance=20e-6:5e-6 --out branch")
+    p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file (with rub plates)")
+    p.add_argument("--param", required=True, metavar="KEY=START:STOP",
+                   help="the key and its first and last value (scene units: m for rub.clearance, Hz for speeds)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
+    p.add_argument("--harmonics", type=int, default=50, help="harmonics of the base frequency f_0 (default 50)")
+    p.add_argument("--samples", type=int, default=1024, help="AFT samples a period, even (default 1024)")
+    p.add_argument("--tol", type=float, default=1e-9, help="relative residual of every point (default 1e-9)")
+    p.add_argument("--no-stability", action="store_true", help="skip the Floquet multipliers (the slow part)")
+    p.add_argument("--out", required=True, help="output directory")
+    return p
+
+
+def _param(text: str) -> tuple[str, float, float]:
+    """KEY, START, STOP of ``--param KEY=START:STOP``."""
+    key, sep, values = text.partition("=")
+    parts = values.split(":")
+    if not sep or len(parts) != 2:
+        checks.fail("--param", text, "must be KEY=START:STOP, e.g. rub.clearance=20e-6:5e-6 or speeds.outer=85:95")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        checks.fail("--param", text, "must have numbers START and STOP")
+    if not (start > 0 and stop > 0) or start == stop:
+        checks.fail("--param", text, "must have START and STOP > 0 and different")
+    return key.strip(), start, stop
+
+
+def run(args) -> int:
+    """Check everything, then follow the branch into ``--out`` (exit 130 when interrupted, its points kept)."""
+    from rotorred.cli import EXIT_SIGINT
+    from rotorred.cli.run import _settings
+    from rotorred.scenes.branch import continue_scene
+    from rotorred.scenes.branch_outputs import format_branch, write_branch
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.writers import OutputFolder
+
+    out = out_dir("--out", args.out)
+    key, start, stop = _param(args.param)
+    H = checks.integer("--harmonics", args.harmonics, ge=1)
+    N = checks.integer("--samples", args.samples, ge=2 * H + 2)
+    if N % 2:
+        checks.fail("--samples", N, "must be even")
+    tol = checks.positive("--tol", args.tol)
+    scene = load_scene(args.scene, _settings(args.set))
+    if not scene.plates:
+        checks.fail("SCENE", args.scene, "must have a rub plate ([[rub]]): the branch is of the rub response")
+    model = build_model(scene).model
+    print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
+    branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
+                            progress=_progress)
+    print()
+    print(format_branch(branch))
+    with OutputFolder(out) as folder:
+        write_branch(branch, folder, scene.name)
+        files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
+    for f in files:
+        print(f"wrote {f}")
+    if branch.interrupted:
+        print(f"rotorred continue: {branch.stopped}; the points so far are written", file=sys.stderr)
+        return EXIT_SIGINT
+    return 0
+
+
+def _progress(points: int, value) -> None:
+    if value is None:
+        print(f"\r  stability: {points} points", end="", flush=True)
+    else:
+        print(f"\r  {points} points, at {value:.6g}", end="", flush=True)

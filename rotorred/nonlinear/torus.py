@@ -1,0 +1,606 @@
+"""Quasi-periodic harmonic balance on a two-dimensional torus (docs/model.md §15).
+
+A response with two incommensurate base frequencies ``w = (w_1, w_2)`` (rad/s) is a function on the torus of the
+angles ``theta = (theta_1, theta_2)``, read along the flow ``theta = w t``:
+
+    q(t) = a_0 + sum_{k in K} (a_k cos(k . theta) + b_k sin(k . theta)),   k = (k_1, k_2),
+
+with the truncated index set ``K`` of the half-plane (``k_1 > 0``, or ``k_1 = 0`` and ``k_2 > 0``), ``|k_1| <= H_1``,
+``|k_2| <= H_2`` (a box), optionally only the orders whose frequency ``|k . w| <= w_max`` (a band). Each order is a
+line at ``k_1 w_1 + k_2 w_2`` (of either sign). The coefficients are stored harmonic-major as in
+:mod:`rotorred.nonlinear.fourier`: ``z = [a_0, a_1, b_1, ..., a_F, b_F]``, each block the ``n`` DOFs.
+
+The AFT samples ``q`` and ``dq/dt = (w . nabla_theta) q`` on an ``N_1 x N_2`` grid of angles
+``theta_ij = (2 pi i / N_1, 2 pi j / N_2)`` by the inverse 2-D FFT, evaluates the nonlinear forces there and
+returns their coefficients by the 2-D FFT. A polynomial force of degree ``p`` is alias-free for
+``N_i >= (p + 1) H_i + 1`` in each direction (:func:`alias_free_grid`); a contact force is not a polynomial and
+``N_1, N_2`` are convergence parameters. The Jacobian is analytic: the coefficients of ``d(theta) p(theta)`` for a
+sampled derivative ``d`` are ``T(d) z_p``, ``T(d) = forward diag(d) E`` (:meth:`TorusHarmonics.toeplitz_by_samples`,
+the sums over samples), computed from ``d``'s 2-D spectrum: with ``D_m`` the complex coefficient of order ``m``
+(indices taken modulo the grid, which makes the two equal to round-off),
+
+    T[a_k, a_j] = Re(D_{k-j} + D_{k+j}),   T[a_k, b_j] = Im(D_{k-j} - D_{k+j}),
+    T[b_k, a_j] = -Im(D_{k-j} + D_{k+j}),  T[b_k, b_j] = Re(D_{k-j} - D_{k+j}),   row a_0 halved.
+
+The linear rest is condensed per order through the dynamic compliance, as in
+:class:`rotorred.nonlinear.condensed.CondensedProblem`: ``Z_k = K - (k.w)^2 M + i (k.w) D`` and
+
+    R(z_c) = z_c - z_lin + G F_nl(z_c),   dR/dz = I + G sum_t (T_t (x) A_t),
+
+the sum over the distinct shapes of the sampled force derivatives (``T_t`` their Toeplitz matrices, times the
+derivative operator for a velocity derivative; ``A_t`` the DOF pattern). When the patterns span few directions (a
+rub's force is one direction times the normal force: rank 1), Newton's step is solved through the Woodbury identity
+on the orders times that rank, not on the orders times the contact DOFs (:meth:`TorusProblem.newton_step`).
+
+Both base frequencies must be forced or the solution has a continuous phase in each angle; with every base forced
+(the rig: unbalances at ``f_L`` and ``f_H = 3 w_2 / (2 pi)``) the solution is isolated and no phase condition is
+needed. A sub-harmonic base (``f_H / 3``) leaves a discrete choice of three phases, which the start picks.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from rotorred import checks
+from rotorred.nonlinear.fourier import proportional_columns, alias_free_samples
+from rotorred.nonlinear.hb import Evaluation, NotConverged, sampled_forces
+
+__all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
+
+#: singular values of the stacked DOF patterns below this share of the largest count as zero (their rank)
+RANK_RTOL = 1e-12
+
+
+def alias_free_grid(H1: int, H2: int, degree: int) -> tuple[int, int]:
+    """The least even grid ``(N_1, N_2)`` that transforms a degree-``degree`` polynomial of a box ``H_1 x H_2``
+    without aliasing: ``N_i >= (degree + 1) H_i + 1`` in each direction (as :func:`alias_free_samples`)."""
+    return alias_free_samples(H1, degree), alias_free_samples(H2, degree)
+
+
+def _half_plane_orders(H1: int, H2: int, w, w_max) -> np.ndarray:
+    """(0, 0) and the orders of the half-plane in the box, in the band if ``w_max``; shape (K, 2), int."""
+    k1, k2 = np.meshgrid(np.arange(H1 + 1), np.arange(-H2, H2 + 1), indexing="ij")
+    k1, k2 = k1.ravel(), k2.ravel()
+    keep = (k1 > 0) | (k2 > 0)
+    if w_max is not None:
+        keep &= np.abs(k1 * w[0] + k2 * w[1]) <= w_max
+    return np.vstack([[0, 0], np.column_stack([k1[keep], k2[keep]])]).astype(int)
+
+
+@dataclass(frozen=True)
+class TorusHarmonics:
+    """The 2-D harmonic basis: the orders of a box (and band) and an ``N_1 x N_2`` AFT grid.
+
+    Parameters
+    ----------
+    H1, H2 : int
+        Largest ``|k_1|`` and ``|k_2|``, >= 1.
+    N1, N2 : int
+        Grid points in each angle, even and >= 2 H_i + 2 (the basis itself is then not aliased).
+    w_max : float, optional
+        Keep only the orders with ``|k_1 w_1 + k_2 w_2| <= w_max`` (rad/s); needs ``w``.
+    w : (float, float), optional
+        The base frequencies (rad/s) of the band.
+    """
+
+    H1: int
+    H2: int
+    N1: int
+    N2: int
+    w_max: float | None = None
+    w: tuple[float, float] | None = None
+
+    def __post_init__(self):
+        for i, (H, N) in enumerate(((self.H1, self.N1), (self.H2, self.N2)), start=1):
+            checks.integer(f"H{i}", H, ge=1)
+            checks.integer(f"N{i}", N, ge=2 * H + 2)
+            if N % 2:
+                checks.fail(f"N{i}", N, "must be even")
+        if self.w is not None:
+            object.__setattr__(self, "w", checks.sequence("w", tuple(np.ravel(self.w)),
+                                                          lambda f, v: checks.positive(f, v, "rad/s"), min_len=2,
+                                                          max_len=2))
+        if self.w_max is not None:
+            object.__setattr__(self, "w_max", checks.positive("w_max", self.w_max, "rad/s"))
+            if self.w is None:
+                checks.fail("w", self.w, "must be given with w_max (the band |k . w| <= w_max)", "rad/s")
+        orders = _half_plane_orders(self.H1, self.H2, self.w, self.w_max)
+        object.__setattr__(self, "orders", orders)
+        self._index_maps()
+
+    def _index_maps(self) -> None:
+        """Where each order, its negative, and each difference and sum of two orders sit on the flattened FFT grid."""
+        k1, k2 = self.orders[:, 0], self.orders[:, 1]
+
+        index_type = np.int32 if self.n_samples < 2**31 else np.intp  # K x K of them: 100 MB at K = 5000
+
+        def flat(m1, m2):
+            return ((m1 % self.N1) * self.N2 + (m2 % self.N2)).astype(index_type)
+        object.__setattr__(self, "_plus", flat(k1, k2))
+        object.__setattr__(self, "_minus", flat(-k1, -k2))
+        object.__setattr__(self, "_difference", flat(k1[:, None] - k1[None, :], k2[:, None] - k2[None, :]))
+        object.__setattr__(self, "_sum", flat(k1[:, None] + k1[None, :], k2[:, None] + k2[None, :]))
+
+    # ----------------------------------------------------------------------------------------------- sizes
+    @property
+    def n_orders(self) -> int:
+        """K: the orders, (0, 0) included."""
+        return len(self.orders)
+
+    @property
+    def size(self) -> int:
+        """Coefficients a DOF: 2 K - 1."""
+        return 2 * self.n_orders - 1
+
+    @property
+    def n_samples(self) -> int:
+        """N_1 N_2."""
+        return self.N1 * self.N2
+
+    def frequencies(self, w) -> np.ndarray:
+        """``k . w`` of each order (rad/s if ``w`` is), shape (K,); signed."""
+        return self.orders @ np.asarray(w, float)
+
+    def index(self, k1: int, k2: int) -> int:
+        """The position of the order ``(k1, k2)`` or of its negative in :attr:`orders` (the line is the same)."""
+        if k1 < 0 or (k1 == 0 and k2 < 0):
+            k1, k2 = -k1, -k2
+        hit = np.flatnonzero((self.orders[:, 0] == k1) & (self.orders[:, 1] == k2))
+        if hit.size == 0:
+            checks.fail("order", (k1, k2), f"must be in the truncated set (|k1| <= {self.H1}, |k2| <= {self.H2}"
+                        + (", in the band" if self.w_max is not None else "") + ")")
+        return int(hit[0])
+
+    def angles(self) -> np.ndarray:
+        """The grid of angles, shape (N_1 N_2, 2) (rad), theta_1 major."""
+        t1, t2 = np.meshgrid(2 * np.pi * np.arange(self.N1) / self.N1, 2 * np.pi * np.arange(self.N2) / self.N2,
+                             indexing="ij")
+        return np.column_stack([t1.ravel(), t2.ravel()])
+
+    # ----------------------------------------------------------------------------------------------- AFT
+    def phasors(self, z: np.ndarray, n: int) -> np.ndarray:
+        """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of the coefficients of ``n`` DOFs, shape (K, n):
+        the line of order k is ``Re(Q_k exp(i k . theta))``."""
+        c = z.reshape(self.size, n)
+        Q = np.empty((self.n_orders, n), complex)
+        Q[0] = c[0]
+        Q[1:] = c[1::2] - 1j * c[2::2]
+        return Q
+
+    def from_phasors(self, Q: np.ndarray) -> np.ndarray:
+        """Harmonic-major coefficients of the complex amplitudes ``Q`` (K, n) (the inverse of :meth:`phasors`)."""
+        Q = np.asarray(Q)
+        z = np.empty((self.size, Q.shape[1]))
+        z[0] = Q[0].real
+        z[1::2], z[2::2] = Q[1:].real, -Q[1:].imag
+        return z.reshape(-1)
+
+    def transfer(self, z: np.ndarray, n: int, target: TorusHarmonics) -> np.ndarray:
+        """The coefficients ``z`` of ``n`` DOFs on the orders of ``target`` (orders ``target`` has and this set lacks
+        start at 0; the others are dropped): a solution as the start of a larger truncation."""
+        Q = self.phasors(z, n)
+        out = np.zeros((target.n_orders, n), complex)
+        position = {(int(a), int(b)): i for i, (a, b) in enumerate(self.orders)}
+        for i, (a, b) in enumerate(target.orders):
+            j = position.get((int(a), int(b)))
+            if j is not None:
+                out[i] = Q[j]
+        return target.from_phasors(out)
+
+    def samples(self, z: np.ndarray, n: int) -> np.ndarray:
+        """``q`` on the grid, shape (N_1 N_2, n), of the harmonic-major coefficients ``z`` of ``n`` DOFs (inverse
+        FFT)."""
+        Q = self.phasors(z, n)
+        C = np.zeros((self.n_samples, n), complex)
+        C[self._plus[1:]] = 0.5 * Q[1:]
+        C[self._minus[1:]] = 0.5 * Q[1:].conj()
+        C[0] = Q[0]
+        q = np.fft.ifft2(C.reshape(self.N1, self.N2, n), axes=(0, 1)).real * self.n_samples
+        return q.reshape(self.n_samples, n)
+
+    def derivative(self, z: np.ndarray, n: int, w) -> np.ndarray:
+        """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``, shape ((2K - 1) n,)."""
+        c = z.reshape(self.size, n)
+        wk = self.frequencies(w)[1:, None]
+        out = np.zeros_like(c)
+        out[1::2], out[2::2] = wk * c[2::2], -wk * c[1::2]
+        return out.reshape(-1)
+
+    def rates(self, z: np.ndarray, n: int, w) -> np.ndarray:
+        """``dq/dt`` on the grid, shape (N_1 N_2, n) (units of q per s for ``w`` in rad/s)."""
+        return self.samples(self.derivative(z, n, w), n)
+
+    def times_derivative(self, X: np.ndarray, n: int, w) -> np.ndarray:
+        """``X (Omega (x) I_n)`` for X of shape (p, (2K - 1) n), Omega the derivative operator of :meth:`derivative`:
+        columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k), a scaling and permutation, not a product."""
+        X3 = X.reshape(X.shape[0], self.size, n)
+        wk = self.frequencies(w)[None, 1:, None]
+        out = np.zeros_like(X3)
+        out[:, 1::2], out[:, 2::2] = -wk * X3[:, 2::2], wk * X3[:, 1::2]
+        return out.reshape(X.shape)
+
+    def coefficients(self, f: np.ndarray) -> np.ndarray:
+        """The harmonic-major coefficients of samples ``f`` (N_1 N_2, n) on the orders (2-D FFT), shape
+        ((2K - 1) n,)."""
+        n = f.shape[1]
+        S = np.fft.fft2(f.reshape(self.N1, self.N2, n), axes=(0, 1)).reshape(self.n_samples, n) / self.n_samples
+        c = S[self._plus]
+        z = np.empty((self.size, n))
+        z[0] = c[0].real
+        z[1::2], z[2::2] = 2.0 * c[1:].real, -2.0 * c[1:].imag
+        return z.reshape(-1)
+
+    # ----------------------------------------------------------------------------------------------- Jacobians
+    def basis_matrix(self) -> np.ndarray:
+        """E: coefficients of one DOF -> samples, shape (N_1 N_2, 2K - 1) (for small problems and tests)."""
+        phase = self.angles() @ self.orders[1:].T
+        E = np.empty((self.n_samples, self.size))
+        E[:, 0] = 1.0
+        E[:, 1::2], E[:, 2::2] = np.cos(phase), np.sin(phase)
+        return E
+
+    def toeplitz_blocks(self, columns: np.ndarray) -> np.ndarray:
+        """``T(d)`` of each sampled column ``d`` of ``columns`` (N_1 N_2, p), from its 2-D spectrum (module docstring),
+        shape (p, 2K - 1, 2K - 1). Written in place, a real part at a time (the blocks are large: 2K - 1 = 7000)."""
+        p, K = columns.shape[1], self.n_orders
+        S = np.fft.fft2(columns.reshape(self.N1, self.N2, p), axes=(0, 1)).reshape(self.n_samples, p) / self.n_samples
+        real, imag = np.ascontiguousarray(S.real.T), np.ascontiguousarray(S.imag.T)
+        out = np.empty((p, self.size, self.size))
+        for i in range(p):
+            rm, rp = real[i][self._difference], real[i][self._sum]  # Re D_{k-j}, Re D_{k+j}
+            im, ip = imag[i][self._difference], imag[i][self._sum]
+            inner = out[i, 1:, 1:].reshape(K - 1, 2, K - 1, 2)  # (order, a or b) x (order, a or b), a view
+            np.add(rm[1:, 1:], rp[1:, 1:], out=inner[:, 0, :, 0])
+            np.subtract(im[1:, 1:], ip[1:, 1:], out=inner[:, 0, :, 1])
+            np.add(im[1:, 1:], ip[1:, 1:], out=inner[:, 1, :, 0])
+            np.negative(inner[:, 1, :, 0], out=inner[:, 1, :, 0])
+            np.subtract(rm[1:, 1:], rp[1:, 1:], out=inner[:, 1, :, 1])
+            out[i, 0, 0] = rm[0, 0]  # the a_0 row is halved: (Re D_{-j} + Re D_j) / 2
+            out[i, 0, 1::2], out[i, 0, 2::2] = 0.5 * (rm[0, 1:] + rp[0, 1:]), 0.5 * (im[0, 1:] - ip[0, 1:])
+            out[i, 1::2, 0], out[i, 2::2, 0] = rm[1:, 0] + rp[1:, 0], -(im[1:, 0] + ip[1:, 0])
+        return out
+
+    def toeplitz(self, d: np.ndarray) -> np.ndarray:
+        """``T(d)`` for sampled Jacobians ``d`` (N_1 N_2, n, n), harmonic-major, shape ((2K - 1) n,) * 2."""
+        n = d.shape[1]
+        return _assembled(self.toeplitz_blocks(d.reshape(self.n_samples, n * n)), n)
+
+    def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
+        """:meth:`toeplitz` as its definition, ``forward diag(d) E`` per DOF pair: sums over the samples."""
+        n = d.shape[1]
+        E = self.basis_matrix()
+        forward = E.T * (2.0 / self.n_samples)
+        forward[0] *= 0.5
+        flat = d.reshape(self.n_samples, n * n)
+        return _assembled(np.matmul(forward, flat.T[:, :, None] * E), n)
+
+    def fit(self, t: np.ndarray, x: np.ndarray, w, within: tuple[int, int] | None = None) -> np.ndarray:
+        """Coefficients of one DOF fitted by least squares to a record ``x(t)`` on the orders' lines at ``theta = w t``
+        (phase origin t = 0), shape (2K - 1,) (:func:`rotorred.signals.linefit.fit_frequencies`: the lines must be
+        at least 2 / T apart and from 0). With ``within = (h1, h2)`` only the orders with ``|k_1| <= h1`` and
+        ``|k_2| <= h2`` are fitted (the others are 0): a cheaper start for a large set."""
+        from rotorred.signals.linefit import fit_frequencies
+
+        f = self.frequencies(w) / (2 * math.pi)
+        used = np.ones(self.n_orders, bool) if within is None else \
+            (np.abs(self.orders[:, 0]) <= within[0]) & (np.abs(self.orders[:, 1]) <= within[1])
+        used[0] = False
+        fit = fit_frequencies(t, x, np.abs(f[used]))
+        Q = np.zeros(self.n_orders, complex)
+        Q[0] = fit.mean
+        Q[used] = np.where(f[used] > 0, fit.coefficients, fit.coefficients.conj())
+        return self.from_phasors(Q[:, None])
+
+
+def _assembled(blocks: np.ndarray, n: int) -> np.ndarray:
+    """The DOF pairs' blocks (n n, m, m) as one harmonic-major matrix ((m n,) * 2)."""
+    m = blocks.shape[1]
+    return blocks.reshape(n, n, m, m).transpose(2, 0, 3, 1).reshape(m * n, m * n)
+
+
+@dataclass(frozen=True)
+class _Compliance:
+    """The condensation at the problem's base frequencies: G as blocks (G0, the (2c, 2c) block of each order), the
+    linear response of the ``c`` DOFs, and per order the full linear response and the compliance columns."""
+
+    G0: np.ndarray
+    Gk: np.ndarray
+    z_lin: np.ndarray
+    Q_full: np.ndarray  # (K, n_all) complex
+    X: np.ndarray  # (K, n_all, c) complex: (Z_k^-1)[:, c]
+
+
+@dataclass(frozen=True)
+class _Linearisation:
+    """The residual at z and its Jacobian as terms: dR/dz = I + G sum_t kron(T_t, A_t)."""
+
+    R: np.ndarray
+    terms: tuple  # of (T_t (m, m), A_t (c, c))
+
+
+@dataclass(frozen=True)
+class TorusProblem:
+    """A system forced at two incommensurate base frequencies with nonlinear forces on a few DOFs: its quasi-periodic
+    response by harmonic balance on the torus, condensed onto those DOFs.
+
+    Parameters
+    ----------
+    M, D, K : ndarray, shape (n, n)
+        Mass, velocity (damping plus gyroscopic at the fixed spin speeds) and stiffness matrices (SI).
+    harmonics : TorusHarmonics
+    w : (float, float)
+        Base frequencies ``(w_1, w_2)`` (rad/s), > 0.
+    dofs : tuple of int
+        The DOFs ``c`` the nonlinear forces act on: the unknowns.
+    forcing : ndarray, shape ((2K - 1) n,)
+        Harmonic-major coefficients of the external force on all ``n`` DOFs (N); build them from complex amplitudes
+        with :meth:`TorusHarmonics.from_phasors`.
+    forces : tuple
+        Nonlinear forces (:mod:`rotorred.nonlinear.forces`), their ``dofs`` numbered in the whole system, among
+        ``dofs``.
+    """
+
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    harmonics: TorusHarmonics
+    w: tuple[float, float]
+    dofs: tuple[int, ...]
+    forcing: np.ndarray
+    forces: tuple = ()
+    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        n = np.shape(self.M)[0] if np.ndim(self.M) == 2 else 0
+        for name in ("M", "D", "K"):
+            object.__setattr__(self, name, checks.array(name, getattr(self, name), (n, n)))
+        if not isinstance(self.harmonics, TorusHarmonics):
+            checks.fail("harmonics", self.harmonics, "must be a TorusHarmonics")
+        w = checks.sequence("w", tuple(np.ravel(self.w)), lambda f, v: checks.positive(f, v, "rad/s"), min_len=2,
+                            max_len=2)
+        object.__setattr__(self, "w", w)
+        dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
+                               min_len=1, unique=True)
+        object.__setattr__(self, "dofs", dofs)
+        object.__setattr__(self, "forcing", checks.array("forcing", np.ravel(self.forcing), (self.harmonics.size * n,),
+                                                         "N"))
+        local = {d: i for i, d in enumerate(dofs)}
+        for i, force in enumerate(self.forces):
+            if not set(force.dofs) <= set(local):
+                checks.fail(f"forces[{i}].dofs", force.dofs, f"must be among dofs = {dofs}")
+        object.__setattr__(self, "_local_forces", tuple((f, [local[d] for d in f.dofs]) for f in self.forces))
+
+    @property
+    def n(self) -> int:
+        """The unknown DOFs an order: len(dofs)."""
+        return len(self.dofs)
+
+    @property
+    def size(self) -> int:
+        """Unknowns: (2K - 1) len(dofs)."""
+        return self.harmonics.size * self.n
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """``k . w`` of each order (rad/s), shape (K,)."""
+        return self.harmonics.frequencies(self.w)
+
+    def samples(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements and velocities of the ``dofs`` on the grid, shape (N_1 N_2, len(dofs)) each."""
+        h = self.harmonics
+        return h.samples(z, self.n), h.rates(z, self.n, self.w)
+
+    # ----------------------------------------------------------------------------------------------- condensation
+    def _compliance(self) -> _Compliance:
+        """Z_k^-1 at every order's frequency, by one batched solve (computed once: w is fixed)."""
+        if "compliance" in self._cache:
+            return self._cache["compliance"]
+        n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
+        Z = self.K[None] - (wk**2)[:, None, None] * self.M[None] + 1j * wk[:, None, None] * self.D[None]
+        F = self.harmonics.phasors(self.forcing, n_all)
+        rhs = np.zeros((len(wk), n_all, len(c) + 1), complex)
+        rhs[:, c, np.arange(len(c))] = 1.0
+        rhs[:, :, -1] = F
+        sol = np.linalg.solve(Z, rhs)
+        X, Q_full = sol[:, :, :-1], sol[:, :, -1]
+        H = X[:, c, :]
+        G0 = H[0].real
+        Gk = np.block([[H[1:].real, H[1:].imag], [-H[1:].imag, H[1:].real]])
+        z_lin = self.harmonics.from_phasors(Q_full[:, c])
+        out = _Compliance(G0, Gk, z_lin, Q_full, X)
+        self._cache["compliance"] = out
+        return out
+
+    def linear_response(self) -> np.ndarray:
+        """The coefficients of the ``dofs`` without the nonlinear forces, shape (size,)."""
+        return self._compliance().z_lin
+
+    def apply(self, X: np.ndarray) -> np.ndarray:
+        """``G X`` on the harmonic-major rows of X (a vector or a matrix), G applied an order at a time."""
+        g = self._compliance()
+        return _block_product(g.G0, g.Gk, X.reshape(self.size, -1), self.n).reshape(X.shape)
+
+    @property
+    def scale(self) -> float:
+        """||z_lin||: what the residual is relative to."""
+        return float(np.linalg.norm(self.linear_response())) or 1.0
+
+    def residual(self, z: np.ndarray) -> np.ndarray:
+        """``R(z) = z - z_lin + G F_nl(z)``, shape (size,) (no Jacobian: for line searches)."""
+        q, v = self.samples(z)
+        f = sampled_forces(self._local_forces, q, v)[0]
+        return z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
+
+    def _linearise(self, z: np.ndarray) -> _Linearisation:
+        """R and the Jacobian's terms: the sampled force derivatives grouped by shape (a shape shared by several DOF
+        pairs, e.g. a rub's rank-1 Jacobian, gets one Toeplitz block), velocity shapes times the derivative."""
+        h, c = self.harmonics, self.n
+        q, v = self.samples(z)
+        f, dq, dv = sampled_forces(self._local_forces, q, v)
+        R = z - self.linear_response() + self.apply(h.coefficients(f))
+        flat = np.hstack([dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)])
+        base, factor = proportional_columns(flat)
+        blocks = h.toeplitz_blocks(flat[:, base]) if base else np.zeros((0, h.size, h.size))
+        terms = []
+        for b in range(len(base)):
+            for kind in (0, 1):  # 0: a derivative by q, 1: by dq/dt
+                pairs = factor[kind * c * c:(kind + 1) * c * c]
+                A = np.where(pairs[:, 1] == b, pairs[:, 0], 0.0).reshape(c, c)
+                if A.any():
+                    T = blocks[b] if kind == 0 else h.times_derivative(blocks[b], 1, self.w)
+                    terms.append((T, A))
+        return _Linearisation(R, tuple(terms))
+
+    def evaluate(self, z: np.ndarray, omega: float | None = None, jacobian: bool = True) -> Evaluation:
+        """The residual and its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)`` (:class:`Evaluation`, so
+        :func:`rotorred.nonlinear.hb.solve` takes the problem; ``omega`` is ignored: the base frequencies are fixed,
+        and ``dR_domega`` is NaN, not defined). With ``jacobian`` False, the residual only (derivatives None)."""
+        if not jacobian:
+            return Evaluation(self.residual(z), None, None, self.scale)
+        lin = self._linearise(z)
+        T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
+        J = np.eye(self.size) + self.apply(T)
+        return Evaluation(lin.R, J, np.full(self.size, np.nan), self.scale)
+
+    def newton_step(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The residual at ``z`` and Newton's step ``-J^-1 R``, through the Woodbury identity on the rank r of the DOF
+        patterns: ``J = I + X Y``, ``X = G (I (x) U)``, ``Y = sum_t kron(T_t, U^T A_t V) (I (x) V^T)``, so that
+        ``J^-1 = I - X (I + Y X)^-1 Y`` needs one dense solve of size (2K - 1) r (r = 1 for a rub)."""
+        lin = self._linearise(z)
+        if not lin.terms:
+            return lin.R, -lin.R
+        U, V = _pattern_bases([A for _, A in lin.terms])
+        m, c, r, s = self.harmonics.size, self.n, U.shape[1], V.shape[1]
+        core = sum((np.kron(T, U.T @ A @ V) for T, A in lin.terms), np.zeros((m * r, m * s)))
+        g = self._compliance()
+        G0, Gk = V.T @ g.G0 @ U, _projected_blocks(g.Gk, V, U)
+        YX = _block_product_right(core, G0, Gk, s, r)
+        YR = core @ (lin.R.reshape(m, c) @ V).reshape(-1)
+        y = sla.solve(np.eye(m * r) + YX, YR)
+        X_y = self.apply((y.reshape(m, r) @ U.T).reshape(-1))
+        return lin.R, -lin.R + X_y
+
+    # ----------------------------------------------------------------------------------------------- recovery
+    def recover(self, z: np.ndarray) -> np.ndarray:
+        """Complex amplitudes ``Q_k`` of every DOF (the line ``Re(Q_k exp(i k . theta))``), shape (K, n_all)."""
+        g = self._compliance()
+        q, v = self.samples(z)
+        f = self.harmonics.coefficients(sampled_forces(self._local_forces, q, v)[0])
+        F = self.harmonics.phasors(f, self.n)
+        return g.Q_full - np.einsum("kac,kc->ka", g.X, F)
+
+
+def _block_product(G0: np.ndarray, Gk: np.ndarray, X: np.ndarray, c: int) -> np.ndarray:
+    """``G X`` for block-diagonal G: G0 (c, c) on the first c rows, Gk[k] (2c, 2c) on each next 2c rows."""
+    out = np.empty_like(X)
+    out[:c] = G0 @ X[:c]
+    out[c:] = np.matmul(Gk, X[c:].reshape(len(Gk), 2 * c, -1)).reshape(-1, X.shape[1])
+    return out
+
+
+def _block_product_right(P: np.ndarray, B0: np.ndarray, Bk: np.ndarray, s: int, r: int) -> np.ndarray:
+    """``P B`` for block-diagonal B: B0 (s, r) on the first s columns of P, Bk[k] (2s, 2r) on each next 2s."""
+    p = P.shape[0]
+    Pk, Ok = P[:, s:].reshape(p, len(Bk), 2 * s), np.zeros((p, len(Bk), 2 * r))
+    for j in range(2 * s):  # the blocks are small: a sum of 4 s r scaled columns, not a batched product
+        for i in range(2 * r):
+            Ok[:, :, i] += Pk[:, :, j] * Bk[None, :, j, i]
+    return np.hstack([P[:, :s] @ B0, Ok.reshape(p, -1)])
+
+
+def _projected_blocks(Gk: np.ndarray, V: np.ndarray, U: np.ndarray) -> np.ndarray:
+    """``(I_2 (x) V^T) Gk[k] (I_2 (x) U)`` for every order: shape (K - 1, 2s, 2r)."""
+    V2, U2 = np.kron(np.eye(2), V), np.kron(np.eye(2), U)
+    return V2.T @ Gk @ U2
+
+
+def _pattern_bases(patterns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal bases U (c, r) of the patterns' column spaces and V (c, s) of their row spaces."""
+    def basis(stack):
+        u, sv, _ = np.linalg.svd(stack, full_matrices=False)
+        return u[:, sv > RANK_RTOL * sv[0]]
+    return basis(np.hstack(patterns)), basis(np.hstack([A.T for A in patterns]))
+
+
+@dataclass(frozen=True)
+class TorusSolution:
+    """A converged torus: its coefficients and how Newton got there.
+
+    Attributes
+    ----------
+    z : ndarray, shape (size,)
+        Harmonic-major coefficients of the problem's ``dofs`` (their units: m for the rig).
+    iterations : int
+        Newton iterations.
+    residual : float
+        Relative residual ``||R|| / ||z_lin||`` at ``z``.
+    history : tuple of float
+        The relative residual before each iteration and at the end.
+    """
+
+    z: np.ndarray
+    iterations: int
+    residual: float
+    history: tuple[float, ...]
+
+    def __post_init__(self):
+        object.__setattr__(self, "z", checks.array("z", self.z))
+        checks.integer("iterations", self.iterations, ge=0)
+        checks.number("residual", self.residual, ge=0.0)
+
+
+def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 40,
+                max_halvings: int = 30) -> TorusSolution:
+    """The torus near ``z0`` by Newton's method (steps by :meth:`TorusProblem.newton_step`) with a backtracking line
+    search on ``||R||`` (trial points by their residual alone).
+
+    Parameters
+    ----------
+    problem : TorusProblem
+    z0 : ndarray, shape (problem.size,)
+        The start: e.g. the linear response, a transient's record fitted on the orders, or a smaller truncation's
+        solution (:meth:`TorusHarmonics.transfer`).
+    tol : float
+        Relative residual ``||R|| / ||z_lin||`` to reach.
+    max_iter, max_halvings : int
+        Newton iterations, and halvings of a step in the line search.
+
+    Returns
+    -------
+    TorusSolution
+
+    Raises
+    ------
+    NotConverged
+        (with omega = w_1) if the relative residual is not below ``tol`` after ``max_iter`` iterations, or no step
+        lowers it.
+    """
+    z = checks.array("z0", z0, (problem.size,)).copy()
+    scale, history = problem.scale, []
+    R = problem.residual(z)
+    for it in range(max_iter + 1):
+        norm = float(np.linalg.norm(R))
+        history.append(norm / scale)
+        if history[-1] <= tol:
+            return TorusSolution(z, it, history[-1], tuple(history))
+        if it == max_iter:
+            break
+        try:
+            step = problem.newton_step(z)[1]
+        except (sla.LinAlgError, ValueError):
+            raise NotConverged(problem.w[0], history[-1], tol, it, "singular Jacobian") from None
+        a = 1.0
+        for _ in range(max_halvings):  # the residual alone (no Jacobian) for each trial
+            trial = z + a * step
+            R_trial = problem.residual(trial)
+            if np.linalg.norm(R_trial) <= (1.0 - 1e-4 * a) * norm:
+                z, R = trial, R_trial
+                break
+            a *= 0.5
+        else:
+            raise NotConverged(problem.w[0], history[-1], tol, it, "no step reduces the residual")
+    raise NotConverged(problem.w[0], history[-1], tol, max_iter, "iteration limit")

@@ -1,0 +1,313 @@
+"""Branches of a rub scene's periodic response: harmonic balance with pseudo-arclength continuation in a scene key,
+its folds, and the stability of each point (issue 20; docs/model.md §15).
+
+Keys (:data:`KEYS`):
+
+- ``rub.clearance`` (m): the clearance of the scene's plate, at its speeds (:class:`ClearanceFamily`, analytic
+  dR/dclearance);
+- ``speeds.<spool>`` (Hz): that spool's speed, every other spool's scaled with it (the scene's speed ratio kept, so
+  the base frequency ``f_0`` moves with the speed and each spool stays at its harmonic of it). The problem is built
+  again at each speed (the model's speed-dependent matrices, the unbalance forcing, the rim speed) and dR/dspeed is a
+  central difference of the residual (a step of 1e-6 of the speed: the tangent and the folds need no more). The
+  speed is carried scaled, in metres like the unknowns, so that the arclength weighs both alike.
+
+The first point is found cold (:func:`cold_start`): Newton from the linear response; where that fails (the linear
+orbit goes deep into the plate), a continuation in the clearance from where the linear orbit just reaches the plate
+down to the plate's clearance. Each point's stability is from the monodromy matrix of the whole linearised system
+(:func:`rotorred.nonlinear.stability.floquet_by_monodromy`, ``STABILITY_SUBSTEPS`` intervals an AFT sample).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.nonlinear.condensed import ClearanceFamily
+from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
+from rotorred.nonlinear.stability import floquet_by_monodromy
+from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
+
+__all__ = ["KEYS", "SpeedFamily", "SceneBranch", "cold_start", "continue_scene"]
+
+#: the keys a branch follows, and their units
+KEYS = {"rub.clearance": "m", "speeds.<spool>": "Hz"}
+#: the relative step of the central difference in dR/dspeed
+SPEED_STEP = 1e-6
+#: intervals of the monodromy product a sample interval of the AFT: the rig's orbit reached by continuation at 13 um
+#: (H = 100, N = 2048) has its largest multiplier 0.780, 1.034, 0.640, 0.698, 0.674, 0.676, 0.679, 0.678 with 256 to
+#: 32768 intervals a period: settled from 4 N (the transient's orbit: 0.773 to 0.662, settled from 1024)
+STABILITY_SUBSTEPS = 4
+
+
+@dataclass(frozen=True)
+class SpeedFamily:
+    """The rub problem of ``scene`` along the speed of ``spool`` (Hz), every spool scaled with it.
+
+    Parameters
+    ----------
+    scene : Scene
+    model : SystemMatrices or ReducedSystem
+    spool : str
+    H, N : int
+    scale : float
+        Metres per Hz of the carried parameter ``s = scale f`` (:meth:`parameter_value` gives f back).
+    """
+
+    scene: object
+    model: object
+    spool: str
+    H: int
+    N: int
+    scale: float = 1.0
+    _problems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.spool not in self.scene.speeds:
+            checks.fail("key", f"speeds.{self.spool}", f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
+        object.__setattr__(self, "parameter", (f"speeds.{self.spool}", "Hz"))
+        f = self.scene.frequencies_hz
+        base = rub_problem(self.scene, self.model, self.H, self.N)
+        object.__setattr__(self, "_orders", base.f0 / f[self.spool])  # f_0 per Hz of the spool
+
+    def parameter_value(self, s: float) -> float:
+        """The spool speed (Hz) of the carried parameter ``s``."""
+        return s / self.scale
+
+    def at(self, f_hz: float) -> RubProblem:
+        """The rub problem with ``spool`` at ``f_hz`` (the last few kept: Newton and its differences revisit them)."""
+        key = float(f_hz)
+        if key not in self._problems:
+            factor = key / self.scene.frequencies_hz[self.spool]
+            scene = dataclasses.replace(self.scene, speeds={s: w * factor for s, w in self.scene.speeds.items()})
+            if len(self._problems) >= 6:
+                self._problems.pop(next(iter(self._problems)))
+            self._problems[key] = rub_problem(scene, self.model, self.H, self.N, f0=key * self._orders)
+        return self._problems[key]
+
+    @property
+    def n(self) -> int:
+        return self.at(self.scene.frequencies_hz[self.spool]).problem.n
+
+    @property
+    def size(self) -> int:
+        return self.at(self.scene.frequencies_hz[self.spool]).problem.size
+
+    @property
+    def harmonics(self):
+        return self.at(self.scene.frequencies_hz[self.spool]).problem.harmonics
+
+    def linear_response(self, s: float) -> np.ndarray:
+        rp = self.at(s / self.scale)
+        return rp.problem.linear_response(rp.omega)
+
+    def evaluate(self, z: np.ndarray, s: float, jacobian: bool = True) -> Evaluation:
+        f = s / self.scale
+        rp = self.at(f)
+        ev = rp.problem.evaluate(z, rp.omega, jacobian)
+        if not jacobian:
+            return ev
+        h = SPEED_STEP * f
+        up, down = self.at(f + h), self.at(f - h)
+        dR = (up.problem.evaluate(z, up.omega, False).R - down.problem.evaluate(z, down.omega, False).R) / (2 * h)
+        return Evaluation(ev.R, ev.dR_dz, dR / self.scale, ev.scale)
+
+
+@dataclass(frozen=True)
+class SceneBranch:
+    """A branch of a rub scene's periodic response.
+
+    Attributes
+    ----------
+    key, unit : str
+        The varied scene key and its unit ("m" or "Hz").
+    values : ndarray, shape (p,)
+        The key at each point.
+    f0 : ndarray, shape (p,)
+        Base frequency of each point (Hz).
+    dofs : tuple of (int, str)
+        The output DOFs (the scene's).
+    peaks : ndarray, shape (p, len(dofs))
+        Largest |q(t)| over the period of each output DOF (m).
+    lines : ndarray, shape (p, H + 1)
+        Amplitude of each harmonic k f_0 of ``dofs[0]`` (m).
+    critical : ndarray of complex, shape (p,)
+        The Floquet multiplier of largest modulus at each point (NaN where stability was not computed).
+    folds : tuple of (float, bool)
+        Each turn of the branch: the key's value and whether it is smooth (a saddle-node) or a corner (a contact's
+        start or end).
+    stopped : str
+        Why the branch ended ("reached the end, ...", or where and why it stopped).
+    iterations : ndarray, shape (p,)
+    start_time, solve_time, stability_time : float
+        Seconds: the cold start, the continuation, the stability of every point.
+    """
+
+    key: str
+    unit: str
+    values: np.ndarray
+    f0: np.ndarray
+    dofs: tuple
+    peaks: np.ndarray
+    lines: np.ndarray
+    critical: np.ndarray
+    folds: tuple
+    stopped: str
+    iterations: np.ndarray
+    start_time: float
+    solve_time: float
+    stability_time: float
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        """The largest Floquet multiplier modulus of each point (NaN where not computed)."""
+        return np.abs(self.critical)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Whether each point is stable (largest multiplier modulus below 1; False where not computed)."""
+        return self.multipliers < 1.0
+
+    @property
+    def bifurcations(self) -> tuple:
+        """Where stability changes between two points: (the key's values at both, the kind) with the kind from the
+        critical multiplier of the unstable one: "period-doubling" (it leaves the unit circle near -1, its angle
+        within 10 degrees of 180), "fold" (near +1, within 10 degrees of 0: a saddle-node, smooth or at a corner),
+        else "Neimark-Sacker" (a complex pair: a second frequency, the torus)."""
+        out = []
+        for i in range(len(self.values) - 1):
+            a, b = self.critical[i], self.critical[i + 1]
+            if np.isnan(a) or np.isnan(b) or (abs(a) < 1.0) == (abs(b) < 1.0):
+                continue
+            angle = abs(np.degrees(np.angle(b if abs(b) >= 1.0 else a)))
+            kind = "period-doubling" if angle > 170.0 else "fold" if angle < 10.0 else "Neimark-Sacker"
+            out.append((float(self.values[i]), float(self.values[i + 1]), kind))
+        return tuple(out)
+
+    @property
+    def interrupted(self) -> bool:
+        return self.stopped.startswith("interrupted")
+
+
+def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
+    """A periodic solution of the condensed rub ``problem`` at ``omega`` from nothing: Newton from the linear
+    response; if that fails, a continuation in the first plate's clearance from where the linear orbit just reaches
+    the plate down to its clearance, and Newton there from the nearest point.
+
+    Raises
+    ------
+    NotConverged
+        If neither reaches a solution (with the residual and where).
+    """
+    z_lin = problem.linear_response(omega)
+    try:
+        return solve(problem, z_lin, omega, tol=tol)[0]
+    except NotConverged:
+        pass
+    family = ClearanceFamily(problem, omega)
+    rub, idx = problem.force_columns[0]
+    grad = np.array([np.cos(rub.plate.theta), np.sin(rub.plate.theta), -1.0, 0.0])
+    reach = float(np.max(problem.samples(z_lin, omega)[0][:, idx] @ grad))
+    clearance = rub.plate.clearance
+    scale = max(float(np.linalg.norm(z_lin)), reach)
+    branch = continue_branch(family, z_lin, max(1.05 * reach, 1.05 * clearance), clearance, ds=0.05 * scale,
+                             ds_min=1e-10 * scale, ds_max=0.12 * scale, stability=False, tol=tol)
+    i = int(np.argmin(np.abs(branch.omega - clearance)))
+    return solve(family.at(clearance), branch.z[i], omega, tol=tol)[0]
+
+
+def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: int, *, tol: float = 1e-9,
+                   stability: bool = True, max_points: int = 400, progress=None) -> SceneBranch:
+    """The branch of ``scene``'s rub response on ``model`` as ``key`` goes from ``start`` to ``end``.
+
+    Parameters
+    ----------
+    scene : Scene
+        With rub plates, at commensurate speeds.
+    model : SystemMatrices or ReducedSystem
+        The scene's model (:func:`rotorred.scenes.run.build_model`).
+    key : str
+        ``rub.clearance`` or ``speeds.<spool>`` (:data:`KEYS`).
+    start, end : float
+        The key's first and last value (m or Hz).
+    H, N : int
+        Harmonics of f_0 and AFT samples a period.
+    tol : float
+        Relative residual of every point.
+    stability : bool
+        Floquet multipliers of every point (monodromy).
+    max_points : int
+    progress : callable, optional
+        ``progress(points, value)`` as the branch grows, then ``progress(i, None)`` per point's stability.
+
+    Returns
+    -------
+    SceneBranch
+    """
+    family, to_value, rub_at = _family(scene, model, key, start, H, N)
+    t0 = time.perf_counter()
+    first = rub_at(start)
+    z0 = cold_start(first.problem, first.omega, tol)
+    t1 = time.perf_counter()
+    s_start, s_end = to_value(start, inverse=True), to_value(end, inverse=True)
+    scale = max(float(np.linalg.norm(z0)), abs(s_end - s_start))  # the steps: a few hundred along a branch
+    branch = continue_branch(family, z0, s_start, s_end, ds=0.01 * scale,
+                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=max_points, tol=tol,
+                             stability=False, progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
+    t2 = time.perf_counter()
+    values = np.array([to_value(s) for s in branch.omega])
+    multipliers = _multipliers(rub_at, values, branch.z, stability and "interrupted" not in branch.stopped, progress)
+    t3 = time.perf_counter()
+    dofs = _output_dofs(scene)
+    rps = [rub_at(v) for v in values]
+    return SceneBranch(key, "m" if key == "rub.clearance" else "Hz", values, np.array([rp.f0 for rp in rps]), dofs,
+                       np.array([[np.max(np.abs(rp.waveform(z, d))) for d in dofs] for rp, z in zip(rps, branch.z)]),
+                       np.array([list(rp.lines(z, dofs[0]).values()) for rp, z in zip(rps, branch.z)]),
+                       multipliers, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
+                       branch.iterations, t1 - t0, t2 - t1, t3 - t2)
+
+
+def _family(scene, model, key: str, start: float, H: int, N: int):
+    """The continuation family of ``key``, the map from its carried parameter to the key's value (``inverse``: back),
+    and ``rub_at(value) -> RubProblem``."""
+    if key == "rub.clearance":
+        if len(scene.plates) != 1:
+            checks.fail("key", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
+        rp = rub_problem(scene, model, H, N)
+        family = ClearanceFamily(rp.problem, rp.omega)
+        return family, (lambda v, inverse=False: v), (lambda v: dataclasses.replace(rp, problem=family.at(v)))
+    spool = key.partition(".")[2] if key.startswith("speeds.") else ""
+    if not spool:
+        checks.fail("key", key, f"must be one of {', '.join(KEYS)}")
+    rp = SpeedFamily(scene, model, spool, H, N).at(start)
+    scale = float(np.linalg.norm(rp.problem.linear_response(rp.omega))) / start  # m per Hz
+    family = SpeedFamily(scene, model, spool, H, N, scale)
+    return family, (lambda v, inverse=False: v * scale if inverse else v / scale), family.at
+
+
+def _output_dofs(scene) -> tuple:
+    """The scene's output DOFs, its table DOF (the response it is judged by) first."""
+    dofs = tuple(scene.output.dofs)
+    table = scene.output.table
+    return dofs if table is None else (table,) + tuple(d for d in dofs if d != table)
+
+
+def _multipliers(rub_at, values, z, stability: bool, progress) -> np.ndarray:
+    """The Floquet multiplier of largest modulus of each point (NaN without ``stability``, or after an interrupt)."""
+    out = np.full(len(values), np.nan, dtype=complex)
+    if not stability:
+        return out
+    try:
+        for i, (v, zi) in enumerate(zip(values, z)):
+            rp = rub_at(v)
+            mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers
+            out[i] = mu[np.argmax(np.abs(mu))]
+            if progress is not None:
+                progress(i + 1, None)
+    except KeyboardInterrupt:
+        pass
+    return out

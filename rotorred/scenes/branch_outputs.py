@@ -1,0 +1,78 @@
+"""The files of a harmonic-balance branch (``rotorred continue``): CSV, NetCDF, the figure and a summary."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotorred.writers import render_table, write_csv, write_netcdf, write_text
+
+__all__ = ["format_branch", "branch_dataset", "write_branch"]
+
+
+def _scale(branch) -> tuple[float, str]:
+    """The key's plotted scale and unit: a clearance in µm, a speed in Hz."""
+    return (1e6, "µm") if branch.unit == "m" else (1.0, "Hz")
+
+
+def _dof_name(dof) -> str:
+    return f"{dof[0]}{dof[1]}"
+
+
+def format_branch(branch) -> str:
+    """A summary: the points, the folds, where it stopped, the stable share and the times."""
+    xs, xu = _scale(branch)
+    dof = _dof_name(branch.dofs[0])
+    rows = [[f"{xs * v:.4g}", f"{1e6 * p:.3f}", "-" if np.isnan(m) else f"{m:.3f}",
+             "-" if np.isnan(m) else ("stable" if s else "unstable")]
+            for v, p, m, s in zip(branch.values, branch.peaks[:, 0], branch.multipliers, branch.stable)]
+    step = max(1, len(rows) // 25)
+    table = render_table([f"{branch.key} ({xu})", f"peak {dof} (µm)", "max |mu|", "stability"], rows[::step])
+    folds = ", ".join(f"{xs * v:.6g} {xu} ({'fold' if smooth else 'corner'})" for v, smooth in branch.folds) or "none"
+    changes = ", ".join(f"{kind} between {xs * a:.6g} and {xs * b:.6g} {xu}" for a, b, kind in branch.bifurcations)
+    n = len(branch.values)
+    return (f"{table}\n{n} points{f' (every {step}th shown)' if step > 1 else ''}; turns: {folds}\n"
+            f"stability changes: {changes or 'none'}\n"
+            f"{branch.stopped}\n"
+            f"times: cold start {branch.start_time:.2f} s, continuation {branch.solve_time:.2f} s "
+            f"({1e3 * branch.solve_time / max(n - 1, 1):.0f} ms a point), stability {branch.stability_time:.2f} s")
+
+
+def branch_dataset(branch, scene_name: str):
+    """The branch as an :class:`xarray.Dataset`: dims point, dof, harmonic."""
+    import xarray as xr
+
+    return xr.Dataset(
+        {"peak": (("point", "dof"), branch.peaks, {"units": "m", "long_name": "largest |q(t)| over the period"}),
+         "line": (("point", "harmonic"), branch.lines,
+                  {"units": "m", "long_name": f"amplitude of harmonic k f0 of {_dof_name(branch.dofs[0])}"}),
+         "critical_multiplier_re": ("point", branch.critical.real, {"units": "1", "long_name": "Floquet multiplier of largest modulus, real part"}),
+         "critical_multiplier_im": ("point", branch.critical.imag, {"units": "1", "long_name": "Floquet multiplier of largest modulus, imaginary part"}),
+         "stable": ("point", branch.stable & ~np.isnan(branch.multipliers)),
+         "f0": ("point", branch.f0, {"units": "Hz", "long_name": "base frequency"}),
+         "iterations": ("point", branch.iterations)},
+        coords={branch.key: ("point", branch.values, {"units": branch.unit}),
+                "dof": [_dof_name(d) for d in branch.dofs], "harmonic": np.arange(branch.lines.shape[1])},
+        attrs={"scene": scene_name, "stopped": branch.stopped,
+               "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in branch.folds),
+               "bifurcations": "; ".join(f"{kind} between {a:.9g} and {b:.9g}" for a, b, kind in branch.bifurcations)})
+
+
+def write_branch(branch, folder, scene_name: str) -> None:
+    """Stage the branch's files in ``folder`` (:class:`rotorred.writers.OutputFolder`)."""
+    from rotorred.plots.branch import plot_branch  # matplotlib only when figures are written
+
+    xs, xu = _scale(branch)
+    dof = _dof_name(branch.dofs[0])
+    header = [f"{branch.key} ({branch.unit})", "f0 (Hz)"] + [f"peak {_dof_name(d)} (um)" for d in branch.dofs] + \
+        ["max |mu|", "stable", "iterations"]
+    write_csv(folder.staged("branch.csv"), header,
+              [branch.values, branch.f0, *(1e6 * branch.peaks.T), branch.multipliers,
+               ["" if np.isnan(m) else int(s) for m, s in zip(branch.multipliers, branch.stable)], branch.iterations])
+    write_csv(folder.staged("branch_lines.csv"), [f"{branch.key} ({branch.unit})"] +
+              [f"{dof} k={k} (um)" for k in range(branch.lines.shape[1])], [branch.values, *(1e6 * branch.lines.T)])
+    write_netcdf(folder.staged("branch.nc"), branch_dataset(branch, scene_name))
+    stable = None if np.isnan(branch.multipliers).all() else branch.stable
+    plot_branch(branch.values, branch.peaks[:, 0], stable, branch.folds, folder.staged("branch.png"),
+                xlabel=f"{branch.key} ({xu})", ylabel=f"peak |{dof}| (µm)", changes=branch.bifurcations, xscale=xs,
+                title=f"{scene_name}: harmonic-balance branch")
+    write_text(folder.staged("branch.txt"), format_branch(branch) + "\n")

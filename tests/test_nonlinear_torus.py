@@ -1,0 +1,284 @@
+"""Quasi-periodic harmonic balance on a two-dimensional torus (rotorred.nonlinear.torus, rotorred.scenes.torus_balance)
+against independent references: direct sums and central differences for the AFT and its Jacobian, the closed-form
+linear response, scipy's solve_ivp, the periodic harmonic balance at commensurate frequencies, and on the rig the
+linear steady state and the transient.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rotorred.checks import InputError
+from rotorred.nonlinear.forces import CubicSpring
+from rotorred.nonlinear.fourier import Harmonics, alias_free_samples
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
+
+# the cubic oscillator x'' + C x' + x + K3 x^3 = F1 cos(w1 t) + F2 cos(w2 t), both tones near its resonance
+C, K3, F1, F2 = 0.2, 0.5, 0.15, 0.1
+W_INCOMMENSURATE = (0.8, 0.8 * math.sqrt(2.0))
+
+
+class LinearSpring:
+    """A 'nonlinear' force that is linear, f = S q (through the AFT all the same)."""
+
+    def __init__(self, S):
+        self.S, self.dofs = np.asarray(S, float), tuple(range(len(S)))
+
+    def evaluate(self, q, v):
+        N = q.shape[0]
+        return q @ self.S.T, np.broadcast_to(self.S, (N,) + self.S.shape).copy(), np.zeros((N,) + self.S.shape)
+
+
+class VelocityCubic:
+    """f = c3 v^3 on one DOF: a velocity-dependent force."""
+
+    def __init__(self, dof, c3):
+        self.dofs, self.c3 = (dof,), c3
+
+    def evaluate(self, q, v):
+        return self.c3 * v**3, np.zeros(q.shape + (1,)), (3.0 * self.c3 * v**2)[:, :, None]
+
+
+class RankOneCubic:
+    """f = u k3 (g . q)^3: every DOF pair's derivative a multiple of one shape (a rub's structure, rank 1)."""
+
+    def __init__(self, u, g, k3):
+        self.u, self.g, self.k3, self.dofs = np.asarray(u, float), np.asarray(g, float), k3, tuple(range(len(u)))
+
+    def evaluate(self, q, v):
+        p = q @ self.g
+        d = 3.0 * self.k3 * p**2
+        return np.outer(self.k3 * p**3, self.u), d[:, None, None] * np.outer(self.u, self.g)[None], \
+            np.zeros((q.shape[0], len(self.u), len(self.u)))
+
+
+def two_dof(h: TorusHarmonics, w, forces, amplitudes=(0.3, 0.2j)) -> TorusProblem:
+    M = np.array([[1.0, 0.1], [0.1, 2.0]])
+    D = np.array([[0.05, 0.01], [0.0, 0.08]])  # not symmetric: as a gyroscopic part would make it
+    K = np.array([[2.0, -0.5], [-0.5, 1.5]])
+    Q = np.zeros((h.n_orders, 2), complex)
+    Q[h.index(1, 0), 0], Q[h.index(0, 1), 1] = amplitudes
+    return TorusProblem(M, D, K, h, w, (0, 1), h.from_phasors(Q), tuple(forces))
+
+
+def cubic_oscillator(H: int, w) -> TorusProblem:
+    h = TorusHarmonics(H, H, *alias_free_grid(H, H, 3))
+    Q = np.zeros((h.n_orders, 1), complex)
+    Q[h.index(1, 0)], Q[h.index(0, 1)] = F1, F2
+    return TorusProblem(np.eye(1), C * np.eye(1), np.eye(1), h, w, (0,), h.from_phasors(Q), (CubicSpring(0, K3),))
+
+
+# ------------------------------------------------------------------------------------------------- the basis and AFT
+def test_torus_aft_equals_the_direct_sums_and_inverts_exactly():
+    """Samples and rates by the inverse 2-D FFT equal the Fourier sums written out (measured 2.9e-15 and 2.6e-15 of
+    their largest value); the forward FFT returns the coefficients (3.1e-15); the Toeplitz matrices from the spectrum
+    equal forward diag(d) E, the sums over samples (6.7e-16); a transfer to a larger set and back is exact."""
+    h = TorusHarmonics(3, 4, 12, 14)
+    rng = np.random.default_rng(0)
+    n, w = 2, (1.0, math.sqrt(2.0))
+    z = rng.standard_normal(h.size * n)
+    c = z.reshape(h.size, n)
+    theta, wk = h.angles(), h.frequencies(w)
+    q_ref, v_ref = np.tile(c[0], (h.n_samples, 1)), np.zeros((h.n_samples, n))
+    for i, k in enumerate(h.orders[1:], start=1):
+        phase = (theta @ k)[:, None]
+        q_ref += np.cos(phase) * c[2 * i - 1] + np.sin(phase) * c[2 * i]
+        v_ref += wk[i] * (-np.sin(phase) * c[2 * i - 1] + np.cos(phase) * c[2 * i])
+    assert np.max(np.abs(h.samples(z, n) - q_ref)) < 3e-14 * np.max(np.abs(q_ref))
+    assert np.max(np.abs(h.rates(z, n, w) - v_ref)) < 3e-14 * np.max(np.abs(v_ref))
+    assert np.max(np.abs(h.coefficients(q_ref) - z)) < 3e-14
+    d = rng.standard_normal((h.n_samples, n, n))
+    assert np.max(np.abs(h.toeplitz(d) - h.toeplitz_by_samples(d))) < 1e-14
+    larger = TorusHarmonics(4, 6, 10, 14)
+    assert np.array_equal(larger.transfer(h.transfer(z, n, larger), n, h), z)
+    assert h.size == 2 * h.n_orders - 1 and h.n_orders == 1 + 3 * 9 + 4  # (0,0), k1 = 1..3 x 9, k1 = 0 x 4
+
+
+def test_torus_harmonics_refuses_an_aliased_grid_and_a_band_without_frequencies():
+    with pytest.raises(InputError, match="N1 = 7: must be an integer >= 8"):
+        TorusHarmonics(3, 4, 7, 14)
+    with pytest.raises(InputError, match="N2 = 15: must be even"):
+        TorusHarmonics(3, 4, 8, 15)
+    with pytest.raises(InputError, match="w = None: must be given with w_max"):
+        TorusHarmonics(3, 4, 8, 14, w_max=5.0)
+    band = TorusHarmonics(3, 4, 8, 14, w_max=2.0, w=(1.0, math.sqrt(2.0)))
+    assert np.all(np.abs(band.frequencies((1.0, math.sqrt(2.0)))) <= 2.0) and band.n_orders < 32
+
+
+def test_torus_jacobian_is_the_analytic_chain_rule_and_the_woodbury_step_is_newtons():
+    """dR/dz (a cubic spring, a velocity-cubic damper and a rank-1 cubic on a 2-DOF system) equals central differences
+    (measured 1.5e-10 of its largest entry); Newton's step through the Woodbury identity equals the dense solve (full
+    rank: 3.0e-15; rank 1: 1.8e-15 of the step)."""
+    h = TorusHarmonics(3, 4, *alias_free_grid(3, 4, 3))
+    w = (1.0, math.sqrt(2.0))
+    problem = two_dof(h, w, (CubicSpring(0, 0.5), VelocityCubic(1, 0.3), RankOneCubic((1.0, -0.5), (0.3, 1.0), 2.0)))
+    z = problem.linear_response() * 3.0
+    J = problem.evaluate(z).dR_dz
+    eps = 1e-6
+    J_fd = np.column_stack([(problem.residual(z + eps * e) - problem.residual(z - eps * e)) / (2 * eps)
+                            for e in np.eye(problem.size)])
+    assert np.max(np.abs(J - J_fd)) < 2e-9 * np.max(np.abs(J))
+    R, step = problem.newton_step(z)
+    assert np.max(np.abs(step - np.linalg.solve(J, -R))) < 3e-14 * np.max(np.abs(step))
+    rank_one = two_dof(h, w, (RankOneCubic((1.0, -0.5), (0.3, 1.0), 2.0),))
+    ev, step1 = rank_one.evaluate(z), rank_one.newton_step(z)[1]
+    assert np.max(np.abs(step1 - np.linalg.solve(ev.dR_dz, -ev.R))) < 3e-14 * np.max(np.abs(step1))
+
+
+# ------------------------------------------------------------------------------------------------- solutions
+def test_linear_system_at_two_incommensurate_frequencies_is_the_closed_form():
+    """A 2-DOF system with a linear spring S passed through the AFT as a force, forced at w1 and w2 = sqrt(2) w1: each
+    forced line is (K + S - w^2 M + i w D)^-1 F (measured 3.4e-15 relative), every other line 0 (8.8e-17); the dense
+    Newton of hb.solve and the Woodbury Newton give the same coefficients (1.6e-15)."""
+    h = TorusHarmonics(2, 3, 6, 8)
+    w = (1.0, math.sqrt(2.0))
+    S = np.array([[0.4, -0.1], [-0.1, 0.7]])
+    problem = two_dof(h, w, (LinearSpring(S),))
+    sol = solve_torus(problem, np.zeros(problem.size))
+    Q = problem.recover(sol.z)
+    for (k1, k2), F in (((1, 0), np.array([0.3, 0.0])), ((0, 1), np.array([0.0, 0.2j]))):
+        om = k1 * w[0] + k2 * w[1]
+        ref = np.linalg.solve(problem.K + S - om**2 * problem.M + 1j * om * problem.D, F)
+        assert np.max(np.abs(Q[h.index(k1, k2)] - ref)) < 3e-14 * np.max(np.abs(ref))
+    others = [i for i in range(h.n_orders) if i not in (h.index(1, 0), h.index(0, 1))]
+    assert np.max(np.abs(Q[others])) < 1e-15
+    z_dense, _, _ = solve(problem, np.zeros(problem.size), w[0])
+    assert np.max(np.abs(z_dense - sol.z)) < 2e-14 * np.max(np.abs(sol.z))
+    assert sol.iterations == 1 and sol.history[0] == pytest.approx(1.0)  # linear: one Newton step from 0
+
+
+def test_solve_torus_refuses_a_point_that_does_not_converge():
+    problem = cubic_oscillator(3, W_INCOMMENSURATE)
+    with pytest.raises(NotConverged, match="after 1 Newton iterations"):
+        solve_torus(problem, np.zeros(problem.size), max_iter=1)
+
+
+def test_cubic_oscillator_on_the_torus_equals_a_long_transient():
+    """The cubic oscillator forced at w1 = 0.8 and w2 = 0.8 sqrt(2): the torus (H1 = H2 = 9, alias-free grid 38 x 38)
+    against solve_ivp (DOP853, rtol 1e-10) from the linear settled state, its record over 200-700 s projected by least
+    squares on the torus's lines. Measured: the two forced lines 1.1e-11 and 1.8e-11 relative, the cubic's combinations
+    2w1 - w2 and w1 - 2w2 (3.7 % and 3.6 % of the larger forced line) 9.5e-11 and 9.9e-11, the fifth-order 2w1 + w2
+    (0.49 %) 4.0e-10 and 3w1 - 2w2 (0.16 %) 5.9e-9; the torus converges with H (the forced line's change H = 5 -> 7:
+    4.0e-10, 7 -> 9: 2.2e-13), in 4 Newton iterations from the linear response."""
+    problem = cubic_oscillator(9, W_INCOMMENSURATE)
+    sol = solve_torus(problem, problem.linear_response())
+    assert sol.iterations <= 6
+    h, w = problem.harmonics, W_INCOMMENSURATE
+    Q = problem.recover(sol.z)[:, 0]
+    Q5 = cubic_oscillator(5, w)
+    Q7 = cubic_oscillator(7, w)
+    a5, a7 = (abs(p.recover(solve_torus(p, p.linear_response()).z)[p.harmonics.index(1, 0), 0]) for p in (Q5, Q7))
+    assert abs(a7 - a5) < 4e-9 * a7
+
+    lin = problem.linear_response()  # the linear settled state at t = 0 (no nonlinear part): an independent start
+    x0 = h.samples(lin, 1)[0, 0]
+    v0 = h.rates(lin, 1, w)[0, 0]
+
+    def rhs(t, y):
+        return [y[1], F1 * math.cos(w[0] * t) + F2 * math.cos(w[1] * t) - C * y[1] - y[0] - K3 * y[0] ** 3]
+    ode = solve_ivp(rhs, (0.0, 700.0), [x0, v0], method="DOP853", rtol=1e-10, atol=1e-12, dense_output=True)
+    t = np.linspace(200.0, 700.0, 20001)
+    phase = np.outer(t, h.frequencies(w)[1:])
+    coef = np.linalg.lstsq(np.hstack([np.ones((t.size, 1)), np.cos(phase), np.sin(phase)]), ode.sol(t)[0],
+                           rcond=None)[0]
+    K = h.n_orders
+    Q_ode = np.concatenate([[coef[0]], coef[1:K] - 1j * coef[K:]])
+    for order, tol in (((1, 0), 2e-10), ((0, 1), 2e-10), ((2, -1), 1e-9), ((1, -2), 1e-9), ((2, 1), 4e-9),
+                       ((3, -2), 6e-8)):
+        i = h.index(*order)
+        assert abs(Q_ode[i] - Q[i]) < tol * abs(Q[i]), order
+    assert abs(Q[h.index(1, 1)]) < 1e-15  # an odd force has no even combinations
+
+
+def test_torus_at_commensurate_frequencies_is_the_periodic_balance():
+    """At w2 = 2 w1 the torus u(theta1, theta2) read along theta = w t is the periodic response: the torus's lines
+    summed per harmonic k1 + 2 k2 equal rotorred.nonlinear.hb's periodic solution (30 harmonics) forced at harmonics 1
+    and 2. Two paths to one answer: measured 1.5e-8 (H = 7) and 9e-11 (H = 9) of the largest line."""
+    w1, Hp = 0.6, 30
+    hp = Harmonics(Hp, alias_free_samples(Hp, 3))
+
+    def forcing(omega):
+        f = np.zeros(hp.size)
+        f[1], f[3] = F1, F2
+        return f, np.zeros(hp.size)
+    periodic = PeriodicProblem(np.eye(1), C * np.eye(1), np.eye(1), hp, forcing, (CubicSpring(0, K3),))
+    zp = solve(periodic, periodic.linear_response(w1), w1)[0]
+    Qp = np.concatenate([[zp[0]], zp[1::2] - 1j * zp[2::2]])
+    for H, tol in ((7, 2e-7), (9, 1e-9)):
+        problem = cubic_oscillator(H, (w1, 2 * w1))
+        Q = problem.recover(solve_torus(problem, problem.linear_response()).z)[:, 0]
+        harmonic = problem.harmonics.orders @ np.array([1, 2])
+        collapsed = np.zeros(Hp + 1, complex)
+        for i, m in enumerate(harmonic):
+            if m == 0:
+                collapsed[0] += Q[i].real
+            else:
+                collapsed[abs(m)] += Q[i] if m > 0 else Q[i].conj()
+        assert np.max(np.abs(collapsed - Qp)) < tol * np.max(np.abs(Qp))
+
+
+# ------------------------------------------------------------------------------------------------- the rig
+def test_rub_scene_out_of_contact_is_the_linear_unbalance_response_on_the_torus():
+    """paper-rub at outer 91.37 Hz on the signal layer's torus (f_L, f_H/3), the clearance opened to 1 mm: each spool's
+    unbalance forces its order ((1, 0) and (0, 3)); the solution, read along theta = w t, is the scene's linear steady
+    state (rotorred.scenes.run.settled_response; measured 1.2e-13 of the peak at nodes 14 and 18 over 1 s), and the
+    start fitted to that record by least squares is the solution (1.1e-13)."""
+    from rotorred.scenes.run import build_model, settled_response
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+    from rotorred.signals.linefit import Torus
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": 1e-3})
+    model = build_model(scene).model
+    rp = torus_rub_problem(scene, model, Torus(70.0, 91.37, k=3, j=1), 2, 4, 8, 16)
+    assert rp.bases_hz == pytest.approx((70.0, 91.37 / 3), rel=1e-15)
+    assert rp.spool_orders == {"inner": (1, 0), "outer": (0, 3)}
+    sol = solve_torus(rp.problem, rp.problem.linear_response())
+    assert sol.iterations == 0
+    t = np.arange(0.0, 1.0, 1e-4)
+    dofs = [(14, "y"), (18, "x"), (18, "y")]
+    reference = settled_response(scene, model, model.output_rows(dofs), t)
+    Q = rp.problem.recover(sol.z)[:, :rp.n_model] @ model.output_rows(dofs).T
+    y = np.real(np.exp(1j * np.outer(t, rp.problem.frequencies)) @ Q).T
+    assert np.max(np.abs(y - reference)) < 1e-12 * np.max(np.abs(reference))
+    records = {0: reference[1], 1: reference[2], 2: np.zeros_like(t), 3: np.zeros_like(t)}
+    z0 = rp.start_from_record(t, records)
+    assert np.max(np.abs(z0 - sol.z)) < 1e-12 * np.max(np.abs(sol.z))
+    with pytest.raises(InputError, match="commensurate"):
+        torus_rub_problem(scene, model, (10.0, 20.0), 2, 4, 8, 16)
+
+
+def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced_lines():
+    """paper-rub at outer 91.37 Hz, rubbing: a 3 s transient (its line fit on 2-3 s finds the torus (f_H/3, f_L)
+    itself) starts the torus on a coarse set (|k1| <= 6, |k2| <= 30, grid 32 x 256; least squares on |k1| <= 4,
+    |k2| <= 30). Newton converges (measured 7 iterations; the rub's Jacobian pattern is rank 1, so each step is one
+    solve of 2K - 1 = 793 unknowns), and the three largest lines at node 14 Y equal the transient's (measured f_H
+    -0.15 %, 4f_H/3 -0.35 %, f_L -0.017 %); the impacts' combination lines need the larger sets of
+    validation/hb_torus.py (here 2f_H/3 + f_L is 3.7 % off)."""
+    from rotorred.scenes.run import build_model, run_scene
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+    from rotorred.signals.linefit import fit_lines
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37, "solver.duration": 3.0, "solver.record_start": 2.0,
+                                     "output.nodes": [14, 18], "output.directions": ["x", "y"], "output.table": "14:y",
+                                     "output.plots": [], "output.formats": [], "output.compare_normal": False,
+                                     "output.plot_window": [2.0, 3.0]})
+    sm = build_model(scene)
+    result = run_scene(scene, sm, compare_normal=False, analyse=False)
+    fit = fit_lines(result.t, result.outputs[(14, "y")], 70.0, 91.37)
+    assert (fit.torus.k, fit.torus.j) == (3, 1)
+    rp = torus_rub_problem(scene, sm.model, fit.torus, 6, 30, 32, 256)
+    contact = result.contacts[0]
+    records = {0: result.outputs[(18, "x")], 1: result.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    sol = solve_torus(rp.problem, rp.start_from_record(result.t, records, within=(4, 30)))
+    assert sol.iterations <= 10 and sol.residual < 1e-10
+    largest = {ln.label_ascii: ln for ln in fit.lines}
+    for label, tol in (("f_H", 1.5e-2), ("4f_H/3", 3.5e-2), ("f_L", 2e-3)):
+        ln = largest[label]
+        assert rp.amplitudes_at(sol.z, (14, "y"), [ln.frequency_hz])[0] == pytest.approx(ln.amplitude, rel=tol)
