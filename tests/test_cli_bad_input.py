@@ -85,6 +85,18 @@ CASES = [
     (["map", "paper-rub", "--vary", "speeds.outer=60:110:101", "--limit", "1e4", "--out", "{d}/o"],
      ["--vary", "speeds.outer=<101 values>", "steps in all", "--force"]),
     (["campbell", "seed-rig", "--speeds", "0:1000:1000000000", "--out", "{d}/o"], ["--speeds", "COUNT"]),
+    # ---- continue (harmonic-balance branches)
+    (["continue", "paper-rub", "--param", "rub.clearance=20e-6", "--out", "{d}/o"], ["--param", "KEY=START:STOP"]),
+    (["continue", "paper-rub", "--param", "rub.clearance=2e-5:2e-5", "--out", "{d}/o"], ["--param", "different"]),
+    (["continue", "paper-rub", "--param", "rub.k_n=1e8:2e8", "--out", "{d}/o"], ["--param", "rub.k_n", "rub.clearance"]),
+    (["continue", "paper-rub", "--param", "speeds.middle=80:90", "--out", "{d}/o"], ["speeds.middle", "inner"]),
+    (["continue", "paper-normal", "--param", "rub.clearance=2e-5:1e-5", "--out", "{d}/o"], ["SCENE", "rub plate"]),
+    (["continue", "paper-rub", "--param", "rub.clearance=2e-5:1e-5", "--samples", "1023", "--out", "{d}/o"],
+     ["--samples", "1023", "even"]),
+    (["continue", "paper-rub", "--param", "rub.clearance=2e-5:1e-5", "--harmonics", "0", "--out", "{d}/o"],
+     ["--harmonics", "0"]),
+    (["continue", "paper-rub", "--set", "speeds.outer=91.37", "--param", "rub.clearance=2e-5:1e-5", "--out", "{d}/o"],
+     ["speeds", "91.37", "greatest common divisor"]),
     # ---- campbell options
     (["campbell", "seed-rig", "--speeds", "0:12000", "--out", "{d}/o"], ["--speeds", "0:12000"]),
     (["campbell", "seed-rig", "--speeds=-100:100:5", "--out", "{d}/o"], ["--speeds", "-100:100:5", "rpm"]),

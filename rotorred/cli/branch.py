@@ -55,7 +55,7 @@ def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 when interrupted, its points kept)."""
     from rotorred.cli import EXIT_SIGINT
     from rotorred.cli.run import _settings
-    from rotorred.scenes.branch import continue_scene
+    from rotorred.scenes.branch import check_key, continue_scene
     from rotorred.scenes.branch_outputs import format_branch, write_branch
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
@@ -69,8 +69,7 @@ def run(args) -> int:
         checks.fail("--samples", N, "must be even")
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
-    if not scene.plates:
-        checks.fail("SCENE", args.scene, "must have a rub plate ([[rub]]): the branch is of the rub response")
+    check_key(scene, key, start)
     model = build_model(scene).model
     print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,

@@ -134,9 +134,9 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     while len(points) < max_points:
-        if progress is not None:
-            progress(len(points), points[-1].y[-1])
         try:
+            if progress is not None:
+                progress(len(points), points[-1].y[-1])
             nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
             if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
                 folds.append(_locate_fold(problem, points[-1], nxt, tol))

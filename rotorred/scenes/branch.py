@@ -30,9 +30,9 @@ from rotorred.nonlinear.condensed import ClearanceFamily
 from rotorred.nonlinear.continuation import continue_branch
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
-from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
+from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
 
-__all__ = ["KEYS", "SpeedFamily", "SceneBranch", "cold_start", "continue_scene"]
+__all__ = ["KEYS", "SpeedFamily", "SceneBranch", "check_key", "cold_start", "continue_scene"]
 
 #: the keys a branch follows, and their units
 KEYS = {"rub.clearance": "m", "speeds.<spool>": "Hz"}
@@ -68,7 +68,7 @@ class SpeedFamily:
 
     def __post_init__(self):
         if self.spool not in self.scene.speeds:
-            checks.fail("key", f"speeds.{self.spool}", f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
+            checks.fail("spool", self.spool, f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
         object.__setattr__(self, "parameter", (f"speeds.{self.spool}", "Hz"))
         f = self.scene.frequencies_hz
         base = rub_problem(self.scene, self.model, self.H, self.N)
@@ -133,6 +133,9 @@ class SceneBranch:
         The output DOFs (the scene's).
     peaks : ndarray, shape (p, len(dofs))
         Largest |q(t)| over the period of each output DOF (m).
+    z : ndarray, shape (p, (2H + 1) m)
+        Each point's solution: the Fourier coefficients of the unknowns (:class:`RubProblem`; its ``final_state``
+        starts a transient on it).
     lines : ndarray, shape (p, H + 1)
         Amplitude of each harmonic k f_0 of ``dofs[0]`` (m).
     critical : ndarray of complex, shape (p,)
@@ -153,6 +156,7 @@ class SceneBranch:
     f0: np.ndarray
     dofs: tuple
     peaks: np.ndarray
+    z: np.ndarray
     lines: np.ndarray
     critical: np.ndarray
     folds: tuple
@@ -191,6 +195,22 @@ class SceneBranch:
     @property
     def interrupted(self) -> bool:
         return self.stopped.startswith("interrupted")
+
+
+def check_key(scene, key: str, start: float) -> None:
+    """Refuse, before anything is computed, a key the branch cannot follow in ``scene`` (:data:`KEYS`), a scene
+    without a plate, and speeds that are not commensurate at ``start`` (for a speed key) or now."""
+    if not scene.plates:
+        checks.fail("SCENE", scene.name, "must have a rub plate ([[rub]]): the branch is of the rub response")
+    spools = tuple(scene.speeds)
+    allowed = ("rub.clearance",) + tuple(f"speeds.{s}" for s in spools)
+    if key not in allowed:
+        checks.fail("--param", key, f"must be one of {', '.join(allowed)}")
+    if key == "rub.clearance" and len(scene.plates) != 1:
+        checks.fail("--param", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
+    f = scene.frequencies_hz
+    factor = start / f[key.partition(".")[2]] if key.startswith("speeds.") else 1.0
+    base_frequency(tuple(v * factor for v in f.values()))
 
 
 def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
@@ -266,6 +286,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     rps = [rub_at(v) for v in values]
     return SceneBranch(key, "m" if key == "rub.clearance" else "Hz", values, np.array([rp.f0 for rp in rps]), dofs,
                        np.array([[np.max(np.abs(rp.waveform(z, d))) for d in dofs] for rp, z in zip(rps, branch.z)]),
+                       branch.z,
                        np.array([list(rp.lines(z, dofs[0]).values()) for rp, z in zip(rps, branch.z)]),
                        multipliers, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
                        branch.iterations, t1 - t0, t2 - t1, t3 - t2)
@@ -274,15 +295,12 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
 def _family(scene, model, key: str, start: float, H: int, N: int):
     """The continuation family of ``key``, the map from its carried parameter to the key's value (``inverse``: back),
     and ``rub_at(value) -> RubProblem``."""
+    check_key(scene, key, start)
     if key == "rub.clearance":
-        if len(scene.plates) != 1:
-            checks.fail("key", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
         rp = rub_problem(scene, model, H, N)
         family = ClearanceFamily(rp.problem, rp.omega)
         return family, (lambda v, inverse=False: v), (lambda v: dataclasses.replace(rp, problem=family.at(v)))
-    spool = key.partition(".")[2] if key.startswith("speeds.") else ""
-    if not spool:
-        checks.fail("key", key, f"must be one of {', '.join(KEYS)}")
+    spool = key.partition(".")[2]
     rp = SpeedFamily(scene, model, spool, H, N).at(start)
     scale = float(np.linalg.norm(rp.problem.linear_response(rp.omega))) / start  # m per Hz
     family = SpeedFamily(scene, model, spool, H, N, scale)

@@ -1,0 +1,113 @@
+"""Harmonic-balance branches of a rub scene (rotorred.scenes.branch, ``rotorred continue``): every point solves the
+problem built independently from the scene at that value, the folds are where the branch turns, stability changes
+are classified by the critical multiplier, an interrupt keeps the points, and the command writes its files."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from rotorred.cli import main
+from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.examples import jeffcott
+from rotorred.scenes.branch import SceneBranch, continue_scene
+from rotorred.scenes.harmonic_balance import rub_problem
+from rotorred.scenes.run import build_model
+from rotorred.scenes.schema import load_scene
+
+H, N = 20, 128  # coarse: the tests check the machinery, validation/hb_rig.py the rig at 100 harmonics
+
+
+@pytest.fixture(scope="module")
+def rig():
+    scene = load_scene("paper-rub")
+    return scene, build_model(scene).model
+
+
+def _residual(scene, model, z) -> float:
+    rp = rub_problem(scene, model, H, N)
+    return rp.problem.evaluate(z, rp.omega, jacobian=False).relative
+
+
+def test_a_clearance_branch_solves_the_scene_at_each_clearance_and_turns_at_its_folds(rig):
+    """From 45 um (out of contact: the linear response) to 25 um: each of 5 points solves the problem built from the
+    scene loaded with that clearance (relative residual below the branch's 1e-9), the branch turns an even number of
+    times (it goes on down: 4 smooth folds at 20 harmonics, 2 at 100 in validation/hb_rig.py), each fold within a step
+    of its nearest point, and the peak at 45 um is the linear response's."""
+    scene, model = rig
+    branch = continue_scene(scene, model, "rub.clearance", 45e-6, 25e-6, H, N, stability=False)
+    assert branch.stopped == "reached the end, clearance = 2.5e-05 m"
+    for i in np.linspace(0, len(branch.values) - 1, 5).astype(int):
+        at = load_scene("paper-rub", {"rub.clearance": float(branch.values[i])})
+        assert _residual(at, model, branch.z[i]) < 1e-9
+    assert len(branch.folds) >= 2 and len(branch.folds) % 2 == 0 and all(smooth for _, smooth in branch.folds)
+    for value, _ in branch.folds:
+        near = np.argsort(np.abs(branch.values - value))[:3]
+        assert np.min(np.abs(branch.values[near] - value)) < 0.05 * value
+    free = rub_problem(load_scene("paper-rub", {"rub.clearance": 45e-6}), model, H, N)
+    free_z = free.problem.linear_response(free.omega)
+    assert branch.peaks[0, 0] == pytest.approx(np.max(np.abs(free.waveform(free_z, branch.dofs[0]))), rel=1e-9)
+
+
+def test_a_speed_branch_keeps_the_speed_ratio_and_solves_the_scene_at_each_speed(rig):
+    """From 90 to 91 Hz on the outer spool, the inner one at 7/9 of it: each point solves the problem built from the
+    scene loaded at those two speeds (measured below 1e-9), its base frequency is the outer speed / 9."""
+    scene, model = rig
+    branch = continue_scene(scene, model, "speeds.outer", 90.0, 91.0, H, N, stability=False)
+    assert branch.stopped.startswith("reached the end, speeds.outer = 91")
+    assert np.allclose(branch.f0, branch.values / 9, rtol=1e-12)
+    for i in (0, len(branch.values) // 2, len(branch.values) - 1):
+        f = float(branch.values[i])
+        at = load_scene("paper-rub", {"speeds.outer": f, "speeds.inner": f * 7 / 9})
+        rp = rub_problem(at, model, H, N, f0=f / 9)
+        assert rp.problem.evaluate(branch.z[i], rp.omega, jacobian=False).relative < 1e-9
+
+
+def test_stability_changes_are_classified_by_the_critical_multiplier():
+    """A multiplier leaving the unit circle near -1 is a period-doubling, near +1 a fold, elsewhere a Neimark-Sacker;
+    no change, no report."""
+    values = np.arange(6.0)
+    critical = np.array([0.5, -1.2, -0.9, 0.5 + 0.6j, 0.8 + 0.8j, 1.3])
+    branch = SceneBranch("rub.clearance", "m", values, values, ((18, "y"),), np.zeros((6, 1)), np.zeros((6, 4)),
+                         np.zeros((6, 3)), critical, (), "reached the end", np.ones(6, int), 0.0, 0.0, 0.0)
+    assert [kind for _, _, kind in branch.bifurcations] == ["period-doubling", "period-doubling", "Neimark-Sacker"]
+    assert [(a, b) for a, b, _ in branch.bifurcations] == [(0.0, 1.0), (1.0, 2.0), (3.0, 4.0)]
+    assert list(branch.stable) == [True, False, True, True, False, False]
+
+
+def test_an_interrupt_keeps_the_points_so_far():
+    """SIGINT during a continuation (raised by the progress report at the 6th point) ends it there: 6 points kept,
+    each a solution, and the branch says where it stopped."""
+    problem = jeffcott(5, 128)
+
+    def progress(points, omega):
+        if points == 6:
+            raise KeyboardInterrupt
+    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ds=0.1, stability=False,
+                             progress=progress)
+    assert len(branch.omega) == 6 and branch.stopped.startswith("interrupted (SIGINT) at omega = ")
+    assert max(problem.evaluate(z, w, jacobian=False).relative for z, w in zip(branch.z, branch.omega)) < 1e-10
+
+
+def test_rotorred_continue_writes_the_branch(tmp_path):
+    """The command writes branch.csv (a row a point, the key first), branch_lines.csv, branch.nc (the same values,
+    labelled), branch.png and branch.txt (with the folds); the multipliers are computed (finite)."""
+    import xarray as xr
+
+    out = tmp_path / "b"
+    assert main(["continue", "paper-rub", "--param", "rub.clearance=45e-6:25e-6", "--harmonics", str(H), "--samples",
+                 str(N), "--out", str(out)]) == 0
+    assert {p.name for p in out.iterdir()} >= {"branch.csv", "branch_lines.csv", "branch.nc", "branch.png",
+                                               "branch.txt"}
+    with open(out / "branch.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][0] == "rub.clearance (m)" and rows[0][2] == "peak 14y (um)"
+    ds = xr.open_dataset(out / "branch.nc", engine="h5netcdf")
+    values = np.array([float(r[0]) for r in rows[1:]])
+    assert np.allclose(ds["rub.clearance"].values, values, rtol=1e-8)
+    assert np.allclose(ds["peak"].values[:, 0] * 1e6, [float(r[2]) for r in rows[1:]], rtol=1e-8)
+    assert np.isfinite(ds["critical_multiplier_re"].values).all()
+    assert "µm (fold)" in (out / "branch.txt").read_text()
+    ds.close()
