@@ -1,5 +1,5 @@
-"""Harmonic balance of the rig's rub response (paper-rub, 70/90 Hz) against the settled transient, and the two
-periodic responses it has there.
+"""Harmonic balance of the rig's rub response (paper-rub, 70/90 Hz) against the settled transient, its cold solution,
+a continuation in the clearance, and the costs of each, measured in one run.
 
 Run::
 
@@ -7,15 +7,19 @@ Run::
 
 Prints:
 
-1. the settled transient's 10 largest lines at node 14 Y and, for 60, 100 and 150 harmonics of f_0 = 10 Hz, the
+1. the settled transient's 10 largest lines at node 14 Y and, for 60, 150 and 100 harmonics of f_0 = 10 Hz, the
    harmonic-balance solution started from the transient's last period: Newton iterations, solve time and each line's
    relative difference;
-2. a continuation in the clearance from 50 um (no contact) to 13 um with 30 harmonics (points, folds, time), the
-   orbit it ends on refined to 100 harmonics, its distance from the transient's orbit and its lines;
-3. the stability of both orbits from the monodromy matrix of the whole linearised system (largest Floquet
+2. the cold solution at 13 um (:func:`rotorred.scenes.branch.cold_start`): its time, its distance from the
+   transient's orbit and its lines (a second periodic response);
+3. the branch from 20 to 5 um (:func:`rotorred.scenes.branch.continue_scene`, 100 harmonics): points and time a
+   point, and the settled transients at 20 and 5 um;
+4. the stability of both orbits from the monodromy matrix of the whole linearised system (largest Floquet
    multiplier modulus; < 1 stable);
-4. transients started on each orbit (its state at t = 0, ``RubProblem.final_state``) and run for 2 s: the distance of
-   their last period from each orbit (relative, in the Fourier coefficients of the unknowns).
+5. transients started on each orbit (its state at t = 0, ``RubProblem.final_state``) and run for 2 s: the distance of
+   their last period from each orbit (relative, in the Fourier coefficients of the unknowns);
+6. the cost table of the README's Performance section: transient, HB from the transient, HB cold, continuation a
+   point (solve times only).
 """
 
 from __future__ import annotations
@@ -24,10 +28,9 @@ import time
 
 import numpy as np
 
-from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import continue_branch
 from rotorred.nonlinear.hb import solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
+from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.run import build_model, run_scene
 from rotorred.scenes.schema import load_scene
@@ -56,29 +59,34 @@ def from_transient(scene, sm, result, largest, records, H: int, N: int):
     diffs = [lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1 for ln in largest]
     print(f"  H = {H:3d}, N = {N:4d}: {iterations} Newton iterations, {elapsed:.2f} s; worst {max(map(abs, diffs)):.2%}: "
           + " ".join(f"{ln.frequency_hz:.0f}:{d:+.2%}" for ln, d in zip(largest, diffs)))
-    return rp, z
+    return rp, z, elapsed
 
 
-def by_clearance(scene, sm, rp100, largest, zA):
-    rp = rub_problem(scene, sm.model, 30, 256)
-    family = ClearanceFamily(rp.problem, rp.omega)
+def cold(scene, sm, rp100, largest, zA):
+    """The cold solution at 13 um (:func:`rotorred.scenes.branch.cold_start`), its time and lines."""
     t0 = time.perf_counter()
-    branch = continue_branch(family, rp.problem.linear_response(rp.omega), 50e-6, 13e-6, ds=2e-6, ds_min=1e-12,
-                             ds_max=5e-6, stability=False, tol=1e-9)
+    zB = cold_start(rp100.problem, rp100.omega)
     elapsed = time.perf_counter() - t0
-    print(f"  30 harmonics: {len(branch.omega)} points in {elapsed:.1f} s ({1e3 * elapsed / len(branch.omega):.0f} ms "
-          f"a point); folds at {', '.join(f'{1e6 * f.omega:.2f} um' for f in branch.folds)}; {branch.stopped}")
-    i = int(np.argmin(np.abs(branch.omega - 13e-6)))
-    z30, _, _ = solve(family.at(13e-6), branch.z[i], rp.omega)
-    z0 = np.zeros(rp100.problem.size)
-    z0[:len(z30)] = z30
-    zB, _, iterations = solve(rp100.problem, z0, rp100.omega, max_iter=60)
     lines = rp100.lines(zB, OUTPUT)
-    print(f"  refined to 100 harmonics in {iterations} iterations; distance from the transient's orbit "
-          f"{np.linalg.norm(zB - zA) / np.linalg.norm(zA):.2f} (relative); its lines against the transient's:")
+    print(f"  {elapsed:.2f} s; distance from the transient's orbit {np.linalg.norm(zB - zA) / np.linalg.norm(zA):.2f} "
+          f"(relative); its lines against the transient's:")
     print("   " + " ".join(f"{ln.frequency_hz:.0f}:{lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1:+.1%}"
                          for ln in largest))
-    return zB
+    return zB, elapsed
+
+
+def by_clearance(scene, sm):
+    """The branch from 20 to 5 um at 100 harmonics (no stability: the continuation's own cost), and the settled
+    transients at its ends (the transient's cost at 13 um is the first run's)."""
+    branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, 100, 2048, stability=False)
+    per_point = branch.solve_time / (len(branch.values) - 1)
+    print(f"  {len(branch.values)} points from 20 to 5 um in {branch.solve_time:.2f} s: {1e3 * per_point:.0f} ms a "
+          f"point (cold start at 20 um {branch.start_time:.2f} s); {branch.stopped}")
+    ends = {}
+    for c in (20e-6, 5e-6):
+        at = load_scene("paper-rub", {"rub.clearance": c})
+        ends[c] = run_scene(at, sm, compare_normal=False).solve_time
+    return per_point, ends
 
 
 def main() -> None:
@@ -90,20 +98,31 @@ def main() -> None:
     print("harmonic balance started from the transient's last period:")
     for H, N in ((60, 512), (150, 4096)):
         from_transient(scene, sm, result, largest, records, H, N)
-    rp100, zA = from_transient(scene, sm, result, largest, records, 100, 2048)
-    print("continuation in the clearance from 50 um (no contact) to 13 um:")
-    zB = by_clearance(scene, sm, rp100, largest, zA)
-    print("stability (monodromy of the whole linearised system, 2048 intervals):")
-    for name, z in (("the transient's orbit", zA), ("the continuation's orbit", zB)):
+    rp100, zA, warm = from_transient(scene, sm, result, largest, records, 100, 2048)
+    print("cold harmonic balance at 13 um, 100 harmonics (Newton from the linear response, else a continuation in the "
+          "clearance from where the linear orbit reaches the plate):")
+    zB, cold_time = cold(scene, sm, rp100, largest, zA)
+    print("continuation in the clearance, 100 harmonics:")
+    per_point, ends = by_clearance(scene, sm)
+    print(f"stability (monodromy of the whole linearised system, {STABILITY_SUBSTEPS} intervals an AFT sample):")
+    for name, z in (("the transient's orbit", zA), ("the cold solution's orbit", zB)):
         t0 = time.perf_counter()
-        fl = floquet_by_monodromy(rp100.problem, z, rp100.omega, substeps=1)
+        fl = floquet_by_monodromy(rp100.problem, z, rp100.omega, STABILITY_SUBSTEPS)
         print(f"  {name}: largest |multiplier| {np.abs(fl.multipliers).max():.4f} "
               f"({'stable' if fl.stable else 'unstable'}), {time.perf_counter() - t0:.1f} s")
     print("transients started on each orbit, 2 s later (last period):")
-    for name, z in (("from the transient's orbit", zA), ("from the continuation's orbit", zB)):
+    for name, z in (("from the transient's orbit", zA), ("from the cold solution's orbit", zB)):
         zt = settled_from(scene, sm, rp100, z)
         print(f"  {name}: distance {np.linalg.norm(zt - zA) / np.linalg.norm(zA):.4f} from the transient's orbit, "
-              f"{np.linalg.norm(zt - zB) / np.linalg.norm(zB):.4f} from the continuation's")
+              f"{np.linalg.norm(zt - zB) / np.linalg.norm(zB):.4f} from the cold solution's")
+    transient = min(run_scene(scene, sm, compare_normal=False).solve_time for _ in range(3))  # warm: no first call
+    print("costs (solve time only, this run; 100 harmonics, 2048 samples):")
+    print(f"  settled transient at 13 um (warm)   {transient:6.3f} s  (20 um: {ends[20e-6]:.3f} s, 5 um: {ends[5e-6]:.3f} s; "
+          f"the first run {result.solve_time:.2f} s)")
+    print(f"  HB from the transient's last period {warm:6.3f} s  ({warm / transient:.2f}x the transient's time)")
+    print(f"  HB cold                             {cold_time:6.2f} s  ({cold_time / transient:.0f}x the transient's time)")
+    print(f"  continuation, per point (20-5 um)   {per_point:6.3f} s  ({per_point / min(ends.values()):.2f}x the time of "
+          f"the fastest transient at its ends)")
 
 
 def settled_from(scene, sm, rp, z):

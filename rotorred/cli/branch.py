@@ -74,7 +74,8 @@ def run(args) -> int:
     print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
                             progress=_progress)
-    print()
+    if sys.stdout.isatty():
+        print()
     print(format_branch(branch))
     with OutputFolder(out) as folder:
         write_branch(branch, folder, scene.name)
@@ -88,7 +89,9 @@ def run(args) -> int:
 
 
 def _progress(points: int, value) -> None:
-    if value is None:
-        print(f"\r  stability: {points} points", end="", flush=True)
-    else:
-        print(f"\r  {points} points, at {value:.6g}", end="", flush=True)
+    """A line that updates in place on a terminal; every 50th point otherwise (a log)."""
+    tty = sys.stdout.isatty()
+    if not tty and points % 50:
+        return
+    text = f"  stability: {points} points" if value is None else f"  {points} points, at {value:.6g}"
+    print(f"\r{text}" if tty else text, end="" if tty else "\n", flush=True)
