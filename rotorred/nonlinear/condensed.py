@@ -28,7 +28,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
-from rotorred.nonlinear.hb import Evaluation, checked_matrices, force_coefficients, sampled_forces
+from rotorred.nonlinear.hb import Evaluation, checked_matrices, force_coefficients, local_forces, sampled_forces
 from rotorred.nonlinear.lowrank import IdentityPlusLowRank
 
 __all__ = ["CondensedProblem"]
@@ -83,13 +83,7 @@ class CondensedProblem:
         dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
                                min_len=1, unique=True)
         object.__setattr__(self, "dofs", dofs)
-        local = {d: i for i, d in enumerate(dofs)}
-        for i, force in enumerate(self.forces):
-            if not set(force.dofs) <= set(local):
-                checks.fail(f"forces[{i}].dofs", force.dofs, f"must be among dofs = {dofs}")
-        # the forces renumbered on the unknowns, for the AFT
-        object.__setattr__(self, "_local_forces", tuple((force, [local[d] for d in force.dofs])
-                                                        for force in self.forces))
+        object.__setattr__(self, "_local_forces", local_forces(self.forces, dofs))  # renumbered on the unknowns
 
     @property
     def n(self) -> int:

@@ -27,7 +27,7 @@ from rotorred.nonlinear.fourier import Harmonics
 from rotorred.nonlinear.lowrank import factored
 
 __all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "sampled_forces",
-           "force_coefficients", "transformed_forces"]
+           "force_coefficients", "transformed_forces", "local_forces"]
 
 
 class NotConverged(RuntimeError):
@@ -170,6 +170,16 @@ class PeriodicProblem:
         A2 = np.kron(eye, self.M)
         A1 = 2.0 * omega * self._ops["NM"] + np.kron(eye, self.velocity_matrix(omega)) + Tv
         return A2, A1, self._jacobian(self.linear(omega)[0], Tq, Tv, omega)
+
+
+def local_forces(forces, dofs: tuple[int, ...]) -> tuple:
+    """Each force with the positions of its DOFs among ``dofs`` (the unknowns, for the AFT); an error naming the force
+    whose DOFs are not all among them."""
+    local = {d: i for i, d in enumerate(dofs)}
+    for i, force in enumerate(forces):
+        if not set(force.dofs) <= set(local):
+            checks.fail(f"forces[{i}].dofs", force.dofs, f"must be among dofs = {dofs}")
+    return tuple((force, [local[d] for d in force.dofs]) for force in forces)
 
 
 def checked_matrices(problem) -> int:

@@ -47,7 +47,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import proportional_columns, alias_free_samples
-from rotorred.nonlinear.hb import Evaluation, NotConverged, sampled_forces
+from rotorred.nonlinear.hb import Evaluation, NotConverged, local_forces, sampled_forces
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
 
@@ -368,11 +368,7 @@ class TorusProblem:
         object.__setattr__(self, "dofs", dofs)
         object.__setattr__(self, "forcing", checks.array("forcing", np.ravel(self.forcing), (self.harmonics.size * n,),
                                                          "N"))
-        local = {d: i for i, d in enumerate(dofs)}
-        for i, force in enumerate(self.forces):
-            if not set(force.dofs) <= set(local):
-                checks.fail(f"forces[{i}].dofs", force.dofs, f"must be among dofs = {dofs}")
-        object.__setattr__(self, "_local_forces", tuple((f, [local[d] for d in f.dofs]) for f in self.forces))
+        object.__setattr__(self, "_local_forces", local_forces(self.forces, dofs))
 
     @property
     def n(self) -> int:

@@ -23,7 +23,7 @@ from rotorred.nonlinear.condensed import CondensedProblem
 from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.fourier import Harmonics, basis
 
-__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate"]
+__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate", "plate_rubs"]
 
 
 def base_frequency(frequencies_hz) -> float:
@@ -146,19 +146,13 @@ def rub_problem(scene, model, H: int, N: int, f0: float | None = None) -> RubPro
     h = basis(H, N)
     n = model.n_dof
     M, D, K = augmented_matrices(model, scene)
-    dofs, forces = [], []
-    for i, plate in enumerate(scene.plates):
-        x, y = (own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
-        spool = scene.rotor.spool_of[plate.node]
-        rub = PlateRub((x, y, n + 2 * i, n + 2 * i + 1), plate, scene.speeds[spool] * (plate.disk_radius or 0.0))
-        dofs += list(rub.dofs)
-        forces.append(rub)
+    dofs, forces = plate_rubs(model, scene)
     orders = {s: int(round(fs / f0)) for s, fs in f.items()}
     if any(k > H for k in orders.values()):
         checks.fail("H", H, f"must reach the spools' harmonics of f0 = {f0:g} Hz ({max(orders.values())})")
     phasors = unbalance_forces(model, scene.unbalances, scene.rotor.spool_of) if scene.unbalances else {}
     forcing = _forcing(h, n + 2 * len(scene.plates), phasors, orders)
-    problem = CondensedProblem(M, D, K, h, tuple(dofs), forcing, tuple(forces))
+    problem = CondensedProblem(M, D, K, h, dofs, forcing, forces)
     return RubProblem(problem, 2 * math.pi * f0, f0, n, model)
 
 
@@ -173,6 +167,19 @@ def augmented_matrices(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray
         D[j, j], D[j + 1, j + 1] = plate.c_n, plate.c_t
         K[j, j], K[j + 1, j + 1] = plate.k_n, plate.k_t
     return M, D, K
+
+
+def plate_rubs(model, scene) -> tuple[tuple[int, ...], tuple[PlateRub, ...]]:
+    """The unknowns (each plate's rub disk x, y and its u_n, u_t, numbered after the model's DOFs) and a
+    :class:`PlateRub` for each plate, at its spool's rim speed."""
+    n, dofs, forces = model.n_dof, [], []
+    for i, plate in enumerate(scene.plates):
+        x, y = (own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
+        spool = scene.rotor.spool_of[plate.node]
+        rub = PlateRub((x, y, n + 2 * i, n + 2 * i + 1), plate, scene.speeds[spool] * (plate.disk_radius or 0.0))
+        dofs += list(rub.dofs)
+        forces.append(rub)
+    return tuple(dofs), tuple(forces)
 
 
 def own_coordinate(model, dof) -> int:

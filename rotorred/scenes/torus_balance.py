@@ -19,9 +19,8 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.linear.harmonic import unbalance_forces
-from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem
-from rotorred.scenes.harmonic_balance import augmented_matrices, own_coordinate
+from rotorred.scenes.harmonic_balance import augmented_matrices, plate_rubs
 from rotorred.signals.linefit import Torus
 
 __all__ = ["TorusRubProblem", "torus_rub_problem", "torus_bases"]
@@ -139,17 +138,11 @@ def torus_rub_problem(scene, model, torus, H1: int, H2: int, N1: int, N2: int,
     h = TorusHarmonics(H1, H2, N1, N2, w_max, w if w_max is not None else None)
     n, p = model.n_dof, 2 * len(scene.plates)
     M, D, K = augmented_matrices(model, scene)
-    dofs, forces = [], []
-    for i, plate in enumerate(scene.plates):
-        x, y = (own_coordinate(model, (plate.node, d)) for d in ("x", "y"))
-        spool = scene.rotor.spool_of[plate.node]
-        rub = PlateRub((x, y, n + 2 * i, n + 2 * i + 1), plate, scene.speeds[spool] * (plate.disk_radius or 0.0))
-        dofs += list(rub.dofs)
-        forces.append(rub)
+    dofs, forces = plate_rubs(model, scene)
     orders = {s: _spool_order(h, bases, f_s) for s, f_s in scene.frequencies_hz.items()}
     Q = np.zeros((h.n_orders, n + p), complex)
     phasors = unbalance_forces(model, scene.unbalances, scene.rotor.spool_of) if scene.unbalances else {}
     for s, phasor in phasors.items():  # F = Re(Omega_s^2 F_s e^{i Omega_s t}) at the spool's order
         Q[h.index(*orders[s]), :n] += scene.speeds[s] ** 2 * phasor
-    problem = TorusProblem(M, D, K, h, w, tuple(dofs), h.from_phasors(Q), tuple(forces))
+    problem = TorusProblem(M, D, K, h, w, dofs, h.from_phasors(Q), forces)
     return TorusRubProblem(problem, bases, orders, n, model)
