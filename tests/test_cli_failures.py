@@ -69,9 +69,12 @@ def test_diverging_sweep_point_is_recorded_and_the_others_kept(tmp_path, capsys)
 
 # --------------------------------------------------------------------------- interrupts and concurrency
 def _rotorred(*args, **kw) -> subprocess.Popen:
+    """The command in a child process, with SIGINT at its default as in a terminal: a test run started in the
+    background (``pytest &``) ignores SIGINT, and a child would inherit that and never see the interrupt."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONUNBUFFERED="1")
     return subprocess.Popen([sys.executable, "-c", "import sys; from rotorred.cli import main; sys.exit(main())", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env, **kw)
+                            stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL), **kw)
 
 
 def _snapshot(folder: Path) -> dict:
