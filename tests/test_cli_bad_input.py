@@ -85,6 +85,15 @@ CASES = [
     (["map", "paper-rub", "--vary", "speeds.outer=60:110:101", "--limit", "1e4", "--out", "{d}/o"],
      ["--vary", "speeds.outer=<101 values>", "steps in all", "--force"]),
     (["campbell", "seed-rig", "--speeds", "0:1000:1000000000", "--out", "{d}/o"], ["--speeds", "COUNT"]),
+    # ---- solver.method = "harmonic-balance"
+    (["run", "paper-rub", "--set", "solver.harmonics=50", "--out", "{d}/o"], ["solver.harmonics", "harmonic-balance"]),
+    (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "solver.samples=1001", "--out", "{d}/o"],
+     ["solver.samples", "1001", "even"]),
+    (["run", "paper-normal", "--set", "solver.method=harmonic-balance", "--out", "{d}/o"], ["solver.method", "rub plate"]),
+    (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "solver.gravity=9.81", "--out", "{d}/o"],
+     ["solver.gravity", "9.81"]),
+    (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "speeds.outer=91.37", "--out", "{d}/o"],
+     ["speeds", "91.37", "greatest common divisor"]),
     # ---- continue (harmonic-balance branches)
     (["continue", "paper-rub", "--param", "rub.clearance=20e-6", "--out", "{d}/o"], ["--param", "KEY=START:STOP"]),
     (["continue", "paper-rub", "--param", "rub.clearance=2e-5:2e-5", "--out", "{d}/o"], ["--param", "different"]),

@@ -89,7 +89,8 @@ BAD = [
     ("unknown top-level key", "colour", "red", "colour = 'red': unknown key; allowed keys are description, name, "
      "output, rotor, rub, runup, solver, speeds, unbalance"),
     ("unknown solver key", "solver.step", 1e-5, "solver.step = 1e-05: unknown key; allowed keys are alpha, "
-     "boundary_nodes, cutoff_hz, dt, duration, gravity, method, model, modes, record_start, start"),
+     "boundary_nodes, cutoff_hz, dt, duration, gravity, harmonics, method, model, modes, record_start, samples, "
+     "start"),
     ("unknown rub key", "rub[0].gap", 1e-5, "rub[0].gap = 1e-05: unknown key; allowed keys are K_nr, a0, b0, "),
     ("unknown unbalance key", "unbalance[0].mass", 1.0,
      "unbalance[0].mass = 1.0: unknown key; allowed keys are m_e, node, phase_deg"),

@@ -162,8 +162,10 @@ def _is_internal(exc: BaseException) -> bool:
 
 
 def _is_diverged(exc: BaseException) -> bool:
-    module = sys.modules.get("rotorred.transient.results")
-    return module is not None and isinstance(exc, module.SimulationDiverged)
+    """A transient that diverged, or a harmonic balance that did not converge (each says where and why)."""
+    kinds = [getattr(sys.modules.get(name), kind, None) for name, kind in
+             (("rotorred.transient.results", "SimulationDiverged"), ("rotorred.nonlinear.hb", "NotConverged"))]
+    return any(k is not None and isinstance(exc, k) for k in kinds)
 
 
 def _internal(args, exc: BaseException) -> int:

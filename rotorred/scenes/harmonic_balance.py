@@ -81,6 +81,33 @@ class RubProblem:
         """The model DOF ``dof`` over one period at the N AFT instants (m)."""
         return self.problem.harmonics.E @ self.coefficients(z, dof)
 
+    def record(self, z: np.ndarray, t: np.ndarray, dofs) -> tuple[dict, tuple]:
+        """The solution as a transient's record at the times ``t`` (s): each model DOF of ``dofs`` (m or rad), and a
+        :class:`rotorred.transient.results.ContactHistory` per plate from the law at those instants (slip where the
+        plate pushes, open elsewhere; stick is not modelled here, docs/model.md §15)."""
+        from rotorred.transient.contact import sliding_velocity
+        from rotorred.transient.results import ContactHistory
+
+        h = self.problem.harmonics
+        theta = self.omega * np.asarray(t, float)
+        k = np.arange(1, h.H + 1)
+        E = np.empty((len(theta), h.size))
+        E[:, 0], E[:, 1::2], E[:, 2::2] = 1.0, np.cos(np.outer(theta, k)), np.sin(np.outer(theta, k))
+        c = self.problem.recover(z, self.omega).reshape(h.size, -1)
+        outputs = {d: E @ (c[:, :self.n_model] @ row) for d, row in zip(dofs, self.model.output_rows(list(dofs)))}
+        v_c = self.omega * (h.nabla @ c)  # the coefficients of the velocities (d/dt)
+        contacts = []
+        for rub in self.problem.forces:
+            q, v = E @ c[:, list(rub.dofs)], E @ v_c[:, list(rub.dofs)]
+            f, _, _ = rub.evaluate(q, v)
+            P, T = -f[:, 2], f[:, 3]  # the force on (u_n, u_t) is (-P, T)
+            plate, (cn, sn) = rub.plate, rub.plate.normal
+            contacts.append(ContactHistory(
+                plate, P, T, np.where(P > 0.0, 1, 0).astype(np.int8), q[:, 2], q[:, 3],
+                sliding_velocity(plate, rub.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]),
+                plate.clearance + q[:, 2] - (q[:, 0] * cn + q[:, 1] * sn)))
+        return outputs, tuple(contacts)
+
     def final_state(self, z: np.ndarray):
         """The solution's state at t = 0 as a transient's start (:class:`rotorred.transient.results.FinalState`): the
         model's and the plates' displacements, velocities and accelerations from the Fourier series, the contact

@@ -123,7 +123,7 @@ class SceneResult:
         Labelled peaks of each spectrum.
     f_L, f_H : float
         Lower and higher spool frequency (Hz).
-    method : {"harmonic", "transient"}
+    method : {"harmonic", "transient", "harmonic-balance"}
     model_label : str
     n_steps : int
         Time steps taken (0 for the harmonic solution).
@@ -426,7 +426,7 @@ class Response:
     outputs : dict of (int, str) to ndarray, shape (n,)
         Recorded DOFs (m or rad).
     contacts : tuple of ContactHistory
-    method : {"harmonic", "transient"}
+    method : {"harmonic", "transient", "harmonic-balance"}
     n_steps : int
     counters : dict
     final : FinalState or None
@@ -448,8 +448,11 @@ def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None
     ``initial`` (a FinalState) continues another run (:func:`run_scene`). Raises
     :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
     """
-    if scene.is_linear and scene.solver.start == "settled" and initial is None:
+    balance = scene.solver.method == "harmonic-balance"
+    if scene.is_linear and (scene.solver.start == "settled" or balance) and initial is None:
         return _harmonic_response(scene, model.model)
+    if balance:
+        return _balance_response(scene, model.model)
     f_L, f_H = spool_frequencies(scene)
     return _transient_response(scene, model, progress, f_L, f_H, initial)
 
@@ -460,6 +463,21 @@ def _harmonic_response(scene: Scene, model) -> Response:
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
     return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+
+
+def _balance_response(scene: Scene, model) -> Response:
+    """The periodic rub response by harmonic balance (``solver.method = "harmonic-balance"``: a cold start,
+    :func:`rotorred.scenes.branch.cold_start`) at the record times, as a transient's record."""
+    from rotorred.scenes.branch import cold_start
+    from rotorred.scenes.harmonic_balance import rub_problem
+
+    s = scene.solver
+    n = int(round((s.duration - s.record_start) / s.dt))
+    t = s.record_start + s.dt * np.arange(n + 1)
+    rp = rub_problem(scene, model, s.harmonics, s.samples)
+    z = cold_start(rp.problem, rp.omega)
+    outputs, contacts = rp.record(z, t, scene.output.dofs)
+    return Response(t, outputs, contacts, "harmonic-balance", 0, {"f0": rp.f0})
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,

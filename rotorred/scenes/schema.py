@@ -59,7 +59,7 @@ PLOTS = ("waveforms", "spectra", "orbits", "poincare")
 FORMATS = ("npz", "csv", "mat")
 MODELS = ("reduced", "full")
 STARTS = ("settled", "rest")
-METHODS = ("newmark", "hht")
+METHODS = ("newmark", "hht", "harmonic-balance")
 BENDING = ("navier", "clamped-free", "rigid")
 
 _TOP_KEYS = {"name", "description", "rotor", "speeds", "unbalance", "rub", "solver", "output", "runup"}
@@ -76,7 +76,10 @@ _PLATE_NUMBERS = {"plate_a": ("m", 0.0, True), "plate_b": ("m", 0.0, True), "pla
                   "plate_eta": ("m", 0.0, True), "a0": ("N/m", 0.0, True), "b0": ("N", 0.0, False)}
 _RUB_KEYS = {"node", "theta_deg", "bending", "name"} | set(_RUB_NUMBERS) | set(_PLATE_NUMBERS)
 _SOLVER_KEYS = {"model", "modes", "cutoff_hz", "boundary_nodes", "dt", "duration", "record_start", "start",
-                "method", "alpha", "gravity", "tolerance"}
+                "method", "alpha", "gravity", "tolerance", "harmonics", "samples"}
+#: harmonics of f_0 and AFT samples a period of ``solver.method = "harmonic-balance"`` unless given: the rig's 10
+#: largest lines at node 14 Y within 0.29 % of the settled transient (docs/model.md §15)
+BALANCE_DEFAULTS = (100, 2048)
 #: range of ``solver.tolerance``: below 1e-5 the time step needed leaves double precision little room
 TOLERANCE_RANGE = (1e-5, 0.1)
 _OUTPUT_KEYS = {"nodes", "directions", "plots", "formats", "plot_window", "table", "line_threshold", "f_max_hz",
@@ -129,9 +132,14 @@ class SolverSpec:
         Start of the recorded window (s).
     start : {"settled", "rest"}
         Initial state: the linear steady state (unbalance and gravity) or rest (the start-up).
-    method : {"newmark", "hht"}
+    method : {"newmark", "hht", "harmonic-balance"}
+        The time step, or the periodic response by harmonic balance (a rub scene at commensurate speeds: the
+        record is that periodic solution at the record times, :mod:`rotorred.scenes.harmonic_balance`).
     alpha : float or None
         HHT-alpha parameter (only with method "hht").
+    harmonics, samples : int or None
+        Harmonics of the base frequency and AFT samples a period (only with method "harmonic-balance"; default
+        :data:`BALANCE_DEFAULTS`).
     gravity : float
         Gravity along -y (m/s^2); 0 for none.
     tolerance : float or None
@@ -151,6 +159,8 @@ class SolverSpec:
     alpha: float | None = None
     gravity: float = 0.0
     tolerance: float | None = None
+    harmonics: int | None = None
+    samples: int | None = None
 
 
 @dataclass(frozen=True)
@@ -630,9 +640,26 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = Solve
         if method != "newmark":
             fail("solver.tolerance", tolerance, f'needs solver.method = "newmark" (its error estimates are the '
                  f'average-acceleration step\'s), not {method!r}')
+    harmonics, samples = _solver_balance(table, method)
     return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
                       record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity,
-                      tolerance=tolerance)
+                      tolerance=tolerance, harmonics=harmonics, samples=samples)
+
+
+def _solver_balance(table: dict, method: str) -> tuple[int | None, int | None]:
+    """``solver.harmonics`` and ``solver.samples``: only with method "harmonic-balance" (then their defaults)."""
+    if method != "harmonic-balance":
+        for key in ("harmonics", "samples"):
+            if key in table:
+                fail(f"solver.{key}", table[key], 'must not be given unless solver.method = "harmonic-balance"')
+        return None, None
+    if table.get("tolerance") is not None:
+        fail("solver.tolerance", table["tolerance"], 'is for the time step, not solver.method = "harmonic-balance"')
+    H = checks.integer("solver.harmonics", table.get("harmonics", BALANCE_DEFAULTS[0]), ge=1)
+    N = checks.integer("solver.samples", table.get("samples", BALANCE_DEFAULTS[1]), ge=2 * H + 2)
+    if N % 2:
+        fail("solver.samples", N, "must be even")
+    return H, N
 
 
 def _solver_reduction(table: dict, rotor: Rotor) -> tuple[int | None, float | None, tuple[int, ...]]:
@@ -736,6 +763,8 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     solver = _solver(data.get("solver"), rotor, speeds, defaults)
     if runup is not None:
         _check_runup_solver(runup, solver)
+    if solver.method == "harmonic-balance":
+        _check_balance(speeds, plates, solver)
     output = _output(data.get("output"), rotor, solver, plates)
     if not unbalances and solver.gravity == 0:
         fail("unbalance", data.get("unbalance", []), "must hold at least one entry unless solver.gravity is given: "
@@ -743,6 +772,19 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source, speeds=speeds,
                  unbalances=unbalances, plates=plates, solver=solver, output=output, runup=runup, source=source,
                  data=data)
+
+
+def _check_balance(speeds: dict, plates, solver: SolverSpec) -> None:
+    """Harmonic balance here is of a rub response at commensurate speeds, without gravity."""
+    from rotorred.scenes.harmonic_balance import base_frequency
+
+    if not plates:
+        fail("solver.method", solver.method, "must have a rub plate ([[rub]]): harmonic balance here is of the rub "
+             "response (a linear scene's settled response is harmonic already)")
+    if solver.gravity:
+        fail("solver.gravity", solver.gravity, 'must be 0 with solver.method = "harmonic-balance" (no static load in '
+             "its forcing)", "m/s^2")
+    base_frequency(tuple(w / (2 * math.pi) for w in speeds.values()))
 
 
 def _check_runup_solver(runup: RunupSpec, solver: SolverSpec) -> None:

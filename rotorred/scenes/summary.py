@@ -88,6 +88,11 @@ def _setup(result: SceneResult) -> str:
     if result.method == "harmonic":
         lines.append(f"response: harmonic steady state (linear scene, settled start), {len(result.t)} samples "
                      f"of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
+    elif result.method == "harmonic-balance":
+        lines.append(f"response: harmonic balance, {s.harmonics} harmonics of f0 = {result.counters['f0']:g} Hz and "
+                     f"{s.samples} AFT samples a period (the periodic solution a cold start reaches), at "
+                     f"{len(result.t)} samples of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; "
+                     f"{result.solve_time:.2f} s")
     else:
         c = result.counters
         origin = "the settled linear state" if s.start == "settled" else "rest"
