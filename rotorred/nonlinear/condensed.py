@@ -145,20 +145,19 @@ class CondensedProblem:
         G, dG, z_lin, dz_lin = self._blocks(omega)
         q, v = self.samples(z, omega)
         h, m = self.harmonics, self.n
-        if not jacobian:
-            F_nl = force_coefficients(h, self._local_forces, q, v)
-            return Evaluation(z - z_lin + self.apply(G, F_nl), None, None, float(np.linalg.norm(z_lin)) or 1.0)
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         F_nl = h.coefficients(f)
+        R, scale = z - z_lin + self.apply(G, F_nl), float(np.linalg.norm(z_lin)) or 1.0
+        if not jacobian:
+            return Evaluation(R, None, None, scale)
         factors = h.low_rank(dq, dv, omega, max_rank=self.size // 2)
         if factors is not None:  # I + G U V^T, solved by Woodbury
             J = IdentityPlusLowRank(self.apply(G, factors[0]), factors[1])
         else:
             J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
-        R = z - z_lin + self.apply(G, F_nl)
         dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
         dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
-        return Evaluation(R, J, dR, float(np.linalg.norm(z_lin)) or 1.0)
+        return Evaluation(R, J, dR, scale)
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
         """``G X`` for G given by its blocks (:meth:`_blocks`): the m x m block of harmonic 0 and the (2m x 2m) ones of

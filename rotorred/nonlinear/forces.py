@@ -128,13 +128,18 @@ class PlateRub:
         the rim speed given as Omega r)."""
         return np.sign(sliding_velocity(self.plate, self.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]))
 
+    @property
+    def gradient(self) -> np.ndarray:
+        """d p / d(x, y, u_n, u_t): the disk's approach to the plate ``p = q . gradient - clearance`` (the
+        penetration, m, > 0 in contact) is its displacement along the normal less the plate's."""
+        return np.array([math.cos(self.plate.theta), math.sin(self.plate.theta), -1.0, 0.0])
+
     def _law(self, q: np.ndarray, v: np.ndarray):
         """d p / d(x, y, u_n, u_t) (also of p' on the velocities), P and its tangents at the samples, and the forces
         per unit P, shape (N, 4): ``P n - T t`` on the disk (:func:`rotorred.transient.contact.disk_force` turned to
         the left-hand side), ``(-P, T)`` on the plate, with ``T = -mu_d sign(v_rel) P``."""
-        plate = self.plate
-        c, s = math.cos(plate.theta), math.sin(plate.theta)
-        grad = np.array([c, s, -1.0, 0.0])
+        plate, grad = self.plate, self.gradient
+        c, s = grad[0], grad[1]
         P, dP_dp, dP_drate = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
         T_per_P = -plate.mu_d * self.slip_sign(v)
         fx, fy = disk_force(1.0, T_per_P, c, s)

@@ -90,12 +90,8 @@ class Harmonics:
         checks.integer("N", self.N, ge=2 * self.H + 2)
         if self.N % 2:
             checks.fail("N", self.N, "must be even")
-        theta = 2.0 * math.pi * np.arange(self.N) / self.N
         k = np.arange(1, self.H + 1)
-        E = np.empty((self.N, 2 * self.H + 1))
-        E[:, 0] = 1.0
-        E[:, 1::2] = np.cos(np.outer(theta, k))
-        E[:, 2::2] = np.sin(np.outer(theta, k))
+        E = self.rows_at(2.0 * math.pi * np.arange(self.N) / self.N)
         nabla = np.zeros((2 * self.H + 1, 2 * self.H + 1))
         for j in k:  # d/dtheta (a cos j theta + b sin j theta) = j b cos - j a sin
             nabla[2 * j - 1, 2 * j] = j
@@ -135,6 +131,15 @@ class Harmonics:
                     weights[t, r, c], index[t, r, c] = w, i
         object.__setattr__(self, "_weights", weights)
         object.__setattr__(self, "_index", index)
+
+    def rows_at(self, theta: np.ndarray) -> np.ndarray:
+        """The rows ``[1, cos theta, sin theta, ..., cos H theta, sin H theta]`` at the angles ``theta`` (rad), shape
+        (len(theta), 2H + 1): coefficients -> values there (``E`` at the AFT instants)."""
+        theta = np.asarray(theta, float)
+        k = np.arange(1, self.H + 1)
+        rows = np.empty((len(theta), 2 * self.H + 1))
+        rows[:, 0], rows[:, 1::2], rows[:, 2::2] = 1.0, np.cos(np.outer(theta, k)), np.sin(np.outer(theta, k))
+        return rows
 
     @property
     def size(self) -> int:

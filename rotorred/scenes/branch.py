@@ -54,8 +54,9 @@ class SpeedFamily:
     model : SystemMatrices or ReducedSystem
     spool : str
     H, N : int
-    scale : float
-        Metres per Hz of the carried parameter ``s = scale f`` (:meth:`parameter_value` gives f back).
+    reference_hz : float
+        The speed (Hz) that sets the scale of the carried parameter ``s = scale f``: ``scale`` (m per Hz) is the
+        norm of the linear response there over that speed (:meth:`parameter_value` gives f back).
     """
 
     scene: object
@@ -63,16 +64,19 @@ class SpeedFamily:
     spool: str
     H: int
     N: int
-    scale: float = 1.0
+    reference_hz: float
     _problems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if self.spool not in self.scene.speeds:
             checks.fail("spool", self.spool, f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
+        checks.positive("reference_hz", self.reference_hz, "Hz")
         object.__setattr__(self, "parameter", (f"speeds.{self.spool}", "Hz"))
         f = self.scene.frequencies_hz
-        base = rub_problem(self.scene, self.model, self.H, self.N)
-        object.__setattr__(self, "_orders", base.f0 / f[self.spool])  # f_0 per Hz of the spool
+        object.__setattr__(self, "_orders", base_frequency(tuple(f.values())) / f[self.spool])  # f_0 per Hz
+        rp = self.at(self.reference_hz)
+        object.__setattr__(self, "scale", float(np.linalg.norm(rp.problem.linear_response(rp.omega)))
+                           / self.reference_hz)
 
     def parameter_value(self, s: float) -> float:
         """The spool speed (Hz) of the carried parameter ``s``."""
@@ -91,15 +95,15 @@ class SpeedFamily:
 
     @property
     def n(self) -> int:
-        return self.at(self.scene.frequencies_hz[self.spool]).problem.n
+        return self.at(self.reference_hz).problem.n
 
     @property
     def size(self) -> int:
-        return self.at(self.scene.frequencies_hz[self.spool]).problem.size
+        return self.at(self.reference_hz).problem.size
 
     @property
     def harmonics(self):
-        return self.at(self.scene.frequencies_hz[self.spool]).problem.harmonics
+        return self.at(self.reference_hz).problem.harmonics
 
     def linear_response(self, s: float) -> np.ndarray:
         rp = self.at(s / self.scale)
@@ -230,8 +234,7 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
         pass
     family = ClearanceFamily(problem, omega)
     rub, idx = problem.force_columns[0]
-    grad = np.array([np.cos(rub.plate.theta), np.sin(rub.plate.theta), -1.0, 0.0])
-    reach = float(np.max(problem.samples(z_lin, omega)[0][:, idx] @ grad))
+    reach = float(np.max(problem.samples(z_lin, omega)[0][:, idx] @ rub.gradient))
     clearance = rub.plate.clearance
     scale = max(float(np.linalg.norm(z_lin)), reach)
     branch = continue_branch(family, z_lin, max(1.05 * reach, 1.05 * clearance), clearance, ds=0.05 * scale,
@@ -280,16 +283,12 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
                              stability=False, progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
     t2 = time.perf_counter()
     values = np.array([to_value(s) for s in branch.omega])
-    multipliers = _multipliers(rub_at, values, branch.z, stability and "interrupted" not in branch.stopped, progress)
-    t3 = time.perf_counter()
     dofs = _output_dofs(scene)
-    rps = [rub_at(v) for v in values]
-    return SceneBranch(key, "m" if key == "rub.clearance" else "Hz", values, np.array([rp.f0 for rp in rps]), dofs,
-                       np.array([[np.max(np.abs(rp.waveform(z, d))) for d in dofs] for rp, z in zip(rps, branch.z)]),
-                       branch.z,
-                       np.array([list(rp.lines(z, dofs[0]).values()) for rp, z in zip(rps, branch.z)]),
-                       multipliers, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
-                       branch.iterations, t1 - t0, t2 - t1, t3 - t2)
+    f0, peaks, lines, critical, stability_time = _points(rub_at, values, branch.z, dofs,
+                                                         stability and "interrupted" not in branch.stopped, progress)
+    return SceneBranch(key, "m" if key == "rub.clearance" else "Hz", values, f0, dofs, peaks, branch.z, lines,
+                       critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
+                       branch.iterations, t1 - t0, t2 - t1, stability_time)
 
 
 def _family(scene, model, key: str, start: float, H: int, N: int):
@@ -300,10 +299,8 @@ def _family(scene, model, key: str, start: float, H: int, N: int):
         rp = rub_problem(scene, model, H, N)
         family = ClearanceFamily(rp.problem, rp.omega)
         return family, (lambda v, inverse=False: v), (lambda v: dataclasses.replace(rp, problem=family.at(v)))
-    spool = key.partition(".")[2]
-    rp = SpeedFamily(scene, model, spool, H, N).at(start)
-    scale = float(np.linalg.norm(rp.problem.linear_response(rp.omega))) / start  # m per Hz
-    family = SpeedFamily(scene, model, spool, H, N, scale)
+    family = SpeedFamily(scene, model, key.partition(".")[2], H, N, start)
+    scale = family.scale
     return family, (lambda v, inverse=False: v * scale if inverse else v / scale), family.at
 
 
@@ -314,18 +311,24 @@ def _output_dofs(scene) -> tuple:
     return dofs if table is None else (table,) + tuple(d for d in dofs if d != table)
 
 
-def _multipliers(rub_at, values, z, stability: bool, progress) -> np.ndarray:
-    """The Floquet multiplier of largest modulus of each point (NaN without ``stability``, or after an interrupt)."""
-    out = np.full(len(values), np.nan, dtype=complex)
-    if not stability:
-        return out
-    try:
-        for i, (v, zi) in enumerate(zip(values, z)):
-            rp = rub_at(v)
-            mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers
-            out[i] = mu[np.argmax(np.abs(mu))]
-            if progress is not None:
-                progress(i + 1, None)
-    except KeyboardInterrupt:
-        pass
-    return out
+def _points(rub_at, values, z, dofs, stability: bool, progress):
+    """Each point's problem built once (a speed's is built anew): its f_0 (Hz), the peak of each of ``dofs`` (m), the
+    harmonics of ``dofs[0]`` (m), the Floquet multiplier of largest modulus (NaN without ``stability``, and from an
+    interrupt on) and the time the multipliers took (s)."""
+    f0, peaks, lines = np.empty(len(values)), np.empty((len(values), len(dofs))), []
+    critical, stability_time = np.full(len(values), np.nan, dtype=complex), 0.0
+    for i, (v, zi) in enumerate(zip(values, z)):
+        rp = rub_at(v)
+        f0[i], peaks[i] = rp.f0, [np.max(np.abs(rp.waveform(zi, d))) for d in dofs]
+        lines.append(list(rp.lines(zi, dofs[0]).values()))
+        if stability:
+            t0 = time.perf_counter()
+            try:
+                mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers
+                critical[i] = mu[np.argmax(np.abs(mu))]
+                if progress is not None:
+                    progress(i + 1, None)
+            except KeyboardInterrupt:
+                stability = False
+            stability_time += time.perf_counter() - t0
+    return f0, peaks, np.array(lines), critical, stability_time

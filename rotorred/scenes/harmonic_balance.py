@@ -89,10 +89,7 @@ class RubProblem:
         from rotorred.transient.results import ContactHistory
 
         h = self.problem.harmonics
-        theta = self.omega * np.asarray(t, float)
-        k = np.arange(1, h.H + 1)
-        E = np.empty((len(theta), h.size))
-        E[:, 0], E[:, 1::2], E[:, 2::2] = 1.0, np.cos(np.outer(theta, k)), np.sin(np.outer(theta, k))
+        E = h.rows_at(self.omega * np.asarray(t, float))
         c = self.problem.recover(z, self.omega).reshape(h.size, -1)
         outputs = {d: E @ (c[:, :self.n_model] @ row) for d, row in zip(dofs, self.model.output_rows(list(dofs)))}
         v_c = self.omega * (h.nabla @ c)  # the coefficients of the velocities (d/dt)
@@ -101,11 +98,11 @@ class RubProblem:
             q, v = E @ c[:, list(rub.dofs)], E @ v_c[:, list(rub.dofs)]
             f, _, _ = rub.evaluate(q, v)
             P, T = -f[:, 2], f[:, 3]  # the force on (u_n, u_t) is (-P, T)
-            plate, (cn, sn) = rub.plate, rub.plate.normal
+            plate = rub.plate
             contacts.append(ContactHistory(
                 plate, P, T, np.where(P > 0.0, 1, 0).astype(np.int8), q[:, 2], q[:, 3],
                 sliding_velocity(plate, rub.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]),
-                plate.clearance + q[:, 2] - (q[:, 0] * cn + q[:, 1] * sn)))
+                plate.clearance - q @ rub.gradient))
         return outputs, tuple(contacts)
 
     def final_state(self, z: np.ndarray):
@@ -135,13 +132,12 @@ class RubProblem:
         position (0, 1, ... : disk x, disk y, plate u_n, plate u_t per plate) to its samples at ``t``, which must span
         whole periods 1 / f_0 at a constant step (the phase origin is t = 0, as the solution's)."""
         h, m = self.problem.harmonics, self.problem.n
-        theta = self.omega * np.asarray(t)
+        rows = h.rows_at(self.omega * np.asarray(t))
+        weights = np.full(h.size, 2.0 / len(rows))  # the mean of x cos k theta, twice; of x for a_0
+        weights[0] = 1.0 / len(rows)
         z = np.zeros((h.size, m))
         for j, x in records.items():
-            z[0, j] = np.mean(x)
-            for k in range(1, h.H + 1):
-                z[2 * k - 1, j] = 2.0 * np.mean(x * np.cos(k * theta))
-                z[2 * k, j] = 2.0 * np.mean(x * np.sin(k * theta))
+            z[:, j] = weights * (rows.T @ np.asarray(x))
         return z.reshape(-1)
 
 
