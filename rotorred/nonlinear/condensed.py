@@ -138,26 +138,25 @@ class CondensedProblem:
         """The coefficients of the ``dofs`` without the nonlinear forces."""
         return self._blocks(omega)[2]
 
-    def evaluate(self, z: np.ndarray, omega: float, jacobian: bool = True) -> Evaluation:
-        """The condensed residual and (unless ``jacobian`` is False: then None) its analytic derivatives at
-        ``(z, omega)``. G is applied block by block (one block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a
-        permutation of columns: no dense product of size^3."""
+    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
+        """The condensed residual at ``(z, omega)``, and its analytic derivatives on first use (:class:`Evaluation`).
+        G is applied block by block (one block a harmonic), and ``T(df/dv) (nabla (x) I)`` as a permutation of
+        columns: no dense product of size^3."""
         G, dG, z_lin, dz_lin = self._blocks(omega)
         q, v = self.samples(z, omega)
         h, m = self.harmonics, self.n
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         F_nl = h.coefficients(f)
-        R, scale = z - z_lin + self.apply(G, F_nl), float(np.linalg.norm(z_lin)) or 1.0
-        if not jacobian:
-            return Evaluation(R, None, None, scale)
-        factors = h.low_rank(dq, dv, omega, max_rank=self.size // 2)
-        if factors is not None:  # I + G U V^T, solved by Woodbury
-            J = IdentityPlusLowRank(self.apply(G, factors[0]), factors[1])
-        else:
-            J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
-        dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
-        dR = -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
-        return Evaluation(R, J, dR, scale)
+
+        def derive():
+            factors = h.low_rank(dq, dv, omega, max_rank=self.size // 2)
+            if factors is not None:  # I + G U V^T, solved by Woodbury
+                J = IdentityPlusLowRank(self.apply(G, factors[0]), factors[1])
+            else:
+                J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
+            dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
+            return J, -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
+        return Evaluation(z - z_lin + self.apply(G, F_nl), scale=float(np.linalg.norm(z_lin)) or 1.0, derive=derive)
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
         """``G X`` for G given by its blocks (:meth:`_blocks`): the m x m block of harmonic 0 and the (2m x 2m) ones of
@@ -266,14 +265,13 @@ class ClearanceFamily:
     def linear_response(self, clearance: float) -> np.ndarray:
         return self.base.linear_response(self.omega)
 
-    def evaluate(self, z: np.ndarray, clearance: float, jacobian: bool = True) -> Evaluation:
+    def evaluate(self, z: np.ndarray, clearance: float) -> Evaluation:
         problem = self.at(clearance)
-        ev = problem.evaluate(z, self.omega, jacobian)
-        if not jacobian:
-            return ev
-        rub, idx = problem._local_forces[self.rub]
-        q, v = problem.samples(z, self.omega)
-        d = np.zeros((self.harmonics.N, self.n))
-        d[:, idx] = rub.d_clearance(q[:, idx], v[:, idx])
-        dR = self.base.apply(self.base.compliance_blocks(self.omega), self.harmonics.coefficients(d))
-        return Evaluation(ev.R, ev.dR_dz, dR, ev.scale)
+
+        def dR_dclearance():
+            rub, idx = problem._local_forces[self.rub]
+            q, v = problem.samples(z, self.omega)
+            d = np.zeros((self.harmonics.N, self.n))
+            d[:, idx] = rub.d_clearance(q[:, idx], v[:, idx])
+            return self.base.apply(self.base.compliance_blocks(self.omega), self.harmonics.coefficients(d))
+        return problem.evaluate(z, self.omega).with_parameter(dR_dclearance)

@@ -194,8 +194,8 @@ def _unit_along(matrix, guide: np.ndarray) -> np.ndarray:
 def _correct(problem, y_pred, t, tol, max_iter: int = 20):
     """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``, each step shortened until it lowers the residual (a
     contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its unit tangent, or
-    None. Each new iterate's residual is evaluated first, its Jacobian only if it has not converged: the tangent
-    is the one of the last Jacobian (the iterate a Newton step before, solved with its factors)."""
+    None. An iterate's derivatives are built only if the iteration goes on from it (:class:`Evaluation`): the
+    tangent is the one of the last Jacobian (the iterate a Newton step before, solved with its factors)."""
     y = y_pred.copy()
     ev = problem.evaluate(y[:-1], y[-1])
     for it in range(max_iter):
@@ -209,19 +209,17 @@ def _correct(problem, y_pred, t, tol, max_iter: int = 20):
             return None
         if ev.relative <= tol:
             return y, it + 1, _unit_along(matrix, t)
-        if ev.dR_dz is None:
-            ev = problem.evaluate(y[:-1], y[-1])
     return None
 
 
 def _shortened(problem, y, step, ev, tries: int = 12):
     """``y + a step`` for the largest ``a`` in 1, 1/2, ... that lowers ``||R||`` (omega kept > 0), and its
-    evaluation, without its derivatives; (y, None) if none does."""
+    evaluation (its derivatives built on first use); (y, None) if none does."""
     r0, a = np.linalg.norm(ev.R), 1.0
     for _ in range(tries):
         trial = y + a * step
         if trial[-1] > 0.0:
-            ev_t = problem.evaluate(trial[:-1], trial[-1], jacobian=False)
+            ev_t = problem.evaluate(trial[:-1], trial[-1])
             if np.linalg.norm(ev_t.R) < r0 or ev_t.relative <= 1e-3 * ev.relative:
                 return trial, ev_t
         a *= 0.5

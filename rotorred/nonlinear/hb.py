@@ -39,14 +39,50 @@ class NotConverged(RuntimeError):
                          f"{residual:.3g} > {tol:.3g} after {iterations} Newton iterations ({why})")
 
 
-@dataclass(frozen=True)
 class Evaluation:
-    """The residual at ``(z, omega)`` and its derivatives (None when only the residual was asked)."""
+    """The residual at ``(z, omega)``, what it is relative to, and its derivatives, computed on first use.
 
-    R: np.ndarray
-    dR_dz: np.ndarray | None
-    dR_domega: np.ndarray | None
-    scale: float  # ||F_ex|| (or ||L z|| when there is no forcing): what the residual is relative to
+    A Newton iteration evaluates every trial point, and needs the derivatives only at the point it goes on
+    from: so an evaluator samples the forces once (values and derivatives come out of one call of the law)
+    and hands over ``derive``, which builds ``(dR_dz, dR_domega)`` from those samples when they are first read.
+
+    Parameters
+    ----------
+    R : ndarray, shape (size,)
+    dR_dz : ndarray or linear operator, shape (size, size), optional
+    dR_domega : ndarray, shape (size,), optional
+    scale : float
+        ``||F_ex||`` (or ``||L z||`` without forcing): what the residual is relative to.
+    derive : callable, optional
+        ``derive() -> (dR_dz, dR_domega)``, called at most once, on the first read of either.
+    """
+
+    __slots__ = ("R", "scale", "_dR_dz", "_dR_domega", "_derive")
+
+    def __init__(self, R: np.ndarray, dR_dz=None, dR_domega: np.ndarray | None = None, scale: float = 1.0,
+                 derive: Callable[[], tuple] | None = None):
+        self.R, self.scale = R, float(scale)
+        self._dR_dz, self._dR_domega, self._derive = dR_dz, dR_domega, derive
+
+    def _complete(self) -> None:
+        if self._derive is not None:
+            self._dR_dz, self._dR_domega = self._derive()
+            self._derive = None
+
+    @property
+    def dR_dz(self):
+        self._complete()
+        return self._dR_dz
+
+    @property
+    def dR_domega(self) -> np.ndarray:
+        self._complete()
+        return self._dR_domega
+
+    def with_parameter(self, dR_dp: Callable[[], np.ndarray]) -> Evaluation:
+        """This evaluation with the derivative by another parameter in place of ``dR_domega`` (``dR_dp()``, computed on
+        first use too): a family of problems continued in a parameter other than omega."""
+        return Evaluation(self.R, scale=self.scale, derive=lambda: (self.dR_dz, dR_dp()))
 
     @property
     def relative(self) -> float:
@@ -141,22 +177,21 @@ class PeriodicProblem:
         """D(omega) = D + omega D1 (N s/m)."""
         return self.D if self.D1 is None else self.D + omega * self.D1
 
-    def evaluate(self, z: np.ndarray, omega: float, jacobian: bool = True) -> Evaluation:
-        """The residual and (unless ``jacobian`` is False: then None) its analytic derivatives at ``(z, omega)``."""
+    def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
+        """The residual at ``(z, omega)``, and its analytic derivatives on first use (:class:`Evaluation`)."""
         L, dL = self.linear(omega)
         F, dF = self.forcing(omega)
         q, v = self.samples(z, omega)
-        if jacobian:
-            F_nl, Tq, Tv = transformed_forces(self.harmonics, self.force_columns, q, v)
-        else:
-            F_nl = force_coefficients(self.harmonics, self.force_columns, q, v)
+        f, dq, dv = sampled_forces(self.force_columns, q, v)
         Lz = L @ z
-        R = Lz + F_nl - F
+        R = Lz + self.harmonics.coefficients(f) - F
         scale = float(np.linalg.norm(F)) or float(np.linalg.norm(Lz)) or 1.0
-        if not jacobian:
-            return Evaluation(R, None, None, scale)
-        dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
-        return Evaluation(R, self._jacobian(L, Tq, Tv, omega), dR_domega, scale)
+
+        def derive():
+            Tq, Tv = toeplitz_pair(self.harmonics, dq, dv)
+            dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
+            return self._jacobian(L, Tq, Tv, omega), dR_domega
+        return Evaluation(R, scale=scale, derive=derive)
 
     def _jacobian(self, L: np.ndarray, Tq: np.ndarray, Tv: np.ndarray, omega: float) -> np.ndarray:
         """dR/dz = L + T(df/dq) + omega T(df/dv) (nabla (x) I)."""
@@ -219,9 +254,15 @@ def transformed_forces(h: Harmonics, forces, q: np.ndarray, v: np.ndarray):
     """The AFT of the nonlinear forces at the samples ``q``, ``v`` (N, m): their coefficients, and the Toeplitz matrices
     of their derivatives, T(df/dq) and T(df/dv). ``forces`` pairs each force with the columns of its DOFs."""
     f, dq, dv = sampled_forces(forces, q, v)
-    m = q.shape[1]
+    return (h.coefficients(f),) + toeplitz_pair(h, dq, dv)
+
+
+def toeplitz_pair(h: Harmonics, dq: np.ndarray, dv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """T(df/dq) and T(df/dv) of the sampled derivatives ``dq``, ``dv`` (N, m, m) (T(dv) is zeros without a velocity
+    dependence)."""
+    m = dq.shape[1]
     Tv = h.toeplitz(dv) if dv.any() else np.zeros((h.size * m, h.size * m))
-    return h.coefficients(f), h.toeplitz(dq), Tv
+    return h.toeplitz(dq), Tv
 
 
 def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
@@ -252,7 +293,7 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
             raise NotConverged(omega, ev.relative, tol, it, "singular Jacobian") from None
         z, ev = _line_search(problem, z, step, omega, ev, tries=max_halvings)
         if ev is None:
-            raise NotConverged(omega, problem.evaluate(z, omega, jacobian=False).relative, tol, it,
+            raise NotConverged(omega, problem.evaluate(z, omega).relative, tol, it,
                                "no step reduces the residual")
     if ev.relative <= tol:
         return z, ev, max_iter
@@ -261,14 +302,13 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
 
 def _line_search(problem, z, step, omega, ev, shrink: float = 0.5, tries: int = 30):
     """``z + a step`` for the largest ``a`` in 1, 1/2, 1/4, ... that lowers ``||R||`` (Armijo with a small slope), and
-    its evaluation. The full step is evaluated with its Jacobian (it is taken most often), the shortened ones by their
-    residual only until one is taken."""
+    its evaluation (its derivatives are built only if the iteration goes on from it)."""
     r0 = np.linalg.norm(ev.R)
     a = 1.0
-    for i in range(tries):
+    for _ in range(tries):
         trial = z + a * step
-        ev_t = problem.evaluate(trial, omega, jacobian=i == 0)
+        ev_t = problem.evaluate(trial, omega)
         if np.linalg.norm(ev_t.R) <= (1.0 - 1e-4 * a) * r0:
-            return trial, (ev_t if i == 0 else problem.evaluate(trial, omega))
+            return trial, ev_t
         a *= shrink
     return z, None

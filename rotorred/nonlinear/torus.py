@@ -451,16 +451,15 @@ class TorusProblem:
                     terms.append((T, A))
         return _Linearisation(R, tuple(terms))
 
-    def evaluate(self, z: np.ndarray, omega: float | None = None, jacobian: bool = True) -> Evaluation:
-        """The residual and its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)`` (:class:`Evaluation`, so
-        :func:`rotorred.nonlinear.hb.solve` takes the problem; ``omega`` is ignored: the base frequencies are fixed,
-        and ``dR_domega`` is NaN, not defined). With ``jacobian`` False, the residual only (derivatives None)."""
-        if not jacobian:
-            return Evaluation(self.residual(z), None, None, self.scale)
-        lin = self._linearise(z)
-        T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
-        J = np.eye(self.size) + self.apply(T)
-        return Evaluation(lin.R, J, np.full(self.size, np.nan), self.scale)
+    def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
+        """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
+        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve` takes the problem; ``omega`` is ignored: the base
+        frequencies are fixed, and ``dR_domega`` is NaN, not defined)."""
+        def derive():
+            lin = self._linearise(z)
+            T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
+            return np.eye(self.size) + self.apply(T), np.full(self.size, np.nan)
+        return Evaluation(self.residual(z), scale=self.scale, derive=derive)
 
     def newton_step(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The residual at ``z`` and Newton's step ``-J^-1 R``, through the Woodbury identity on the rank r of the DOF

@@ -109,16 +109,15 @@ class SpeedFamily:
         rp = self.at(s / self.scale)
         return rp.problem.linear_response(rp.omega)
 
-    def evaluate(self, z: np.ndarray, s: float, jacobian: bool = True) -> Evaluation:
+    def evaluate(self, z: np.ndarray, s: float) -> Evaluation:
         f = s / self.scale
         rp = self.at(f)
-        ev = rp.problem.evaluate(z, rp.omega, jacobian)
-        if not jacobian:
-            return ev
-        h = SPEED_STEP * f
-        up, down = self.at(f + h), self.at(f - h)
-        dR = (up.problem.evaluate(z, up.omega, False).R - down.problem.evaluate(z, down.omega, False).R) / (2 * h)
-        return Evaluation(ev.R, ev.dR_dz, dR / self.scale, ev.scale)
+
+        def dR_ds():
+            h = SPEED_STEP * f
+            up, down = self.at(f + h), self.at(f - h)
+            return (up.problem.evaluate(z, up.omega).R - down.problem.evaluate(z, down.omega).R) / (2 * h * self.scale)
+        return rp.problem.evaluate(z, rp.omega).with_parameter(dR_ds)
 
 
 @dataclass(frozen=True)
