@@ -212,9 +212,14 @@ def _correct(problem, y_pred, t, tol, max_iter: int = 20):
     return None
 
 
-def _shortened(problem, y, step, ev, tries: int = 12):
-    """``y + a step`` for the largest ``a`` in 1, 1/2, ... that lowers ``||R||`` (omega kept > 0), and its
-    evaluation (its derivatives built on first use); (y, None) if none does."""
+def _shortened(problem, y, step, ev, tries: int = 8):
+    """``y + a step`` for the largest ``a`` in 1, 1/2, ... 1/128 that lowers ``||R||`` (omega kept > 0), and its
+    evaluation (its derivatives built on first use); (y, None) if none does.
+
+    Eight tries: a step that must be shortened further rarely converges, and the step control's halving of ds is
+    the cheaper way on. On the Jeffcott branch (H = 5, N = 1024) 12 tries took 3719 evaluations, 48 of its 67
+    searches past 8 tries failed all the same; 8 took 2550, for the same 334 points (and the rig's clearance branch
+    the same 373)."""
     r0, a = np.linalg.norm(ev.R), 1.0
     for _ in range(tries):
         trial = y + a * step
