@@ -132,3 +132,36 @@ def test_a_harmonic_balance_scene_records_its_periodic_solution(rig):
     assert max(abs(ln.amplitude - exact[round(ln.frequency_hz, 6)]) for ln in fitted) < 2e-13 * largest
     contact = result.contacts[0]
     assert np.array_equal(contact.state == 1, contact.normal_force > 0) and 0 < np.mean(contact.state) < 0.5
+
+
+def test_the_tolerance_chooses_the_harmonics_by_the_convergence_of_the_response(rig):
+    """solver.tolerance with method "harmonic-balance": the first truncation of the ladder whose response changes from
+    the one before by at most the tolerance is returned (the earlier ones changed by more), its solution solves its
+    problem, and the change bounds the error of what is returned: against the next truncation, solved here from it,
+    the error is below the estimate (measured at tol = 0.05: 100 harmonics, estimate 0.027, error 0.0030), and the
+    observed order of the ladder's changes is above 1 (measured 3.9), the condition under which it does."""
+    from rotorred.nonlinear.hb import solve
+    from rotorred.scenes.balance_harmonics import balance_to_tolerance, padded, response_change, samples_for
+
+    scene, model = rig
+    dofs, tol = scene.output.dofs, 0.05
+    rp, z, choice = balance_to_tolerance(scene, model, tol, dofs)
+    assert choice.estimate <= tol and all(change > tol for _, change in choice.steps[:-1])
+    assert (rp.problem.harmonics.H, rp.problem.harmonics.N) == (choice.harmonics, choice.samples)
+    assert rp.problem.evaluate(z, rp.omega).relative < 1e-9
+    fine = rub_problem(scene, model, 2 * choice.harmonics, samples_for(2 * choice.harmonics))
+    z_fine = solve(fine.problem, padded(z, rp, fine), fine.omega, tol=1e-9)[0]
+    error = response_change(rp, z, fine, z_fine, dofs)
+    assert error < choice.estimate
+    assert np.log2(choice.steps[-2][1] / choice.estimate) > 1.0
+
+
+def test_a_harmonic_balance_scene_with_a_tolerance_says_what_it_chose(tmp_path, capsys):
+    """``rotorred run`` with solver.tolerance and method "harmonic-balance" prints the harmonics chosen and the
+    estimate behind them, and writes that solution's record."""
+    status = main(["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "solver.tolerance=0.05",
+                   "--set", "output.plots=[]", "--no-normal", "--out", str(tmp_path / "o")])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "solver.tolerance = 0.05: 100 harmonics and 2048 AFT samples a period" in out
+    assert "response: harmonic balance, 100 harmonics of f0 = 10 Hz" in out

@@ -94,6 +94,10 @@ CASES = [
      ["solver.gravity", "9.81"]),
     (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "speeds.outer=91.37", "--out", "{d}/o"],
      ["speeds", "91.37", "greatest common divisor"]),
+    (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "solver.tolerance=0.01", "--set",
+      "solver.harmonics=50", "--out", "{d}/o"], ["solver.harmonics", "solver.tolerance"]),
+    (["run", "paper-rub", "--set", "solver.method=hht", "--set", "solver.tolerance=0.01", "--out", "{d}/o"],
+     ["solver.tolerance", "harmonic-balance"]),
     # ---- continue (harmonic-balance branches)
     (["continue", "paper-rub", "--param", "rub.clearance=20e-6", "--out", "{d}/o"], ["--param", "KEY=START:STOP"]),
     (["continue", "paper-rub", "--param", "rub.clearance=2e-5:2e-5", "--out", "{d}/o"], ["--param", "different"]),

@@ -474,10 +474,17 @@ def _balance_response(scene: Scene, model) -> Response:
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
-    rp = rub_problem(scene, model, s.harmonics, s.samples)
-    z = cold_start(rp.problem, rp.omega)
+    if s.tolerance is not None:
+        from rotorred.scenes.balance_harmonics import balance_to_tolerance
+
+        rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs)
+    else:
+        rp, choice = rub_problem(scene, model, s.harmonics, s.samples), None
+        z = cold_start(rp.problem, rp.omega)
     outputs, contacts = rp.record(z, t, scene.output.dofs)
-    return Response(t, outputs, contacts, "harmonic-balance", 0, {"f0": rp.f0})
+    counters = {"f0": rp.f0, "harmonics": rp.problem.harmonics.H, "samples": rp.problem.harmonics.N,
+                "choice": choice}
+    return Response(t, outputs, contacts, "harmonic-balance", 0, counters)
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,

@@ -139,12 +139,13 @@ class SolverSpec:
         HHT-alpha parameter (only with method "hht").
     harmonics, samples : int or None
         Harmonics of the base frequency and AFT samples a period (only with method "harmonic-balance"; default
-        :data:`BALANCE_DEFAULTS`).
+        :data:`BALANCE_DEFAULTS`; None when ``tolerance`` chooses them).
     gravity : float
         Gravity along -y (m/s^2); 0 for none.
     tolerance : float or None
         Relative error target of the outputs (:mod:`rotorred.scenes.tolerance`): the tool then chooses
-        ``modes``, ``boundary_nodes``, ``dt``, ``record_start`` and ``duration`` (the window's length kept).
+        ``modes``, ``boundary_nodes``, ``dt``, ``record_start`` and ``duration`` (the window's length kept); with
+        method "harmonic-balance", the harmonics and samples (:mod:`rotorred.scenes.balance_harmonics`).
     """
 
     model: str = "reduced"
@@ -637,9 +638,9 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = Solve
     tolerance = table.get("tolerance")
     if tolerance is not None:
         tolerance = checks.number("solver.tolerance", tolerance, "-", ge=TOLERANCE_RANGE[0], le=TOLERANCE_RANGE[1])
-        if method != "newmark":
-            fail("solver.tolerance", tolerance, f'needs solver.method = "newmark" (its error estimates are the '
-                 f'average-acceleration step\'s), not {method!r}')
+        if method not in ("newmark", "harmonic-balance"):
+            fail("solver.tolerance", tolerance, f'must go with solver.method = "newmark" (its error estimates are '
+                 f'the average-acceleration step\'s) or "harmonic-balance" (it chooses the harmonics), not {method!r}')
     harmonics, samples = _solver_balance(table, method)
     return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
                       record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity,
@@ -653,8 +654,12 @@ def _solver_balance(table: dict, method: str) -> tuple[int | None, int | None]:
             if key in table:
                 fail(f"solver.{key}", table[key], 'must not be given unless solver.method = "harmonic-balance"')
         return None, None
-    if table.get("tolerance") is not None:
-        fail("solver.tolerance", table["tolerance"], 'is for the time step, not solver.method = "harmonic-balance"')
+    if table.get("tolerance") is not None:  # the harmonics are chosen (rotorred.scenes.balance_harmonics)
+        for key in ("harmonics", "samples"):
+            if key in table:
+                fail(f"solver.{key}", table[key], "must not be given with solver.tolerance (the tolerance chooses "
+                     "the harmonics and samples); give one or the other")
+        return None, None
     H = checks.integer("solver.harmonics", table.get("harmonics", BALANCE_DEFAULTS[0]), ge=1)
     N = checks.integer("solver.samples", table.get("samples", BALANCE_DEFAULTS[1]), ge=2 * H + 2)
     if N % 2:

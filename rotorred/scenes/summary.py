@@ -89,8 +89,11 @@ def _setup(result: SceneResult) -> str:
         lines.append(f"response: harmonic steady state (linear scene, settled start), {len(result.t)} samples "
                      f"of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
     elif result.method == "harmonic-balance":
-        lines.append(f"response: harmonic balance, {s.harmonics} harmonics of f0 = {result.counters['f0']:g} Hz and "
-                     f"{s.samples} AFT samples a period (the periodic solution a cold start reaches), at "
+        c = result.counters
+        if c.get("choice") is not None:
+            lines.append(c["choice"].describe())
+        lines.append(f"response: harmonic balance, {c['harmonics']} harmonics of f0 = {c['f0']:g} Hz and "
+                     f"{c['samples']} AFT samples a period (the periodic solution a cold start reaches), at "
                      f"{len(result.t)} samples of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; "
                      f"{result.solve_time:.2f} s")
     else:

@@ -150,10 +150,11 @@ def choose(scene: Scene) -> Settings:
 
 def run_to_tolerance(scene: Scene, **options):
     """Choose the settings of ``scene`` (:func:`choose`) and run them (:func:`rotorred.scenes.run.run_scene` with
-    ``options``); the result's ``settings`` says what was chosen. A scene without a tolerance runs as it is."""
+    ``options``); the result's ``settings`` says what was chosen. A scene without a tolerance runs as it is, and so
+    does a harmonic balance (its tolerance chooses the harmonics: :mod:`rotorred.scenes.balance_harmonics`)."""
     from rotorred.scenes.run import run_scene
 
-    if scene.solver.tolerance is None:
+    if scene.solver.tolerance is None or scene.solver.method == "harmonic-balance":  # that chooses its harmonics
         return run_scene(scene, **options)
     settings = choose(scene)
     return run_scene(settings.scene, settings=settings, **options)
