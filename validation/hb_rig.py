@@ -10,8 +10,9 @@ Prints:
 1. the settled transient's 10 largest lines at node 14 Y and, for 60, 150 and 100 harmonics of f_0 = 10 Hz, the
    harmonic-balance solution started from the transient's last period: Newton iterations, solve time and each line's
    relative difference;
-2. the cold solution at 13 um (:func:`rotorred.scenes.branch.cold_start`): its time, its distance from the
-   transient's orbit and its lines (a second periodic response);
+2. the cold solution at 13 um (:func:`rotorred.scenes.balance_harmonics.cold_solution`, through 25 and 50 harmonics,
+   and the cold start at 100 harmonics itself, :func:`rotorred.scenes.branch.cold_start`): their times, their
+   distance, the distance from the transient's orbit and the lines (a second periodic response);
 3. the branch from 20 to 5 um (:func:`rotorred.scenes.branch.continue_scene`, 100 harmonics): points and time a
    point, and the settled transients at 20 and 5 um;
 4. the stability of both orbits from the monodromy matrix of the whole linearised system (largest Floquet
@@ -30,6 +31,7 @@ import numpy as np
 
 from rotorred.nonlinear.hb import solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
+from rotorred.scenes.balance_harmonics import cold_solution
 from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.run import build_model, run_scene
@@ -63,10 +65,17 @@ def from_transient(scene, sm, result, largest, records, H: int, N: int):
 
 
 def cold(scene, sm, rp100, largest, zA):
-    """The cold solution at 13 um (:func:`rotorred.scenes.branch.cold_start`), its time and lines."""
+    """The cold solution at 13 um (:func:`rotorred.scenes.balance_harmonics.cold_solution`: a cold start at 25
+    harmonics, then Newton up through 50 to 100), its time and lines, and its distance from the cold start at 100
+    harmonics itself (:func:`rotorred.scenes.branch.cold_start`) and that one's time."""
     t0 = time.perf_counter()
-    zB = cold_start(rp100.problem, rp100.omega)
+    zB = cold_solution(scene, sm.model, rp100.problem.harmonics.H, rp100.problem.harmonics.N)[1]
     elapsed = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    zD = cold_start(rp100.problem, rp100.omega)
+    direct = time.perf_counter() - t0
+    print(f"  the cold start at 100 harmonics itself: {direct:.2f} s, {np.linalg.norm(zB - zD) / np.linalg.norm(zD):.1e} "
+          f"(relative) from the one through coarser truncations")
     lines = rp100.lines(zB, OUTPUT)
     print(f"  {elapsed:.2f} s; distance from the transient's orbit {np.linalg.norm(zB - zA) / np.linalg.norm(zA):.2f} "
           f"(relative); its lines against the transient's:")
@@ -99,8 +108,8 @@ def main() -> None:
     for H, N in ((60, 512), (150, 4096)):
         from_transient(scene, sm, result, largest, records, H, N)
     rp100, zA, warm = from_transient(scene, sm, result, largest, records, 100, 2048)
-    print("cold harmonic balance at 13 um, 100 harmonics (Newton from the linear response, else a continuation in the "
-          "clearance from where the linear orbit reaches the plate):")
+    print("cold harmonic balance at 13 um, 100 harmonics (at 25 harmonics Newton from the linear response, else a "
+          "continuation in the clearance from where the linear orbit reaches the plate; then Newton at 50 and 100):")
     zB, cold_time = cold(scene, sm, rp100, largest, zA)
     print("continuation in the clearance, 100 harmonics:")
     per_point, ends = by_clearance(scene, sm)

@@ -1,5 +1,5 @@
-"""Harmonics of a rub scene's harmonic balance chosen by the convergence of its response (``[solver] tolerance`` with
-``method = "harmonic-balance"``).
+"""The truncations of a rub scene's harmonic balance: harmonics chosen by the convergence of its response
+(``[solver] tolerance`` with ``method = "harmonic-balance"``), and a cold start up through coarser truncations.
 
 The harmonics double along :data:`LADDER`, each with :data:`SAMPLES_PER_HARMONIC` AFT samples a period (the
 default's 2048 for 100), and each solution starts Newton from the one before it (its coefficients, the new harmonics
@@ -26,7 +26,7 @@ from rotorred.scenes.branch import cold_start
 from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
 
 __all__ = ["LADDER", "SAMPLES_PER_HARMONIC", "HarmonicsChoice", "HarmonicsNotConverged", "balance_to_tolerance",
-           "response_change"]
+           "cold_solution", "response_change"]
 
 #: the harmonics tried, in order (each doubles the one before)
 LADDER = (25, 50, 100, 200, 400)
@@ -144,6 +144,31 @@ def balance_to_tolerance(scene, model, tol: float, dofs, progress=None) -> tuple
             return fine, z_fine, HarmonicsChoice(tol, H, samples_for(H), change, tuple(steps))
         rp, z = fine, z_fine
     raise HarmonicsNotConverged(rp.omega, steps[-1][1], tol, LADDER[-1])
+
+
+def cold_solution(scene, model, H: int, N: int) -> tuple[RubProblem, np.ndarray]:
+    """The periodic rub response of ``scene`` on ``model`` with ``H`` harmonics and ``N`` AFT samples, from nothing:
+    a cold start (:func:`rotorred.scenes.branch.cold_start`) at the first truncation of :data:`LADDER` below ``H``,
+    then Newton up the ladder, each truncation from the one before, to ``H`` itself.
+
+    The cold start's continuation in the clearance costs per point what a truncation costs per Newton iteration, so
+    it is cheapest at the coarsest: on paper-rub at 100 harmonics 1.4 s, against 4.9 s for the cold start at 100
+    harmonics itself, and the same solution (7.6e-11 apart; validation/hb_rig.py).
+
+    Returns
+    -------
+    (RubProblem, ndarray)
+    """
+    coarser = [h for h in LADDER if h < H]
+    if not coarser:
+        rp = rub_problem(scene, model, H, N)
+        return rp, cold_start(rp.problem, rp.omega)
+    rp = rub_problem(scene, model, coarser[0], samples_for(coarser[0]))
+    z = cold_start(rp.problem, rp.omega)
+    for h, n in [(h, samples_for(h)) for h in coarser[1:]] + [(H, N)]:
+        fine = rub_problem(scene, model, h, n)
+        z, rp = _solve_from(fine, padded(z, rp, fine)), fine
+    return rp, z
 
 
 def _solve_from(rp: RubProblem, z0: np.ndarray) -> np.ndarray:

@@ -42,7 +42,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rotorred import checks
 from rotorred.model.assembly import assemble
 from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.signals.lines import label_lines
@@ -466,21 +465,18 @@ def _harmonic_response(scene: Scene, model) -> Response:
 
 
 def _balance_response(scene: Scene, model) -> Response:
-    """The periodic rub response by harmonic balance (``solver.method = "harmonic-balance"``: a cold start,
-    :func:`rotorred.scenes.branch.cold_start`) at the record times, as a transient's record."""
-    from rotorred.scenes.branch import cold_start
-    from rotorred.scenes.harmonic_balance import rub_problem
+    """The periodic rub response by harmonic balance (``solver.method = "harmonic-balance"``: a cold start up through
+    coarser truncations, :func:`rotorred.scenes.balance_harmonics.cold_solution`, or the harmonics chosen by
+    ``solver.tolerance``) at the record times, as a transient's record."""
+    from rotorred.scenes.balance_harmonics import balance_to_tolerance, cold_solution
 
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
     if s.tolerance is not None:
-        from rotorred.scenes.balance_harmonics import balance_to_tolerance
-
         rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs)
     else:
-        rp, choice = rub_problem(scene, model, s.harmonics, s.samples), None
-        z = cold_start(rp.problem, rp.omega)
+        (rp, z), choice = cold_solution(scene, model, s.harmonics, s.samples), None
     outputs, contacts = rp.record(z, t, scene.output.dofs)
     counters = {"f0": rp.f0, "harmonics": rp.problem.harmonics.H, "samples": rp.problem.harmonics.N,
                 "choice": choice}
