@@ -6,10 +6,13 @@ The pool starts its workers when it is created, so they import matplotlib while 
 computes; the caller then submits figure jobs (:func:`rotorred.plots.scene.scene_figures`: a plot
 function and plain arrays) and writes its data files while they are drawn.
 
-Workers are spawned (a fresh interpreter: no fork of a process that holds numba's or BLAS's
-threads) and ignore SIGINT: Ctrl-C is the caller's to handle, and leaving the pool stops them
-before the caller cleans up (:class:`rotorred.writers.OutputFolder` removes its staging folder
-after a worker can no longer write into it). ``workers=0`` draws in the calling process.
+Workers are forked from a fork server (a fresh interpreter, not the caller: no fork of a process that holds
+numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`), so two workers cost one
+import of it, not two: a warm ``rotorred run`` of paper-rub took 3.51 s against 3.87 s with spawned workers
+(medians of 10, alternated). Where there is no fork server (Windows) they are spawned. Workers ignore
+SIGINT: Ctrl-C is the caller's to handle, and leaving the pool stops them before the caller cleans up
+(:class:`rotorred.writers.OutputFolder` removes its staging folder after a worker can no longer write into
+it). ``workers=0`` draws in the calling process.
 """
 
 from __future__ import annotations
@@ -36,16 +39,18 @@ def _start_worker() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     import gc
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.figure  # noqa: F401 - imported now, while the caller computes
-    import matplotlib.patches  # noqa: F401
-    import matplotlib.transforms  # noqa: F401
-
-    import rotorred.plots.scene  # noqa: F401 - light: no signals module, no pyFFTW (the jobs carry plain arrays)
+    import rotorred.plots._preload  # noqa: F401 - already there when forked from the fork server; now, if spawned
 
     gc.freeze()  # the imported modules are never garbage: drawing then collects only its own objects
+
+
+def _context():
+    """The fork server's context with matplotlib preloaded, or spawn where there is none."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["rotorred.plots._preload"])
+    return context
 
 
 def _ready() -> int:
@@ -84,7 +89,7 @@ class FigurePool:
         self._executor = None
         if self.workers > 0:
             self._executor = concurrent.futures.ProcessPoolExecutor(
-                self.workers, mp_context=multiprocessing.get_context("spawn"), initializer=_start_worker)
+                self.workers, mp_context=_context(), initializer=_start_worker)
             for _ in range(self.workers):  # one job each: every worker starts now
                 self._executor.submit(_ready)
 
@@ -109,3 +114,15 @@ class FigurePool:
             self._executor.shutdown(wait=True, cancel_futures=True)
         else:
             self._executor.shutdown(wait=True)
+        _stop_fork_server()
+
+
+def _stop_fork_server() -> None:
+    """Stop the fork server and wait for it (it has reaped its workers): their CPU time then counts as the caller's
+    children's, as spawned workers' did (``getrusage``, ``time``). multiprocessing starts it again when asked; its
+    stop is not public API, so where it is missing the server simply ends with the caller."""
+    from multiprocessing import forkserver
+
+    stop = getattr(getattr(forkserver, "_forkserver", None), "_stop", None)
+    if stop is not None:
+        stop()
