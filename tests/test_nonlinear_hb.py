@@ -215,6 +215,20 @@ def test_the_aft_transforms_are_the_dft(H, N):
     assert np.array_equal(h.times_derivative(X, 2), X @ N1) and np.array_equal(h.derivative(z, 2), N1 @ z)
 
 
+@pytest.mark.parametrize("H, N", [(50, 1024), (100, 2048)])
+def test_samples_by_the_inverse_fft_are_the_sampling_matrix(H, N):
+    """Above SYNTHESIS_BY_FFT the samples and rates come from an inverse real FFT: they equal the products ``E Z`` and
+    ``E nabla Z`` (measured 1.2e-12 at worst, 4 DOFs of unit random coefficients: sums of 201 terms at 2048 angles)."""
+    from rotorred.nonlinear.fourier import SYNTHESIS_BY_FFT
+
+    h = Harmonics(H, N)
+    assert h.N * h.size > SYNTHESIS_BY_FFT
+    z = np.random.default_rng(H).standard_normal(h.size * 4)
+    Z = z.reshape(h.size, 4)
+    assert np.max(np.abs(h.samples(z, 4) - h.E @ Z)) < 1.2e-11
+    assert np.max(np.abs(h.rates(z, 4) - h.E @ (h.nabla @ Z))) < 1.2e-11 * H
+
+
 @pytest.fixture(scope="module")
 def four_dof():
     """A Jeffcott disk (x, y) in the clearance, joined by springs to a second mass: the full problem, the problem

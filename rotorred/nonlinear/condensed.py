@@ -156,7 +156,8 @@ class CondensedProblem:
                 J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
             dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
             return J, -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
-        return Evaluation(z - z_lin + self.apply(G, F_nl), scale=float(np.linalg.norm(z_lin)) or 1.0, derive=derive)
+        return Evaluation(z - z_lin + self.apply(G, F_nl), scale=float(np.linalg.norm(z_lin)) or 1.0, derive=derive,
+                          sampled=(f, dq, dv))
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
         """``G X`` for G given by its blocks (:meth:`_blocks`): the m x m block of harmonic 0 and the (2m x 2m) ones of
@@ -221,7 +222,8 @@ class CondensedProblem:
 class ClearanceFamily:
     """A :class:`CondensedProblem` at a fixed frequency, parameterised by the clearance of one of its rubs: the
     problem :func:`rotorred.nonlinear.continuation.continue_branch` follows in the clearance (the parameter takes the
-    place of omega; ``dR/dclearance = G dF_nl/dclearance`` from the rub's own derivative).
+    place of omega; ``dR/dclearance = G dF_nl/dclearance``, the forces' derivative by the DOF the clearance enters the
+    gap with, ``PlateRub.clearance_dof``).
 
     Parameters
     ----------
@@ -229,7 +231,7 @@ class ClearanceFamily:
     omega : float
         The base frequency (rad/s).
     rub : int
-        Index in ``base.forces`` of the rub (a force with ``with_clearance`` and ``d_clearance``).
+        Index in ``base.forces`` of the rub (a force with ``with_clearance`` and ``clearance_dof``).
     """
 
     base: CondensedProblem
@@ -266,12 +268,10 @@ class ClearanceFamily:
         return self.base.linear_response(self.omega)
 
     def evaluate(self, z: np.ndarray, clearance: float) -> Evaluation:
-        problem = self.at(clearance)
+        ev = self.at(clearance).evaluate(z, self.omega)
 
-        def dR_dclearance():
-            rub, idx = problem._local_forces[self.rub]
-            q, v = problem.samples(z, self.omega)
-            d = np.zeros((self.harmonics.N, self.n))
-            d[:, idx] = rub.d_clearance(q[:, idx], v[:, idx])
-            return self.base.apply(self.base.compliance_blocks(self.omega), self.harmonics.coefficients(d))
-        return problem.evaluate(z, self.omega).with_parameter(dR_dclearance)
+        def dR_dclearance():  # G dF_nl/dclearance: the forces' derivative by the DOF the clearance enters the gap with
+            rub, idx = self.base._local_forces[self.rub]
+            dq = ev.sampled[1][:, :, idx[rub.clearance_dof]]
+            return self.base.apply(self.base.compliance_blocks(self.omega), self.harmonics.coefficients(dq))
+        return ev.with_parameter(dR_dclearance)

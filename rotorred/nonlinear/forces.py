@@ -150,7 +150,6 @@ class PlateRub:
         """The same rub at another clearance (m)."""
         return PlateRub(self.dofs, self.plate.with_(clearance=clearance), self.surface_speed)
 
-    def d_clearance(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """d f / d clearance at the samples, shape (N, 4) (N/m): the penetration falls as the clearance grows."""
-        _, _, dP_dp, _, per_P = self._law(q, v)
-        return -per_P * dP_dp[:, None]
+    #: the position among ``dofs`` of the DOF the clearance enters the gap with: ``g = clearance + u_n - (x, y) . n``,
+    #: so d f / d clearance is the column of d f / dq at u_n (the derivative of the forces by the clearance, for free)
+    clearance_dof = 2

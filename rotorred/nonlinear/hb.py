@@ -55,13 +55,16 @@ class Evaluation:
         ``||F_ex||`` (or ``||L z||`` without forcing): what the residual is relative to.
     derive : callable, optional
         ``derive() -> (dR_dz, dR_domega)``, called at most once, on the first read of either.
+    sampled : tuple, optional
+        The forces and their derivatives at the AFT samples, ``(f, df/dq, df/dv)`` (N, m) and (N, m, m), where the
+        evaluator keeps them (a family's parameter derivative reads them).
     """
 
-    __slots__ = ("R", "scale", "_dR_dz", "_dR_domega", "_derive")
+    __slots__ = ("R", "scale", "sampled", "_dR_dz", "_dR_domega", "_derive")
 
     def __init__(self, R: np.ndarray, dR_dz=None, dR_domega: np.ndarray | None = None, scale: float = 1.0,
-                 derive: Callable[[], tuple] | None = None):
-        self.R, self.scale = R, float(scale)
+                 derive: Callable[[], tuple] | None = None, sampled: tuple | None = None):
+        self.R, self.scale, self.sampled = R, float(scale), sampled
         self._dR_dz, self._dR_domega, self._derive = dR_dz, dR_domega, derive
 
     def _complete(self) -> None:
@@ -82,7 +85,7 @@ class Evaluation:
     def with_parameter(self, dR_dp: Callable[[], np.ndarray]) -> Evaluation:
         """This evaluation with the derivative by another parameter in place of ``dR_domega`` (``dR_dp()``, computed on
         first use too): a family of problems continued in a parameter other than omega."""
-        return Evaluation(self.R, scale=self.scale, derive=lambda: (self.dR_dz, dR_dp()))
+        return Evaluation(self.R, scale=self.scale, derive=lambda: (self.dR_dz, dR_dp()), sampled=self.sampled)
 
     @property
     def relative(self) -> float:
