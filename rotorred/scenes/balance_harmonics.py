@@ -152,7 +152,7 @@ def cold_solution(scene, model, H: int, N: int) -> tuple[RubProblem, np.ndarray]
     then Newton up the ladder, each truncation from the one before, to ``H`` itself.
 
     The cold start's continuation in the clearance costs per point what a truncation costs per Newton iteration, so
-    it is cheapest at the coarsest: on paper-rub at 100 harmonics 1.4 s, against 4.9 s for the cold start at 100
+    it is cheapest at the coarsest: on paper-rub at 100 harmonics 1.3 s, against 3.2 s for the cold start at 100
     harmonics itself, and the same solution (7.6e-11 apart; validation/hb_rig.py).
 
     Returns
