@@ -122,17 +122,20 @@ class Harmonics:
         object.__setattr__(self, "_rfft_index", np.where(upper, self.N - orders, orders))
         object.__setattr__(self, "_conjugate", upper)
         # R = Q^-1 T_c Q entry by entry: each real row combines at most two complex rows, each real column two
-        # complex columns, so R[h', j'] = sum over at most 4 terms w d_{h - j}: the weights and indices of d
-        Q_inv = np.linalg.inv(Q)
-        weights = np.zeros((4, m, m), complex)
-        index = np.zeros((4, m, m), int)
-        for r in range(m):
-            rows = np.flatnonzero(Q_inv[r])
-            for c in range(m):
-                cols = np.flatnonzero(Q[:, c])
-                terms = [(Q_inv[r, a] * Q[b, c], a - b + 2 * H) for a in rows for b in cols]
-                for t, (w, i) in enumerate(terms):
-                    weights[t, r, c], index[t, r, c] = w, i
+        # complex columns, so R[h', j'] = sum over at most 4 terms w d_{h - j}: the weights and indices of d. Term
+        # t = 2 (the row's entry) + (the column's entry), each entry's complex index ascending; the second entry of
+        # a_0's row and column is weighted 0. Q^-1: a_0 = c_0, a_k = c_-k + c_k, b_k = -i c_-k + i c_k.
+        k = np.arange(1, H + 1)
+        entries = np.full((m, 2), H)  # the complex indices of each real coefficient: Q's columns, Q^-1's rows
+        entries[1::2, 0], entries[1::2, 1] = H - k, H + k
+        entries[2::2, 0], entries[2::2, 1] = H - k, H + k
+        col_w = Q[entries, np.arange(m)[:, None]]
+        col_w[0, 1] = 0.0
+        row_w = np.zeros((m, 2), complex)
+        row_w[0, 0], row_w[1::2] = 1.0, 1.0
+        row_w[2::2, 0], row_w[2::2, 1] = -1j, 1j
+        weights = (row_w[:, :, None, None] * col_w[None, None, :, :]).transpose(1, 3, 0, 2).reshape(4, m, m)
+        index = (entries[:, :, None, None] - entries[None, None, :, :] + 2 * H).transpose(1, 3, 0, 2).reshape(4, m, m)
         object.__setattr__(self, "_weights", weights)
         object.__setattr__(self, "_index", index)
 
@@ -287,6 +290,6 @@ class Harmonics:
 
 @functools.lru_cache(maxsize=16)
 def basis(H: int, N: int) -> Harmonics:
-    """``Harmonics(H, N)``, built once for each (H, N) (its complex-basis tables take 0.17 s at H = 50): for the
-    problems built again and again along a branch."""
+    """``Harmonics(H, N)``, built once for each (H, N) (0.036 s at H = 100, N = 2048; 0.58 s at H = 400, N = 8192): for
+    the problems built again and again along a branch."""
     return Harmonics(H, N)
