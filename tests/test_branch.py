@@ -118,15 +118,16 @@ def test_a_harmonic_balance_scene_records_its_periodic_solution(rig):
     the line fit of node 14 Y equals the solution's own harmonics on the 8 largest lines (measured 2.2e-14 of the
     largest: the fit is least squares on an exactly periodic record), the normal run is the linear steady state, and
     the contact is slip while the plate pushes (P > 0), open elsewhere."""
-    from rotorred.scenes.branch import cold_start
-    from rotorred.scenes.run import build_model, run_scene
+    from rotorred.scenes.balance_harmonics import cold_solution
+    from rotorred.scenes.run import build_model, run_scene, start_record
 
     scene = load_scene("paper-rub", {"solver.method": "harmonic-balance", "solver.harmonics": H,
                                      "solver.samples": N})
     result = run_scene(scene, build_model(scene), compare_normal=True)
     assert result.method == "harmonic-balance" and result.normal.method == "harmonic"
-    rp = rub_problem(scene, build_model(scene).model, H, N)
-    exact = rp.lines(cold_start(rp.problem, rp.omega), (14, "y"))
+    model = build_model(scene).model
+    rp, z, _ = cold_solution(scene, model, H, N, record=start_record(scene, model))
+    exact = rp.lines(z, (14, "y"))
     fitted = sorted(result.analyses[(14, "y")].fit.lines, key=lambda ln: -ln.amplitude)[:8]
     largest = max(exact.values())
     assert max(abs(ln.amplitude - exact[round(ln.frequency_hz, 6)]) for ln in fitted) < 2e-13 * largest
@@ -170,12 +171,12 @@ def test_a_harmonic_balance_scene_with_a_tolerance_says_what_it_chose(tmp_path, 
 def test_the_cold_solution_through_coarser_truncations_is_the_cold_start_at_its_own(rig):
     """cold_solution (a cold start at 25 harmonics, Newton at 50) reaches the solution the cold start at 50 harmonics
     reaches by itself (measured 1.4e-12 apart, both solved to 1e-9), for less (validation/hb_rig.py times them)."""
-    from rotorred.scenes.balance_harmonics import cold_solution
+    from rotorred.scenes.balance_harmonics import COLD, cold_solution
     from rotorred.scenes.branch import cold_start
 
     scene, model = rig
-    rp, z = cold_solution(scene, model, 50, 1024)
-    assert (rp.problem.harmonics.H, rp.problem.harmonics.N) == (50, 1024)
+    rp, z, how = cold_solution(scene, model, 50, 1024)
+    assert (rp.problem.harmonics.H, rp.problem.harmonics.N, how) == (50, 1024, COLD)
     direct = cold_start(rp.problem, rp.omega)
     assert rp.problem.evaluate(z, rp.omega).relative < 1e-9
     assert np.linalg.norm(z - direct) < 1e-10 * np.linalg.norm(direct)

@@ -8,11 +8,13 @@ import math
 import numpy as np
 import pytest
 
+from rotorred.checks import InputError
 from rotorred.nonlinear.condensed import ClearanceFamily
 from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.hb import solve
+from rotorred.scenes.balance_harmonics import FROM_RECORD, cold_solution
 from rotorred.scenes.harmonic_balance import base_frequency, rub_problem
-from rotorred.scenes.run import build_model, run_scene
+from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.contact import disk_force, normal_force, sliding_velocity
 from rotorred.transient.newmark import simulate
@@ -119,3 +121,26 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
                3: again.contacts[0].u_t}
     settled = rp.start_from_record(again.t[window], {j: x[window] for j, x in records.items()})
     assert np.linalg.norm(settled - z) < 7.8e-3 * np.linalg.norm(z)
+    # a scene's cold solution (Newton from a 5-period transient's last period) is this orbit (measured 4.5e-16)
+    _, z_cold, how = cold_solution(scene, sm.model, 100, 2048, record=start_record(scene, sm.model))
+    assert how == FROM_RECORD and np.linalg.norm(z_cold - z) < 1e-8 * np.linalg.norm(z)
+
+
+def test_the_fit_of_a_record_is_the_dft_of_whole_periods(paper_rub):
+    """RubProblem.start_from_record (by the FFT) equals the mean of x cos k theta and x sin k theta, twice, over the
+    samples (the definition, written out) on one and on two whole periods of uniform samples starting off the phase
+    origin (measured 2.7e-13 of the largest coefficient), and refuses a record that is not whole periods."""
+    scene, sm = paper_rub
+    rp = rub_problem(scene, sm.model, 100, 2048)
+    h, rng = rp.problem.harmonics, np.random.default_rng(5)
+    for periods, t0 in ((1, 0.4), (2, 0.0123)):
+        t = t0 + 2e-5 * np.arange(1, 5000 * periods + 1)
+        records = {j: rng.standard_normal(t.size) for j in range(4)}
+        rows = h.rows_at(rp.omega * t)
+        weights = np.full(h.size, 2.0 / t.size)
+        weights[0] = 1.0 / t.size
+        expected = np.column_stack([weights * (rows.T @ records[j]) for j in range(4)]).reshape(-1)
+        got = rp.start_from_record(t, records)
+        assert np.max(np.abs(got - expected)) < 2.7e-12 * np.max(np.abs(expected))
+    with pytest.raises(InputError, match="whole periods"):
+        rp.start_from_record(t[:-7], {j: x[:-7] for j, x in records.items()})

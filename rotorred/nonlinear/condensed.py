@@ -21,10 +21,9 @@ Its Jacobian is analytic: ``I + G (T(df/dq) + omega T(df/dv)(nabla (x) I))``, an
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
-import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
@@ -34,17 +33,17 @@ from rotorred.nonlinear.lowrank import IdentityPlusLowRank
 __all__ = ["CondensedProblem"]
 
 
-@dataclass(frozen=True)
-class _Harmonic:
-    """One harmonic's compliance data at one omega: (Z^-1)_cc, its omega-derivative, the linear response's ``c``
-    rows and their omega-derivative, and the full linear response with the compliance columns (for recovery)."""
+class _Compliance(NamedTuple):
+    """The compliance data of every harmonic k = 0..H at one omega, stacked on k: (Z_k^-1)_cc, its omega-derivative,
+    the linear response's ``c`` rows and their omega-derivative, and the full linear response with the compliance
+    columns (for recovery)."""
 
-    H_cc: np.ndarray
-    dH_cc: np.ndarray
-    q_lin: np.ndarray
-    dq_lin: np.ndarray
-    Q_full: np.ndarray
-    X: np.ndarray
+    H_cc: np.ndarray    # (H + 1, m, m) complex
+    dH_cc: np.ndarray   # (H + 1, m, m)
+    q_lin: np.ndarray   # (H + 1, m)
+    dq_lin: np.ndarray  # (H + 1, m)
+    Q_full: np.ndarray  # (H + 1, n)
+    X: np.ndarray       # (H + 1, n, m): (Z_k^-1)[:, c]
 
 
 @dataclass(frozen=True)
@@ -104,31 +103,35 @@ class CondensedProblem:
         self._compliance(omega)
         return dict(self._cache)
 
-    def _compliance(self, omega: float) -> list[_Harmonic]:
-        """Each harmonic's compliance data at ``omega`` (kept for the last omega asked: Newton iterates there)."""
+    def _compliance(self, omega: float) -> _Compliance:
+        """Every harmonic's compliance data at ``omega`` (kept for the last omega asked: Newton iterates there), from
+        one batched solve of the dynamic stiffnesses ``Z_k = K - (k omega)^2 M + i k omega D(omega)``."""
         if self._cache.get("omega") == omega:
             return self._cache["harmonics"]
         F, dF = self.forcing(omega)
-        N = self.M.shape[0]
-        F, dF = F.reshape(self.harmonics.size, N), dF.reshape(self.harmonics.size, N)
-        out = [self._harmonic(k, omega, F, dF) for k in range(self.harmonics.H + 1)]
+        n, H, c = self.M.shape[0], self.harmonics.H, list(self.dofs)
+        k = np.arange(H + 1)[:, None, None]
+        D = self.velocity_matrix(omega)
+        Z = self.K - (k * omega) ** 2 * self.M + 1j * k * omega * D
+        dZ = -2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
+        f, df = (self._phasors(G.reshape(self.harmonics.size, n)) for G in (F, dF))
+        unit = np.zeros((n, len(c)))
+        unit[c, range(len(c))] = 1.0
+        XQ = np.linalg.solve(Z, np.concatenate([np.broadcast_to(unit, (H + 1, n, len(c))), f[:, :, None]], axis=2))
+        X, Q = XQ[:, :, :-1], XQ[:, :, -1]  # (Z^-1)[:, c] and the linear response
+        Y = np.linalg.solve(Z.transpose(0, 2, 1), np.broadcast_to(unit, (H + 1, n, len(c)))).transpose(0, 2, 1)
+        out = _Compliance(H_cc=X[:, c], dH_cc=-Y @ dZ @ X, q_lin=Q[:, c],
+                          dq_lin=(Y @ (df - (dZ @ Q[:, :, None])[:, :, 0])[:, :, None])[:, :, 0], Q_full=Q, X=X)
         self._cache.clear()
         self._cache.update(omega=omega, harmonics=out)
         return out
 
-    def _harmonic(self, k: int, omega: float, F: np.ndarray, dF: np.ndarray) -> _Harmonic:
-        D = self.D if self.D1 is None else self.D + omega * self.D1
-        Z = self.K - (k * omega) ** 2 * self.M + 1j * k * omega * D
-        dZ = -2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
-        f, df = (F[0], dF[0]) if k == 0 else (F[2 * k - 1] - 1j * F[2 * k], dF[2 * k - 1] - 1j * dF[2 * k])
-        lu = sla.lu_factor(Z)
-        c = list(self.dofs)
-        unit = np.zeros((Z.shape[0], len(c)))
-        unit[c, range(len(c))] = 1.0
-        X = sla.lu_solve(lu, unit)  # (Z^-1)[:, c]
-        Y = sla.lu_solve(lu, unit, trans=1).T  # (Z^-1)[c, :]
-        Q = sla.lu_solve(lu, f.astype(complex))
-        return _Harmonic(H_cc=X[c], dH_cc=-Y @ dZ @ X, q_lin=Q[c], dq_lin=Y @ (df - dZ @ Q), Q_full=Q, X=X)
+    def _phasors(self, C: np.ndarray) -> np.ndarray:
+        """Harmonic-major real coefficients (2H + 1, n) as phasors (H + 1, n): a_0, and a_k - i b_k."""
+        out = np.empty((self.harmonics.H + 1, C.shape[1]), complex)
+        out[0] = C[0]
+        out[1:] = C[1::2] - 1j * C[2::2]
+        return out
 
     def compliance_blocks(self, omega: float):
         """G(omega): the real block-diagonal form of (Z_k^-1)_cc over the harmonics, as blocks (:meth:`apply`)."""
@@ -177,20 +180,19 @@ class CondensedProblem:
             self._cache["blocks"] = self._real_blocks(parts)
         return self._cache["blocks"]
 
-    def _real_blocks(self, parts: list[_Harmonic]):
+    def _real_blocks(self, parts: _Compliance):
         """G, dG/domega as blocks (the real form [[Re H, Im H], [-Im H, Re H]] per harmonic) and z_lin, dz_lin/domega
         (harmonic-major) from the harmonics."""
-        m, H = self.n, self.harmonics.H
-        Gk, dGk = np.zeros((H, 2 * m, 2 * m)), np.zeros((H, 2 * m, 2 * m))
-        z_lin, dz_lin = np.zeros(self.size), np.zeros(self.size)
-        z_lin[:m], dz_lin[:m] = parts[0].q_lin.real, parts[0].dq_lin.real
-        for k, p in enumerate(parts[1:], start=1):
-            for target, Hc in ((Gk, p.H_cc), (dGk, p.dH_cc)):
-                target[k - 1] = np.block([[Hc.real, Hc.imag], [-Hc.imag, Hc.real]])
-            a, b = slice((2 * k - 1) * m, 2 * k * m), slice(2 * k * m, (2 * k + 1) * m)
-            z_lin[a], z_lin[b] = p.q_lin.real, -p.q_lin.imag
-            dz_lin[a], dz_lin[b] = p.dq_lin.real, -p.dq_lin.imag
-        return (parts[0].H_cc.real, Gk), (parts[0].dH_cc.real, dGk), z_lin, dz_lin
+        def real_form(Hc):
+            return np.concatenate([np.concatenate([Hc.real, Hc.imag], axis=2),
+                                   np.concatenate([-Hc.imag, Hc.real], axis=2)], axis=1)
+
+        def coefficients(q):  # phasors (H + 1, m) -> harmonic-major (a_0, a_1, b_1, ...)
+            out = np.empty((self.harmonics.size, self.n))
+            out[0], out[1::2], out[2::2] = q[0].real, q[1:].real, -q[1:].imag
+            return out.reshape(-1)
+        return ((parts.H_cc[0].real, real_form(parts.H_cc[1:])), (parts.dH_cc[0].real, real_form(parts.dH_cc[1:])),
+                coefficients(parts.q_lin), coefficients(parts.dq_lin))
 
     @property
     def force_columns(self) -> list:
@@ -206,15 +208,9 @@ class CondensedProblem:
         parts = self._compliance(omega)
         q, v = self.samples(z, omega)  # the forces only: no Toeplitz matrices
         F_nl = force_coefficients(self.harmonics, self._local_forces, q, v).reshape(self.harmonics.size, self.n)
-        N = self.M.shape[0]
-        out = np.zeros((self.harmonics.size, N))
-        for k, p in enumerate(parts):
-            f = F_nl[0] if k == 0 else F_nl[2 * k - 1] - 1j * F_nl[2 * k]
-            Q = p.Q_full - p.X @ f
-            if k == 0:
-                out[0] = Q.real
-            else:
-                out[2 * k - 1], out[2 * k] = Q.real, -Q.imag
+        Q = parts.Q_full - (parts.X @ self._phasors(F_nl)[:, :, None])[:, :, 0]
+        out = np.empty((self.harmonics.size, self.M.shape[0]))
+        out[0], out[1::2], out[2::2] = Q[0].real, Q[1:].real, -Q[1:].imag
         return out.reshape(-1)
 
 

@@ -3,7 +3,7 @@
 
 The harmonics double along :data:`LADDER`, each with :data:`SAMPLES_PER_HARMONIC` AFT samples a period (the
 default's 2048 for 100), and each solution starts Newton from the one before it (its coefficients, the new harmonics
-zero; a cold start, :func:`rotorred.scenes.branch.cold_start`, only for the first). The error estimate of a
+zero; the first from a short transient's record, or a cold start, :func:`cold_solution`). The error estimate of a
 truncation is the change of the response to the next one, the largest over the scene's output DOFs of
 
     ||c_H - c_2H|| / ||c_2H||,
@@ -11,7 +11,7 @@ truncation is the change of the response to the next one, the largest over the s
 with ``c`` the DOF's Fourier coefficients (its RMS and spectrum, by Parseval). The first truncation whose change is
 within the tolerance is met, and the finer solution of the pair is the one returned. With an error ``e(H) ~ H^-p``
 the change is ``e(H) (1 - 2^-p)`` and the finer error ``e(H) 2^-p``: below the change for any order p >= 1. The
-rig's changes fall with observed orders of 2.4 to 3.9 (:mod:`validation.hb_harmonics`, docs/model.md §15), so
+rig's changes fall with observed orders of 2.2 to 3.9 (:mod:`validation.hb_harmonics`, docs/model.md §15), so
 what is returned is about 4-8 times more accurate than its estimate.
 """
 
@@ -32,6 +32,12 @@ __all__ = ["LADDER", "SAMPLES_PER_HARMONIC", "HarmonicsChoice", "HarmonicsNotCon
 LADDER = (25, 50, 100, 200, 400)
 #: AFT samples a period per harmonic: the default (2048 samples for 100 harmonics, ``BALANCE_DEFAULTS``)
 SAMPLES_PER_HARMONIC = 20.48
+#: the relative residual every solution here is solved to (that of :func:`rotorred.scenes.branch.cold_start`)
+TOL = 1e-9
+#: how :func:`cold_solution` started its solution (for the summary)
+FROM_RECORD = "Newton from a short transient's last period"
+COLD = ("a cold start (Newton from the linear response, else a continuation in the clearance) at the coarsest "
+        "truncation, then Newton up to the harmonics asked")
 
 
 @dataclass(frozen=True)
@@ -101,8 +107,8 @@ def padded(z: np.ndarray, coarse: RubProblem, fine: RubProblem) -> np.ndarray:
     return out
 
 
-def balance_to_tolerance(scene, model, tol: float, dofs, progress=None) -> tuple[RubProblem, np.ndarray,
-                                                                                   HarmonicsChoice]:
+def balance_to_tolerance(scene, model, tol: float, dofs, progress=None, record=None) -> tuple[
+        RubProblem, np.ndarray, HarmonicsChoice]:
     """The periodic rub response of ``scene`` on ``model`` with the harmonics chosen for ``tol`` (module docstring).
 
     Parameters
@@ -116,6 +122,9 @@ def balance_to_tolerance(scene, model, tol: float, dofs, progress=None) -> tuple
         The output DOFs whose response is compared.
     progress : callable, optional
         ``progress(H, change)`` after each truncation (change None for the first).
+    record : (ndarray, dict), optional
+        A short transient's last period (:func:`cold_solution`): each truncation's Newton starts from its fit first,
+        then from the truncation before.
 
     Returns
     -------
@@ -128,14 +137,14 @@ def balance_to_tolerance(scene, model, tol: float, dofs, progress=None) -> tuple
         If a truncation's Newton does not converge from the one before nor from a cold start, or
         :class:`HarmonicsNotConverged` when the last truncation still changes by more than ``tol``.
     """
-    rp = rub_problem(scene, model, LADDER[0], samples_for(LADDER[0]))
-    z = cold_start(rp.problem, rp.omega)
+    rp, z, _ = cold_solution(scene, model, LADDER[0], samples_for(LADDER[0]), record)
     if progress is not None:
         progress(LADDER[0], None)
     steps = []
     for H in LADDER[1:]:
         fine = rub_problem(scene, model, H, samples_for(H))
-        z_fine = _solve_from(fine, padded(z, rp, fine))
+        z_fine = _solve_from(fine, *([fine.start_from_record(*record)] if record is not None else []),
+                             padded(z, rp, fine))
         change = response_change(rp, z, fine, z_fine, dofs)
         steps.append((H, change))
         if progress is not None:
@@ -146,34 +155,52 @@ def balance_to_tolerance(scene, model, tol: float, dofs, progress=None) -> tuple
     raise HarmonicsNotConverged(rp.omega, steps[-1][1], tol, LADDER[-1])
 
 
-def cold_solution(scene, model, H: int, N: int) -> tuple[RubProblem, np.ndarray]:
-    """The periodic rub response of ``scene`` on ``model`` with ``H`` harmonics and ``N`` AFT samples, from nothing:
-    a cold start (:func:`rotorred.scenes.branch.cold_start`) at the first truncation of :data:`LADDER` below ``H``,
-    then Newton up the ladder, each truncation from the one before, to ``H`` itself.
+def cold_solution(scene, model, H: int, N: int, record=None) -> tuple[RubProblem, np.ndarray, str]:
+    """The periodic rub response of ``scene`` on ``model`` with ``H`` harmonics and ``N`` AFT samples, from nothing.
 
-    The cold start's continuation in the clearance costs per point what a truncation costs per Newton iteration, so
-    it is cheapest at the coarsest: on paper-rub at 100 harmonics 1.3 s, against 3.2 s for the cold start at 100
-    harmonics itself, and the same solution (7.6e-11 apart; validation/hb_rig.py).
+    With ``record``, a short transient's last period ``(t, {position: samples})``
+    (:func:`rotorred.scenes.run.start_record`), Newton from its fit: on paper-rub, 5 periods of f_0 from the
+    settled linear state put Newton 4 iterations from the orbit the settled transient reaches (docs/model.md §15).
+    Without one, or if Newton does not converge from it: a cold start (:func:`rotorred.scenes.branch.cold_start`) at
+    the first truncation of :data:`LADDER` below ``H``, then Newton up the ladder, each truncation from the one before,
+    to ``H`` itself. The cold start's continuation in the clearance costs per point what a truncation costs per Newton
+    iteration, so it is cheapest at the coarsest: on paper-rub at 100 harmonics 1.3 s, against 3.2 s for the cold
+    start at 100 harmonics itself, and the same solution (7.6e-11 apart; validation/hb_rig.py).
 
     Returns
     -------
-    (RubProblem, ndarray)
+    (RubProblem, ndarray, str)
+        The problem, the solution's coefficients, and how it was started: :data:`FROM_RECORD` or :data:`COLD`.
     """
+    if record is not None:
+        rp = rub_problem(scene, model, H, N)
+        z = _newton(rp, rp.start_from_record(*record))
+        if z is not None:
+            return rp, z, FROM_RECORD
     coarser = [h for h in LADDER if h < H]
     if not coarser:
         rp = rub_problem(scene, model, H, N)
-        return rp, cold_start(rp.problem, rp.omega)
+        return rp, cold_start(rp.problem, rp.omega), COLD
     rp = rub_problem(scene, model, coarser[0], samples_for(coarser[0]))
     z = cold_start(rp.problem, rp.omega)
     for h, n in [(h, samples_for(h)) for h in coarser[1:]] + [(H, N)]:
         fine = rub_problem(scene, model, h, n)
         z, rp = _solve_from(fine, padded(z, rp, fine)), fine
-    return rp, z
+    return rp, z, COLD
 
 
-def _solve_from(rp: RubProblem, z0: np.ndarray) -> np.ndarray:
-    """Newton from ``z0``, or a cold start if that does not converge."""
+def _newton(rp: RubProblem, z0: np.ndarray) -> np.ndarray | None:
+    """Newton from ``z0`` (to the cold start's tolerance), or None if it does not converge."""
     try:
-        return solve(rp.problem, z0, rp.omega, tol=1e-9)[0]
+        return solve(rp.problem, z0, rp.omega, tol=TOL)[0]
     except NotConverged:
-        return cold_start(rp.problem, rp.omega)
+        return None
+
+
+def _solve_from(rp: RubProblem, *starts: np.ndarray) -> np.ndarray:
+    """Newton from each of ``starts`` in turn, or a cold start if it converges from none."""
+    for z0 in starts:
+        z = _newton(rp, z0)
+        if z is not None:
+            return z
+    return cold_start(rp.problem, rp.omega)

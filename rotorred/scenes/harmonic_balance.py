@@ -130,15 +130,35 @@ class RubProblem:
     def start_from_record(self, t: np.ndarray, records: dict) -> np.ndarray:
         """Coefficients of the unknowns fitted to a transient's settled record: ``records`` maps each unknown's
         position (0, 1, ... : disk x, disk y, plate u_n, plate u_t per plate) to its samples at ``t``, which must span
-        whole periods 1 / f_0 at a constant step (the phase origin is t = 0, as the solution's)."""
+        whole periods 1 / f_0 at a constant step (the phase origin is t = 0, as the solution's).
+
+        The fit is the DFT of the samples (the least-squares fit on uniform samples of whole periods), by the FFT:
+        harmonic k of p periods is bin k p, turned to the phase origin by ``exp(-i k omega t_0)``."""
         h, m = self.problem.harmonics, self.problem.n
-        rows = h.rows_at(self.omega * np.asarray(t))
-        weights = np.full(h.size, 2.0 / len(rows))  # the mean of x cos k theta, twice; of x for a_0
-        weights[0] = 1.0 / len(rows)
-        z = np.zeros((h.size, m))
+        t = np.asarray(t, float)
+        n, p = len(t), self._periods(t)
+        if h.H * p >= n / 2:
+            checks.fail("t", f"{n} samples", f"must sample the {h.H} harmonics of f0 = {self.f0:g} Hz: more than "
+                        f"{2 * h.H * p} over {p} period(s)")
+        X = np.zeros((n, m))
         for j, x in records.items():
-            z[:, j] = weights * (rows.T @ np.asarray(x))
+            X[:, j] = x
+        k = np.arange(1, h.H + 1)
+        S = np.fft.rfft(X, axis=0)[k * p] * np.exp(-1j * k * self.omega * t[0])[:, None]
+        z = np.empty((h.size, m))
+        z[0], z[1::2], z[2::2] = X.mean(axis=0), (2.0 / n) * S.real, (-2.0 / n) * S.imag
         return z.reshape(-1)
+
+    def _periods(self, t: np.ndarray) -> int:
+        """The whole periods 1 / f_0 that the samples ``t`` span at a constant step (an error naming ``t`` else)."""
+        step = np.diff(t)
+        if len(t) < 2 or np.ptp(step) > 1e-9 * abs(step[0]) or step[0] <= 0:
+            checks.fail("t", f"{len(t)} samples", "must be at a constant step", "s")
+        periods = len(t) * step[0] * self.f0
+        if round(periods) < 1 or abs(periods - round(periods)) > 1e-6:
+            checks.fail("t", f"{len(t)} samples of {step[0]:g} s", f"must span whole periods 1 / f0 = "
+                        f"{1.0 / self.f0:g} s (spans {periods:.6g})", "s")
+        return int(round(periods))
 
 
 def rub_problem(scene, model, H: int, N: int, f0: float | None = None) -> RubProblem:

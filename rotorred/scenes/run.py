@@ -465,22 +465,57 @@ def _harmonic_response(scene: Scene, model) -> Response:
 
 
 def _balance_response(scene: Scene, model) -> Response:
-    """The periodic rub response by harmonic balance (``solver.method = "harmonic-balance"``: a cold start up through
-    coarser truncations, :func:`rotorred.scenes.balance_harmonics.cold_solution`, or the harmonics chosen by
-    ``solver.tolerance``) at the record times, as a transient's record."""
+    """The periodic rub response by harmonic balance (``solver.method = "harmonic-balance"``) at the record times, as a
+    transient's record: Newton from a short transient's last period (:func:`start_record`), else a cold start up
+    through coarser truncations (:func:`rotorred.scenes.balance_harmonics.cold_solution`), or the harmonics chosen by
+    ``solver.tolerance``."""
     from rotorred.scenes.balance_harmonics import balance_to_tolerance, cold_solution
 
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
+    record = start_record(scene, model)
     if s.tolerance is not None:
-        rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs)
+        rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs, record=record)
+        start = "each truncation's Newton from the record of a short transient or the truncation before"
     else:
-        (rp, z), choice = cold_solution(scene, model, s.harmonics, s.samples), None
+        (rp, z, start), choice = cold_solution(scene, model, s.harmonics, s.samples, record=record), None
     outputs, contacts = rp.record(z, t, scene.output.dofs)
     counters = {"f0": rp.f0, "harmonics": rp.problem.harmonics.H, "samples": rp.problem.harmonics.N,
-                "choice": choice}
+                "choice": choice, "start": start}
     return Response(t, outputs, contacts, "harmonic-balance", 0, counters)
+
+
+#: periods of the base frequency f0 of the transient a scene's harmonic balance starts from (docs/model.md §15)
+START_PERIODS = 5
+
+
+def start_record(scene: Scene, model) -> tuple[np.ndarray, dict] | None:
+    """A harmonic balance's start: the rub scene's transient from the settled linear state over :data:`START_PERIODS`
+    periods 1 / f0 (at the scene's time step or the next smaller one that divides the period) and its last period's
+    samples of the balance's unknowns, ``(t, {position: samples})`` (each plate's disk x, y, u_n, u_t); None if the
+    transient diverges.
+    """
+    from rotorred.scenes.harmonic_balance import base_frequency
+    from rotorred.transient.newmark import simulate
+    from rotorred.transient.results import SimulationDiverged
+
+    period = 1.0 / base_frequency(tuple(scene.frequencies_hz.values()))
+    dt = period / math.ceil(period / scene.solver.dt - 1e-9)
+    q0, v0 = settled_state(scene, model)
+    outputs = [(p.node, d) for p in scene.plates for d in ("x", "y")]
+    try:
+        res = simulate(model, scene.speeds, START_PERIODS * period, dt, unbalances=scene.unbalances,
+                       plates=scene.plates, rotor=scene.rotor, outputs=outputs,
+                       record_start=(START_PERIODS - 1) * period, q0=q0, v0=v0, progress=False)
+    except SimulationDiverged:
+        return None
+    last = res.t > res.t[-1] - period + 0.5 * dt
+    records = {}
+    for i, (plate, contact) in enumerate(zip(scene.plates, res.contacts)):
+        records.update({4 * i: res.outputs[(plate.node, "x")][last], 4 * i + 1: res.outputs[(plate.node, "y")][last],
+                        4 * i + 2: contact.u_n[last], 4 * i + 3: contact.u_t[last]})
+    return res.t[last], records
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,

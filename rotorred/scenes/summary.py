@@ -93,7 +93,7 @@ def _setup(result: SceneResult) -> str:
         if c.get("choice") is not None:
             lines.append(c["choice"].describe())
         lines.append(f"response: harmonic balance, {c['harmonics']} harmonics of f0 = {c['f0']:g} Hz and "
-                     f"{c['samples']} AFT samples a period (the periodic solution a cold start reaches), at "
+                     f"{c['samples']} AFT samples a period ({c['start']}), at "
                      f"{len(result.t)} samples of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; "
                      f"{result.solve_time:.2f} s")
     else:
