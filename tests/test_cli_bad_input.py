@@ -98,6 +98,8 @@ CASES = [
       "solver.harmonics=50", "--out", "{d}/o"], ["solver.harmonics", "solver.tolerance"]),
     (["run", "paper-rub", "--set", "solver.method=hht", "--set", "solver.tolerance=0.01", "--out", "{d}/o"],
      ["solver.tolerance", "harmonic-balance"]),
+    (["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "solver.harmonics=5", "--set",
+      "solver.samples=64", "--out", "{d}/o"], ["solver.harmonics", "at least 9"]),
     # ---- continue (harmonic-balance branches)
     (["continue", "paper-rub", "--param", "rub.clearance=20e-6", "--out", "{d}/o"], ["--param", "KEY=START:STOP"]),
     (["continue", "paper-rub", "--param", "rub.clearance=2e-5:2e-5", "--out", "{d}/o"], ["--param", "different"]),

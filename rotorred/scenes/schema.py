@@ -789,7 +789,12 @@ def _check_balance(speeds: dict, plates, solver: SolverSpec) -> None:
     if solver.gravity:
         fail("solver.gravity", solver.gravity, 'must be 0 with solver.method = "harmonic-balance" (no static load in '
              "its forcing)", "m/s^2")
-    base_frequency(tuple(w / (2 * math.pi) for w in speeds.values()))
+    frequencies = tuple(w / (2 * math.pi) for w in speeds.values())
+    f0 = base_frequency(frequencies)
+    order = max(round(f / f0) for f in frequencies)
+    if solver.harmonics is not None and solver.harmonics < order:
+        fail("solver.harmonics", solver.harmonics, f"must reach the spools' harmonics of f0 = {f0:g} Hz (at least "
+             f"{order})")
 
 
 def _check_runup_solver(runup: RunupSpec, solver: SolverSpec) -> None:
