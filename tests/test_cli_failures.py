@@ -167,3 +167,19 @@ def test_missing_optional_library_names_its_install_command(tmp_path, monkeypatc
     err = capsys.readouterr().err.strip()
     assert "Traceback" not in err and "'matplotlib'" in err and "pip install matplotlib" in err
     assert not (tmp_path / "o").exists()  # the folder this run created is removed again
+
+
+@pytest.mark.parametrize("preset", [None, "4"])
+def test_a_command_runs_blas_on_one_thread_unless_told(monkeypatch, preset):
+    """The command sets OPENBLAS/MKL/OMP_NUM_THREADS to 1 before numpy is imported (it spins against the figure
+    workers on small matrices: rotorred.cli.ONE_THREAD), and leaves a value the environment gives alone."""
+    from rotorred.cli import ONE_THREAD
+
+    for name in ONE_THREAD:
+        if preset is None:
+            monkeypatch.delenv(name, raising=False)
+        else:
+            monkeypatch.setenv(name, preset)
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    assert all(os.environ[name] == (preset or "1") for name in ONE_THREAD)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
+import os
 import signal
 import sys
 import tempfile
@@ -82,8 +83,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: BLAS and OpenMP threads of a command unless the environment sets them: one. rotorred's matrices are small (tens to a
+#: few hundred DOFs), where BLAS's threads spin against the figure workers for the 2 cores: a warm ``rotorred run``
+#: of paper-rub took 3.83 s (CPU 4.5 s) so against 4.30 s (CPU 6.2 s) with OpenBLAS's default (medians of 5,
+#: alternated). Set before numpy is imported (the command imports it lazily); maps' workers set the same.
+ONE_THREAD = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; returns its exit status (:data:`EXIT_STATUSES`)."""
+    for name in ONE_THREAD:
+        os.environ.setdefault(name, "1")
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "_run", None):
