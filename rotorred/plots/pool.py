@@ -22,6 +22,7 @@ import multiprocessing
 from concurrent.futures.process import BrokenProcessPool
 import os
 import signal
+import threading
 
 __all__ = ["FigurePool", "Drawing", "default_workers"]
 
@@ -86,15 +87,30 @@ class FigurePool:
 
     def __init__(self, workers: int | None = None):
         self.workers = default_workers() if workers is None else int(workers)
-        self._executor = None
+        self._executor, self._starting = None, None
         if self.workers > 0:
             self._executor = concurrent.futures.ProcessPoolExecutor(
                 self.workers, mp_context=_context(), initializer=_start_worker)
-            for _ in range(self.workers):  # one job each: every worker starts now
+            # one job each starts every worker; from a thread, since the first waits for the fork server to import
+            # matplotlib (0.4 s), which the caller spends computing
+            self._starting = threading.Thread(target=self._start, daemon=True)
+            self._starting.start()
+
+    def _start(self) -> None:
+        try:
+            for _ in range(self.workers):
                 self._executor.submit(_ready)
+        except (BrokenProcessPool, RuntimeError):  # no workers: submit draws here
+            pass
+
+    def _started(self) -> None:
+        if self._starting is not None:
+            self._starting.join()
+            self._starting = None
 
     def submit(self, job) -> Drawing:
         """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers."""
+        self._started()
         if self._executor is None:
             return Drawing(job, None)
         try:
@@ -106,6 +122,7 @@ class FigurePool:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
+        self._started()
         if self._executor is None:
             return
         if exc_type is not None:  # stop drawing now: the caller is about to remove what the workers write into
