@@ -271,6 +271,31 @@ def test_figures_drawn_by_worker_processes_are_the_figures_drawn_here(rub, tmp_p
         pool.submit(bad).result()
 
 
+def test_the_record_figures_are_drawn_before_the_analysis_and_are_the_same(rub, tmp_path):
+    """run_scene's on_record gets the result once, before the analysis (no analyses yet, the record and the normal run
+    there); the figures submitted from it and the analysis' figure afterwards are the files and pixels that
+    write_outputs draws from the whole result at once."""
+    from matplotlib.image import imread
+
+    from rotorred.plots.pool import FigurePool
+    from rotorred.scenes.outputs import submit_figures
+
+    sc, whole = rub
+    seen, drawing = [], []
+    with FigurePool(workers=1) as pool:
+        def on_record(partial):
+            seen.append(partial)
+            drawing.extend(submit_figures(partial, tmp_path / "early", pool, "record"))
+        res = run_scene(sc, on_record=on_record)
+        early = write_outputs(res, tmp_path / "early", pool=pool, drawing=drawing)
+    assert len(seen) == 1 and seen[0].analyses == {} and seen[0].normal is not None and res.analyses
+    at_once = write_outputs(whole, tmp_path / "whole")
+    assert [f.name for f in early] == [f.name for f in at_once]
+    for a, b in zip(early, at_once):
+        if a.suffix == ".png":
+            np.testing.assert_array_equal(imread(a), imread(b))
+
+
 def test_a_dead_figure_worker_costs_no_figure(rub, tmp_path):
     """A worker killed while the figures are drawn (out of memory, a signal): its figures are drawn here instead,
     and the files are all there."""

@@ -92,13 +92,18 @@ def _compute_and_write(scene, args, folder, out, pool) -> int:
 
     if scene.runup is not None:
         return _runup_and_write(scene, folder, out)
-    from rotorred.scenes.outputs import write_outputs
+    from rotorred.scenes.outputs import submit_figures, write_outputs
     from rotorred.scenes.run import SceneDiverged
     from rotorred.scenes.summary import format_summary
     from rotorred.scenes.tolerance import run_to_tolerance
 
+    drawing = []  # the record's figures: drawn while the line fit, settling and class are computed
+
+    def on_record(partial):
+        drawing.extend(submit_figures(partial, folder.staging, pool, "record"))
     try:
-        result = run_to_tolerance(scene, compare_normal=False if args.no_normal else None, progress=None)
+        result = run_to_tolerance(scene, compare_normal=False if args.no_normal else None, progress=None,
+                                  on_record=on_record)
     except SceneDiverged as exc:
         write_outputs(exc.partial, folder.staging, shown=out, pool=pool)
         files = folder.commit(incomplete=str(exc))
@@ -106,7 +111,7 @@ def _compute_and_write(scene, args, folder, out, pool) -> int:
         print(f"rotorred run: error: {exc}; partial results written to {out} (marked {INCOMPLETE})",
               file=sys.stderr)
         return EXIT_DIVERGED
-    files = write_outputs(result, folder.staging, shown=out, pool=pool)
+    files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing)
     folder.commit()
     print(format_summary(result, files))
     return 0

@@ -30,7 +30,8 @@ if TYPE_CHECKING:
 
     from rotorred.signals.lines import SpectralLine
 
-__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures"]
+__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures",
+           "record_figures", "analysis_figures"]
 
 
 # --------------------------------------------------------------------------- helpers
@@ -455,7 +456,8 @@ def _pair(spectrum) -> tuple[np.ndarray, np.ndarray]:
 def scene_figures(result, out: str | Path) -> list[partial]:
     """The figures of :func:`plot_scene` as jobs: each a ``functools.partial`` of a plot function and plain
     arrays, which draws and writes one file when called (in this process or, pickled, in a
-    :class:`rotorred.plots.pool.FigurePool` worker) and returns its path.
+    :class:`rotorred.plots.pool.FigurePool` worker) and returns its path: :func:`record_figures` and
+    :func:`analysis_figures`.
 
     Parameters
     ----------
@@ -468,15 +470,19 @@ def scene_figures(result, out: str | Path) -> list[partial]:
     -------
     list of functools.partial
     """
+    return record_figures(result, out) + analysis_figures(result, out)
+
+
+def record_figures(result, out: str | Path) -> list[partial]:
+    """The figures of :func:`scene_figures` drawn from the record, its spectra and lines alone (waveforms, spectra,
+    orbits, as the scene asks): they can be drawn while the line fit, settling and class are computed."""
     out = Path(out)
     sc = result.scene
     plots = sc.output.plots
     case = "rub" if sc.plates else "response"
     pairs = [("normal", result.normal), (case, result)] if result.normal is not None else [(case, result)]
     jobs = []
-    rub_text = "; ".join(f"rub at node {p.node} ({math.degrees(p.theta):g} deg, clearance {1e6 * p.clearance:.3g} um)"
-                         for p in sc.plates) or "no rub"
-    speeds = ", ".join(f"{w / (2 * math.pi):.4g} Hz" for w in sc.speeds.values())
+    speeds, rub_text = _texts(sc)
     translational = [d for d in sc.output.directions if d in ("x", "y")]
     if "waveforms" in plots:
         window = sc.output.plot_window or (result.t[0], min(result.t[-1], result.t[0] + 0.14))
@@ -510,9 +516,24 @@ def scene_figures(result, out: str | Path) -> list[partial]:
             orbits[title] = {label: (r.outputs[(n, "x")], r.outputs[(n, "y")]) for label, r in pairs}
         jobs.append(partial(plot_orbits, orbits, out / "orbits.png",
                              title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
-    if "poincare" in plots and result.analysis is not None and result.analysis.classification.poincare.x.size:
-        jobs.append(_scene_poincare(result, out / "poincare.png", speeds, rub_text))
     return jobs
+
+
+def analysis_figures(result, out: str | Path) -> list[partial]:
+    """The figures of :func:`scene_figures` drawn from the table DOF's analysis (the Poincare section): none while
+    ``result`` has none."""
+    sc = result.scene
+    if not ("poincare" in sc.output.plots and result.analysis is not None
+            and result.analysis.classification.poincare.x.size):
+        return []
+    return [_scene_poincare(result, Path(out) / "poincare.png", *_texts(sc))]
+
+
+def _texts(sc) -> tuple[str, str]:
+    """The speeds and the rub, as a figure's title says them."""
+    rub_text = "; ".join(f"rub at node {p.node} ({math.degrees(p.theta):g} deg, clearance {1e6 * p.clearance:.3g} um)"
+                         for p in sc.plates) or "no rub"
+    return ", ".join(f"{w / (2 * math.pi):.4g} Hz" for w in sc.speeds.values()), rub_text
 
 
 def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> partial:

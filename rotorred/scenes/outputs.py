@@ -15,7 +15,7 @@ from rotorred.scenes.run import SceneResult
 from rotorred.scenes.summary import format_summary
 from rotorred.writers import write_csv, write_mat, write_npz, write_text
 
-__all__ = ["data_arrays", "write_data", "write_outputs", "LINEFIT_HEADER", "POINCARE_HEADER"]
+__all__ = ["data_arrays", "write_data", "write_outputs", "submit_figures", "LINEFIT_HEADER", "POINCARE_HEADER"]
 
 #: columns of ``linefit.csv`` (docs/scenes.md)
 LINEFIT_HEADER = ["frequency (Hz)", "label", "labels", "m", "n", "k", "j", "amplitude (um)", "phase (rad)",
@@ -129,18 +129,25 @@ def write_data(result: SceneResult, out: str | Path) -> list[Path]:
     return files
 
 
-def _submit_figures(result: SceneResult, out: Path, pool) -> list:
-    """The scene's figures as :class:`rotorred.plots.pool.Drawing` s, drawn by ``pool`` (None: drawn now, here)."""
-    from rotorred.plots.pool import FigurePool  # matplotlib only when figures are written
-    from rotorred.plots.scene import scene_figures
+def submit_figures(result: SceneResult, out: str | Path, pool, which: str = "all") -> list:
+    """The scene's figures as :class:`rotorred.plots.pool.Drawing` s, drawn by ``pool`` (None: drawn now, here), none
+    for a scene without plots or an incomplete result. ``which``: "all"; "record", those drawn from the record alone
+    (:func:`rotorred.plots.scene.record_figures`: from ``run_scene``'s ``on_record``, while the analysis runs); or
+    "analysis", the others."""
+    from rotorred.plots import scene as figures  # matplotlib only when figures are written
+    from rotorred.plots.pool import FigurePool
 
-    jobs = scene_figures(result, out)
+    if not result.scene.output.plots or result.incomplete:
+        return []
+    make = {"all": figures.scene_figures, "record": figures.record_figures,
+            "analysis": figures.analysis_figures}[which]
     if pool is None:
         pool = FigurePool(workers=0)
-    return [pool.submit(job) for job in jobs]
+    return [pool.submit(job) for job in make(result, Path(out))]
 
 
-def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None, pool=None) -> list[Path]:
+def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None, pool=None,
+                  drawing: list | None = None) -> list[Path]:
     """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written.
 
     An incomplete result (a diverged transient, ``result.incomplete``) gets its data files and
@@ -156,11 +163,15 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
         :class:`rotorred.writers.OutputFolder`); default ``out``.
     pool : rotorred.plots.pool.FigurePool, optional
         Draws the figures while the data files are written (default: one after the other, here).
+    drawing : list of Drawing, optional
+        The record's figures, submitted already (:func:`submit_figures` with "record"): only the others are.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    plots = result.scene.output.plots and not result.incomplete
-    figures = [] if not plots else _submit_figures(result, out, pool)
+    if drawing is None:
+        figures = submit_figures(result, out, pool)
+    else:
+        figures = list(drawing) + submit_figures(result, out, pool, "analysis")
     data = write_data(result, out)
     files = [f.result() for f in figures] + data
     summary = out / "summary.txt"

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -325,7 +325,8 @@ def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- run
 def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: bool | None = None,
-              progress: bool | None = False, analyse: bool = True, initial=None, settings=None) -> SceneResult:
+              progress: bool | None = False, analyse: bool = True, initial=None, settings=None,
+              on_record=None) -> SceneResult:
     """Compute a scene's response, spectra and labelled lines.
 
     Parameters
@@ -347,6 +348,9 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     settings : rotorred.scenes.tolerance.Settings, optional
         What ``solver.tolerance`` chose for ``scene`` (kept in the result for the summary;
         :func:`rotorred.scenes.tolerance.run_to_tolerance` chooses and runs).
+    on_record : callable, optional
+        ``on_record(result)`` once the record, its spectra and lines and the normal run are done, before the
+        analysis: ``result`` is the SceneResult without ``analyses`` (its figures can be drawn meanwhile).
 
     Returns
     -------
@@ -361,13 +365,6 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     response = respond(scene, model, initial, progress)
     spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
-    analyses, errors = {}, {}
-    if analyse:
-        d = table_dof(scene)
-        try:
-            analyses[d] = analyse_lines(response.t, response.outputs[d], f_L, f_H, spectra[d].n_samples, d)
-        except ValueError as exc:  # a record too short to fit (checks' one-line message)
-            errors[d] = str(exc)
     if compare_normal is None:
         compare_normal = scene.output.compare_normal
     normal = None
@@ -375,11 +372,21 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
         without = scene.without_rub()
         normal = run_scene(without, SceneModel(model.model, model.label, 0.0, model_key(without)),
                            compare_normal=False, analyse=False)
-    return SceneResult(scene=scene, t=response.t, outputs=response.outputs, contacts=response.contacts,
-                       spectra=spectra, lines=lines, f_L=f_L, f_H=f_H, method=response.method,
-                       model_label=model.label, n_steps=response.n_steps, build_time=model.build_time,
-                       solve_time=solve_time, normal=normal, counters=response.counters, analyses=analyses,
-                       analysis_errors=errors, final=response.final, settings=settings)
+    result = SceneResult(scene=scene, t=response.t, outputs=response.outputs, contacts=response.contacts,
+                         spectra=spectra, lines=lines, f_L=f_L, f_H=f_H, method=response.method,
+                         model_label=model.label, n_steps=response.n_steps, build_time=model.build_time,
+                         solve_time=solve_time, normal=normal, counters=response.counters, analyses={},
+                         analysis_errors={}, final=response.final, settings=settings)
+    if on_record is not None:
+        on_record(result)
+    if not analyse:
+        return result
+    d = table_dof(scene)
+    try:
+        analyses = {d: analyse_lines(response.t, response.outputs[d], f_L, f_H, spectra[d].n_samples, d)}
+    except ValueError as exc:  # a record too short to fit (checks' one-line message)
+        return replace(result, analysis_errors={d: str(exc)})
+    return replace(result, analyses=analyses)
 
 
 def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: int | None = None,
