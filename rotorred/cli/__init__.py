@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import importlib
 import os
 import signal
@@ -88,6 +89,16 @@ def build_parser() -> argparse.ArgumentParser:
 #: of paper-rub took 3.83 s (CPU 4.5 s) so against 4.30 s (CPU 6.2 s) with OpenBLAS's default (medians of 5,
 #: alternated). Set before numpy is imported (the command imports it lazily); maps' workers set the same.
 ONE_THREAD = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
+
+
+def entry() -> int:
+    """The ``rotorred`` console script: :func:`main`, then every object it leaves frozen for the garbage collector, so
+    that the interpreter's exit does not walk them (numba's and scipy's hundreds of thousands: a warm ``rotorred run``
+    of paper-rub ended 0.23 s sooner, 2.47 against 2.70 s, medians of 5). Files are closed and exit handlers run as
+    before; only the collection at exit is skipped."""
+    status = main()
+    gc.freeze()
+    return status
 
 
 def main(argv: list[str] | None = None) -> int:
