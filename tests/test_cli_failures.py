@@ -183,3 +183,22 @@ def test_a_command_runs_blas_on_one_thread_unless_told(monkeypatch, preset):
     with pytest.raises(SystemExit):
         main(["run", "--help"])
     assert all(os.environ[name] == (preset or "1") for name in ONE_THREAD)
+
+
+def test_the_console_script_runs_main_then_freezes_the_heap(monkeypatch, tmp_path, capsys):
+    """``rotorred`` (pyproject's console script, cli.entry) returns main's status and leaves the objects frozen for
+    the collector (the interpreter's exit then does not walk them)."""
+    import gc
+    import tomllib
+
+    from rotorred.cli import entry
+
+    scripts = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())["project"]["scripts"]
+    assert scripts["rotorred"] == "rotorred.cli:entry"
+    monkeypatch.setattr(sys, "argv", ["rotorred", "run", "no-such-scene", "--out", str(tmp_path / "o")])
+    gc.unfreeze()
+    try:
+        assert entry() == 2 and gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
+    assert "no-such-scene" in capsys.readouterr().err
