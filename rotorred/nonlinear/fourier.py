@@ -249,14 +249,18 @@ class Harmonics:
         active = np.flatnonzero(np.abs(M).reshape(N, -1).max(axis=1) > 0.0)
         if len(active) > max_rank:
             return None
-        u, s, vh = np.linalg.svd(M[active], full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
-        j, i = np.nonzero(s > rtol * s[:, :1])
-        if len(j) > max_rank:
-            return None
-        L, R, at = u[j, :, i] * s[j, i][:, None], vh[j, i, :], active[j]  # (r, m), (r, 2m), (r,)
-        U = (self.forward[:, at][:, None, :] * L.T[None, :, :]).reshape(self.size * m, len(j))
+        factors = _rank_one(M[active], rtol)
+        if factors is not None:  # every sample rank one (a rub): no SVD
+            L, R, at = factors[0], factors[1], active
+        else:
+            u, s, vh = np.linalg.svd(M[active], full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
+            j, i = np.nonzero(s > rtol * s[:, :1])
+            if len(j) > max_rank:
+                return None
+            L, R, at = u[j, :, i] * s[j, i][:, None], vh[j, i, :], active[j]  # (r, m), (r, 2m), (r,)
+        U = (self.forward[:, at][:, None, :] * L.T[None, :, :]).reshape(self.size * m, len(at))
         V = (self.E[at][:, :, None] * R[:, None, :m] + self.rate_rows[at][:, :, None] * R[:, None, m:])
-        return U, V.reshape(len(j), self.size * m).T
+        return U, V.reshape(len(at), self.size * m).T
 
     def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
         """:meth:`toeplitz` as the product ``forward diag(d) E`` written out for every pair (the definition)."""
@@ -286,6 +290,20 @@ class Harmonics:
         """:meth:`toeplitz` from the spectrum for every pair (for tests)."""
         n = d.shape[1]
         return self._assembled(self._blocks_by_spectrum(d.reshape(self.N, n * n)), n)
+
+
+def _rank_one(A: np.ndarray, rtol: float):
+    """``(L, R)`` with ``A[j] = outer(L[j], R[j])`` for every sample's matrix ``A[j]`` (a, m, p) when each is rank one
+    to ``rtol`` of the largest entry (L the column of largest norm, R its least-squares row), else None. A rub's
+    samples are (its force is P along a fixed direction): the SVD then costs more than the Jacobian's use of it."""
+    if len(A) == 0:
+        return None
+    a = np.arange(len(A))
+    L = A[a, :, np.einsum("aij,aij->aj", A, A).argmax(axis=1)]  # (a, m)
+    R = np.einsum("ai,aij->aj", L, A) / np.einsum("ai,ai->a", L, L)[:, None]  # (a, p)
+    if np.abs(A - L[:, :, None] * R[:, None, :]).max() > rtol * np.abs(A).max():
+        return None
+    return L, R
 
 
 @functools.lru_cache(maxsize=16)
