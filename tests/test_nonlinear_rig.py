@@ -13,7 +13,7 @@ from rotorred.nonlinear.condensed import ClearanceFamily
 from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.hb import solve
 from rotorred.scenes.balance_harmonics import FROM_RECORD, cold_solution
-from rotorred.scenes.harmonic_balance import base_frequency, rub_problem
+from rotorred.scenes.harmonic_balance import base_frequency, rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.contact import disk_force, normal_force, sliding_velocity
@@ -105,8 +105,7 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     rp = rub_problem(scene, sm.model, 100, 2048)
     period = 1.0 / rp.f0
     window = result.t >= result.t[-1] - period + 1e-9  # the last period, whole
-    contact = result.contacts[0]
-    records = {0: result.outputs[(18, "x")], 1: result.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    records = unknown_records(scene.plates, result)
     z0 = rp.start_from_record(result.t[window], {j: x[window] for j, x in records.items()})
     z, _, iterations = solve(rp.problem, z0, rp.omega)
     lines = rp.lines(z, (14, "y"))
@@ -117,8 +116,7 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     again = simulate(sm.model, scene.speeds, 0.5, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
                      rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=0.4, start=rp.final_state(z))
     window = again.t >= again.t[-1] - period + 1e-9
-    records = {0: again.outputs[(18, "x")], 1: again.outputs[(18, "y")], 2: again.contacts[0].u_n,
-               3: again.contacts[0].u_t}
+    records = unknown_records(scene.plates, again)
     settled = rp.start_from_record(again.t[window], {j: x[window] for j, x in records.items()})
     assert np.linalg.norm(settled - z) < 7.8e-3 * np.linalg.norm(z)
     # a scene's cold solution (Newton from a 5-period transient's last period) is this orbit (measured 4.5e-16)

@@ -260,6 +260,7 @@ def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced
     solve of 2K - 1 = 793 unknowns), and the three largest lines at node 14 Y equal the transient's (measured f_H
     -0.15 %, 4f_H/3 -0.35 %, f_L -0.017 %); the impacts' combination lines need the larger sets of
     validation/hb_torus.py (here 2f_H/3 + f_L is 3.7 % off)."""
+    from rotorred.scenes.harmonic_balance import unknown_records
     from rotorred.scenes.run import build_model, run_scene
     from rotorred.scenes.schema import load_scene
     from rotorred.scenes.torus_balance import torus_rub_problem
@@ -274,8 +275,7 @@ def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced
     fit = fit_lines(result.t, result.outputs[(14, "y")], 70.0, 91.37)
     assert (fit.torus.k, fit.torus.j) == (3, 1)
     rp = torus_rub_problem(scene, sm.model, fit.torus, 6, 30, 32, 256)
-    contact = result.contacts[0]
-    records = {0: result.outputs[(18, "x")], 1: result.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    records = unknown_records(scene.plates, result)
     sol = solve_torus(rp.problem, rp.start_from_record(result.t, records, within=(4, 30)))
     assert sol.iterations <= 10 and sol.residual < 1e-10
     largest = {ln.label_ascii: ln for ln in fit.lines}

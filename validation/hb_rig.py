@@ -34,7 +34,7 @@ from rotorred.nonlinear.hb import solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.balance_harmonics import cold_solution
 from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scene
-from rotorred.scenes.harmonic_balance import rub_problem
+from rotorred.scenes.harmonic_balance import rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.newmark import simulate
@@ -46,8 +46,7 @@ def transient_orbit(scene, sm):
     """The settled transient, its 10 largest lines at node 14 Y and its last period's records of the unknowns."""
     result = run_scene(scene, sm, compare_normal=False)
     largest = sorted(result.analyses[OUTPUT].fit.lines, key=lambda ln: -ln.amplitude)[:10]
-    contact = result.contacts[0]
-    records = {0: result.outputs[(18, "x")], 1: result.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    records = unknown_records(scene.plates, result)
     return result, largest, records
 
 
@@ -153,8 +152,7 @@ def settled_from(scene, sm, rp, z):
     res = simulate(sm.model, scene.speeds, 2.0, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
                    rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=1.9, start=rp.final_state(z))
     window = res.t >= res.t[-1] - 1.0 / rp.f0 + 1e-9
-    contact = res.contacts[0]
-    records = {0: res.outputs[(18, "x")], 1: res.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    records = unknown_records(scene.plates, res)
     return rp.start_from_record(res.t[window], {j: x[window] for j, x in records.items()})
 
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred.nonlinear.torus import solve_torus
+from rotorred.scenes.harmonic_balance import unknown_records
 from rotorred.scenes.run import build_model, run_scene
 from rotorred.scenes.schema import load_scene
 from rotorred.scenes.torus_balance import torus_rub_problem
@@ -73,8 +74,7 @@ def transient(scene, sm):
     result = run_scene(scene, sm, compare_normal=False)
     analysis = result.analyses[OUTPUT]
     largest = sorted(analysis.fit.lines, key=lambda ln: -ln.amplitude)[:10]
-    contact = result.contacts[0]
-    records = {0: result.outputs[(18, "x")], 1: result.outputs[(18, "y")], 2: contact.u_n, 3: contact.u_t}
+    records = unknown_records(scene.plates, result)
     return result, analysis, largest, records
 
 

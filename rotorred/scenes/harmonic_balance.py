@@ -23,7 +23,8 @@ from rotorred.nonlinear.condensed import CondensedProblem
 from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.fourier import Harmonics, basis
 
-__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate", "plate_rubs"]
+__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate", "plate_rubs",
+           "unknown_records"]
 
 
 def base_frequency(frequencies_hz) -> float:
@@ -223,6 +224,17 @@ def plate_rubs(model, scene) -> tuple[tuple[int, ...], tuple[PlateRub, ...]]:
         dofs += list(rub.dofs)
         forces.append(rub)
     return tuple(dofs), tuple(forces)
+
+
+def unknown_records(plates, run) -> dict:
+    """A run's records of the harmonic balance's unknowns, ``{position: samples}`` (each plate's disk x, y, u_n, u_t, as
+    :func:`plate_rubs` numbers them): ``run`` is a transient's or a scene's result (``outputs`` holding each plate
+    node's x and y, ``contacts`` each plate's history), for :meth:`RubProblem.start_from_record`."""
+    records = {}
+    for i, (plate, contact) in enumerate(zip(plates, run.contacts)):
+        records.update({4 * i: run.outputs[(plate.node, "x")], 4 * i + 1: run.outputs[(plate.node, "y")],
+                        4 * i + 2: contact.u_n, 4 * i + 3: contact.u_t})
+    return records
 
 
 def own_coordinate(model, dof) -> int:

@@ -503,7 +503,7 @@ def start_record(scene: Scene, model) -> tuple[np.ndarray, dict] | None:
     samples of the balance's unknowns, ``(t, {position: samples})`` (each plate's disk x, y, u_n, u_t); None if the
     transient diverges.
     """
-    from rotorred.scenes.harmonic_balance import base_frequency
+    from rotorred.scenes.harmonic_balance import base_frequency, unknown_records
     from rotorred.transient.newmark import simulate
     from rotorred.transient.results import SimulationDiverged
 
@@ -518,11 +518,7 @@ def start_record(scene: Scene, model) -> tuple[np.ndarray, dict] | None:
     except SimulationDiverged:
         return None
     last = res.t > res.t[-1] - period + 0.5 * dt
-    records = {}
-    for i, (plate, contact) in enumerate(zip(scene.plates, res.contacts)):
-        records.update({4 * i: res.outputs[(plate.node, "x")][last], 4 * i + 1: res.outputs[(plate.node, "y")][last],
-                        4 * i + 2: contact.u_n[last], 4 * i + 3: contact.u_t[last]})
-    return res.t[last], records
+    return res.t[last], {j: x[last] for j, x in unknown_records(scene.plates, res).items()}
 
 
 def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | None, f_L: float,
