@@ -26,11 +26,11 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from rotorred import checks
-from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.fourier import Harmonics, from_phasors, to_phasors
 from rotorred.nonlinear.hb import Evaluation, checked_matrices, force_coefficients, local_forces, sampled_forces
 from rotorred.nonlinear.lowrank import IdentityPlusLowRank
 
-__all__ = ["CondensedProblem"]
+__all__ = ["CondensedProblem", "ClearanceFamily", "dynamic_compliance", "real_form"]
 
 
 class _Compliance(NamedTuple):
@@ -44,6 +44,25 @@ class _Compliance(NamedTuple):
     dq_lin: np.ndarray  # (H + 1, m)
     Q_full: np.ndarray  # (H + 1, n)
     X: np.ndarray       # (H + 1, n, m): (Z_k^-1)[:, c]
+
+
+def dynamic_compliance(Z: np.ndarray, dofs, f: np.ndarray | None = None):
+    """``(Z_k^-1)[:, dofs]`` for a stack of dynamic stiffnesses ``Z`` (k, n, n), and with forces ``f`` (k, n) the linear
+    responses ``Z_k^-1 f_k``, by one batched solve: ``(X, Q)``, shapes (k, n, len(dofs)) and (k, n) (Q None without f)."""
+    k, n, c = Z.shape[0], Z.shape[1], list(dofs)
+    rhs = np.zeros((k, n, len(c) + (f is not None)), complex)
+    rhs[:, c, np.arange(len(c))] = 1.0
+    if f is not None:
+        rhs[:, :, -1] = f
+    sol = np.linalg.solve(Z, rhs)
+    return (sol[:, :, :len(c)], sol[:, :, -1] if f is not None else None)
+
+
+def real_form(Hc: np.ndarray) -> np.ndarray:
+    """The real form ``[[Re H, Im H], [-Im H, Re H]]`` of each complex block of ``Hc`` (k, c, c): (k, 2c, 2c), the
+    action of ``H`` on the (cos, sin) coefficients of one order."""
+    return np.concatenate([np.concatenate([Hc.real, Hc.imag], axis=2),
+                           np.concatenate([-Hc.imag, Hc.real], axis=2)], axis=1)
 
 
 @dataclass(frozen=True)
@@ -114,23 +133,13 @@ class CondensedProblem:
         D = self.velocity_matrix(omega)
         Z = self.K - (k * omega) ** 2 * self.M + 1j * k * omega * D
         dZ = -2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
-        f, df = (self._phasors(G.reshape(self.harmonics.size, n)) for G in (F, dF))
-        unit = np.zeros((n, len(c)))
-        unit[c, range(len(c))] = 1.0
-        XQ = np.linalg.solve(Z, np.concatenate([np.broadcast_to(unit, (H + 1, n, len(c))), f[:, :, None]], axis=2))
-        X, Q = XQ[:, :, :-1], XQ[:, :, -1]  # (Z^-1)[:, c] and the linear response
-        Y = np.linalg.solve(Z.transpose(0, 2, 1), np.broadcast_to(unit, (H + 1, n, len(c)))).transpose(0, 2, 1)
+        f, df = (to_phasors(G.reshape(self.harmonics.size, n)) for G in (F, dF))
+        X, Q = dynamic_compliance(Z, c, f)
+        Y = dynamic_compliance(Z.transpose(0, 2, 1), c)[0].transpose(0, 2, 1)  # (Z^-1)[c, :]
         out = _Compliance(H_cc=X[:, c], dH_cc=-Y @ dZ @ X, q_lin=Q[:, c],
                           dq_lin=(Y @ (df - (dZ @ Q[:, :, None])[:, :, 0])[:, :, None])[:, :, 0], Q_full=Q, X=X)
         self._cache.clear()
         self._cache.update(omega=omega, harmonics=out)
-        return out
-
-    def _phasors(self, C: np.ndarray) -> np.ndarray:
-        """Harmonic-major real coefficients (2H + 1, n) as phasors (H + 1, n): a_0, and a_k - i b_k."""
-        out = np.empty((self.harmonics.H + 1, C.shape[1]), complex)
-        out[0] = C[0]
-        out[1:] = C[1::2] - 1j * C[2::2]
         return out
 
     def compliance_blocks(self, omega: float):
@@ -183,16 +192,8 @@ class CondensedProblem:
     def _real_blocks(self, parts: _Compliance):
         """G, dG/domega as blocks (the real form [[Re H, Im H], [-Im H, Re H]] per harmonic) and z_lin, dz_lin/domega
         (harmonic-major) from the harmonics."""
-        def real_form(Hc):
-            return np.concatenate([np.concatenate([Hc.real, Hc.imag], axis=2),
-                                   np.concatenate([-Hc.imag, Hc.real], axis=2)], axis=1)
-
-        def coefficients(q):  # phasors (H + 1, m) -> harmonic-major (a_0, a_1, b_1, ...)
-            out = np.empty((self.harmonics.size, self.n))
-            out[0], out[1::2], out[2::2] = q[0].real, q[1:].real, -q[1:].imag
-            return out.reshape(-1)
         return ((parts.H_cc[0].real, real_form(parts.H_cc[1:])), (parts.dH_cc[0].real, real_form(parts.dH_cc[1:])),
-                coefficients(parts.q_lin), coefficients(parts.dq_lin))
+                from_phasors(parts.q_lin).reshape(-1), from_phasors(parts.dq_lin).reshape(-1))
 
     @property
     def force_columns(self) -> list:
@@ -208,10 +209,8 @@ class CondensedProblem:
         parts = self._compliance(omega)
         q, v = self.samples(z, omega)  # the forces only: no Toeplitz matrices
         F_nl = force_coefficients(self.harmonics, self._local_forces, q, v).reshape(self.harmonics.size, self.n)
-        Q = parts.Q_full - (parts.X @ self._phasors(F_nl)[:, :, None])[:, :, 0]
-        out = np.empty((self.harmonics.size, self.M.shape[0]))
-        out[0], out[1::2], out[2::2] = Q[0].real, Q[1:].real, -Q[1:].imag
-        return out.reshape(-1)
+        Q = parts.Q_full - (parts.X @ to_phasors(F_nl)[:, :, None])[:, :, 0]
+        return from_phasors(Q).reshape(-1)
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ import numpy as np
 from rotorred import checks
 from rotorred.signals.spectra import rfft
 
-__all__ = ["Harmonics", "basis", "alias_free_samples", "proportional_columns"]
+__all__ = ["Harmonics", "basis", "alias_free_samples", "proportional_columns", "to_phasors", "from_phasors"]
 
 #: the cost model that picks the DFT's method, in microseconds for 2 DOFs: the matrix product ``MATRIX_US`` per
 #: term and sample, a pyFFTW plan call ``FFT_US[0] + FFT_US[1] N``. Measured here (2 DOFs): at N = 128 the matrix
@@ -290,6 +290,23 @@ class Harmonics:
         """:meth:`toeplitz` from the spectrum for every pair (for tests)."""
         n = d.shape[1]
         return self._assembled(self._blocks_by_spectrum(d.reshape(self.N, n * n)), n)
+
+
+def to_phasors(C: np.ndarray) -> np.ndarray:
+    """Harmonic-major real coefficients, rows ``[a_0, a_1, b_1, ...]`` (2K - 1, n), as complex amplitudes ``a_0`` and
+    ``a_k - i b_k`` (K, n): the line of order k is ``Re(Q_k exp(i k theta))`` (of the periodic and the torus bases)."""
+    Q = np.empty(((C.shape[0] + 1) // 2, C.shape[1]), complex)
+    Q[0] = C[0]
+    Q[1:] = C[1::2] - 1j * C[2::2]
+    return Q
+
+
+def from_phasors(Q: np.ndarray) -> np.ndarray:
+    """The harmonic-major real coefficients (2K - 1, n) of complex amplitudes ``Q`` (K, n): :func:`to_phasors`'s
+    inverse (a_0 is the real part of Q_0)."""
+    C = np.empty((2 * Q.shape[0] - 1, Q.shape[1]))
+    C[0], C[1::2], C[2::2] = Q[0].real, Q[1:].real, -Q[1:].imag
+    return C
 
 
 def _rank_one(A: np.ndarray, rtol: float):

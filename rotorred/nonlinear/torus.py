@@ -46,7 +46,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
-from rotorred.nonlinear.fourier import proportional_columns, alias_free_samples
+from rotorred.nonlinear.condensed import dynamic_compliance, real_form
+from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
 from rotorred.nonlinear.hb import Evaluation, NotConverged, local_forces, sampled_forces
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
@@ -165,19 +166,11 @@ class TorusHarmonics:
     def phasors(self, z: np.ndarray, n: int) -> np.ndarray:
         """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of the coefficients of ``n`` DOFs, shape (K, n):
         the line of order k is ``Re(Q_k exp(i k . theta))``."""
-        c = z.reshape(self.size, n)
-        Q = np.empty((self.n_orders, n), complex)
-        Q[0] = c[0]
-        Q[1:] = c[1::2] - 1j * c[2::2]
-        return Q
+        return to_phasors(z.reshape(self.size, n))
 
     def from_phasors(self, Q: np.ndarray) -> np.ndarray:
         """Harmonic-major coefficients of the complex amplitudes ``Q`` (K, n) (the inverse of :meth:`phasors`)."""
-        Q = np.asarray(Q)
-        z = np.empty((self.size, Q.shape[1]))
-        z[0] = Q[0].real
-        z[1::2], z[2::2] = Q[1:].real, -Q[1:].imag
-        return z.reshape(-1)
+        return from_phasors(np.asarray(Q)).reshape(-1)
 
     def transfer(self, z: np.ndarray, n: int, target: TorusHarmonics) -> np.ndarray:
         """The coefficients ``z`` of ``n`` DOFs on the orders of ``target`` (orders ``target`` has and this set lacks
@@ -397,17 +390,9 @@ class TorusProblem:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
         Z = self.K[None] - (wk**2)[:, None, None] * self.M[None] + 1j * wk[:, None, None] * self.D[None]
-        F = self.harmonics.phasors(self.forcing, n_all)
-        rhs = np.zeros((len(wk), n_all, len(c) + 1), complex)
-        rhs[:, c, np.arange(len(c))] = 1.0
-        rhs[:, :, -1] = F
-        sol = np.linalg.solve(Z, rhs)
-        X, Q_full = sol[:, :, :-1], sol[:, :, -1]
+        X, Q_full = dynamic_compliance(Z, c, self.harmonics.phasors(self.forcing, n_all))
         H = X[:, c, :]
-        G0 = H[0].real
-        Gk = np.block([[H[1:].real, H[1:].imag], [-H[1:].imag, H[1:].real]])
-        z_lin = self.harmonics.from_phasors(Q_full[:, c])
-        out = _Compliance(G0, Gk, z_lin, Q_full, X)
+        out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
         self._cache["compliance"] = out
         return out
 
