@@ -25,9 +25,8 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics, from_phasors, to_phasors
-from rotorred.nonlinear.hb import Evaluation, checked_matrices, force_coefficients, local_forces, sampled_forces
+from rotorred.nonlinear.hb import Evaluation, checked_matrices, checked_unknowns, force_coefficients, sampled_forces
 from rotorred.nonlinear.lowrank import IdentityPlusLowRank
 
 __all__ = ["CondensedProblem", "ClearanceFamily", "dynamic_compliance", "real_form"]
@@ -97,11 +96,7 @@ class CondensedProblem:
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        n = checked_matrices(self)
-        dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
-                               min_len=1, unique=True)
-        object.__setattr__(self, "dofs", dofs)
-        object.__setattr__(self, "_local_forces", local_forces(self.forces, dofs))  # renumbered on the unknowns
+        checked_unknowns(self, checked_matrices(self))
 
     @property
     def n(self) -> int:

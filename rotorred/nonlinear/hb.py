@@ -26,8 +26,8 @@ from rotorred import checks
 from rotorred.nonlinear.fourier import Harmonics
 from rotorred.nonlinear.lowrank import factored
 
-__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "sampled_forces",
-           "force_coefficients", "transformed_forces", "local_forces"]
+__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "checked_unknowns",
+           "sampled_forces", "force_coefficients", "transformed_forces", "local_forces"]
 
 
 class NotConverged(RuntimeError):
@@ -228,6 +228,15 @@ def checked_matrices(problem) -> int:
     if not isinstance(problem.harmonics, Harmonics):
         checks.fail("harmonics", problem.harmonics, "must be a Harmonics")
     return n
+
+
+def checked_unknowns(problem, n: int) -> None:
+    """Check a condensed problem's ``dofs`` (the unknowns: distinct DOFs of its ``n``) and keep its forces renumbered on
+    them (``problem._local_forces``, :func:`local_forces`)."""
+    dofs = checks.sequence("dofs", tuple(problem.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
+                           min_len=1, unique=True)
+    object.__setattr__(problem, "dofs", dofs)
+    object.__setattr__(problem, "_local_forces", local_forces(problem.forces, dofs))
 
 
 def sampled_forces(forces, q: np.ndarray, v: np.ndarray):

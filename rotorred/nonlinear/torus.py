@@ -48,7 +48,7 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.nonlinear.condensed import dynamic_compliance, real_form
 from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
-from rotorred.nonlinear.hb import Evaluation, NotConverged, local_forces, sampled_forces
+from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, sampled_forces
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
 
@@ -356,12 +356,9 @@ class TorusProblem:
         w = checks.sequence("w", tuple(np.ravel(self.w)), lambda f, v: checks.positive(f, v, "rad/s"), min_len=2,
                             max_len=2)
         object.__setattr__(self, "w", w)
-        dofs = checks.sequence("dofs", tuple(self.dofs), lambda f, v: checks.integer(f, v, ge=0, le=n - 1),
-                               min_len=1, unique=True)
-        object.__setattr__(self, "dofs", dofs)
+        checked_unknowns(self, n)
         object.__setattr__(self, "forcing", checks.array("forcing", np.ravel(self.forcing), (self.harmonics.size * n,),
                                                          "N"))
-        object.__setattr__(self, "_local_forces", local_forces(self.forces, dofs))
 
     @property
     def n(self) -> int:
