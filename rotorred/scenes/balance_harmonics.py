@@ -38,6 +38,8 @@ TOL = 1e-9
 FROM_RECORD = "Newton from a short transient's last period"
 COLD = ("a cold start (Newton from the linear response, else a continuation in the clearance) at the coarsest "
         "truncation, then Newton up to the harmonics asked")
+#: how :func:`balance_to_tolerance` starts each truncation (for the summary)
+LADDER_START = "each truncation's Newton from the record of a short transient or the truncation before"
 
 
 @dataclass(frozen=True)
@@ -100,8 +102,8 @@ def response_change(coarse: RubProblem, z_coarse: np.ndarray, fine: RubProblem, 
     return worst
 
 
-def padded(z: np.ndarray, coarse: RubProblem, fine: RubProblem) -> np.ndarray:
-    """The coarse solution's coefficients on the fine truncation's unknowns (harmonic-major; new harmonics zero)."""
+def padded(z: np.ndarray, fine: RubProblem) -> np.ndarray:
+    """A coarser truncation's coefficients ``z`` on the unknowns of ``fine`` (harmonic-major; new harmonics zero)."""
     out = np.zeros(fine.problem.size)
     out[:z.size] = z  # harmonic-major: [a_0 (m), a_1 (m), b_1 (m), ...], the first 2 H + 1 rows are the coarse ones
     return out
@@ -144,7 +146,7 @@ def balance_to_tolerance(scene, model, tol: float, dofs, progress=None, record=N
     for H in LADDER[1:]:
         fine = rub_problem(scene, model, H, samples_for(H))
         z_fine = _solve_from(fine, *([fine.start_from_record(*record)] if record is not None else []),
-                             padded(z, rp, fine))
+                             padded(z, fine))
         change = response_change(rp, z, fine, z_fine, dofs)
         steps.append((H, change))
         if progress is not None:
@@ -185,7 +187,7 @@ def cold_solution(scene, model, H: int, N: int, record=None) -> tuple[RubProblem
     z = cold_start(rp.problem, rp.omega)
     for h, n in [(h, samples_for(h)) for h in coarser[1:]] + [(H, N)]:
         fine = rub_problem(scene, model, h, n)
-        z, rp = _solve_from(fine, padded(z, rp, fine)), fine
+        z, rp = _solve_from(fine, padded(z, fine)), fine
     return rp, z, COLD
 
 

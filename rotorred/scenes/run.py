@@ -476,7 +476,7 @@ def _balance_response(scene: Scene, model) -> Response:
     transient's record: Newton from a short transient's last period (:func:`start_record`), else a cold start up
     through coarser truncations (:func:`rotorred.scenes.balance_harmonics.cold_solution`), or the harmonics chosen by
     ``solver.tolerance``."""
-    from rotorred.scenes.balance_harmonics import balance_to_tolerance, cold_solution
+    from rotorred.scenes.balance_harmonics import LADDER_START, balance_to_tolerance, cold_solution
 
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
@@ -484,7 +484,7 @@ def _balance_response(scene: Scene, model) -> Response:
     record = start_record(scene, model)
     if s.tolerance is not None:
         rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs, record=record)
-        start = "each truncation's Newton from the record of a short transient or the truncation before"
+        start = LADDER_START
     else:
         (rp, z, start), choice = cold_solution(scene, model, s.harmonics, s.samples, record=record), None
     outputs, contacts = rp.record(z, t, scene.output.dofs)
