@@ -28,16 +28,12 @@ class GeneratedFunction:
         The returned array (a matrix, or a column for a vector).
     doc : str
         Docstring body (numpydoc), without the quotes.
-    sampled : tuple of sympy.Symbol
-        Arguments that may be arrays (of one broadcast shape): the output then has that shape after the
-        matrix's, ``out[i]`` the i-th entry at every sample. Empty: every argument is a float.
     """
 
     name: str
     args: tuple
     expr: sp.Matrix
     doc: str
-    sampled: tuple = ()
 
 
 class _Printer(PythonCodePrinter):
@@ -60,8 +56,6 @@ def _render_function(fn: GeneratedFunction) -> str:
     for sym, sub in replacements:
         lines.append(f"    {sym} = {printer.doprint(sub)}")
     shape = f"({rows}, {cols})" if cols > 1 else f"({rows},)"
-    if fn.sampled:
-        shape = f"{shape} + np.broadcast({', '.join(str(a) for a in fn.sampled)}).shape"
     lines.append(f"    out = np.zeros({shape})")
     for (i, j, _), e in zip(nonzero, reduced):
         index = f"{i}, {j}" if cols > 1 else f"{i}"

@@ -81,15 +81,6 @@ def module_text() -> str:
             "    lam : float\n        Plate bending compliance (m/N).\n\n"
             "    Returns\n    -------\n    ndarray, shape (4,)\n        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)].\n",
         ),
-        GeneratedFunction(
-            "normal_residual_samples", (F, s, rate, K_nr, c, lam), normal_residual(),
-            "normal_residual at many samples at once (harmonic balance's time samples).\n\n"
-            "    Parameters\n    ----------\n    F, s, rate : ndarray\n        As for normal_residual, one value a sample "
-            "(broadcast together).\n    K_nr, c, lam : float\n\n"
-            "    Returns\n    -------\n    ndarray, shape (4,) + the samples' shape\n"
-            "        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)] at each sample.\n",
-            sampled=(F, s, rate),
-        ),
     ]
     return render_module(
         "derivations/contact.py", fns,

@@ -1,5 +1,6 @@
-"""The low-rank form of the harmonic-balance Jacobian (rotorred.nonlinear.lowrank, Harmonics.low_rank): two paths to
-one answer, the Woodbury solves against dense ones and the outer products against the Toeplitz matrices."""
+"""The low-rank form of the harmonic-balance Jacobian (rotorred.nonlinear.lowrank, rotorred.nonlinear.sampled): two
+paths to one answer, the Woodbury solves against dense ones, the outer products against the Toeplitz matrices, their
+operators against their arrays and the kernel's coupling against the product it stands for."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from rotorred.nonlinear.examples import GAP, K_C
 from rotorred.nonlinear.forces import CircularClearance
 from rotorred.nonlinear.fourier import Harmonics
 from rotorred.nonlinear.lowrank import Dense, IdentityPlusLowRank, bordered, factored
+from rotorred.nonlinear.sampled import low_rank
 
 
 def test_woodbury_solves_equal_dense_ones():
@@ -31,7 +33,7 @@ def test_woodbury_solves_equal_dense_ones():
     B = bordered(A, column, row)
     dense_B = np.vstack([np.column_stack([dense, column]), row])
     assert np.max(np.abs(np.asarray(B) - dense_B)) == 0.0
-    assert np.max(np.abs(B.QtP - B.Q.T @ B.P)) < 5e-15 * np.max(np.abs(B.QtP))
+    assert np.max(np.abs(B.QtP - (B.Q.T @ (B.P @ np.eye(r + 2))))) < 5e-15 * np.max(np.abs(B.QtP))
     for trans in (False, True):
         exact = np.linalg.solve(dense_B.T if trans else dense_B, c)
         assert np.max(np.abs(B.solve(c, trans) - exact)) < 2e-13 * np.max(np.abs(exact))
@@ -51,7 +53,7 @@ def test_singular_matrices_are_refused():
 @pytest.mark.parametrize("H, N", [(5, 128), (30, 256)])
 def test_outer_products_equal_the_toeplitz_matrices(H, N):
     """For a Jeffcott disk in a circular clearance (rank 2 a contact sample) and for a rank-1 rub-like Jacobian
-    (a_i g_j s(theta) on 4 DOFs, contact on a tenth of the period), U V^T from Harmonics.low_rank equals
+    (a_i g_j s(theta) on 4 DOFs, contact on a tenth of the period), U V^T from rotorred.nonlinear.sampled.low_rank equals
     T(dq) + omega T(dv) (nabla (x) I) from the Toeplitz matrices (measured 6.5e-15 of the largest entry), with one
     column a rank of a contact sample; above max_rank it declines (None)."""
     h, omega = Harmonics(H, N), 1.7
@@ -65,8 +67,39 @@ def test_outer_products_equal_the_toeplitz_matrices(H, N):
     for (dq_, dv_), rank in (((dq, dv), 2), (rub, 1)):
         m = dq_.shape[1]
         active = np.count_nonzero(np.abs(dq_).sum(axis=(1, 2)) + np.abs(dv_).sum(axis=(1, 2)))
-        U, V = h.low_rank(dq_, dv_, omega, max_rank=10**6)
+        U, V = low_rank(h, dq_, dv_, omega, max_rank=10**6).dense()
         dense = h.toeplitz(dq_) + omega * h.times_derivative(h.toeplitz(dv_), m)
         assert U.shape == V.shape == (h.size * m, rank * active)
         assert np.max(np.abs(U @ V.T - dense)) < 6.5e-14 * np.max(np.abs(dense))
-        assert h.low_rank(dq_, dv_, omega, max_rank=rank * active - 1) is None
+        assert low_rank(h, dq_, dv_, omega, max_rank=rank * active - 1) is None
+
+
+@pytest.mark.parametrize("H, N", [(5, 128), (30, 256)])
+def test_sampled_factors_act_as_their_arrays_and_couple_through_the_kernel(H, N):
+    """SampledFactors' operators equal its arrays on vectors and matrices, both ways (U y, U^T x, V y, V^T x), and
+    its coupling V^T G U from the kernel of G on the sample grid equals the product of the arrays with G's real block
+    form, for a random complex compliance on 4 DOFs and a rub-like Jacobian whose left factors take two directions
+    (friction of either sign) at a tenth of the samples (measured 1.3e-15 of the largest entry); with no contact
+    sample, rank 0, an empty coupling and zero products."""
+    rng = np.random.default_rng(7)
+    h, omega, m = Harmonics(H, N), 1.7, 4
+    theta = 2 * np.pi * np.arange(N) / N
+    s = np.where(np.cos(theta) > 0.8, np.cos(theta) - 0.8, 0.0)
+    sign = np.where(np.sin(theta) > 0.0, 1.0, -1.0)
+    a = np.array([1.0, -0.5, 2.0, 0.0])[None, :] + 0.3 * sign[:, None] * np.array([0.0, 1.0, 0.0, -1.0])
+    g, gv = np.array([0.3, 1.0, -1.0, 0.0]), 0.2 * np.array([0.3, 1.0, -1.0, 0.0])
+    dq = s[:, None, None] * a[:, :, None] * g[None, None, :]
+    dv = (s**2)[:, None, None] * a[:, :, None] * gv[None, None, :]
+    fac = low_rank(h, dq, dv, omega, max_rank=10**6)
+    U, V = fac.dense()
+    y, Y = rng.normal(size=fac.rank), rng.normal(size=(fac.rank, 3))
+    x, X = rng.normal(size=h.size * m), rng.normal(size=(h.size * m, 3))
+    for op, A in ((fac.U, U), (fac.V, V)):
+        for left, right in ((op @ y, A @ y), (op @ Y, A @ Y), (op.T @ x, A.T @ x), (op.T @ X, A.T @ X)):
+            assert left.shape == right.shape and np.max(np.abs(left - right)) < 6e-15 * np.max(np.abs(right))
+    Hc = rng.normal(size=(H + 1, m, m)) + 1j * rng.normal(size=(H + 1, m, m))
+    G = sla.block_diag(Hc[0].real, *[np.block([[c.real, c.imag], [-c.imag, c.real]]) for c in Hc[1:]])
+    exact = V.T @ G @ U
+    assert np.max(np.abs(fac.coupling(Hc) - exact)) < 2e-13 * np.max(np.abs(exact))
+    none = low_rank(h, 0 * dq, 0 * dv, omega, max_rank=10)
+    assert none.rank == 0 and none.coupling(Hc).shape == (0, 0) and not np.any(none.U @ np.zeros(0))

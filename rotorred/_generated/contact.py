@@ -68,30 +68,3 @@ def normal_residual(F, s, rate, K_nr, c, lam):
     out[2] = -_t2*_t4 - _t2
     out[3] = -_t1
     return out
-
-
-def normal_residual_samples(F, s, rate, K_nr, c, lam):
-    """normal_residual at many samples at once (harmonic balance's time samples).
-
-    Parameters
-    ----------
-    F, s, rate : ndarray
-        As for normal_residual, one value a sample (broadcast together).
-    K_nr, c, lam : float
-
-    Returns
-    -------
-    ndarray, shape (4,) + the samples' shape
-        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)] at each sample.
-    """
-    _t0 = K_nr*s**3.0
-    _t1 = _t0*c
-    _t2 = ((3.0/2.0))*K_nr*s
-    _t3 = _t2*lam
-    _t4 = c*rate
-    out = np.zeros((4,) + np.broadcast(F, s, rate).shape)
-    out[0] = F - _t0 - _t1*rate
-    out[1] = _t3*_t4 + _t3 + 1.0
-    out[2] = -_t2*_t4 - _t2
-    out[3] = -_t1
-    return out

@@ -20,14 +20,18 @@ Its Jacobian is analytic: ``I + G (T(df/dq) + omega T(df/dv)(nabla (x) I))``, an
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import Callable, NamedTuple
 
 import numpy as np
+from scipy.sparse.linalg import LinearOperator
 
 from rotorred.nonlinear.fourier import Harmonics, from_phasors, to_phasors
-from rotorred.nonlinear.hb import Evaluation, checked_matrices, checked_unknowns, force_coefficients, sampled_forces
+from rotorred.nonlinear.hb import (Evaluation, checked_matrices, checked_unknowns, force_coefficients, local_forces,
+                                  sampled_forces)
 from rotorred.nonlinear.lowrank import IdentityPlusLowRank
+from rotorred.nonlinear.sampled import low_rank
 
 __all__ = ["CondensedProblem", "ClearanceFamily", "dynamic_compliance", "real_form"]
 
@@ -110,12 +114,16 @@ class CondensedProblem:
     def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and velocities of the ``dofs`` at the AFT instants, shape (N, len(dofs)) each."""
         h = self.harmonics
-        return h.samples(z, self.n), omega * h.rates(z, self.n)
+        return h.motion(z, self.n, omega)
 
-    def _compliance_cache(self, omega: float) -> dict:
-        """The compliance data at ``omega``, as the cache holds it (to share with a copy of the problem)."""
-        self._compliance(omega)
-        return dict(self._cache)
+    def with_forces(self, forces: tuple) -> CondensedProblem:
+        """This problem with other nonlinear forces on the same DOFs: a family's member (the clearance's), sharing the
+        checked linear part and the compliance of the last frequency asked (the forces leave both)."""
+        new = copy.copy(self)
+        object.__setattr__(new, "forces", tuple(forces))
+        object.__setattr__(new, "_local_forces", local_forces(forces, self.dofs))
+        object.__setattr__(new, "_cache", dict(self._cache))
+        return new
 
     def _compliance(self, omega: float) -> _Compliance:
         """Every harmonic's compliance data at ``omega`` (kept for the last omega asked: Newton iterates there), from
@@ -155,15 +163,17 @@ class CondensedProblem:
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         F_nl = h.coefficients(f)
 
-        def derive():
-            factors = h.low_rank(dq, dv, omega, max_rank=self.size // 2)
+        def jacobian():
+            factors = low_rank(h, dq, dv, omega, max_rank=self.size // 2)
             if factors is not None:  # I + G U V^T, solved by Woodbury
-                J = IdentityPlusLowRank(self.apply(G, factors[0]), factors[1])
-            else:
-                J = np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
+                return IdentityPlusLowRank(self._operator(G) @ factors.U, factors.V,
+                                           factors.coupling(self._compliance(omega).H_cc))
+            return np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
+
+        def parameter():
             dF_domega = h.coefficients(np.einsum("jab,jb->ja", dv, h.rates(z, m)))  # T(dv) (nabla (x) I) z
-            return J, -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
-        return Evaluation(z - z_lin + self.apply(G, F_nl), scale=float(np.linalg.norm(z_lin)) or 1.0, derive=derive,
+            return -dz_lin + self.apply(dG, F_nl) + self.apply(G, dF_domega)
+        return Evaluation(z - z_lin + self.apply(G, F_nl), float(np.linalg.norm(z_lin)) or 1.0, jacobian, parameter,
                           sampled=(f, dq, dv))
 
     def apply(self, blocks, X: np.ndarray) -> np.ndarray:
@@ -176,6 +186,13 @@ class CondensedProblem:
         out[:m] = G0 @ X2[:m]
         out[m:] = np.matmul(Gk, X2[m:].reshape(H, 2 * m, -1)).reshape(H * 2 * m, -1)
         return out.reshape(X.shape)
+
+    def _operator(self, blocks) -> LinearOperator:
+        """G, given by its blocks, as a linear operator (``G @ x`` and ``G.T @ x`` by :meth:`apply`)."""
+        transposed = (blocks[0].T, blocks[1].transpose(0, 2, 1))
+        return LinearOperator((self.size, self.size), matvec=lambda x: self.apply(blocks, x),
+                              matmat=lambda x: self.apply(blocks, x), rmatvec=lambda x: self.apply(transposed, x),
+                              rmatmat=lambda x: self.apply(transposed, x), dtype=float)
 
     def _blocks(self, omega: float):
         """G and dG/domega as blocks, z_lin and dz_lin/domega, at ``omega`` (cached with the compliance)."""
@@ -246,10 +263,8 @@ class ClearanceFamily:
         """The problem at ``clearance`` (m), sharing the base's compliance at ``omega`` (the clearance leaves it)."""
         forces = list(self.base.forces)
         forces[self.rub] = forces[self.rub].with_clearance(clearance)
-        problem = CondensedProblem(self.base.M, self.base.D, self.base.K, self.base.harmonics, self.base.dofs,
-                                   self.base.forcing, tuple(forces), self.base.D1)
-        problem._cache.update(self.base._compliance_cache(self.omega))
-        return problem
+        self.base._blocks(self.omega)  # computed once, shared by every member
+        return self.base.with_forces(forces)
 
     def samples(self, z: np.ndarray, clearance: float):
         return self.base.samples(z, self.omega)

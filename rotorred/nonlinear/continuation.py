@@ -2,7 +2,8 @@
 
 The branch is a curve ``y(s) = (z(s), omega(s))`` with ``R(z, omega) = 0`` (:mod:`rotorred.nonlinear.hb`).
 From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the
-previous one), the predictor steps ``ds`` along ``t``; the corrector is Newton's method on ``R = 0`` together
+previous one), the predictor steps ``ds`` along the branch, ``y + ds t + ds^2 / 2 kappa`` (``kappa`` the curvature,
+the change of ``t`` from the previous point over the chord); the corrector is Newton's method on ``R = 0`` together
 with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent), each step shortened
 until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at most 4 iterations, up
 to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it and retries
@@ -31,6 +32,8 @@ __all__ = ["Fold", "Branch", "continue_branch"]
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
 MAX_JUMP = 2.0
+#: the predictor is second order where the tangent turns by at most this (rad) over a step, first order beyond
+MAX_TURN = 0.2
 #: Newton iterations, and step halvings in each, that a step in omega alone gets at a corner: one that lands near
 #: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
 CORNER_ITERATIONS = 12
@@ -98,6 +101,7 @@ class _Point:
     y: np.ndarray  # (z, omega)
     t: np.ndarray  # unit tangent
     iterations: int
+    clean: bool = False  # reached by an arclength step at its first try (no halving): the branch is smooth there
 
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
@@ -238,7 +242,8 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
     omega land on other parts of the branch.)"""
     first, cornered = ds, False
     while ds >= ds_min:
-        done = _arclength(problem, point, ds, tol)
+        smooth = ds == first and point.clean and previous is not None  # a curvature to predict with
+        done = _arclength(problem, point, previous if smooth else None, ds, tol, clean=ds == first)
         if done is not None:
             return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""
         if not cornered and (ds <= first / 64 or ds / 2 < ds_min):
@@ -251,15 +256,28 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
                       f"not converge to a relative residual of {tol:g}, nor a step in omega alone")
 
 
-def _arclength(problem, point: _Point, ds, tol):
-    """The corrected point ``ds`` along the tangent, and its iterations, or None (not converged, or a jump)."""
-    done = _correct(problem, point.y + ds * point.t, point.t, tol)
+def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: bool = False):
+    """The corrected point ``ds`` along the branch, and its iterations, or None (not converged, or a jump).
+
+    With a ``previous`` point the prediction is second order, ``y + ds t + ds^2 / 2 kappa``, with the curvature
+    ``kappa`` the change of the unit tangent from the previous point over the chord between them, where it turns the
+    tangent by at most :data:`MAX_TURN` over the step; else first order. Its error is O(ds^3) against the tangent's
+    O(ds^2): on the rig's clearance branch most corrections take two Newton iterations in place of three
+    (validation/hb_rig.py). :func:`_step` gives a previous point only where the branch is smooth (the last two steps
+    taken at their first try): near a kink the curvature between points on either side means nothing, and a second
+    order prediction there can land on the other side (the Jeffcott rotor's corner, where it then cycled)."""
+    prediction = point.y + ds * point.t
+    if previous is not None:
+        kappa = (point.t - previous.t) / np.linalg.norm(point.y - previous.y)
+        if ds * np.linalg.norm(kappa) <= MAX_TURN:
+            prediction += 0.5 * ds**2 * kappa
+    done = _correct(problem, prediction, point.t, tol)
     if done is None:
         return None
     y, it, t = done
     if np.linalg.norm(y - point.y) > MAX_JUMP * ds:
         return None
-    return _Point(y, t, it), it
+    return _Point(y, t, it, clean), it
 
 
 def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):

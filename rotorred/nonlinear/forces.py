@@ -17,9 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred import checks
-from rotorred.transient.contact import RubPlate, disk_force, normal_force_samples, sliding_velocity
+from rotorred.transient.contact import RubPlate, disk_force, sliding_velocity
+from rotorred.transient.contact_solve import normal_roots
 
 __all__ = ["CubicSpring", "CircularClearance", "PlateRub"]
+
+#: the normal law's root at each sample to this step, relative (as the transient's contact.normal_force)
+ROOT_TOL = 1e-14
 
 
 @dataclass(frozen=True)
@@ -120,8 +124,11 @@ class PlateRub:
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
         grad, P, dP_dp, dP_drate, per_P = self._law(q, v)
-        return per_P * P[:, None], per_P[:, :, None] * (dP_dp[:, None] * grad)[:, None, :], \
-            per_P[:, :, None] * (dP_drate[:, None] * grad)[:, None, :]
+        d = np.zeros((2,) + q.shape + (4,))  # df/dq, df/dv: rank one, (forces per unit P) (dP/dp, dP/dp') grad^T
+        on = np.flatnonzero((dP_dp != 0.0) | (dP_drate != 0.0))  # in contact: zero elsewhere
+        d[0, on] = (per_P[on] * dP_dp[on, None])[:, :, None] * grad
+        d[1, on] = (per_P[on] * dP_drate[on, None])[:, :, None] * grad
+        return per_P * P[:, None], d[0], d[1]
 
     def slip_sign(self, v: np.ndarray) -> np.ndarray:
         """sign(v_rel) at the samples of the velocities ``v`` (N, 4) (:func:`rotorred.transient.contact.sliding_velocity`,
@@ -140,7 +147,8 @@ class PlateRub:
         the left-hand side), ``(-P, T)`` on the plate, with ``T = -mu_d sign(v_rel) P``."""
         plate, grad = self.plate, self.gradient
         c, s = grad[0], grad[1]
-        P, dP_dp, dP_drate = normal_force_samples(q @ grad - plate.clearance, v @ grad, plate)
+        P, dP_dp, dP_drate = normal_roots(np.ascontiguousarray(q @ grad) - plate.clearance, np.ascontiguousarray(v @ grad),
+                                          plate.K_nr, plate.c, plate.compliance, plate.offset, ROOT_TOL)
         T_per_P = -plate.mu_d * self.slip_sign(v)
         fx, fy = disk_force(1.0, T_per_P, c, s)
         per_P = np.column_stack([-fx, -fy, -np.ones_like(T_per_P), T_per_P])

@@ -166,6 +166,16 @@ class Harmonics:
         """``dq/dtheta (theta_j)``, shape (N, n): multiply by omega for dq/dt."""
         return self.synthesised(self.nabla @ z.reshape(self.size, n))
 
+    def motion(self, z: np.ndarray, n: int, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements and velocities ``q(theta_j)``, ``omega dq/dtheta (theta_j)``, shape (N, n) each, of the
+        harmonic-major coefficients ``z`` of ``n`` DOFs at frequency ``omega`` (rad/s): one synthesis of both."""
+        Z = z.reshape(self.size, n)
+        both = np.zeros((self.size, 2 * n))
+        k = np.arange(1, self.H + 1)[:, None]
+        both[:, :n], both[1::2, n:], both[2::2, n:] = Z, k * Z[2::2], -k * Z[1::2]  # nabla Z: (a_k, b_k)' = k (b_k, -a_k)
+        both = self.synthesised(both)
+        return both[:, :n], omega * both[:, n:]
+
     def synthesised(self, Z: np.ndarray) -> np.ndarray:
         """``E Z``: the samples of coefficients ``Z`` (2H + 1, n), by the product or, for a large N (2H + 1)
         (:data:`SYNTHESIS_BY_FFT`), by an inverse real FFT of the spectrum ``X_0 = N a_0``, ``X_k = N (a_k - i b_k) / 2``
@@ -202,13 +212,11 @@ class Harmonics:
 
     def coefficients_fft(self, f: np.ndarray) -> np.ndarray:
         """:meth:`coefficients` by the FFT (pyFFTW plans of :func:`rotorred.signals.spectra.rfft`)."""
-        n = f.shape[1]
-        out = np.empty((self.size, n))
-        for i in range(n):
-            X = rfft(np.ascontiguousarray(f[:, i]))
-            out[0, i] = X[0].real / self.N
-            out[1::2, i] = 2.0 * X[1:self.H + 1].real / self.N
-            out[2::2, i] = -2.0 * X[1:self.H + 1].imag / self.N
+        X = rfft(f)  # every column at once
+        out = np.empty((self.size, f.shape[1]))
+        out[0] = X[0].real / self.N
+        out[1::2] = 2.0 * X[1:self.H + 1].real / self.N
+        out[2::2] = -2.0 * X[1:self.H + 1].imag / self.N
         return out.reshape(-1)
 
     def toeplitz(self, d: np.ndarray) -> np.ndarray:
@@ -229,38 +237,6 @@ class Harmonics:
         used = factor[:, 1] >= 0
         blocks[used] = distinct[factor[used, 1].astype(int)] * factor[used, 0][:, None, None]
         return self._assembled(blocks, n)
-
-    def low_rank(self, dq: np.ndarray, dv: np.ndarray, omega: float, max_rank: int, rtol: float = 1e-12):
-        """The chain rule through the AFT as a sum of outer products: ``T(dq) + omega T(dv) (nabla (x) I) = U V^T``,
-        one term for each rank of each sample's ``[dq, omega dv]`` (m x 2m, its singular values above ``rtol`` of the
-        largest): none out of contact, one a contact sample for a rub (its Jacobian is rank one). (U, V), each of
-        shape ((2H + 1) m, r), or None if r would pass ``max_rank`` (then the Toeplitz form is the cheaper).
-
-        Parameters
-        ----------
-        dq, dv : ndarray, shape (N, m, m)
-            The sampled derivatives of the forces on the displacements and on the velocities (v = omega dq/dtheta).
-        omega : float
-        max_rank : int
-        rtol : float
-        """
-        N, m, _ = dq.shape
-        M = np.concatenate([dq, omega * dv], axis=2)
-        active = np.flatnonzero(np.abs(M).reshape(N, -1).max(axis=1) > 0.0)
-        if len(active) > max_rank:
-            return None
-        factors = _rank_one(M[active], rtol)
-        if factors is not None:  # every sample rank one (a rub): no SVD
-            L, R, at = factors[0], factors[1], active
-        else:
-            u, s, vh = np.linalg.svd(M[active], full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
-            j, i = np.nonzero(s > rtol * s[:, :1])
-            if len(j) > max_rank:
-                return None
-            L, R, at = u[j, :, i] * s[j, i][:, None], vh[j, i, :], active[j]  # (r, m), (r, 2m), (r,)
-        U = (self.forward[:, at][:, None, :] * L.T[None, :, :]).reshape(self.size * m, len(at))
-        V = (self.E[at][:, :, None] * R[:, None, :m] + self.rate_rows[at][:, :, None] * R[:, None, m:])
-        return U, V.reshape(len(at), self.size * m).T
 
     def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
         """:meth:`toeplitz` as the product ``forward diag(d) E`` written out for every pair (the definition)."""
@@ -307,20 +283,6 @@ def from_phasors(Q: np.ndarray) -> np.ndarray:
     C = np.empty((2 * Q.shape[0] - 1, Q.shape[1]))
     C[0], C[1::2], C[2::2] = Q[0].real, Q[1:].real, -Q[1:].imag
     return C
-
-
-def _rank_one(A: np.ndarray, rtol: float):
-    """``(L, R)`` with ``A[j] = outer(L[j], R[j])`` for every sample's matrix ``A[j]`` (a, m, p) when each is rank one
-    to ``rtol`` of the largest entry (L the column of largest norm, R its least-squares row), else None. A rub's
-    samples are (its force is P along a fixed direction): the SVD then costs more than the Jacobian's use of it."""
-    if len(A) == 0:
-        return None
-    a = np.arange(len(A))
-    L = A[a, :, np.einsum("aij,aij->aj", A, A).argmax(axis=1)]  # (a, m)
-    R = np.einsum("ai,aij->aj", L, A) / np.einsum("ai,ai->a", L, L)[:, None]  # (a, p)
-    if np.abs(A - L[:, :, None] * R[:, None, :]).max() > rtol * np.abs(A).max():
-        return None
-    return L, R
 
 
 @functools.lru_cache(maxsize=16)

@@ -40,52 +40,52 @@ class NotConverged(RuntimeError):
 
 
 class Evaluation:
-    """The residual at ``(z, omega)``, what it is relative to, and its derivatives, computed on first use.
+    """The residual at ``(z, omega)``, what it is relative to, and its derivatives, each computed on first use.
 
     A Newton iteration evaluates every trial point, and needs the derivatives only at the point it goes on
-    from: so an evaluator samples the forces once (values and derivatives come out of one call of the law)
-    and hands over ``derive``, which builds ``(dR_dz, dR_domega)`` from those samples when they are first read.
+    from, and the one by the parameter only where a continuation asks: so an evaluator samples the forces once (values
+    and derivatives come out of one call of the law) and hands over ``jacobian`` and ``parameter``, which build
+    ``dR_dz`` and ``dR_domega`` from those samples when each is first read.
 
     Parameters
     ----------
     R : ndarray, shape (size,)
-    dR_dz : ndarray or linear operator, shape (size, size), optional
-    dR_domega : ndarray, shape (size,), optional
     scale : float
         ``||F_ex||`` (or ``||L z||`` without forcing): what the residual is relative to.
-    derive : callable, optional
-        ``derive() -> (dR_dz, dR_domega)``, called at most once, on the first read of either.
+    jacobian : callable
+        ``jacobian() -> dR_dz``, an ndarray or linear operator (size, size), called at most once.
+    parameter : callable
+        ``parameter() -> dR_domega``, shape (size,), called at most once.
     sampled : tuple, optional
         The forces and their derivatives at the AFT samples, ``(f, df/dq, df/dv)`` (N, m) and (N, m, m), where the
         evaluator keeps them (a family's parameter derivative reads them).
     """
 
-    __slots__ = ("R", "scale", "sampled", "_dR_dz", "_dR_domega", "_derive")
+    __slots__ = ("R", "scale", "sampled", "_jacobian", "_parameter")
 
-    def __init__(self, R: np.ndarray, dR_dz=None, dR_domega: np.ndarray | None = None, scale: float = 1.0,
-                 derive: Callable[[], tuple] | None = None, sampled: tuple | None = None):
+    def __init__(self, R: np.ndarray, scale: float, jacobian: Callable, parameter: Callable,
+                 sampled: tuple | None = None):
         self.R, self.scale, self.sampled = R, float(scale), sampled
-        self._dR_dz, self._dR_domega, self._derive = dR_dz, dR_domega, derive
+        self._jacobian, self._parameter = [jacobian, None], [parameter, None]
 
-    def _complete(self) -> None:
-        if self._derive is not None:
-            self._dR_dz, self._dR_domega = self._derive()
-            self._derive = None
+    @staticmethod
+    def _read(slot: list):
+        if slot[0] is not None:
+            slot[1], slot[0] = slot[0](), None
+        return slot[1]
 
     @property
     def dR_dz(self):
-        self._complete()
-        return self._dR_dz
+        return self._read(self._jacobian)
 
     @property
     def dR_domega(self) -> np.ndarray:
-        self._complete()
-        return self._dR_domega
+        return self._read(self._parameter)
 
     def with_parameter(self, dR_dp: Callable[[], np.ndarray]) -> Evaluation:
         """This evaluation with the derivative by another parameter in place of ``dR_domega`` (``dR_dp()``, computed on
         first use too): a family of problems continued in a parameter other than omega."""
-        return Evaluation(self.R, scale=self.scale, derive=lambda: (self.dR_dz, dR_dp()), sampled=self.sampled)
+        return Evaluation(self.R, self.scale, lambda: self.dR_dz, dR_dp, self.sampled)
 
     @property
     def relative(self) -> float:
@@ -158,7 +158,7 @@ class PeriodicProblem:
     def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and velocities at the AFT instants, shape (N, n) each."""
         h = self.harmonics
-        return h.samples(z, self.n), omega * h.rates(z, self.n)
+        return h.motion(z, self.n, omega)
 
     def nonlinear(self, z: np.ndarray, omega: float):
         """The nonlinear force's coefficients and the Toeplitz matrices of its derivatives, T(df/dq) and
@@ -190,11 +190,14 @@ class PeriodicProblem:
         R = Lz + self.harmonics.coefficients(f) - F
         scale = float(np.linalg.norm(F)) or float(np.linalg.norm(Lz)) or 1.0
 
-        def derive():
-            Tq, Tv = toeplitz_pair(self.harmonics, dq, dv)
-            dR_domega = dL @ z + Tv @ self.harmonics.derivative(z, self.n) - dF
-            return self._jacobian(L, Tq, Tv, omega), dR_domega
-        return Evaluation(R, scale=scale, derive=derive)
+        built = {}  # T(df/dq), T(df/dv): built once, for whichever derivative is read first
+
+        def toeplitz():
+            if not built:
+                built["pair"] = toeplitz_pair(self.harmonics, dq, dv)
+            return built["pair"]
+        return Evaluation(R, scale, lambda: self._jacobian(L, *toeplitz(), omega),
+                          lambda: dL @ z + toeplitz()[1] @ self.harmonics.derivative(z, self.n) - dF)
 
     def _jacobian(self, L: np.ndarray, Tq: np.ndarray, Tv: np.ndarray, omega: float) -> np.ndarray:
         """dR/dz = L + T(df/dq) + omega T(df/dv) (nabla (x) I)."""
@@ -243,17 +246,26 @@ def sampled_forces(forces, q: np.ndarray, v: np.ndarray):
     """The nonlinear forces and their derivatives at the samples ``q``, ``v`` (N, m): f (N, m), df/dq and df/dv
     (N, m, m). ``forces`` pairs each force with the columns of its DOFs."""
     N, m = q.shape
+    if len(forces) == 1 and list(forces[0][1]) == list(range(m)):  # one force on every column, in order: as it is
+        return forces[0][0].evaluate(q, v)
     f = np.zeros((N, m))
     dq = np.zeros((N, m, m))
     dv = np.zeros((N, m, m))
     for force, idx in forces:
         fi, dqi, dvi = force.evaluate(q[:, idx], v[:, idx])
+        block = _block(idx)
         f[:, idx] += fi
-        for a, ia in enumerate(idx):
-            for b, ib in enumerate(idx):
-                dq[:, ia, ib] += dqi[:, a, b]
-                dv[:, ia, ib] += dvi[:, a, b]
+        dq[(slice(None),) + block] += dqi
+        dv[(slice(None),) + block] += dvi
     return f, dq, dv
+
+
+def _block(idx) -> tuple:
+    """The index of a force's DOFs ``idx`` (distinct columns) in a square matrix: slices for a run of consecutive
+    columns (a view: the sum is written in place), else the mesh of the columns."""
+    if list(idx) == list(range(idx[0], idx[0] + len(idx))):
+        return slice(idx[0], idx[0] + len(idx)), slice(idx[0], idx[0] + len(idx))
+    return np.ix_(idx, idx)
 
 
 def force_coefficients(h: Harmonics, forces, q: np.ndarray, v: np.ndarray) -> np.ndarray:

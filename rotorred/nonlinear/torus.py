@@ -437,11 +437,11 @@ class TorusProblem:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
         (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve` takes the problem; ``omega`` is ignored: the base
         frequencies are fixed, and ``dR_domega`` is NaN, not defined)."""
-        def derive():
+        def jacobian():
             lin = self._linearise(z)
             T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
-            return np.eye(self.size) + self.apply(T), np.full(self.size, np.nan)
-        return Evaluation(self.residual(z), scale=self.scale, derive=derive)
+            return np.eye(self.size) + self.apply(T)
+        return Evaluation(self.residual(z), self.scale, jacobian, lambda: np.full(self.size, np.nan))
 
     def newton_step(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The residual at ``z`` and Newton's step ``-J^-1 R``, through the Woodbury identity on the rank r of the DOF

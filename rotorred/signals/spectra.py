@@ -188,30 +188,31 @@ class NumpyPlan:
     """The interface of a ``pyfftw.FFTW`` rfft plan (``input_array``, ``output_array``, ``execute()``)
     computed with :func:`numpy.fft.rfft`: used when pyFFTW is not installed."""
 
-    def __init__(self, n: int, dtype):
-        self.input_array = np.zeros(n, dtype=dtype)
+    def __init__(self, shape: tuple, dtype):
+        self.input_array = np.zeros(shape, dtype=dtype)
         ctype = np.complex64 if np.dtype(dtype) == np.float32 else np.complex128
-        self.output_array = np.zeros(n // 2 + 1, dtype=ctype)
+        self.output_array = np.zeros((shape[0] // 2 + 1,) + tuple(shape[1:]), dtype=ctype)
 
     def execute(self):
-        self.output_array[:] = np.fft.rfft(self.input_array)
+        self.output_array[:] = np.fft.rfft(self.input_array, axis=0)
 
     __call__ = execute
 
 
-def _new_plan(n: int, dtype):
-    """A pyFFTW plan, or a :class:`NumpyPlan` with a one-line note on stderr (once) when pyFFTW is missing."""
+def _new_plan(shape: tuple, dtype):
+    """A pyFFTW plan along the first axis of arrays of ``shape``, or a :class:`NumpyPlan` with a one-line note on
+    stderr (once) when pyFFTW is missing."""
     if pyfftw is None:
         if not _NOTED:
             _NOTED.append(True)
             print(NO_PYFFTW_NOTE, file=sys.stderr)
-        return NumpyPlan(n, dtype)
-    a = pyfftw.empty_aligned(int(n), dtype=dtype)
-    return pyfftw.builders.rfft(a, planner_effort="FFTW_ESTIMATE", threads=1, avoid_copy=False)
+        return NumpyPlan(shape, dtype)
+    a = pyfftw.empty_aligned(shape, dtype=dtype)
+    return pyfftw.builders.rfft(a, axis=0, planner_effort="FFTW_ESTIMATE", threads=1, avoid_copy=False)
 
 
 _PLAN_LOCK = threading.Lock()
-_PLANS: dict[tuple[int, str], tuple[object, threading.Lock]] = {}
+_PLANS: dict[tuple[tuple, str], tuple[object, threading.Lock]] = {}
 _PLAN_STATS = {"hits": 0, "misses": 0}
 
 
@@ -242,21 +243,21 @@ def rfft_plan(n: int, dtype=np.float64):
         Fill ``plan.input_array``, call ``plan.execute()`` and copy ``plan.output_array``,
         shape (n // 2 + 1,), complex (as :func:`amplitude_spectrum` does).
     """
-    return _plan_entry(n, dtype)[0]
+    checks.integer("n", n, ge=1)
+    return _plan_entry((int(n),), dtype)[0]
 
 
-def _plan_entry(n: int, dtype) -> tuple[object, threading.Lock]:
+def _plan_entry(shape: tuple, dtype) -> tuple[object, threading.Lock]:
     checks.choice("dtype", np.dtype(dtype).name, ("float64", "float32"))
     dtype = np.dtype(dtype)
-    checks.integer("n", n, ge=1)
-    key = (int(n), dtype.str)
+    key = (shape, dtype.str)
     with _PLAN_LOCK:
         entry = _PLANS.get(key)
         if entry is not None:
             _PLAN_STATS["hits"] += 1
             return entry
         _PLAN_STATS["misses"] += 1
-        entry = (_new_plan(int(n), dtype), threading.Lock())
+        entry = (_new_plan(shape, dtype), threading.Lock())
         _PLANS[key] = entry
         return entry
 
@@ -276,9 +277,9 @@ def plan_cache_clear() -> None:
 
 
 def rfft(x: np.ndarray) -> np.ndarray:
-    """The real FFT of a 1-D record ``x`` (float64 or float32) on its cached plan (thread-safe), shape
-    (x.size // 2 + 1,), complex, unnormalised (numpy's ``rfft`` convention)."""
-    plan, lock = _plan_entry(x.size, x.dtype)
+    """The real FFT of a 1-D record ``x`` (float64 or float32), or of each column of a 2-D one, on its cached plan
+    (thread-safe), shape (len(x) // 2 + 1,) + x.shape[1:], complex, unnormalised (numpy's ``rfft`` convention)."""
+    plan, lock = _plan_entry(x.shape, x.dtype)
     with lock:  # the plan owns its input/output arrays; one caller at a time
         # Copy into the plan's own aligned input: calling ``plan(input_array=x)`` would let the
         # plan adopt ``x`` as its input buffer, and a later call would overwrite the caller's array.

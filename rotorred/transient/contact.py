@@ -239,8 +239,7 @@ def hunt_crossley(delta: float, rate: float, K_nr: float, c: float) -> tuple[flo
 def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 1e-14) -> tuple[float, float]:
     """Normal contact force P of the plate's series law: P = K_nr (p - w0 - lam P)^1.5 max(0, 1 + c rate).
 
-    The root of :func:`normal_law`'s residual by Newton from P = 0 (the residual is increasing and
-    concave in P for fixed ``rate``, so the iterates increase monotonically to the root).
+    :func:`normal_root` for ``plate``.
 
     Parameters
     ----------
@@ -257,53 +256,40 @@ def normal_force(penetration: float, rate: float, plate: RubPlate, tol: float = 
     dP_dp : float
         Tangent dP/dp (N/m) at fixed rate.
     """
-    lam, w0 = plate.compliance, plate.offset
+    P, dP_dp, _ = normal_root(penetration, rate, plate.K_nr, plate.c, plate.compliance, plate.offset, tol)
+    return P, dP_dp
+
+
+def normal_root(penetration, rate, K_nr, c, lam, w0, tol):
+    """The normal force of the series law and its two tangents: the root P of :func:`normal_law`'s residual at the
+    deformation ``p - w0 - lam P``, by Newton from P = 0 (the residual is increasing and concave in P for a fixed
+    ``rate``, so the iterates increase monotonically to the root; at most 200, to a step of ``tol`` relative).
+
+    Plain Python on floats; harmonic balance compiles this same function and calls it at every AFT sample
+    (:func:`rotorred.transient.contact_solve.normal_roots`).
+
+    Parameters
+    ----------
+    penetration, rate : float
+        Penetration p = -g (m) and its rate p' (m/s).
+    K_nr, c, lam, w0 : float
+        Hertz stiffness (N/m^1.5), Hunt–Crossley coefficient (s/m), bending compliance (m/N) and offset (m).
+    tol : float
+
+    Returns
+    -------
+    P, dP_dp, dP_drate : float
+        The force (N, >= 0) and its derivatives by the penetration (N/m) and its rate (N s/m); zero out of contact.
+    """
     P = 0.0
     for _ in range(200):
-        R, dR_dF, _, _ = normal_law(P, penetration - w0 - lam * P, rate, plate.K_nr, plate.c, lam)
+        R, dR_dF, _, _ = normal_law(P, penetration - w0 - lam * P, rate, K_nr, c, lam)
         step = R / dR_dF
         P -= step
         if abs(step) <= tol * max(abs(P), 1e-300):
             break
-    _, dR_dF, dR_dp, _ = normal_law(P, penetration - w0 - lam * P, rate, plate.K_nr, plate.c, lam)
-    return max(float(P), 0.0), float(-dR_dp / dR_dF)
-
-
-def normal_force_samples(penetration: np.ndarray, rate: np.ndarray, plate: RubPlate, tol: float = 1e-14):
-    """:func:`normal_force` at many samples at once, with both tangents: the roots of the generated residual
-    (``normal_residual_samples``, the same law) by Newton from P = 0 at every sample, the clamp of :func:`normal_law`
-    applied sample by sample.
-
-    Parameters
-    ----------
-    penetration, rate : ndarray, shape (N,)
-        Penetration p = -g (m) and its rate p' (m/s) at each sample.
-    plate : RubPlate
-
-    Returns
-    -------
-    P, dP_dp, dP_drate : ndarray, shape (N,)
-        Normal force (N, >= 0) and its derivatives (N/m, N s/m); zero out of contact.
-    """
-    lam, w0 = plate.compliance, plate.offset
-    P = np.zeros_like(penetration)
-    out = None
-    for _ in range(200):
-        out = _residual_samples(P, penetration - w0 - lam * P, rate, plate)
-        step = out[0] / out[1]
-        P = P - step
-        if np.all(np.abs(step) <= tol * np.maximum(np.abs(P), 1e-300)):
-            break
-    out = _residual_samples(P, penetration - w0 - lam * P, rate, plate)
-    return np.maximum(P, 0.0), -out[2] / out[1], -out[3] / out[1]
-
-
-def _residual_samples(P, delta, rate, plate):
-    """The law's residual and tangent at each sample, clamped as :func:`normal_law` clamps it (s = 0 where
-    ``delta <= 0`` or ``1 + c rate <= 0``)."""
-    active = (delta > 0.0) & (1.0 + plate.c * rate > 0.0)
-    s = np.sqrt(np.where(active, delta, 0.0))
-    return _gen.normal_residual_samples(P, s, rate, plate.K_nr, plate.c, plate.compliance)
+    _, dR_dF, dR_dp, dR_drate = normal_law(P, penetration - w0 - lam * P, rate, K_nr, c, lam)
+    return max(P, 0.0), -dR_dp / dR_dF, -dR_drate / dR_dF
 
 
 def contact_energy(P: float, plate: RubPlate) -> float:
