@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Callable, NamedTuple
 
 import numpy as np
-from scipy.sparse.linalg import LinearOperator
 
 from rotorred.nonlinear.fourier import Harmonics, from_phasors, to_phasors
 from rotorred.nonlinear.hb import (Evaluation, checked_matrices, checked_unknowns, force_coefficients, local_forces,
@@ -166,8 +165,9 @@ class CondensedProblem:
         def jacobian():
             factors = low_rank(h, dq, dv, omega, max_rank=self.size // 2)
             if factors is not None:  # I + G U V^T, solved by Woodbury
-                return IdentityPlusLowRank(self._operator(G) @ factors.U, factors.V,
-                                           factors.coupling(self._compliance(omega).H_cc))
+                transposed = (G[0].T, G[1].transpose(0, 2, 1))
+                GU = factors.U.after(lambda X: self.apply(G, X), lambda X: self.apply(transposed, X))
+                return IdentityPlusLowRank(GU, factors.V, factors.coupling(self._compliance(omega).H_cc))
             return np.eye(self.size) + self.apply(G, h.toeplitz(dq) + omega * h.times_derivative(h.toeplitz(dv), m))
 
         def parameter():
@@ -186,13 +186,6 @@ class CondensedProblem:
         out[:m] = G0 @ X2[:m]
         out[m:] = np.matmul(Gk, X2[m:].reshape(H, 2 * m, -1)).reshape(H * 2 * m, -1)
         return out.reshape(X.shape)
-
-    def _operator(self, blocks) -> LinearOperator:
-        """G, given by its blocks, as a linear operator (``G @ x`` and ``G.T @ x`` by :meth:`apply`)."""
-        transposed = (blocks[0].T, blocks[1].transpose(0, 2, 1))
-        return LinearOperator((self.size, self.size), matvec=lambda x: self.apply(blocks, x),
-                              matmat=lambda x: self.apply(blocks, x), rmatvec=lambda x: self.apply(transposed, x),
-                              rmatmat=lambda x: self.apply(transposed, x), dtype=float)
 
     def _blocks(self, omega: float):
         """G and dG/domega as blocks, z_lin and dz_lin/domega, at ``omega`` (cached with the compliance)."""

@@ -15,10 +15,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from rotorred import checks
+from rotorred.transient import numba_cache
 from rotorred.transient.contact import RubPlate, disk_force, sliding_velocity
-from rotorred.transient.contact_solve import normal_roots
+from rotorred.transient.contact_solve import compiled_normal_root
+
+numba_cache.register()
 
 __all__ = ["CubicSpring", "CircularClearance", "PlateRub"]
 
@@ -123,12 +127,11 @@ class PlateRub:
         object.__setattr__(self, "surface_speed", checks.number("surface_speed", self.surface_speed, "m/s"))
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
-        grad, P, dP_dp, dP_drate, per_P = self._law(q, v)
-        d = np.zeros((2,) + q.shape + (4,))  # df/dq, df/dv: rank one, (forces per unit P) (dP/dp, dP/dp') grad^T
-        on = np.flatnonzero((dP_dp != 0.0) | (dP_drate != 0.0))  # in contact: zero elsewhere
-        d[0, on] = (per_P[on] * dP_dp[on, None])[:, :, None] * grad
-        d[1, on] = (per_P[on] * dP_drate[on, None])[:, :, None] * grad
-        return per_P * P[:, None], d[0], d[1]
+        plate, grad, (N, m) = self.plate, self.gradient, q.shape
+        f, dq, dv = np.zeros((N, m)), np.zeros((N, m, m)), np.zeros((N, m, m))
+        _plate_rub(q @ grad - plate.clearance, v @ grad, self.slip_sign(v), grad, plate.mu_d,
+                   (plate.K_nr, plate.c, plate.compliance, plate.offset, ROOT_TOL), f, dq, dv)
+        return f, dq, dv
 
     def slip_sign(self, v: np.ndarray) -> np.ndarray:
         """sign(v_rel) at the samples of the velocities ``v`` (N, 4) (:func:`rotorred.transient.contact.sliding_velocity`,
@@ -141,19 +144,6 @@ class PlateRub:
         penetration, m, > 0 in contact) is its displacement along the normal less the plate's."""
         return np.array([math.cos(self.plate.theta), math.sin(self.plate.theta), -1.0, 0.0])
 
-    def _law(self, q: np.ndarray, v: np.ndarray):
-        """d p / d(x, y, u_n, u_t) (also of p' on the velocities), P and its tangents at the samples, and the forces
-        per unit P, shape (N, 4): ``P n - T t`` on the disk (:func:`rotorred.transient.contact.disk_force` turned to
-        the left-hand side), ``(-P, T)`` on the plate, with ``T = -mu_d sign(v_rel) P``."""
-        plate, grad = self.plate, self.gradient
-        c, s = grad[0], grad[1]
-        P, dP_dp, dP_drate = normal_roots(np.ascontiguousarray(q @ grad) - plate.clearance, np.ascontiguousarray(v @ grad),
-                                          plate.K_nr, plate.c, plate.compliance, plate.offset, ROOT_TOL)
-        T_per_P = -plate.mu_d * self.slip_sign(v)
-        fx, fy = disk_force(1.0, T_per_P, c, s)
-        per_P = np.column_stack([-fx, -fy, -np.ones_like(T_per_P), T_per_P])
-        return grad, P, dP_dp, dP_drate, per_P
-
     def with_clearance(self, clearance: float) -> PlateRub:
         """The same rub at another clearance (m)."""
         return PlateRub(self.dofs, self.plate.with_(clearance=clearance), self.surface_speed)
@@ -161,3 +151,39 @@ class PlateRub:
     #: the position among ``dofs`` of the DOF the clearance enters the gap with: ``g = clearance + u_n - (x, y) . n``,
     #: so d f / d clearance is the column of d f / dq at u_n (the derivative of the forces by the clearance, for free)
     clearance_dof = 2
+
+
+_disk_force = njit(cache=True)(disk_force)
+
+
+@njit(cache=True)
+def _plate_rub(penetration, rate, slip, grad, mu_d, law, f, dq, dv):
+    """:class:`PlateRub`'s forces and their derivatives at every sample, into ``f`` (N, 4) and ``dq``, ``dv`` (N, 4, 4)
+    (zero out of contact): the normal force P of the series law and its tangents at the penetration and its rate
+    (:func:`rotorred.transient.contact.normal_root`, compiled), friction ``T = -mu_d sign(v_rel) P``, and per unit P
+    the forces ``P n - T t`` on the disk (:func:`rotorred.transient.contact.disk_force` to the left-hand side) and
+    ``(-P, T)`` on the plate; the derivatives are rank one, (forces per unit P) (dP/dp, dP/dp') ``grad^T``.
+
+    Parameters
+    ----------
+    penetration, rate, slip : ndarray, shape (N,)
+        p = q . grad - clearance (m), its rate (m/s) and sign(v_rel) at each sample.
+    grad : ndarray, shape (4,)
+        d p / d(x, y, u_n, u_t) (:attr:`PlateRub.gradient`).
+    mu_d : float
+    law : tuple
+        ``(K_nr, c, lam, w0, tol)`` of the normal law.
+    """
+    per = np.empty(4)
+    for j in range(penetration.shape[0]):
+        if penetration[j] <= law[3]:  # no deformation: no force
+            continue
+        P, dP_dp, dP_drate = compiled_normal_root(penetration[j], rate[j], law[0], law[1], law[2], law[3], law[4])
+        T_per_P = -mu_d * slip[j]
+        fx, fy = _disk_force(1.0, T_per_P, grad[0], grad[1])
+        per[0], per[1], per[2], per[3] = -fx, -fy, -1.0, T_per_P
+        for a in range(4):
+            f[j, a] = per[a] * P
+            for b in range(4):
+                dq[j, a, b] = per[a] * dP_dp * grad[b]
+                dv[j, a, b] = per[a] * dP_drate * grad[b]

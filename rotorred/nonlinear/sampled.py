@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy.sparse.linalg import LinearOperator
 
 from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.lowrank import Factor
 from rotorred.transient import numba_cache
 
 numba_cache.register()
@@ -62,8 +62,9 @@ class SampledFactors:
     def __post_init__(self):
         h = self.harmonics
         object.__setattr__(self, "_forward", np.ascontiguousarray(h.forward[:, self.at]))  # (2H + 1, r)
-        object.__setattr__(self, "_E", h.E[self.at])  # (r, 2H + 1)
-        object.__setattr__(self, "_rate", h.rate_rows[self.at])  # (r, 2H + 1)
+        object.__setattr__(self, "_rows", np.vstack([h.E[self.at], h.rate_rows[self.at]]))  # (2r, 2H + 1): E, rate
+        m = self.L.shape[1]
+        object.__setattr__(self, "_right", np.stack([self.R[:, :m], self.R[:, m:]]))  # (2, r, m): Rq, Rv
 
     @property
     def rank(self) -> int:
@@ -79,22 +80,20 @@ class SampledFactors:
         return self.harmonics.size * self.m
 
     @property
-    def U(self) -> LinearOperator:
-        """U, shape (size, r), as a linear operator (``U @ y``, ``U.T @ x``)."""
-        return LinearOperator((self.size, self.rank), matvec=self._u, matmat=self._u, rmatvec=self._ut,
-                              rmatmat=self._ut, dtype=float)
+    def U(self) -> Factor:
+        """U, shape (size, r), by its action (:class:`rotorred.nonlinear.lowrank.Factor`)."""
+        return Factor((self.size, self.rank), self._u, self._ut)
 
     @property
-    def V(self) -> LinearOperator:
-        """V, shape (size, r), as a linear operator."""
-        return LinearOperator((self.size, self.rank), matvec=self._v, matmat=self._v, rmatvec=self._vt,
-                              rmatmat=self._vt, dtype=float)
+    def V(self) -> Factor:
+        """V, shape (size, r), by its action."""
+        return Factor((self.size, self.rank), self._v, self._vt)
 
     def dense(self) -> tuple[np.ndarray, np.ndarray]:
         """U and V as arrays, each shape (size, r): the definition, written out (for tests and small problems)."""
-        m, r = self.m, self.rank
+        m, r, E, rate = self.m, self.rank, self._rows[:self.rank], self._rows[self.rank:]
         U = (self._forward[:, None, :] * self.L.T[None, :, :]).reshape(self.size, r)
-        V = self._E[:, :, None] * self.R[:, None, :m] + self._rate[:, :, None] * self.R[:, None, m:]
+        V = E[:, :, None] * self.R[:, None, :m] + rate[:, :, None] * self.R[:, None, m:]
         return U, V.reshape(r, self.size).T
 
     def coupling(self, Hc: np.ndarray) -> np.ndarray:
@@ -113,58 +112,55 @@ class SampledFactors:
         return _gathered(self.at, np.ascontiguousarray(A), np.ascontiguousarray(Lam), K)
 
     def _u(self, Y: np.ndarray) -> np.ndarray:
-        Y2 = _columns(Y, self.rank)
-        S = (self.L[:, :, None] * Y2[:, None, :]).reshape(self.rank, self.m * Y2.shape[1])  # the terms' forces
-        return (self._forward @ S).reshape((self.size,) + Y.shape[1:])
+        """U Y, Y (r, k): the coefficients of each column's forces, ``L_j y_j`` at sample j."""
+        S = (self.L[:, :, None] * Y[:, None, :]).reshape(self.rank, self.m * Y.shape[1])
+        return (self._forward @ S).reshape(self.size, Y.shape[1])
 
     def _ut(self, X: np.ndarray) -> np.ndarray:
-        X2 = _columns(X, self.harmonics.size)
-        W = (self._forward.T @ X2).reshape(self.rank, self.m, X2.shape[1] // self.m)
-        return np.einsum("ja,jak->jk", self.L, W).reshape((self.rank,) + X.shape[1:])
+        """U^T X, X (size, k)."""
+        W = (self._forward.T @ X.reshape(self.harmonics.size, -1)).reshape(self.rank, self.m, X.shape[1])
+        return np.einsum("ja,jak->jk", self.L, W)
 
     def _v(self, Y: np.ndarray) -> np.ndarray:
-        m, Y2 = self.m, _columns(Y, self.rank)
-        Sq = (self.R[:, :m, None] * Y2[:, None, :]).reshape(self.rank, m * Y2.shape[1])
-        Sv = (self.R[:, m:, None] * Y2[:, None, :]).reshape(self.rank, m * Y2.shape[1])
-        return (self._E.T @ Sq + self._rate.T @ Sv).reshape((self.size,) + Y.shape[1:])
+        """V Y, Y (r, k)."""
+        S = (self._right[:, :, :, None] * Y[None, :, None, :]).reshape(2 * self.rank, self.m * Y.shape[1])  # Rq y; Rv y
+        return (self._rows.T @ S).reshape(self.size, Y.shape[1])
 
     def _vt(self, X: np.ndarray) -> np.ndarray:
-        m, X2 = self.m, _columns(X, self.harmonics.size)
-        Wq = (self._E @ X2).reshape(self.rank, m, X2.shape[1] // m)
-        Wv = (self._rate @ X2).reshape(self.rank, m, X2.shape[1] // m)
-        out = np.einsum("ja,jak->jk", self.R[:, :m], Wq) + np.einsum("ja,jak->jk", self.R[:, m:], Wv)
-        return out.reshape((self.rank,) + X.shape[1:])
-
-
-def _columns(X: np.ndarray, rows: int) -> np.ndarray:
-    """A vector or a matrix of ``rows`` blocks of rows, as a matrix of ``rows`` rows (each block's entries side by
-    side, the columns within)."""
-    return X.reshape(rows, (X.size // rows) if rows else (X.shape[1] if X.ndim > 1 else 1))
+        """V^T X, X (size, k): each column's values and rates at the samples, along Rq and Rv."""
+        W = (self._rows @ X.reshape(self.harmonics.size, -1)).reshape(2, self.rank, self.m, X.shape[1])
+        return (self._right[:, :, :, None] * W).sum(axis=(0, 2))
 
 
 @njit(cache=True)
 def _gathered(at, A, Lam, K):
     """``(V^T G U)_ij = sum_st (Aq_is K_st(d) + Av_is dK_st(d)) Lam_jt``, d = at_i - at_j on the grid (mod N), for
     the coordinates ``A = [Aq; Av]`` (2r, p) of the right factors and ``Lam`` (r, p') of the left ones, and the kernel
-    ``K`` (2, N, p, p'): K and dK/dDelta. Compiled: r^2 entries of a few products each."""
+    ``K`` (2, N, p, p'): K and dK/dDelta. Compiled: r^2 entries of a few products each, one pair of directions at a
+    time (its kernel contiguous: 0.13 -> 0.05 ms at the rig's r = 175)."""
     r, N = at.shape[0], K.shape[1]
-    out = np.empty((r, r))
-    for i in range(r):
-        for j in range(r):
-            d = at[i] - at[j]
-            if d < 0:
-                d += N
-            acc = 0.0
-            for s in range(A.shape[1]):
-                for t in range(Lam.shape[1]):
-                    acc += (A[i, s] * K[0, d, s, t] + A[r + i, s] * K[1, d, s, t]) * Lam[j, t]
-            out[i, j] = acc
+    out = np.zeros((r, r))
+    for s in range(A.shape[1]):
+        for t in range(Lam.shape[1]):
+            k0, k1 = K[0, :, s, t].copy(), K[1, :, s, t].copy()
+            for i in range(r):
+                aq, av, ai = A[i, s], A[r + i, s], at[i]
+                for j in range(r):
+                    d = ai - at[j]
+                    if d < 0:
+                        d += N
+                    out[i, j] += (aq * k0[d] + av * k1[d]) * Lam[j, t]
     return out
 
 
 def _directions(A: np.ndarray, rtol: float = 1e-13):
     """An orthonormal basis ``B`` (m, p) of the directions the rows of ``A`` (a, m) span (singular values above ``rtol``
-    of the largest), and the rows' coordinates on it, ``A B`` (a, p): ``A = (A B) B^T``."""
+    of the largest), and the rows' coordinates on it, ``A B`` (a, p): ``A = (A B) B^T``. Rows along one direction to
+    ``rtol`` of the largest entry (a rub's gradient; its force with friction of one sign) skip the SVD."""
+    u = A[np.argmax(np.einsum("ij,ij->i", A, A))]
+    u = u / np.linalg.norm(u)
+    if np.abs(A - np.outer(A @ u, u)).max() <= rtol * np.abs(A).max():
+        return u[:, None], (A @ u)[:, None]
     _, s, vt = np.linalg.svd(A, full_matrices=False)
     B = vt[:max(int(np.count_nonzero(s > rtol * s[0])), 1)].T
     return B, A @ B
@@ -190,30 +186,52 @@ def low_rank(h: Harmonics, dq: np.ndarray, dv: np.ndarray, omega: float, max_ran
     -------
     SampledFactors or None
     """
-    N = dq.shape[0]
-    active = np.flatnonzero((dq != 0.0).reshape(N, -1).any(axis=1) | (dv != 0.0).reshape(N, -1).any(axis=1))
-    if len(active) > max_rank:
+    at, L, R, rank_one = _rank_one(np.ascontiguousarray(dq), np.ascontiguousarray(dv), float(omega), rtol)
+    if len(at) > max_rank:
         return None
-    M = np.concatenate([dq[active], omega * dv[active]], axis=2)
-    factors = _rank_one(M, rtol)
-    if factors is not None:  # every sample rank one (a rub): no SVD
-        return SampledFactors(h, active, factors[0], factors[1])
-    u, s, vh = np.linalg.svd(M, full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
-    j, i = np.nonzero(s > rtol * s[:, :1])
+    if rank_one:  # every sample rank one (a rub): no SVD
+        return SampledFactors(h, at, L, R)
+    u, s, vh = np.linalg.svd(np.concatenate([dq[at], omega * dv[at]], axis=2), full_matrices=False)  # (a, m, m),
+    j, i = np.nonzero(s > rtol * s[:, :1])  # (a, m), (a, m, 2m)
     if len(j) > max_rank:
         return None
-    return SampledFactors(h, active[j], u[j, :, i] * s[j, i][:, None], vh[j, i, :])
+    return SampledFactors(h, at[j], u[j, :, i] * s[j, i][:, None], vh[j, i, :])
 
 
-def _rank_one(A: np.ndarray, rtol: float):
-    """``(L, R)`` with ``A[j] = outer(L[j], R[j])`` for every sample's matrix ``A[j]`` (a, m, p) when each is rank one
-    to ``rtol`` of the largest entry (L the column of largest norm, R its least-squares row), else None. A rub's
-    samples are (its force is P along a fixed direction): the SVD then costs more than the Jacobian's use of it."""
-    if len(A) == 0:
-        return np.zeros((0, A.shape[1])), np.zeros((0, A.shape[2]))
-    a = np.arange(len(A))
-    L = A[a, :, np.einsum("aij,aij->aj", A, A).argmax(axis=1)]  # (a, m)
-    R = np.einsum("ai,aij->aj", L, A) / np.einsum("ai,ai->a", L, L)[:, None]  # (a, p)
-    if np.abs(A - L[:, :, None] * R[:, None, :]).max() > rtol * np.abs(A).max():
-        return None
-    return L, R
+@njit(cache=True)
+def _rank_one(dq, dv, omega, rtol):
+    """The samples where ``[dq, omega dv]`` (N, m, 2m) is not zero, and there ``(L, R)`` with ``[dq, omega dv] =
+    outer(L, R)`` (L the column of largest norm, R its least-squares row): ``(at, L, R, rank_one)``, ``rank_one``
+    whether every sample is, to ``rtol`` of the largest entry. A rub's samples are (its force is P along a fixed
+    direction): the SVD then costs more than the Jacobian's use of it. Compiled: one pass over the samples."""
+    N, m = dq.shape[0], dq.shape[1]
+    at, L, R = np.empty(N, np.int64), np.empty((N, m)), np.empty((N, 2 * m))
+    A = np.empty((m, 2 * m))
+    count, largest, worst = 0, 0.0, 0.0
+    for j in range(N):
+        big, best, column = 0.0, -1.0, 0
+        for a in range(m):
+            for b in range(m):
+                A[a, b], A[a, m + b] = dq[j, a, b], omega * dv[j, a, b]
+        for b in range(2 * m):
+            norm = 0.0
+            for a in range(m):
+                norm += A[a, b] * A[a, b]
+                big = max(big, abs(A[a, b]))
+            if norm > best:
+                best, column = norm, b
+        if big == 0.0:
+            continue
+        largest = max(largest, big)
+        for a in range(m):
+            L[count, a] = A[a, column]
+        for b in range(2 * m):
+            dot = 0.0
+            for a in range(m):
+                dot += L[count, a] * A[a, b]
+            R[count, b] = dot / best
+            for a in range(m):
+                worst = max(worst, abs(A[a, b] - L[count, a] * R[count, b]))
+        at[count] = j
+        count += 1
+    return at[:count].copy(), L[:count].copy(), R[:count].copy(), worst <= rtol * largest

@@ -266,7 +266,7 @@ def normal_root(penetration, rate, K_nr, c, lam, w0, tol):
     ``rate``, so the iterates increase monotonically to the root; at most 200, to a step of ``tol`` relative).
 
     Plain Python on floats; harmonic balance compiles this same function and calls it at every AFT sample
-    (:func:`rotorred.transient.contact_solve.normal_roots`).
+    (:class:`rotorred.nonlinear.forces.PlateRub`).
 
     Parameters
     ----------

@@ -46,27 +46,9 @@ def _compiled(fn, **callees):
 #: under the clamp of contact.normal_law, and the Eq. 12 force on the disk
 _normal_residual = njit(cache=True)(_gen.normal_residual)
 _normal_law = _compiled(contact.normal_law, _normal_residual=_normal_residual)
-_normal_root = _compiled(contact.normal_root, normal_law=_normal_law)
-
-
-@njit(cache=True)
-def normal_roots(penetration, rate, K_nr, c, lam, w0, tol):
-    """:func:`rotorred.transient.contact.normal_root` at every sample (harmonic balance's AFT instants): the normal
-    force and its tangents, arrays of the samples' shape (N,) each (N, N/m, N s/m).
-
-    Parameters
-    ----------
-    penetration, rate : ndarray, shape (N,)
-        Penetration p = -g (m) and its rate (m/s) at each sample.
-    K_nr, c, lam, w0, tol : float
-        As for :func:`~rotorred.transient.contact.normal_root`.
-    """
-    n = penetration.shape[0]
-    P, dP_dp, dP_drate = np.zeros(n), np.zeros(n), np.zeros(n)
-    for j in range(n):
-        if penetration[j] > w0:  # else no deformation: P = 0 and its tangents 0, as the root gives
-            P[j], dP_dp[j], dP_drate[j] = _normal_root(penetration[j], rate[j], K_nr, c, lam, w0, tol)
-    return P, dP_dp, dP_drate
+#: the normal force and its tangents (:func:`rotorred.transient.contact.normal_root`), compiled: harmonic balance calls
+#: it at every AFT sample (:class:`rotorred.nonlinear.forces.PlateRub`)
+compiled_normal_root = _compiled(contact.normal_root, normal_law=_normal_law)
 
 
 class Condensed(NamedTuple):

@@ -38,7 +38,8 @@ PACKAGE = Path(__file__).resolve().parent.parent
 #: files (relative to PACKAGE) that numba compiles into rotorred's kernels: every generated
 #: module, and every module of rotorred that defines or wraps an njit function
 KERNEL_SOURCES = ("transient/contact.py", "transient/contact_solve.py", "transient/kernel.py",
-                  "transient/ramp_kernel.py", "transient/eigen_kernel.py", "nonlinear/sampled.py")
+                  "transient/ramp_kernel.py", "transient/eigen_kernel.py", "nonlinear/sampled.py",
+                  "nonlinear/forces.py")
 GENERATED = "_generated"
 
 
