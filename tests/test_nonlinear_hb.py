@@ -95,10 +95,9 @@ def test_hill_stability_agrees_with_the_monodromy_matrix_and_with_transients(bra
 def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
     """Along the branch from 0.5 to 12 rad/s, every point in full annular rub (the orbit beyond the gap all round) has
     the radius of the closed form ((k - m w^2) r + k_c (r - g))^2 + (c w r)^2 = (e m w^2)^2 (a quadratic in r: its
-    root nearer the point; measured 1.4e-11 relative, at the fold, 301 points), and the fold is where that quadratic in
-    r has a double root (measured 9.1e-15; the issue asks 0.5 %: the fold's omega to the rounding of the corrected
-    points Brent's search visits, which the steps decide: 0 to 1.1e-14 over four step settings, before and after the
-    second-order predictor). The branch turns there, comes back along the rubbing branch to where the orbit leaves the gap, and
+    root nearer the point; measured 1.4e-11 relative, at the fold, 259 points), and the fold is where that quadratic in
+    r has a double root (measured 5.6e-16; the issue asks 0.5 %: the fold's omega to the rounding of the corrected
+    points Brent's search visits, which the steps decide: 0 to 1.1e-14 over four step settings). The branch turns there, comes back along the rubbing branch to where the orbit leaves the gap, and
     turns at that corner onto the free branch (the kink of the penalty law: 1.2e-10 from the free response's
     r = g, brentq), which it follows to 12 rad/s."""
     problem = jeffcott(5, 128)
@@ -259,9 +258,8 @@ def test_condensation_onto_the_contact_dofs_equals_the_full_system(four_dof):
     harmonic balance condensed onto the disk's DOFs (the second mass eliminated through the dynamic compliance at each
     harmonic) gives the full system's solution at points along its branch, in and out of contact, and recovers the
     second mass's response; its analytic Jacobian and omega-derivative equal central differences (away from grazing,
-    where differences straddle the kink). Measured at 8 points, both solved to a relative residual of 2e-13 (1e-13 is
-    below the rounding floor at one of them), the condensed one started 1 % off: 3.3e-14 on the solutions, 3.7e-14
-    recovered (of coefficients up to about 1),
+    where differences straddle the kink). Measured at 8 points, both solved to a relative residual of 1e-13, the
+    condensed one started 1 % off: 1.0e-14 on the solutions, 1.8e-14 recovered (of coefficients up to about 1),
     derivatives within 4.9e-7 (the differences' own error at a step of 1e-6). The full branch turns at the fold 1.5896 rad/s, then at the corner
     where the rubbing branch comes back to the gap: where the free (linear) response's orbit reaches the gap (brentq;
     measured 1.5e-10), and goes on to 3 rad/s on the free branch, equal to the linear response there (measured
@@ -285,8 +283,8 @@ def test_condensation_onto_the_contact_dofs_equals_the_full_system(four_dof):
         if np.min(np.abs(radius - GAP)) < 1e-3:  # grazing: differences would straddle the kink
             continue
         checked += 1
-        z_full, _, _ = solve(full, z_full, omega, tol=2e-13)  # both to a tolerance tighter than the branch's
-        z, ev, _ = solve(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=2e-13)
+        z_full, _, _ = solve(full, z_full, omega, tol=1e-13)  # both to a tolerance tighter than the branch's
+        z, ev, _ = solve(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=1e-13)
         worst[0] = max(worst[0], np.max(np.abs(z - z_full.reshape(h.size, 4)[:, :2].reshape(-1))))
         worst[1] = max(worst[1], np.max(np.abs(condensed.recover(z, omega) - z_full)))
         eps = 1e-6

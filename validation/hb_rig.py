@@ -3,7 +3,7 @@ a continuation in the clearance, and the costs of each, measured in one run.
 
 Run::
 
-    python validation/hb_rig.py            # about 2 minutes
+    python validation/hb_rig.py            # about 30 s
 
 Prints:
 
@@ -14,8 +14,8 @@ Prints:
    and without that record (:func:`rotorred.scenes.balance_harmonics.cold_solution` through 25 and 50 harmonics,
    and the cold start at 100 harmonics itself, :func:`rotorred.scenes.branch.cold_start`): their times, their
    distances, and the second periodic response the latter reach, with its lines;
-3. the branch from 20 to 5 um (:func:`rotorred.scenes.branch.continue_scene`, 100 harmonics): points and time a
-   point, and the settled transients at 20 and 5 um;
+3. the branch from 20 to 5 um (:func:`rotorred.scenes.branch.continue_scene`, 100 harmonics): points, time a point
+   (mean, median, largest), and the settled transient at every point's clearance against each point's cost;
 4. the stability of both orbits from the monodromy matrix of the whole linearised system (largest Floquet
    multiplier modulus; < 1 stable);
 5. transients started on each orbit (its state at t = 0, ``RubProblem.final_state``) and run for 2 s: the distance of
@@ -98,17 +98,25 @@ def cold(scene, sm, rp100, largest, zA):
 
 
 def by_clearance(scene, sm):
-    """The branch from 20 to 5 um at 100 harmonics (no stability: the continuation's own cost), and the settled
-    transients at its ends (the transient's cost at 13 um is the first run's)."""
-    branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, 100, 2048, stability=False)
+    """The branch from 20 to 5 um at 100 harmonics (no stability: the continuation's own cost), each point's cost (the
+    time between the continuation's reports: a point carries the corrections that failed before it), and the settled
+    transient at every point's clearance (warm, solve time only)."""
+    stamps = []
+    branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, 100, 2048, stability=False,
+                            progress=lambda p, v: stamps.append(time.perf_counter()))
     per_point = branch.solve_time / (len(branch.values) - 1)
-    print(f"  {len(branch.values)} points from 20 to 5 um in {branch.solve_time:.2f} s: {1e3 * per_point:.0f} ms a "
-          f"point (cold start at 20 um {branch.start_time:.2f} s); {branch.stopped}")
-    ends = {}
-    for c in (20e-6, 5e-6):
-        at = load_scene("paper-rub", {"rub.clearance": c})
-        ends[c] = run_scene(at, sm, compare_normal=False).solve_time
-    return per_point, ends
+    costs = np.diff(stamps)  # points 2 .. p - 1
+    print(f"  {len(branch.values)} points from 20 to 5 um in {branch.solve_time:.3f} s: {1e3 * per_point:.1f} ms a "
+          f"point (median {1e3 * np.median(costs):.1f}, largest {1e3 * costs.max():.1f} ms; cold start at 20 um "
+          f"{branch.start_time:.2f} s); {branch.stopped}")
+    transients = np.array([run_scene(load_scene("paper-rub", {"rub.clearance": c}), sm, compare_normal=False).solve_time
+                           for c in branch.values])
+    ratios = transients[1:-1] / costs
+    print(f"  the settled transient at each point's clearance: {1e3 * transients.min():.1f}-{1e3 * transients.max():.1f} ms "
+          f"(mean {1e3 * transients.mean():.1f}); a point's cost against it: mean {transients.mean() / per_point:.1f}x "
+          f"faster, {np.count_nonzero(ratios >= 10)} of {len(ratios)} points 10x or more (each point's own ratio: "
+          f"median {np.median(ratios):.1f}x, least {ratios.min():.1f}x, after a kink)")
+    return per_point, transients
 
 
 def main() -> None:
@@ -124,7 +132,7 @@ def main() -> None:
     print("cold harmonic balance at 13 um, 100 harmonics:")
     zB, cold_time, ladder_time = cold(scene, sm, rp100, largest, zA)
     print("continuation in the clearance, 100 harmonics:")
-    per_point, ends = by_clearance(scene, sm)
+    per_point, transients = by_clearance(scene, sm)
     print(f"stability (monodromy of the whole linearised system, {STABILITY_SUBSTEPS} intervals an AFT sample):")
     for name, z in (("the transient's orbit", zA), ("the second orbit", zB)):
         t0 = time.perf_counter()
@@ -138,13 +146,13 @@ def main() -> None:
               f"{np.linalg.norm(zt - zB) / np.linalg.norm(zB):.4f} from the second orbit")
     transient = min(run_scene(scene, sm, compare_normal=False).solve_time for _ in range(3))  # warm: no first call
     print("costs (solve time only, this run; 100 harmonics, 2048 samples):")
-    print(f"  settled transient at 13 um (warm)   {transient:6.3f} s  (20 um: {ends[20e-6]:.3f} s, 5 um: {ends[5e-6]:.3f} s; "
-          f"the first run {result.solve_time:.2f} s)")
+    print(f"  settled transient at 13 um (warm)   {transient:6.3f} s  (20 um: {transients[0]:.3f} s, 5 um: "
+          f"{transients[-1]:.3f} s; the first run {result.solve_time:.2f} s)")
     print(f"  HB from the transient's last period {warm:6.3f} s  ({warm / transient:.2f}x the transient's time)")
     print(f"  HB cold (a scene's)                 {cold_time:6.3f} s  ({cold_time / transient:.2f}x the transient's time)")
     print(f"  HB cold without a transient         {ladder_time:6.2f} s  ({ladder_time / transient:.0f}x the transient's time)")
-    print(f"  continuation, per point (20-5 um)   {per_point:6.3f} s  ({per_point / min(ends.values()):.2f}x the time of "
-          f"the fastest transient at its ends)")
+    print(f"  continuation, per point (20-5 um)   {per_point:6.4f} s  ({transients.mean() / per_point:.1f}x faster than the "
+          f"settled transient at the points' clearances, {1e3 * transients.mean():.0f} ms on average)")
 
 
 def settled_from(scene, sm, rp, z):

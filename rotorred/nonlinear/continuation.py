@@ -2,9 +2,9 @@
 
 The branch is a curve ``y(s) = (z(s), omega(s))`` with ``R(z, omega) = 0`` (:mod:`rotorred.nonlinear.hb`).
 From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the
-previous one), the predictor steps ``ds`` along the branch, ``y + ds t + ds^2 / 2 kappa`` (``kappa`` the curvature,
-the change of ``t`` from the previous point over the chord); the corrector is Newton's method on ``R = 0`` together
-with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent), each step shortened
+previous one), the predictor steps ``ds`` along the tangent, or with ``curved`` along the branch to second order,
+``y + ds t + ds^2 / 2 kappa`` (``kappa`` the change of ``t`` from the previous point over the chord); the corrector is
+Newton's method on ``R = 0`` together with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent), each step shortened
 until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at most 4 iterations, up
 to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it and retries
 from the same point, down to ``ds_min``, where the branch stops and says where and why.
@@ -106,7 +106,7 @@ class _Point:
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
                     ds: float = 0.05, ds_min: float = 1e-6, ds_max: float = 0.2, max_points: int = 5000,
-                    tol: float = 1e-10, stability: bool = True, progress=None) -> Branch:
+                    tol: float = 1e-10, stability: bool = True, progress=None, curved: bool = False) -> Branch:
     """Follow the branch through ``z0`` at ``omega_start`` until omega passes ``omega_end`` (either direction).
 
     Parameters
@@ -126,6 +126,11 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     progress : callable, optional
         ``progress(points, omega)`` after each point. An interrupt (SIGINT) ends the branch where it is: the points
         so far are returned, ``stopped`` saying so.
+    curved : bool
+        Predict to second order where the branch is smooth (:func:`_arclength`): fewer corrector iterations a point
+        where each costs much (the rig's condensed problem: 2 in place of 3). Off by default: on a small problem with
+        kinks it lets the steps grow past what the kinks allow (the Jeffcott rotor at H = 10, N = 1024 then jumped
+        from the free branch above resonance to the one below, at ds_max = 0.5, and traced its loop twice).
 
     Returns
     -------
@@ -141,7 +146,8 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         try:
             if progress is not None:
                 progress(len(points), points[-1].y[-1])
-            nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol)
+            nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol,
+                                 curved)
             if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
                 folds.append(_locate_fold(problem, points[-1], nxt, tol))
         except KeyboardInterrupt:
@@ -235,14 +241,14 @@ def _shortened(problem, y, step, ev, tries: int = 8):
     return y, None
 
 
-def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, tol):
+def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, tol, curved: bool = False):
     """The next point from ``point`` with step control: (point, next ds, "") or (None, ds, why). After six
     halvings (or at ``ds_min``), a corner is tried once (:func:`_past_a_corner`), then the halving goes on down to
     ``ds_min``. (Trying a corner at the first failure was tried and taken back: in smooth stretches its steps in
     omega land on other parts of the branch.)"""
     first, cornered = ds, False
     while ds >= ds_min:
-        smooth = ds == first and point.clean and previous is not None  # a curvature to predict with
+        smooth = curved and ds == first and point.clean and previous is not None  # a curvature to predict with
         done = _arclength(problem, point, previous if smooth else None, ds, tol, clean=ds == first)
         if done is not None:
             return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""

@@ -278,7 +278,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     s_start, s_end = to_value(start, inverse=True), to_value(end, inverse=True)
     scale = max(float(np.linalg.norm(z0)), abs(s_end - s_start))  # the steps: a few hundred along a branch
     branch = continue_branch(family, z0, s_start, s_end, ds=0.01 * scale,
-                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=max_points, tol=tol,
+                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=max_points, tol=tol, curved=True,
                              stability=False, progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
     t2 = time.perf_counter()
     values = np.array([to_value(s) for s in branch.omega])
