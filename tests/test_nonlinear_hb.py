@@ -55,6 +55,24 @@ def test_duffing_with_one_harmonic_is_the_closed_form_folds_included():
     assert np.allclose(located, duffing_folds_closed_form(), rtol=3e-13, atol=0)
 
 
+def test_a_curved_prediction_follows_the_same_branch_in_fewer_iterations():
+    """The second-order predictor (curved=True) on the Duffing branch with one harmonic: every point on the closed-form
+    single-term balance (measured 1.9e-12 with F^2 = 0.01: each point to the corrector's relative residual of 1e-10,
+    which the last of fewer iterations passes by less), the same folds as the tangent predictor's and the closed
+    form's (measured 3.2e-14), the same 265 points (the steps are ds_max), in fewer Newton iterations: 1.39 a point on
+    average against 2.07 with the tangent."""
+    problem = duffing(1, 128)
+    branches = [continue_branch(problem, np.zeros(problem.size), 0.5, 2.5, ds=0.05, ds_max=0.05, stability=False,
+                                curved=curved) for curved in (False, True)]
+    tangent, curved = branches
+    A, w = curved.amplitude(problem, 0), curved.omega
+    assert np.max(np.abs(((1 - w**2 + 0.75 * K3 * A**2) ** 2 + (C * w) ** 2) * A**2 - F**2)) < 2e-11
+    for b in branches:
+        assert np.allclose(sorted(f.omega for f in b.folds), duffing_folds_closed_form(), rtol=3e-13, atol=0)
+    assert len(curved.omega) == len(tangent.omega) == 265
+    assert curved.iterations.mean() < 1.5 < 2.0 < tangent.iterations.mean()
+
+
 def test_duffing_converges_with_harmonics_to_the_transient(branch7):
     """On the upper branch at omega = 1.3 (three solutions coexist there), the first-harmonic amplitude converges as
     H grows (errors against H = 9 of 9.1e-3, 1.5e-5, 1.3e-8 for H = 1, 3, 5: each added odd harmonic gains a factor
