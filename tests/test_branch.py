@@ -65,6 +65,20 @@ def test_a_speed_branch_keeps_the_speed_ratio_and_solves_the_scene_at_each_speed
         assert rp.problem.evaluate(branch.z[i], rp.omega).relative < 1e-9
 
 
+def test_a_branch_in_the_plates_stiffness_solves_the_scene_at_each_stiffness(rig):
+    """From 2e8 to 2e9 N/m of the plate's supports (rub.k_n): each of 3 points solves the problem built from the scene
+    loaded with that stiffness (measured below 1e-9, the branch's tolerance), the base frequency stays 10 Hz, and the
+    peak falls as the plate stiffens (the plate gives less, the disk is held nearer its clearance)."""
+    scene, model = rig
+    branch = continue_scene(scene, model, "rub.k_n", 2e8, 2e9, H, N, stability=False)
+    assert branch.stopped.startswith("reached the end, rub.k_n = 2e+09 N/m") and branch.unit == "N/m"
+    assert np.all(branch.f0 == 10.0)
+    for i in (0, len(branch.values) // 2, len(branch.values) - 1):
+        at = load_scene("paper-rub", {"rub.k_n": float(branch.values[i])})
+        assert _residual(at, model, branch.z[i]) < 1e-9
+    assert branch.peaks[-1, 0] < branch.peaks[0, 0]
+
+
 def test_stability_changes_are_classified_by_the_critical_multiplier():
     """A multiplier leaving the unit circle near -1 is a period-doubling, near +1 a fold, elsewhere a Neimark-Sacker;
     no change, no report."""

@@ -1,8 +1,9 @@
 """``rotorred continue SCENE --param KEY=START:STOP --out DIR``: a branch of the rub response by harmonic balance.
 
 Follows the periodic response of the scene (commensurate speeds, rub plates) by pseudo-arclength continuation in
-``rub.clearance`` (m) or a spool speed ``speeds.<spool>`` (Hz, the speed ratio kept), through its folds, with each
-point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key,
+``rub.clearance`` (m), a spool speed ``speeds.<spool>`` (Hz, the speed ratio kept) or a number of the plate
+(``rub.k_n`` its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.PLATE_KEYS``), through its
+folds, with each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key,
 the peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of
 each harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png``
 (peak against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``. An interrupt
@@ -19,14 +20,16 @@ from rotorred.cli.options import out_dir
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "continue", help="follow the rub response by harmonic balance in a key (clearance, speed): folds, stability",
+        "continue", help="follow the rub response by harmonic balance in a key (clearance, speed, plate): folds, stability",
         description="Follow a rub scene's periodic response by harmonic balance with pseudo-arclength continuation in "
-                    "rub.clearance (m) or speeds.<spool> (Hz, the speed ratio kept), through its folds, with each "
+                    "rub.clearance (m), speeds.<spool> (Hz, the speed ratio kept) or a plate number (rub.k_n N/m, "
+                    "rub.K_nr, rub.mu_d, ...), through its folds, with each "
                     "point's stability; write the branch as CSV and NetCDF and plot it. Example: rotorred continue "
                     "paper-rub --param rub.clearance=20e-6:5e-6 --out branch")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file (with rub plates)")
     p.add_argument("--param", required=True, metavar="KEY=START:STOP",
-                   help="the key and its first and last value (scene units: m for rub.clearance, Hz for speeds)")
+                   help="the key and its first and last value (scene units: m for rub.clearance, Hz for speeds, "
+                        "N/m for rub.k_n ...)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
     p.add_argument("--harmonics", type=int, default=50, help="harmonics of the base frequency f_0 (default 50)")
     p.add_argument("--samples", type=int, default=1024, help="AFT samples a period, even (default 1024)")
@@ -41,7 +44,8 @@ def _param(text: str) -> tuple[str, float, float]:
     key, sep, values = text.partition("=")
     parts = values.split(":")
     if not sep or len(parts) != 2:
-        checks.fail("--param", text, "must be KEY=START:STOP, e.g. rub.clearance=20e-6:5e-6 or speeds.outer=85:95")
+        checks.fail("--param", text, "must be KEY=START:STOP, e.g. rub.clearance=20e-6:5e-6, speeds.outer=85:95 or "
+                    "rub.k_n=1e8:1e9")
     try:
         start, stop = float(parts[0]), float(parts[1])
     except ValueError:
@@ -69,7 +73,7 @@ def run(args) -> int:
         checks.fail("--samples", N, "must be even")
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
-    check_key(scene, key, start)
+    check_key(scene, key, start, stop)
     model = build_model(scene).model
     print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,

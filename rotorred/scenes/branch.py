@@ -6,10 +6,16 @@ Keys (:data:`KEYS`):
 - ``rub.clearance`` (m): the clearance of the scene's plate, at its speeds (:class:`ClearanceFamily`, analytic
   dR/dclearance);
 - ``speeds.<spool>`` (Hz): that spool's speed, every other spool's scaled with it (the scene's speed ratio kept, so
-  the base frequency ``f_0`` moves with the speed and each spool stays at its harmonic of it). The problem is built
-  again at each speed (the model's speed-dependent matrices, the unbalance forcing, the rim speed) and dR/dspeed is a
-  central difference of the residual (a step of 1e-6 of the speed: the tangent and the folds need no more). The
-  speed is carried scaled, in metres like the unknowns, so that the arclength weighs both alike.
+  the base frequency ``f_0`` moves with the speed and each spool stays at its harmonic of it);
+- ``rub.<number>`` (:data:`PLATE_KEYS`): a number of the plate, its supports' stiffness ``k_n`` (N/m), its contact
+  stiffness ``K_nr`` (N/m^1.5), friction ``mu_d`` ... at the scene's speeds.
+
+For the last two (:class:`SceneFamily`) the problem is built again at each value (the model's speed-dependent
+matrices, the unbalance forcing, the rim speed; the plate's DOFs and law) and dR/dvalue is a central difference of
+the residual (a step of 1e-6 of the value: the tangent and the folds need no more). The value is carried scaled, in
+metres like the unknowns, so that the arclength weighs both alike. The speed ratio itself is not a key: between two
+commensurate ratios the response is quasi-periodic, on a torus (:mod:`rotorred.scenes.torus_balance`), not a
+periodic branch.
 
 The first point is found cold (:func:`cold_start`): Newton from the linear response; where that fails (the linear
 orbit goes deep into the plate), a continuation in the clearance from where the linear orbit just reaches the plate
@@ -32,12 +38,16 @@ from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
 
-__all__ = ["KEYS", "SpeedFamily", "SceneBranch", "check_key", "cold_start", "continue_scene"]
+__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene"]
 
+#: the plate's numbers a branch follows besides its clearance, and their units: the supports' (Eq. 7), the law's
+#: (Eq. 8) and the rim's; not mu_s (harmonic balance sees sliding only) nor the bending model's (a fitted whole)
+PLATE_KEYS = {"rub.k_n": "N/m", "rub.k_t": "N/m", "rub.c_n": "N s/m", "rub.c_t": "N s/m", "rub.m_p": "kg",
+              "rub.K_nr": "N/m^1.5", "rub.c": "s/m", "rub.mu_d": "-", "rub.disk_radius": "m"}
 #: the keys a branch follows, and their units
-KEYS = {"rub.clearance": "m", "speeds.<spool>": "Hz"}
-#: the relative step of the central difference in dR/dspeed
-SPEED_STEP = 1e-6
+KEYS = {"rub.clearance": "m", "speeds.<spool>": "Hz", **PLATE_KEYS}
+#: the relative step of the central difference in dR/dvalue
+STEP = 1e-6
 #: intervals of the monodromy product a sample interval of the AFT: the rig's orbit reached by continuation at 13 um
 #: (H = 100, N = 2048) has its largest multiplier 0.780, 1.034, 0.640, 0.698, 0.674, 0.676, 0.679, 0.678 with 256 to
 #: 32768 intervals a period: settled from 4 N (the transient's orbit: 0.773 to 0.662, settled from 1024)
@@ -45,65 +55,78 @@ STABILITY_SUBSTEPS = 4
 
 
 @dataclass(frozen=True)
-class SpeedFamily:
-    """The rub problem of ``scene`` along the speed of ``spool`` (Hz), every spool scaled with it.
+class SceneFamily:
+    """The rub problem of ``scene`` along a scene ``key``: ``speeds.<spool>`` (Hz, every spool scaled with it) or a
+    number of the (first) plate, ``rub.<number>`` (:data:`PLATE_KEYS`).
 
     Parameters
     ----------
     scene : Scene
     model : SystemMatrices or ReducedSystem
-    spool : str
+    key : str
     H, N : int
-    reference_hz : float
-        The speed (Hz) that sets the scale of the carried parameter ``s = scale f``: ``scale`` (m per Hz) is the
-        norm of the linear response there over that speed (:meth:`parameter_value` gives f back).
+    reference : float
+        The value (in the key's unit) that sets the scale of the carried parameter ``s = scale value``: ``scale``
+        (m per unit) is the norm of the linear response there over that value (:meth:`parameter_value` gives the
+        value back).
     """
 
     scene: object
     model: object
-    spool: str
+    key: str
     H: int
     N: int
-    reference_hz: float
+    reference: float
     _problems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        if self.spool not in self.scene.speeds:
-            checks.fail("spool", self.spool, f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
-        checks.positive("reference_hz", self.reference_hz, "Hz")
-        object.__setattr__(self, "parameter", (f"speeds.{self.spool}", "Hz"))
-        f = self.scene.frequencies_hz
-        object.__setattr__(self, "_orders", base_frequency(tuple(f.values())) / f[self.spool])  # f_0 per Hz
-        rp = self.at(self.reference_hz)
+        group, _, name = self.key.partition(".")
+        if group == "speeds" and name not in self.scene.speeds:
+            checks.fail("key", self.key, f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
+        checks.positive("reference", self.reference, KEYS.get(self.key, "Hz"))
+        object.__setattr__(self, "parameter", (self.key, KEYS.get(self.key, "Hz")))
+        if group == "speeds":
+            f = self.scene.frequencies_hz
+            object.__setattr__(self, "_orders", base_frequency(tuple(f.values())) / f[name])  # f_0 per Hz
+        rp = self.at(self.reference)
         object.__setattr__(self, "scale", float(np.linalg.norm(rp.problem.linear_response(rp.omega)))
-                           / self.reference_hz)
+                           / self.reference)
 
     def parameter_value(self, s: float) -> float:
-        """The spool speed (Hz) of the carried parameter ``s``."""
+        """The key's value of the carried parameter ``s``."""
         return s / self.scale
 
-    def at(self, f_hz: float) -> RubProblem:
-        """The rub problem with ``spool`` at ``f_hz`` (the last few kept: Newton and its differences revisit them)."""
-        key = float(f_hz)
-        if key not in self._problems:
-            factor = key / self.scene.frequencies_hz[self.spool]
-            scene = dataclasses.replace(self.scene, speeds={s: w * factor for s, w in self.scene.speeds.items()})
+    def at(self, value: float) -> RubProblem:
+        """The rub problem at ``value`` (the last few kept: Newton and its differences revisit them)."""
+        value = float(value)
+        if value not in self._problems:
             if len(self._problems) >= 6:
                 self._problems.pop(next(iter(self._problems)))
-            self._problems[key] = rub_problem(scene, self.model, self.H, self.N, f0=key * self._orders)
-        return self._problems[key]
+            scene, f0 = self._scene_at(value)
+            self._problems[value] = rub_problem(scene, self.model, self.H, self.N, f0=f0)
+        return self._problems[value]
+
+    def _scene_at(self, value: float):
+        """The scene at ``value``, and the base frequency (Hz) to build it with (None: the speeds' own)."""
+        group, _, name = self.key.partition(".")
+        if group == "speeds":
+            factor = value / self.scene.frequencies_hz[name]
+            scene = dataclasses.replace(self.scene, speeds={s: w * factor for s, w in self.scene.speeds.items()})
+            return scene, value * self._orders
+        plates = (self.scene.plates[0].with_(**{name: value}),) + tuple(self.scene.plates[1:])
+        return dataclasses.replace(self.scene, plates=plates), None
 
     @property
     def n(self) -> int:
-        return self.at(self.reference_hz).problem.n
+        return self.at(self.reference).problem.n
 
     @property
     def size(self) -> int:
-        return self.at(self.reference_hz).problem.size
+        return self.at(self.reference).problem.size
 
     @property
     def harmonics(self):
-        return self.at(self.reference_hz).problem.harmonics
+        return self.at(self.reference).problem.harmonics
 
     def linear_response(self, s: float) -> np.ndarray:
         rp = self.at(s / self.scale)
@@ -114,7 +137,7 @@ class SpeedFamily:
         rp = self.at(f)
 
         def dR_ds():
-            h = SPEED_STEP * f
+            h = STEP * f
             up, down = self.at(f + h), self.at(f - h)
             return (up.problem.evaluate(z, up.omega).R - down.problem.evaluate(z, down.omega).R) / (2 * h * self.scale)
         return rp.problem.evaluate(z, rp.omega).with_parameter(dR_ds)
@@ -127,7 +150,7 @@ class SceneBranch:
     Attributes
     ----------
     key, unit : str
-        The varied scene key and its unit ("m" or "Hz").
+        The varied scene key and its unit (:data:`KEYS`).
     values : ndarray, shape (p,)
         The key at each point.
     f0 : ndarray, shape (p,)
@@ -200,17 +223,21 @@ class SceneBranch:
         return self.stopped.startswith("interrupted")
 
 
-def check_key(scene, key: str, start: float) -> None:
+def check_key(scene, key: str, start: float, end: float | None = None) -> None:
     """Refuse, before anything is computed, a key the branch cannot follow in ``scene`` (:data:`KEYS`), a scene
-    without a plate, and speeds that are not commensurate at ``start`` (for a speed key) or now."""
+    without a plate, speeds that are not commensurate at ``start`` (for a speed key) or now, and a plate's number the
+    plate refuses at ``start`` or ``end``."""
     if not scene.plates:
         checks.fail("SCENE", scene.name, "must have a rub plate ([[rub]]): the branch is of the rub response")
     spools = tuple(scene.speeds)
-    allowed = ("rub.clearance",) + tuple(f"speeds.{s}" for s in spools)
+    allowed = ("rub.clearance",) + tuple(f"speeds.{s}" for s in spools) + tuple(PLATE_KEYS)
     if key not in allowed:
         checks.fail("--param", key, f"must be one of {', '.join(allowed)}")
-    if key == "rub.clearance" and len(scene.plates) != 1:
+    if key.startswith("rub.") and len(scene.plates) != 1:
         checks.fail("--param", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
+    if key in PLATE_KEYS:
+        for value in (start,) + (() if end is None else (end,)):
+            scene.plates[0].with_(**{key.partition(".")[2]: value})  # the plate's own check, naming the field
     f = scene.frequencies_hz
     factor = start / f[key.partition(".")[2]] if key.startswith("speeds.") else 1.0
     base_frequency(tuple(v * factor for v in f.values()))
@@ -253,9 +280,9 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     model : SystemMatrices or ReducedSystem
         The scene's model (:func:`rotorred.scenes.run.build_model`).
     key : str
-        ``rub.clearance`` or ``speeds.<spool>`` (:data:`KEYS`).
+        ``rub.clearance``, ``speeds.<spool>`` or a plate's number ``rub.<number>`` (:data:`KEYS`).
     start, end : float
-        The key's first and last value (m or Hz).
+        The key's first and last value (in its unit, :data:`KEYS`).
     H, N : int
         Harmonics of f_0 and AFT samples a period.
     tol : float
@@ -270,7 +297,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     -------
     SceneBranch
     """
-    family, to_value, rub_at = _family(scene, model, key, start, H, N)
+    family, to_value, rub_at = _family(scene, model, key, start, end, H, N)
     t0 = time.perf_counter()
     first = rub_at(start)
     z0 = cold_start(first.problem, first.omega, tol)
@@ -285,20 +312,20 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     dofs = _output_dofs(scene)
     f0, peaks, lines, critical, stability_time = _points(rub_at, values, branch.z, dofs,
                                                          stability and "interrupted" not in branch.stopped, progress)
-    return SceneBranch(key, "m" if key == "rub.clearance" else "Hz", values, f0, dofs, peaks, branch.z, lines,
+    return SceneBranch(key, KEYS.get(key, "Hz"), values, f0, dofs, peaks, branch.z, lines,
                        critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
                        branch.iterations, t1 - t0, t2 - t1, stability_time)
 
 
-def _family(scene, model, key: str, start: float, H: int, N: int):
+def _family(scene, model, key: str, start: float, end: float, H: int, N: int):
     """The continuation family of ``key``, the map from its carried parameter to the key's value (``inverse``: back),
     and ``rub_at(value) -> RubProblem``."""
-    check_key(scene, key, start)
+    check_key(scene, key, start, end)
     if key == "rub.clearance":
         rp = rub_problem(scene, model, H, N)
         family = ClearanceFamily(rp.problem, rp.omega)
         return family, (lambda v, inverse=False: v), (lambda v: dataclasses.replace(rp, problem=family.at(v)))
-    family = SpeedFamily(scene, model, key.partition(".")[2], H, N, start)
+    family = SceneFamily(scene, model, key, H, N, start)
     scale = family.scale
     return family, (lambda v, inverse=False: v * scale if inverse else v / scale), family.at
 

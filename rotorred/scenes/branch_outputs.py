@@ -10,8 +10,8 @@ __all__ = ["format_branch", "branch_dataset", "write_branch"]
 
 
 def _scale(branch) -> tuple[float, str]:
-    """The key's plotted scale and unit: a clearance in µm, a speed in Hz."""
-    return (1e6, "µm") if branch.unit == "m" else (1.0, "Hz")
+    """The key's shown scale and unit: a clearance in µm, any other key in its own unit (Hz, N/m, ...)."""
+    return (1e6, "µm") if branch.key == "rub.clearance" else (1.0, branch.unit)
 
 
 def _dof_name(dof) -> str:
