@@ -79,6 +79,27 @@ def test_a_branch_in_the_plates_stiffness_solves_the_scene_at_each_stiffness(rig
     assert branch.peaks[-1, 0] < branch.peaks[0, 0]
 
 
+def test_a_value_the_plate_refuses_is_no_solution_not_a_crash(rig):
+    """Along rub.mu_d (bounded by mu_s = 0.2): past the bound the family has no problem, an infinite residual (a failed
+    step for the corrector, which keeps its points), a Jacobian that raises LinAlgError and a NaN linear response;
+    at the bound itself dR/dmu_d is one-sided and equals the central difference a hair inside (measured 7.4e-10
+    relative: both are differences with a step of 1e-6)."""
+    from scipy.linalg import LinAlgError
+
+    from rotorred.scenes.branch import SceneFamily
+
+    scene, model = rig
+    family = SceneFamily(scene, model, "rub.mu_d", H, N, 0.15)
+    z = family.linear_response(0.15 * family.scale)
+    past = family.evaluate(z, 0.25 * family.scale)
+    assert past.relative == np.inf and np.isnan(family.linear_response(0.25 * family.scale)).all()
+    with pytest.raises(LinAlgError):
+        past.dR_dz
+    at_bound = family.evaluate(z, 0.2 * family.scale).dR_domega
+    inside = family.evaluate(z, 0.2 * (1 - 1e-5) * family.scale).dR_domega
+    assert np.linalg.norm(at_bound - inside) < 7e-9 * np.linalg.norm(inside)
+
+
 def test_stability_changes_are_classified_by_the_critical_multiplier():
     """A multiplier leaving the unit circle near -1 is a period-doubling, near +1 a fold, elsewhere a Neimark-Sacker;
     no change, no report."""

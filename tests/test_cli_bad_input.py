@@ -104,6 +104,7 @@ CASES = [
     (["continue", "paper-rub", "--param", "rub.clearance=20e-6", "--out", "{d}/o"], ["--param", "KEY=START:STOP"]),
     (["continue", "paper-rub", "--param", "rub.clearance=2e-5:2e-5", "--out", "{d}/o"], ["--param", "different"]),
     (["continue", "paper-rub", "--param", "rub.mu_s=0.1:0.2", "--out", "{d}/o"], ["--param", "rub.mu_s", "rub.k_n"]),
+    (["continue", "paper-rub", "--param", "rub.mu_d=0.15:0.2", "--out", "{d}/o"], ["--param", "room", "mu_s = 0.2"]),
     (["continue", "paper-rub", "--param", "speeds.middle=80:90", "--out", "{d}/o"], ["speeds.middle", "inner"]),
     (["continue", "paper-normal", "--param", "rub.clearance=2e-5:1e-5", "--out", "{d}/o"], ["SCENE", "rub plate"]),
     (["continue", "paper-rub", "--param", "rub.clearance=2e-5:1e-5", "--samples", "1023", "--out", "{d}/o"],

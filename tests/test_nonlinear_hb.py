@@ -143,6 +143,19 @@ def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
     assert branch.stopped.startswith("reached the end")
 
 
+def test_a_branch_that_comes_back_onto_its_path_stops_there():
+    """The Jeffcott rotor started with ds = 0.11 (0.1 in the test above) goes round its fold and corner and back onto
+    the free branch it started on: the branch stops where it meets its own path, saying so, after one loop (320
+    points), where it went round 15 times until max_points = 5000 before."""
+    problem = jeffcott(5, 128)
+    z0 = np.zeros(problem.size)
+    z0[2] = z0[5] = E_UNB * 0.25 / (1 - 0.25)
+    branch = continue_branch(problem, z0, 0.5, 12.0, ds=0.11, ds_max=0.5, stability=False)
+    assert branch.stopped.startswith("the branch came back onto its own path at omega = ")
+    assert "a closed loop, followed once" in branch.stopped and len(branch.omega) < 400
+    assert [f.smooth for f in branch.folds] == [True, False]
+
+
 def test_a_point_that_does_not_converge_says_so():
     """Newton stopped short raises NotConverged naming omega, the residual and the iterations; no solution is
     returned."""

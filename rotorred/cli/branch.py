@@ -1,13 +1,13 @@
 """``rotorred continue SCENE --param KEY=START:STOP --out DIR``: a branch of the rub response by harmonic balance.
 
 Follows the periodic response of the scene (commensurate speeds, rub plates) by pseudo-arclength continuation in
-``rub.clearance`` (m), a spool speed ``speeds.<spool>`` (Hz, the speed ratio kept) or a number of the plate
-(``rub.k_n`` its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.PLATE_KEYS``), through its
-folds, with each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key,
-the peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of
-each harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png``
-(peak against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``. An interrupt
-keeps the points so far (written, marked INCOMPLETE; exit 130).
+``rub.clearance`` (m), a spool speed ``speeds.<spool>`` (Hz, the speed ratio kept) or a number of the plate (``rub.k_n``
+its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.PLATE_KEYS``), through its folds, with
+each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key, the
+peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of each
+harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png`` (peak
+against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``. An interrupt keeps the
+points so far (written, marked INCOMPLETE; exit 130).
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ from rotorred.cli.options import out_dir
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "continue", help="follow the rub response by harmonic balance in a key (clearance, speed, plate): folds, stability",
+        "continue",
+        help="follow the rub response by harmonic balance in a key (clearance, speed, plate): folds, stability",
         description="Follow a rub scene's periodic response by harmonic balance with pseudo-arclength continuation in "
                     "rub.clearance (m), speeds.<spool> (Hz, the speed ratio kept) or a plate number (rub.k_n N/m, "
                     "rub.K_nr, rub.mu_d, ...), through its folds, with each "
@@ -44,7 +45,7 @@ def _param(text: str) -> tuple[str, float, float]:
     key, sep, values = text.partition("=")
     parts = values.split(":")
     if not sep or len(parts) != 2:
-        checks.fail("--param", text, "must be KEY=START:STOP, e.g. rub.clearance=20e-6:5e-6, speeds.outer=85:95 or "
+        checks.fail("--param", text, "must be KEY=START:STOP, e.g. rub.clearance=20e-6:5e-6, speeds.outer=90:95 or "
                     "rub.k_n=1e8:1e9")
     try:
         start, stop = float(parts[0]), float(parts[1])

@@ -1,13 +1,14 @@
 """Pseudo-arclength continuation of periodic solutions in the response frequency omega, with folds located.
 
 The branch is a curve ``y(s) = (z(s), omega(s))`` with ``R(z, omega) = 0`` (:mod:`rotorred.nonlinear.hb`).
-From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the
-previous one), the predictor steps ``ds`` along the tangent, or with ``curved`` along the branch to second order,
+From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]``, oriented along the previous one),
+the predictor steps ``ds`` along the tangent, or with ``curved`` along the branch to second order,
 ``y + ds t + ds^2 / 2 kappa`` (``kappa`` the change of ``t`` from the previous point over the chord); the corrector is
-Newton's method on ``R = 0`` together with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the tangent), each step shortened
-until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at most 4 iterations, up
-to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it and retries
-from the same point, down to ``ds_min``, where the branch stops and says where and why.
+Newton's method on ``R = 0`` together with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the
+tangent), each step shortened until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at
+most 4 iterations, up to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it
+and retries from the same point, down to ``ds_min``, where the branch stops and says where and why; a branch that comes
+back onto its own path stops there (:func:`_retraced`).
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
@@ -142,6 +143,8 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     z, _, it = solve(problem, z0, omega_start, tol=tol)
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
+    path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
+    path[0] = first.y
     while len(points) < max_points:
         try:
             if progress is not None:
@@ -159,6 +162,12 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         points.append(nxt)
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
             break
+        path[len(points) - 1] = nxt.y
+        again = _retraced(path[:len(points)], nxt.t)
+        if again is not None:
+            stopped = (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
+                       f"{again} to {again + 1} of {len(points)}): a closed loop, followed once")
+            break
         if direction * (nxt.y[-1] - omega_start) < 0.0:
             stopped = (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
                        f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
@@ -166,6 +175,28 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     else:
         stopped = f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
     return _branch(problem, points, folds, stopped, stability)
+
+
+def _retraced(Y: np.ndarray, t: np.ndarray) -> int | None:
+    """The index j of an earlier segment [y_j, y_j+1] of the path ``Y`` (p, size + 1) its last point lies on, going
+    the same way (the unit tangent ``t`` there within
+    about 18 degrees of the segment's), after a path of more than 20 times that segment or step since, or None: the
+    branch retracing itself. On the segment means within a quarter of the larger of the segment and the last step (a
+    chord leaves its arc by L^2 kappa / 8); the path since keeps the creeping steps at a corner, on one line, apart. A
+    branch that closes on
+    itself (an isola, or a corner that led back onto a part traced) would otherwise go round until max_points: the
+    Jeffcott rotor with ds = 0.11 went round its fold-corner loop 15 times."""
+    if len(Y) < 5:
+        return None
+    last, step = Y[-1], float(np.linalg.norm(Y[-1] - Y[-2]))
+    A, AB = Y[:-4], Y[1:-3] - Y[:-4]
+    length = np.linalg.norm(AB, axis=1)
+    travelled = np.cumsum(np.linalg.norm(np.diff(Y, axis=0), axis=1)[::-1])[::-1][1:-2]  # from each segment's end
+    u = np.clip(np.einsum("ij,ij->i", last - A, AB) / np.where(length > 0, length**2, 1.0), 0.0, 1.0)
+    distance = np.linalg.norm(last - (A + u[:, None] * AB), axis=1)
+    scale = np.maximum(length, step)
+    near = np.flatnonzero((AB @ t > 0.95 * length) & (distance < 0.25 * scale) & (travelled > 20.0 * scale))
+    return int(near[0]) if len(near) else None
 
 
 def _at(problem, value: float) -> str:
@@ -208,6 +239,8 @@ def _correct(problem, y_pred, t, tol, max_iter: int = 20):
     tangent is the one of the last Jacobian (the iterate a Newton step before, solved with its factors)."""
     y = y_pred.copy()
     ev = problem.evaluate(y[:-1], y[-1])
+    if not np.isfinite(ev.relative):  # no problem there (a family's value refused): a failed step
+        return None
     for it in range(max_iter):
         try:
             matrix = bordered(ev.dR_dz, ev.dR_domega, t)

@@ -4,7 +4,7 @@ A contact acts on a small part of the period, so the Jacobian of its force coeff
 products ``U V^T``, one term a contact sample (:mod:`rotorred.nonlinear.sampled`). The condensed Jacobian
 ``I + G U V^T`` (:mod:`rotorred.nonlinear.condensed`) is then solved through the Woodbury identity, with an LU of the
 small ``I + V^T G U`` (r x r, r the contact samples) in place of the size^3 one: at the rig's H = 100, N = 2048, r is
-90-180 against a size of 804. Both forms solve the bordered systems of the continuation ``[[A, r], [t^T, tau]]`` (a
+90-200 against a size of 804. Both forms solve the bordered systems of the continuation ``[[A, r], [t^T, tau]]`` (a
 rank-two update more). Singular matrices raise ``LinAlgError``."""
 
 from __future__ import annotations
@@ -44,9 +44,9 @@ class Dense:
 
 @dataclass(frozen=True)
 class Factor:
-    """A factor F (n, r) of a low-rank product, by its action on matrices: ``times(Y) = F Y`` for Y (r, k) and
-    ``t_times(X) = F^T X`` for X (n, k). An array is one (:meth:`of`); so are factors never formed
-    (:class:`rotorred.nonlinear.sampled.SampledFactors`). Not scipy's ``LinearOperator``: its checks on every product
+    """A factor F (n, r) of a low-rank product, by its action on matrices (2-D only; :class:`IdentityPlusLowRank`
+    takes vectors): ``times(Y) = F Y`` for Y (r, k) and ``t_times(X) = F^T X`` for X (n, k). An array is one
+    (:meth:`of`); so are factors never formed (:class:`rotorred.nonlinear.sampled.SampledFactors`). Not scipy's ``LinearOperator``: its checks on every product
     cost half of a Woodbury solve here (0.11 of 0.23 ms at the rig's H = 100)."""
 
     shape: tuple

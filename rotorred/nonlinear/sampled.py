@@ -191,8 +191,9 @@ def low_rank(h: Harmonics, dq: np.ndarray, dv: np.ndarray, omega: float, max_ran
         return None
     if rank_one:  # every sample rank one (a rub): no SVD
         return SampledFactors(h, at, L, R)
-    u, s, vh = np.linalg.svd(np.concatenate([dq[at], omega * dv[at]], axis=2), full_matrices=False)  # (a, m, m),
-    j, i = np.nonzero(s > rtol * s[:, :1])  # (a, m), (a, m, 2m)
+    M = np.concatenate([dq[at], omega * dv[at]], axis=2)  # (a, m, 2m)
+    u, s, vh = np.linalg.svd(M, full_matrices=False)  # (a, m, m), (a, m), (a, m, 2m)
+    j, i = np.nonzero(s > rtol * s[:, :1])
     if len(j) > max_rank:
         return None
     return SampledFactors(h, at[j], u[j, :, i] * s[j, i][:, None], vh[j, i, :])

@@ -30,6 +30,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import ClearanceFamily
@@ -38,7 +39,7 @@ from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
 
-__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene"]
+__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "scene_at"]
 
 #: the plate's numbers a branch follows besides its clearance, and their units: the supports' (Eq. 7), the law's
 #: (Eq. 8) and the rim's; not mu_s (harmonic balance sees sliding only) nor the bending model's (a fitted whole)
@@ -85,9 +86,6 @@ class SceneFamily:
             checks.fail("key", self.key, f"must name a spool of the rotor ({', '.join(self.scene.speeds)})")
         checks.positive("reference", self.reference, KEYS.get(self.key, "Hz"))
         object.__setattr__(self, "parameter", (self.key, KEYS.get(self.key, "Hz")))
-        if group == "speeds":
-            f = self.scene.frequencies_hz
-            object.__setattr__(self, "_orders", base_frequency(tuple(f.values())) / f[name])  # f_0 per Hz
         rp = self.at(self.reference)
         object.__setattr__(self, "scale", float(np.linalg.norm(rp.problem.linear_response(rp.omega)))
                            / self.reference)
@@ -102,19 +100,9 @@ class SceneFamily:
         if value not in self._problems:
             if len(self._problems) >= 6:
                 self._problems.pop(next(iter(self._problems)))
-            scene, f0 = self._scene_at(value)
+            scene, f0 = scene_at(self.scene, self.key, value)
             self._problems[value] = rub_problem(scene, self.model, self.H, self.N, f0=f0)
         return self._problems[value]
-
-    def _scene_at(self, value: float):
-        """The scene at ``value``, and the base frequency (Hz) to build it with (None: the speeds' own)."""
-        group, _, name = self.key.partition(".")
-        if group == "speeds":
-            factor = value / self.scene.frequencies_hz[name]
-            scene = dataclasses.replace(self.scene, speeds={s: w * factor for s, w in self.scene.speeds.items()})
-            return scene, value * self._orders
-        plates = (self.scene.plates[0].with_(**{name: value}),) + tuple(self.scene.plates[1:])
-        return dataclasses.replace(self.scene, plates=plates), None
 
     @property
     def n(self) -> int:
@@ -129,18 +117,38 @@ class SceneFamily:
         return self.at(self.reference).problem.harmonics
 
     def linear_response(self, s: float) -> np.ndarray:
-        rp = self.at(s / self.scale)
-        return rp.problem.linear_response(rp.omega)
+        """The linear response at the carried value ``s``; NaN where the plate refuses the value (no problem there:
+        Newton from it fails, as at :meth:`evaluate`)."""
+        rp = self._valid(s / self.scale)
+        return np.full(self.size, np.nan) if rp is None else rp.problem.linear_response(rp.omega)
 
     def evaluate(self, z: np.ndarray, s: float) -> Evaluation:
+        """The residual at ``z`` and the carried value ``s``; where the plate refuses the value (past one of its bounds,
+        mu_d above mu_s), no solution: an infinite residual, which the corrector takes for a failed step (a smaller
+        one follows, and the points so far are kept)."""
         f = s / self.scale
-        rp = self.at(f)
+        rp = self._valid(f)
+        if rp is None:
+            return Evaluation(np.full(len(z), np.inf), 1.0, _refused, _refused)
 
-        def dR_ds():
-            h = STEP * f
-            up, down = self.at(f + h), self.at(f - h)
-            return (up.problem.evaluate(z, up.omega).R - down.problem.evaluate(z, down.omega).R) / (2 * h * self.scale)
+        def dR_ds():  # central, or one-sided at a bound
+            up, down = f * (1.0 + STEP), f * (1.0 - STEP)
+            p_up, p_down = self._valid(up) or rp, self._valid(down) or rp
+            up, down = (up if p_up is not rp else f), (down if p_down is not rp else f)
+            R_up, R_down = (q.problem.evaluate(z, q.omega).R for q in (p_up, p_down))
+            return (R_up - R_down) / ((up - down) * self.scale)
         return rp.problem.evaluate(z, rp.omega).with_parameter(dR_ds)
+
+    def _valid(self, value: float) -> RubProblem | None:
+        """:meth:`at`, or None where the plate refuses ``value``."""
+        try:
+            return self.at(value)
+        except checks.InputError:
+            return None
+
+
+def _refused():
+    raise sla.LinAlgError("no problem at this value: the plate refuses it")
 
 
 @dataclass(frozen=True)
@@ -235,9 +243,17 @@ def check_key(scene, key: str, start: float, end: float | None = None) -> None:
         checks.fail("--param", key, f"must be one of {', '.join(allowed)}")
     if key.startswith("rub.") and len(scene.plates) != 1:
         checks.fail("--param", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
+    for value in (start,) + (() if end is None else (end,)):
+        checks.positive("--param", value, KEYS.get(key, "Hz"))  # the carried parameter is > 0
     if key in PLATE_KEYS:
+        name = key.partition(".")[2]
         for value in (start,) + (() if end is None else (end,)):
-            scene.plates[0].with_(**{key.partition(".")[2]: value})  # the plate's own check, naming the field
+            scene.plates[0].with_(**{name: value})  # the plate's own check, naming the field
+        past = None if end is None else end + 0.01 * (end - start)  # the branch ends at its first point past END
+        try:
+            past is None or scene.plates[0].with_(**{name: past})
+        except checks.InputError as error:
+            checks.fail("--param", end, f"must leave the branch room to pass it ({key} = {past:g} just past it: {error})")
     f = scene.frequencies_hz
     factor = start / f[key.partition(".")[2]] if key.startswith("speeds.") else 1.0
     base_frequency(tuple(v * factor for v in f.values()))
@@ -315,6 +331,20 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     return SceneBranch(key, KEYS.get(key, "Hz"), values, f0, dofs, peaks, branch.z, lines,
                        critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
                        branch.iterations, t1 - t0, t2 - t1, stability_time)
+
+
+def scene_at(scene, key: str, value: float):
+    """``scene`` with ``key`` at ``value``: a spool's speed with every spool scaled with it, or a number of the first
+    plate (``rub.clearance`` and :data:`PLATE_KEYS`); and the base frequency (Hz) to build it with (None: its speeds'
+    own)."""
+    group, _, name = key.partition(".")
+    if group == "speeds":
+        factor = value / scene.frequencies_hz[name]
+        speeds = {s: w * factor for s, w in scene.speeds.items()}
+        f = scene.frequencies_hz
+        return dataclasses.replace(scene, speeds=speeds), value * base_frequency(tuple(f.values())) / f[name]
+    plates = (scene.plates[0].with_(**{name: value}),) + tuple(scene.plates[1:])
+    return dataclasses.replace(scene, plates=plates), None
 
 
 def _family(scene, model, key: str, start: float, end: float, H: int, N: int):

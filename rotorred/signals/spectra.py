@@ -279,6 +279,8 @@ def plan_cache_clear() -> None:
 def rfft(x: np.ndarray) -> np.ndarray:
     """The real FFT of a 1-D record ``x`` (float64 or float32), or of each column of a 2-D one, on its cached plan
     (thread-safe), shape (len(x) // 2 + 1,) + x.shape[1:], complex, unnormalised (numpy's ``rfft`` convention)."""
+    if x.ndim not in (1, 2) or len(x) < 1:
+        checks.fail("x", f"an array of shape {x.shape}", "must be a record (n,) or records side by side (n, k), n >= 1")
     plan, lock = _plan_entry(x.shape, x.dtype)
     with lock:  # the plan owns its input/output arrays; one caller at a time
         # Copy into the plan's own aligned input: calling ``plan(input_array=x)`` would let the
