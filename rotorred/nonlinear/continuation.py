@@ -35,6 +35,12 @@ __all__ = ["Fold", "Branch", "continue_branch"]
 MAX_JUMP = 2.0
 #: the predictor is second order where the tangent turns by at most this (rad) over a step, first order beyond
 MAX_TURN = 0.2
+#: with ``curved``, a corrector iteration must leave at most this fraction of the last residual, else the step is
+#: halved at once: where each correction costs much, a prediction Newton converges from contracts by 1e-2 or more an
+#: iteration, and one that does not (a kink of the branch, where a contact starts or ends) is cheaper to retry shorter
+#: than to iterate on. Not for the tangent predictor's branches: corrections at grazing that creep (0.99 an iteration)
+#: and then converge take the 4-DOF branch of the tests past its corner
+CONTRACTION = 0.5
 #: Newton iterations, and step halvings in each, that a step in omega alone gets at a corner: one that lands near
 #: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
 CORNER_ITERATIONS = 12
@@ -232,7 +238,7 @@ def _unit_along(matrix, guide: np.ndarray) -> np.ndarray:
     return t if t @ guide > 0 else -t
 
 
-def _correct(problem, y_pred, t, tol, max_iter: int = 20):
+def _correct(problem, y_pred, t, tol, max_iter: int = 20, contraction: float | None = None):
     """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``, each step shortened until it lowers the residual (a
     contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its unit tangent, or
     None. An iterate's derivatives are built only if the iteration goes on from it (:class:`Evaluation`): the
@@ -247,8 +253,9 @@ def _correct(problem, y_pred, t, tol, max_iter: int = 20):
             step = matrix.solve(-np.append(ev.R, t @ (y - y_pred)))
         except (sla.LinAlgError, ValueError):
             return None
+        before = ev.relative
         y, ev = _shortened(problem, y, step, ev)
-        if ev is None:
+        if ev is None or (contraction is not None and ev.relative > contraction * before):
             return None
         if ev.relative <= tol:
             return y, it + 1, _unit_along(matrix, t)
@@ -282,7 +289,8 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
     first, cornered = ds, False
     while ds >= ds_min:
         smooth = curved and ds == first and point.clean and previous is not None  # a curvature to predict with
-        done = _arclength(problem, point, previous if smooth else None, ds, tol, clean=ds == first)
+        done = _arclength(problem, point, previous if smooth else None, ds, tol, clean=ds == first,
+                          contraction=CONTRACTION if curved else None)
         if done is not None:
             return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""
         if not cornered and (ds <= first / 64 or ds / 2 < ds_min):
@@ -295,7 +303,8 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
                       f"not converge to a relative residual of {tol:g}, nor a step in omega alone")
 
 
-def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: bool = False):
+def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: bool = False,
+               contraction: float | None = None):
     """The corrected point ``ds`` along the branch, and its iterations, or None (not converged, or a jump).
 
     With a ``previous`` point the prediction is second order, ``y + ds t + ds^2 / 2 kappa``, with the curvature
@@ -310,7 +319,7 @@ def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: 
         kappa = (point.t - previous.t) / np.linalg.norm(point.y - previous.y)
         if ds * np.linalg.norm(kappa) <= MAX_TURN:
             prediction += 0.5 * ds**2 * kappa
-    done = _correct(problem, prediction, point.t, tol)
+    done = _correct(problem, prediction, point.t, tol, contraction=contraction)
     if done is None:
         return None
     y, it, t = done
