@@ -28,10 +28,12 @@ from rotorred.signals.spectra import rfft
 __all__ = ["Harmonics", "basis", "alias_free_samples", "proportional_columns", "to_phasors", "from_phasors"]
 
 #: the cost model that picks the DFT's method, in microseconds for 2 DOFs: the matrix product ``MATRIX_US`` per
-#: term and sample, a pyFFTW plan call ``FFT_US[0] + FFT_US[1] N``. Measured here (2 DOFs): at N = 128 the matrix
-#: takes 2.7-10 us for H = 5-60 and the FFT 38 us; at N = 1024 they cross near H = 30, at N = 4096 near H = 15.
+#: term and sample, one pyFFTW plan call for all the columns ``FFT_US[0] + FFT_US[1] N``. Measured here (2 DOFs,
+#: one thread): at N = 128 the matrix takes 2.5-10 us for H = 5-60 and the FFT 20-21 us; at N = 1024 (23, 42, 80
+#: against 30, 25, 31 us at H = 15, 30, 60) they cross near H = 18, at N = 4096 (42, 86 against 45, 46 us at H = 8,
+#: 15) near H = 8. (A plan call a column, before: 38 + 0.018 N.)
 MATRIX_US = 1.4e-3
-FFT_US = (38.0, 0.018)
+FFT_US = (19.5, 0.0063)
 #: below this N (2H + 1), the Toeplitz matrices are the product forward diag(d) E itself; above, they are built from
 #: d's spectrum (measured per DOF pair set: H = 5, N = 128: 0.05 against 0.19 ms; H = 10, N = 1024: 0.39 against
 #: 0.32; H = 30, N = 256: 6.3 against 1.4; H = 100, N = 2048: 149 against 51)
