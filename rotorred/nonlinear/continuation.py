@@ -150,7 +150,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
-    path[0] = first.y
+    path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
     while len(points) < max_points:
         try:
             if progress is not None:
@@ -169,7 +169,8 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
             break
         path[len(points) - 1] = nxt.y
-        again = _retraced(path[:len(points)], nxt.t)
+        chords[len(points) - 2] = np.linalg.norm(nxt.y - points[-2].y)
+        again = _retraced(path[:len(points)], chords[:len(points) - 1], nxt.t)
         if again is not None:
             stopped = (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
                        f"{again} to {again + 1} of {len(points)}): a closed loop, followed once")
@@ -183,26 +184,29 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     return _branch(problem, points, folds, stopped, stability)
 
 
-def _retraced(Y: np.ndarray, t: np.ndarray) -> int | None:
-    """The index j of an earlier segment [y_j, y_j+1] of the path ``Y`` (p, size + 1) its last point lies on, going
-    the same way (the unit tangent ``t`` there within
-    about 18 degrees of the segment's), after a path of more than 20 times that segment or step since, or None: the
-    branch retracing itself. On the segment means within a quarter of the larger of the segment and the last step (a
-    chord leaves its arc by L^2 kappa / 8); the path since keeps the creeping steps at a corner, on one line, apart. A
-    branch that closes on
-    itself (an isola, or a corner that led back onto a part traced) would otherwise go round until max_points: the
-    Jeffcott rotor with ds = 0.11 went round its fold-corner loop 15 times."""
+def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
+    """The index j of an earlier segment [y_j, y_j+1] of the path ``Y`` (p, size + 1) that its last point lies on,
+    going the same way (the unit tangent ``t`` there within about 18 degrees of the segment), after a path of more than
+    20 times that segment or the last step since, or None: the branch retracing itself. ``chords`` (p - 1,) are the
+    segments' lengths. On the segment means within a quarter of the larger of the segment and the last step (a chord
+    leaves its arc by L^2 kappa / 8); the path since keeps the creeping steps at a corner, on one line, apart. A branch
+    that closes on itself (an isola, or a corner that led back onto a part traced) would otherwise go round until
+    max_points: the Jeffcott rotor with ds = 0.11 went round its fold-corner loop 15 times.
+
+    Only the segments whose parameter range comes within that distance of the last point's parameter are measured in
+    full (a lower bound of the distance, O(p)): the check costs O(p), not O(p size), a point."""
     if len(Y) < 5:
         return None
-    last, step = Y[-1], float(np.linalg.norm(Y[-1] - Y[-2]))
-    A, AB = Y[:-4], Y[1:-3] - Y[:-4]
-    length = np.linalg.norm(AB, axis=1)
-    travelled = np.cumsum(np.linalg.norm(np.diff(Y, axis=0), axis=1)[::-1])[::-1][1:-2]  # from each segment's end
+    last, step, k = Y[-1], chords[-1], len(Y) - 4  # segments 0 .. k - 1: all but the last three
+    scale = np.maximum(chords[:k], step)
+    travelled = np.sum(chords) - np.cumsum(chords[:k])  # from each segment's end to the last point
+    lo, hi = np.minimum(Y[:k, -1], Y[1:k + 1, -1]), np.maximum(Y[:k, -1], Y[1:k + 1, -1])
+    j = np.flatnonzero((travelled > 20.0 * scale) & (last[-1] > lo - 0.25 * scale) & (last[-1] < hi + 0.25 * scale))
+    A, AB, length = Y[j], Y[j + 1] - Y[j], chords[j]
     u = np.clip(np.einsum("ij,ij->i", last - A, AB) / np.where(length > 0, length**2, 1.0), 0.0, 1.0)
     distance = np.linalg.norm(last - (A + u[:, None] * AB), axis=1)
-    scale = np.maximum(length, step)
-    near = np.flatnonzero((AB @ t > 0.95 * length) & (distance < 0.25 * scale) & (travelled > 20.0 * scale))
-    return int(near[0]) if len(near) else None
+    on = j[(AB @ t > 0.95 * length) & (distance < 0.25 * scale[j])]
+    return int(on[0]) if len(on) else None
 
 
 def _at(problem, value: float) -> str:

@@ -20,8 +20,8 @@ from numba import njit
 
 from rotorred import checks
 from rotorred.transient import numba_cache
-from rotorred.transient.contact import RubPlate, disk_force, sliding_velocity
-from rotorred.transient.contact_solve import compiled_normal_root
+from rotorred.transient.contact import RubPlate, sliding_velocity
+from rotorred.transient.contact_solve import compiled_disk_force, compiled_normal_root
 
 numba_cache.register()
 
@@ -158,8 +158,6 @@ class PlateRub:
     clearance_dof = 2
 
 
-_disk_force = njit(cache=True)(disk_force)
-
 
 @njit(cache=True)
 def _plate_rub(penetration, rate, slip, grad, mu_d, law, f, dq, dv):
@@ -185,7 +183,7 @@ def _plate_rub(penetration, rate, slip, grad, mu_d, law, f, dq, dv):
             continue
         P, dP_dp, dP_drate = compiled_normal_root(penetration[j], rate[j], law[0], law[1], law[2], law[3], law[4])
         T_per_P = -mu_d * slip[j]
-        fx, fy = _disk_force(1.0, T_per_P, grad[0], grad[1])
+        fx, fy = compiled_disk_force(1.0, T_per_P, grad[0], grad[1])
         per[0], per[1], per[2], per[3] = -fx, -fy, -1.0, T_per_P
         for a in range(4):
             f[j, a] = per[a] * P

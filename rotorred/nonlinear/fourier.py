@@ -166,16 +166,12 @@ class Harmonics:
 
     def rates(self, z: np.ndarray, n: int) -> np.ndarray:
         """``dq/dtheta (theta_j)``, shape (N, n): multiply by omega for dq/dt."""
-        return self.synthesised(self.nabla @ z.reshape(self.size, n))
+        return self.synthesised(self.derivative(z, n).reshape(self.size, n))
 
     def motion(self, z: np.ndarray, n: int, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and velocities ``q(theta_j)``, ``omega dq/dtheta (theta_j)``, shape (N, n) each, of the
         harmonic-major coefficients ``z`` of ``n`` DOFs at frequency ``omega`` (rad/s): one synthesis of both."""
-        Z = z.reshape(self.size, n)
-        both = np.zeros((self.size, 2 * n))
-        k = np.arange(1, self.H + 1)[:, None]
-        both[:, :n], both[1::2, n:], both[2::2, n:] = Z, k * Z[2::2], -k * Z[1::2]  # nabla Z: (a_k, b_k)' = k (b_k, -a_k)
-        both = self.synthesised(both)
+        both = self.synthesised(np.hstack([z.reshape(self.size, n), self.derivative(z, n).reshape(self.size, n)]))
         return both[:, :n], omega * both[:, n:]
 
     def synthesised(self, Z: np.ndarray) -> np.ndarray:
@@ -190,8 +186,12 @@ class Harmonics:
         return np.fft.irfft(X, n=self.N, axis=0)
 
     def derivative(self, z: np.ndarray, n: int) -> np.ndarray:
-        """The harmonic-major coefficients of dq/dtheta, ``(nabla (x) I_n) z``, shape ((2H + 1) n,)."""
-        return (self.nabla @ z.reshape(self.size, n)).reshape(-1)
+        """The harmonic-major coefficients of dq/dtheta, ``(nabla (x) I_n) z``, shape ((2H + 1) n,): (a_k, b_k)' =
+        k (b_k, -a_k), written out (not the dense product with ``nabla``)."""
+        Z, out = z.reshape(self.size, n), np.zeros((self.size, n))
+        k = np.arange(1, self.H + 1)[:, None]
+        out[1::2], out[2::2] = k * Z[2::2], -k * Z[1::2]
+        return out.reshape(-1)
 
     def times_derivative(self, X: np.ndarray, n: int) -> np.ndarray:
         """``X (nabla (x) I_n)`` for X of shape (p, (2H + 1) n): a permutation and scaling of X's columns,

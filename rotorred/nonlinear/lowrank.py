@@ -46,8 +46,9 @@ class Dense:
 class Factor:
     """A factor F (n, r) of a low-rank product, by its action on matrices (2-D only; :class:`IdentityPlusLowRank`
     takes vectors): ``times(Y) = F Y`` for Y (r, k) and ``t_times(X) = F^T X`` for X (n, k). An array is one
-    (:meth:`of`); so are factors never formed (:class:`rotorred.nonlinear.sampled.SampledFactors`). Not scipy's ``LinearOperator``: its checks on every product
-    cost half of a Woodbury solve here (0.11 of 0.23 ms at the rig's H = 100)."""
+    (:meth:`of`); so are factors never formed (:class:`rotorred.nonlinear.sampled.SampledFactors`). Not scipy's
+    ``LinearOperator``: its checks on every product cost half of a Woodbury solve here (0.11 of 0.23 ms at the rig's
+    H = 100)."""
 
     shape: tuple
     times: Callable[[np.ndarray], np.ndarray]

@@ -104,7 +104,7 @@ class SampledFactors:
         if r == 0:
             return np.zeros((0, 0))
         C, Lam = _directions(self.L)  # L = Lam C^T
-        B, A = _directions(np.vstack([self.R[:, :m], self.R[:, m:]]))  # [Rq; Rv] = A B^T
+        B, A = _directions(self._right.reshape(2 * r, m))  # [Rq; Rv] = A B^T
         spectrum = np.zeros((2, h.N // 2 + 1, B.shape[1], C.shape[1]), complex)
         spectrum[0, :h.H + 1] = np.einsum("as,kab,bt->kst", B, Hc, C)  # the compliance between the directions
         spectrum[1, :h.H + 1] = spectrum[0, :h.H + 1] * 1j * np.arange(h.H + 1)[:, None, None]  # d/dDelta

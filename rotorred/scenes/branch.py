@@ -131,10 +131,9 @@ class SceneFamily:
         if rp is None:
             return Evaluation(np.full(len(z), np.inf), 1.0, _refused, _refused)
 
-        def dR_ds():  # central, or one-sided at a bound
-            up, down = f * (1.0 + STEP), f * (1.0 - STEP)
-            p_up, p_down = self._valid(up) or rp, self._valid(down) or rp
-            up, down = (up if p_up is not rp else f), (down if p_down is not rp else f)
+        def dR_ds():  # central, or one-sided at a bound (the value itself where the plate refuses the step)
+            (up, p_up), (down, p_down) = ((v, q) if q is not None else (f, rp)
+                                          for v, q in ((v, self._valid(v)) for v in (f * (1.0 + STEP), f * (1.0 - STEP))))
             R_up, R_down = (q.problem.evaluate(z, q.omega).R for q in (p_up, p_down))
             return (R_up - R_down) / ((up - down) * self.scale)
         return rp.problem.evaluate(z, rp.omega).with_parameter(dR_ds)
@@ -249,11 +248,13 @@ def check_key(scene, key: str, start: float, end: float | None = None) -> None:
         name = key.partition(".")[2]
         for value in (start,) + (() if end is None else (end,)):
             scene.plates[0].with_(**{name: value})  # the plate's own check, naming the field
-        past = None if end is None else end + 0.01 * (end - start)  # the branch ends at its first point past END
-        try:
-            past is None or scene.plates[0].with_(**{name: past})
-        except checks.InputError as error:
-            checks.fail("--param", end, f"must leave the branch room to pass it ({key} = {past:g} just past it: {error})")
+        if end is not None:  # the branch ends at its first point past END: the plate must take one
+            past = end + 0.01 * (end - start)
+            try:
+                scene.plates[0].with_(**{name: past})
+            except checks.InputError as error:
+                checks.fail("--param", end, f"must leave the branch room to pass it ({key} = {past:g} just past it: "
+                            f"{error})")
     f = scene.frequencies_hz
     factor = start / f[key.partition(".")[2]] if key.startswith("speeds.") else 1.0
     base_frequency(tuple(v * factor for v in f.values()))

@@ -49,6 +49,9 @@ _normal_law = _compiled(contact.normal_law, _normal_residual=_normal_residual)
 #: the normal force and its tangents (:func:`rotorred.transient.contact.normal_root`), compiled: harmonic balance calls
 #: it at every AFT sample (:class:`rotorred.nonlinear.forces.PlateRub`)
 compiled_normal_root = _compiled(contact.normal_root, normal_law=_normal_law)
+#: the Eq. 12 force on the disk (:func:`rotorred.transient.contact.disk_force`), compiled: the step kernel's and harmonic
+#: balance's
+compiled_disk_force = njit(cache=True)(contact.disk_force)
 
 
 class Condensed(NamedTuple):

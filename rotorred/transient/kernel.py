@@ -58,15 +58,13 @@ from numba import types as nbtypes
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from rotorred.transient import contact, numba_cache
+from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import (  # noqa: F401 - also read as kernel.<name> by newmark, matrices, tests
     C_CONTACT, C_MAXNEWTON, C_NEWTON, C_STEPS, C_SUBSTEPS, N_COUNTERS, N_PLATE_PAR, P_CLEAR, P_COS, P_MP, P_SIN, P_V,
     P_W0, Condensed, _kinematics, _normal_law, _open_plates, _solve_small, contact_residual, solve_contact)
+from rotorred.transient.contact_solve import compiled_disk_force as _disk_force
 
 numba_cache.register()
-
-
-_disk_force = njit(cache=True)(contact.disk_force)
 
 
 def _borrow_codegen(context, builder, ty, value):
