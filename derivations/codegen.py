@@ -28,12 +28,21 @@ class GeneratedFunction:
         The returned array (a matrix, or a column for a vector).
     doc : str
         Docstring body (numpydoc), without the quotes.
+    returns : {"array", "tuple"}
+        Return a new ndarray of ``expr``'s shape, or (a column only) a tuple of its entries: a function
+        the step kernel calls at every Newton iteration allocates nothing (the kernel compiles without
+        numba's reference counting, so it could not).
     """
 
     name: str
     args: tuple
     expr: sp.Matrix
     doc: str
+    returns: str = "array"
+
+    def __post_init__(self):
+        if self.returns not in ("array", "tuple") or (self.returns == "tuple" and self.expr.shape[1] != 1):
+            raise ValueError(f"{self.name}: returns = {self.returns!r}: must be 'array', or 'tuple' for a column")
 
 
 class _Printer(PythonCodePrinter):
@@ -55,6 +64,11 @@ def _render_function(fn: GeneratedFunction) -> str:
     lines = [f"def {fn.name}({arg_list}):", f'    """{fn.doc.strip()}', '    """']
     for sym, sub in replacements:
         lines.append(f"    {sym} = {printer.doprint(sub)}")
+    if fn.returns == "tuple":
+        printed = dict(zip((i for i, _, _ in nonzero), (printer.doprint(e) for e in reduced)))
+        items = ",\n".join(f"        {printed.get(i, '0.0')}" for i in range(rows))
+        lines.append(f"    return (\n{items},\n    )")
+        return "\n".join(lines) + "\n"
     shape = f"({rows}, {cols})" if cols > 1 else f"({rows},)"
     lines.append(f"    out = np.zeros({shape})")
     for (i, j, _), e in zip(nonzero, reduced):

@@ -79,7 +79,8 @@ def module_text() -> str:
             "    rate : float\n        Penetration rate (m/s).\n"
             "    K_nr : float\n        Hertz stiffness (N/m^1.5).\n    c : float\n        Hunt–Crossley damping (s/m).\n"
             "    lam : float\n        Plate bending compliance (m/N).\n\n"
-            "    Returns\n    -------\n    ndarray, shape (4,)\n        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)].\n",
+            "    Returns\n    -------\n    tuple of 4 floats\n        (R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)).\n",
+            returns="tuple",
         ),
     ]
     return render_module(

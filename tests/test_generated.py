@@ -87,3 +87,24 @@ def test_every_generated_function_is_used():
         assert names, relative
         unused = [n for n in names if not re.search(rf"\b_?gen\.{n}\b|\bimport [^\n]*\b{n}\b", sources)]
         assert not unused, f"{relative}: {unused} are generated but not used"
+
+
+def test_tuple_return_equals_array_return():
+    """A column rendered as a tuple (what the step loops call: they compile without reference counting and
+    cannot allocate) gives the same values as the same column rendered as an array; only columns may."""
+    import numpy as np
+    import sympy as sp
+
+    from derivations.codegen import GeneratedFunction, render_module
+
+    a, b = sp.symbols("a b")
+    expr = sp.Matrix([a * b + sp.Rational(1, 3), 0, a ** 3 / b ** 2])
+    spaces = []
+    for returns in ("array", "tuple"):
+        space: dict = {}
+        exec(render_module("t.py", [GeneratedFunction("f", (a, b), expr, "doc", returns)], "doc"), space)
+        spaces.append(space["f"](2.0, 3.0))
+    assert isinstance(spaces[1], tuple) and len(spaces[1]) == 3
+    np.testing.assert_array_equal(np.asarray(spaces[1]), spaces[0])
+    with pytest.raises(ValueError, match="returns = 'tuple': must be 'array', or 'tuple' for a column"):
+        GeneratedFunction("g", (a, b), sp.Matrix([[a, b]]), "doc", "tuple")

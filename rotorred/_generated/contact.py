@@ -54,17 +54,17 @@ def normal_residual(F, s, rate, K_nr, c, lam):
 
     Returns
     -------
-    ndarray, shape (4,)
-        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)].
+    tuple of 4 floats
+        (R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)).
     """
     _t0 = K_nr*s**3.0
     _t1 = _t0*c
     _t2 = ((3.0/2.0))*K_nr*s
     _t3 = _t2*lam
     _t4 = c*rate
-    out = np.zeros((4,))
-    out[0] = F - _t0 - _t1*rate
-    out[1] = _t3*_t4 + _t3 + 1.0
-    out[2] = -_t2*_t4 - _t2
-    out[3] = -_t1
-    return out
+    return (
+        F - _t0 - _t1*rate,
+        _t3*_t4 + _t3 + 1.0,
+        -_t2*_t4 - _t2,
+        -_t1,
+    )

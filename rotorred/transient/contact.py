@@ -204,8 +204,9 @@ def normal_law(F, delta, rate, K_nr, c, lam):
 
     Returns
     -------
-    ndarray, shape (4,)
-        [R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)], ``p`` the penetration.
+    tuple of 4 floats
+        (R (N), dR/dF (-), dR/dp (N/m), dR/d(rate) (N s/m)), ``p`` the penetration: a tuple, so that the
+        compiled law allocates nothing at each Newton iteration of the step loops (:data:`kernel.LOOP`).
     """
     s = math.sqrt(delta) if delta > 0.0 and 1.0 + c * rate > 0.0 else 0.0
     return _normal_residual(F, s, rate, K_nr, c, lam)

@@ -76,7 +76,7 @@ class Condensed(NamedTuple):
 
 
 # ----------------------------------------------------------------------------------- contact solve
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def _solve_small(J, R, out, A):
     """Solve J out = -R (Gaussian elimination with partial pivoting, A a work array); False if singular."""
     m = R.shape[0]
@@ -117,7 +117,7 @@ def _solve_small(J, R, out, A):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def _kinematics(z, cond, k):
     """Penetration - w0 (m), its rate (m/s) and v_rel (m/s) of plate ``k`` at the forces ``z``."""
     p = cond.p[k]
@@ -180,7 +180,7 @@ def contact_residual(z, cond, par, mode, sgn, R, J):
             J[2 * k + 1, 2 * k] = mu * sgn[k]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def _newton(z, cond, par, mode, sgn, tol, atol, maxiter, counters, wv, wm):
     """Newton with backtracking on the contact residual; returns True on convergence.
 
@@ -199,7 +199,7 @@ def _newton(z, cond, par, mode, sgn, tol, atol, maxiter, counters, wv, wm):
         merit += R[i] * R[i]
     for it in range(maxiter):
         counters[C_NEWTON] += 1
-        if not _solve_small(J, R, dz, wm[2]):
+        if not _solve_small(J[:m, :m], R, dz, wm[2][:m, :m]):  # the stick reset's types ('A' slices): one compile
             return False
         small = True
         for k in range(m // 2):
@@ -244,7 +244,7 @@ def _newton(z, cond, par, mode, sgn, tol, atol, maxiter, counters, wv, wm):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def solve_contact(z, cond, par, mode, sgn, tol, atol, maxiter, counters, wv, wm):
     """Solve the condensed contact problem of one step with the Coulomb active set.
 

@@ -33,8 +33,8 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
-                                       Condensed, State, _add_columns, _beyond_limit, _borrowed, _condense_rlin,
+from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, LIMIT, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
+                                       LOOP, Condensed, State, _add_columns, _beyond_limit, _condense_rlin,
                                        _cos_sin, _disk_forces, _forcing_at_step_end, _matvec, _record,
                                        _solve_contact_forces, _start_forcing, _stick_reset, _stop_at_limit,
                                        _update_contact_dofs, _write_state)
@@ -213,7 +213,7 @@ def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, 
     return RUNNING
 
 
-@njit(cache=True)
+@njit(**LOOP)
 def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, work, ework, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` as :func:`rotorred.transient.kernel.run_steps` does, level 0 in
     the eigenbasis (``record.rows`` act on y: the output rows times ``P``). ``state.x`` holds q, v on entry
@@ -224,43 +224,41 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
     failure), and calls again from the next step. Inlining the dense step's halvings here took 20 of the
     kernel's 53 s of compilation, for a path paper-rub never takes.
     """
-    levels, eig, forcing, plates, record, diag = (_borrowed(levels), _borrowed(eig), _borrowed(forcing),
-                                                  _borrowed(plates), _borrowed(record), _borrowed(diag))
-    cur, new, w, ew = _borrowed(state), _borrowed(spare), _borrowed(work), _borrowed(ework)
+    cur, new, w, ew = state, spare, work, ework
     t0, dt = settings.t0, settings.dt
     y, y_new = ew.y, ew.y_new
     _phases_at(t0 + i_begin * dt, eig, ew)
     _from_physical(cur.x, eig, ew, y)
-    if i_begin == 0 and record.start == 0 and record.count[0] == 0:
-        _record_eigen(0, t0, y, cur, eig, ew, record)
-        record.count[0] = 1
     extrapolate = False
     _start_forcing(forcing, dt, w)
-    for i in range(i_begin, i_end):
-        t_main = t0 + i * dt
+    status = RUNNING
+    limit_dof = -1
+    i = i_begin
+    while True:
+        if ((i > i_begin or (i == 0 and record.count[0] == 0)) and i >= record.start
+                and (i - record.start) % record.every == 0 and record.count[0] < record.t.shape[0]):
+            _record_eigen(record.count[0], t0 + i * dt, y, cur, eig, ew, record)
+            record.count[0] += 1
+        if i == i_end:
+            break
         _forcing_at_step_end(i - i_begin, t0 + (i + 1) * dt, forcing, w)
         _phases_from_forcing(eig, w, ew)
         status = _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w, ew)
-        if status == RUNNING:
-            j = _beyond_limit(new.xc, settings.limit)
-            if j >= 0:
-                _phases_at(t_main, eig, ew)
-                _to_physical(y, eig, ew, cur.x)
-                return _stop_at_limit(t0 + (i + 1) * dt, j, cur, state, diag)
-            cur, new = new, cur
-            y, y_new = y_new, y
-            extrapolate = True
-        else:  # the dense step redoes this main step (its halvings, or its failure report): the caller runs it
-            _phases_at(t_main, eig, ew)
-            _to_physical(y, eig, ew, cur.x)
-            _write_state(cur, state)
-            return NEED_DENSE
+        if status != RUNNING:  # the dense step redoes this main step (its halvings, or its failure report)
+            status = NEED_DENSE
+            break
+        limit_dof = _beyond_limit(new.xc, settings.limit)
+        if limit_dof >= 0:
+            status = LIMIT
+            break
+        cur, new = new, cur
+        y, y_new = y_new, y
+        extrapolate = True
         diag.counters[C_STEPS] += 1
-        j = i + 1
-        if j >= record.start and (j - record.start) % record.every == 0 and record.count[0] < record.t.shape[0]:
-            _record_eigen(record.count[0], t0 + j * dt, y, cur, eig, ew, record)
-            record.count[0] += 1
-    _phases_at(t0 + i_end * dt, eig, ew)
+        i += 1
+    _phases_at(t0 + i * dt, eig, ew)
     _to_physical(y, eig, ew, cur.x)
+    if status == LIMIT:
+        return _stop_at_limit(t0 + (i + 1) * dt, limit_dof, cur, state, diag)
     _write_state(cur, state)
-    return RUNNING
+    return status

@@ -3,7 +3,7 @@
 Everything here is ``numba.njit(cache=True)``; no Python runs per step. The Python side
 (:mod:`rotorred.transient.newmark`) builds the constant step matrices once per step size ("level":
 ``dt / 2**level``, used when a step must be halved) and calls :func:`run_steps` in chunks with a
-few typed containers (namedtuples of arrays; the loop reads them as borrowed views, :func:`_borrowed`):
+few typed containers (namedtuples of arrays; the loop compiles without reference counting, :data:`LOOP`):
 
 * :class:`Levels` -- the step matrices of every level;
 * :class:`Forcing` -- the time functions of the external forces;
@@ -54,9 +54,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba import types as nbtypes
-from numba.core import cgutils
-from numba.extending import intrinsic
 
 from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import (  # noqa: F401 - also read as kernel.<name> by newmark, matrices, tests
@@ -67,38 +64,19 @@ from rotorred.transient.contact_solve import compiled_disk_force as _disk_force
 numba_cache.register()
 
 
-def _borrow_codegen(context, builder, ty, value):
-    """LLVM value of ``value`` (numba type ``ty``) with the meminfo and parent of every array in it set to NULL."""
-    if isinstance(ty, nbtypes.Array):
-        ary = context.make_array(ty)(context, builder, value=value)
-        ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
-        ary.parent = cgutils.get_null_value(ary.parent.type)
-        return ary._getvalue()
-    if isinstance(ty, nbtypes.BaseTuple):
-        for i, member in enumerate(ty):
-            value = builder.insert_value(value, _borrow_codegen(context, builder, member,
-                                                                builder.extract_value(value, i)), i)
-    return value
-
-
-@intrinsic
-def _borrowed(typingctx, container):
-    """``container`` (a namedtuple of arrays and scalars) with its arrays as borrowed views.
-
-    numba counts the references to every array a compiled function binds (an atomic add and
-    subtract on the array's meminfo), and in the inlined step functions of the loop it cannot
-    prove most of those counts redundant: they would cost more than the step's arithmetic. Every
-    array the loop touches is owned by the Python caller of :func:`run_steps` for the whole call,
-    so the loop works on views without a meminfo (same data, shape and strides), which numba's
-    reference counting skips. Nothing keeps such a view beyond the call.
-    """
-    if not isinstance(container, nbtypes.BaseTuple):
-        return None
-
-    def codegen(context, builder, sig, args):
-        return _borrow_codegen(context, builder, container, args[0])
-
-    return container(container), codegen
+#: numba options of the step loops (:func:`run_steps`, :func:`rotorred.transient.eigen_kernel.run_eigen_steps`,
+#: :func:`rotorred.transient.ramp_kernel.run_ramp_steps`): cached on disk, and compiled without numba's reference
+#: counting. Every array a loop touches is owned by its Python caller for the whole call and nothing in a loop
+#: allocates, so the atomic count updates numba would emit for every array bound in the inlined steps (it cannot
+#: prove most of them redundant, and they cost more than a step's arithmetic) are left out: they were two thirds of
+#: the eigenbasis loop's unoptimised code. ``_nrt`` is the option behind numba's ``nrt`` flag; a loop that
+#: allocated would fail to compile (numba finds no allocation without it), not run wrongly.
+LOOP = {"cache": True, "_nrt": False}
+#: numba options of the loops' cold paths (writing a record, the stick correction, a loop's exits): called, not
+#: inlined, so that each compiles once rather than at every call site (numba types and lowers an inlined function
+#: anew at each site: inlining ``_write_state`` at the dense loop's five exits took 5 s of its 19 s compilation);
+#: no CPython wrapper, only compiled callers call them
+COLD = {"cache": True, "no_cpython_wrapper": True}
 
 
 # status codes
@@ -686,8 +664,9 @@ def _copy_into(src, dst):
         d[i] = s[i]
 
 
-@njit(cache=True, inline="always")
+@njit(**COLD)
 def _write_state(src, dst):
+    """Copy the state ``src`` into ``dst``."""
     _copy_into(src.x, dst.x)
     _copy_into(src.xc, dst.xc)
     _copy_into(src.ps, dst.ps)
@@ -713,7 +692,7 @@ def spare_state(state: State) -> State:
 
 
 # ----------------------------------------------------------------------------------- the loop
-@njit(cache=True)
+@njit(**LOOP)
 def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` (time ``t0 + i dt`` to ``t0 + (i+1) dt``).
 
@@ -742,10 +721,7 @@ def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, recor
     int
         RUNNING when the chunk completed, else the failure code.
     """
-    # borrowed views of the caller's arrays; the current and new state swap buffers each step
-    levels, forcing, plates, record, diag = (_borrowed(levels), _borrowed(forcing), _borrowed(plates),
-                                             _borrowed(record), _borrowed(diag))
-    cur, new, w = _borrowed(state), _borrowed(spare), _borrowed(work)
+    cur, new, w = state, spare, work  # the current and new state swap buffers each step
     t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
     if i_begin == 0 and record.start == 0 and record.count[0] == 0:
         _record(0, t0, cur, record)

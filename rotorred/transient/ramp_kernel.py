@@ -42,9 +42,9 @@ from numba import njit
 
 from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import C_MAXPASSES, C_PASSES
-from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, NEWTON_FAILED,
-                                       P_V, RUNNING, Condensed, _beyond_limit,
-                                       _borrowed, _condense_contact, _disk_forces, _add_columns, _matvec,
+from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, LOOP,
+                                       NEWTON_FAILED, P_V, RUNNING, Condensed, _beyond_limit,
+                                       _condense_contact, _disk_forces, _add_columns, _matvec,
                                        _newmark_update, _record, _record_step, _solve_contact_forces,
                                        _stick_reset, _update_contact, _write_state, solve_contact)
 
@@ -269,16 +269,14 @@ def _ramp_substep(level, ta, tb, first_try, cur, new, levels, var, plates, setti
     return PASSES_FAILED
 
 
-@njit(cache=True)
+@njit(**LOOP)
 def run_ramp_steps(i_begin, i_end, levels, var, plates, state, spare, work, rwork, record, settings, diag):
     """Advance main steps ``i_begin .. i_end - 1`` at the profile's speeds (as :func:`kernel.run_steps`).
 
     Parameters are those of :func:`rotorred.transient.kernel.run_steps`, with ``var`` (:class:`Varying`) in
     place of the forcing and ``rwork`` (:class:`RampWork`). Returns RUNNING or the failure code.
     """
-    levels, var, plates, record, diag = (_borrowed(levels), _borrowed(var), _borrowed(plates), _borrowed(record),
-                                         _borrowed(diag))
-    cur, new, w, rw = _borrowed(state), _borrowed(spare), _borrowed(work), _borrowed(rwork)
+    cur, new, w, rw = state, spare, work, rwork
     t0, dt, n_halvings = settings.t0, settings.dt, settings.n_halvings
     if i_begin == 0 and record.start == 0 and record.count[0] == 0:
         _record(0, t0, cur, record)
