@@ -311,3 +311,22 @@ def test_a_dead_figure_worker_costs_no_figure(rub, tmp_path):
         files = write_outputs(res, tmp_path, pool=pool)
     assert {"waveforms.png", "orbits.png", "spectra_node14.png"} <= {f.name for f in files}
     assert all(f.stat().st_size > 0 for f in files)
+
+
+def test_a_stopped_figure_pool_ends_its_workers():
+    """``rotorred run`` starts its figure pool before it reads the scene, and stops it (FigurePool.stop) when the scene
+    draws no figures or the scene is refused: its workers end then, drawing or not; a pool stopped while its workers
+    are still starting (the fork server importing matplotlib) stops as well."""
+    import os
+
+    from rotorred.plots.pool import FigurePool
+
+    pool = FigurePool(workers=1)
+    pid = pool.submit(os.getpid).result()  # handed over by the pool's thread, drawn in a worker
+    processes = list(pool._executor._processes.values())
+    assert pid != os.getpid() and [p.pid for p in processes] == [pid]
+    pool.stop()
+    assert not any(p.is_alive() for p in processes)
+    starting = FigurePool(workers=1)
+    starting.stop()
+    assert starting._executor is None and starting.submit(os.getpid).result() == os.getpid()  # drawn here now

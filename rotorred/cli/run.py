@@ -22,13 +22,14 @@ import time
 
 from rotorred import checks
 from rotorred.cli.options import out_dir
+from rotorred.plots.pool import FigurePool
 from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
 
 
 def add_parser(subparsers):
-    from rotorred.scenes.schema import builtin_scenes
+    from rotorred.scenes.builtin import builtin_scenes  # light: the scene schema is imported when a scene is read
     p = subparsers.add_parser(
         "run", help="run a scene (default paper-rub): figures, data (NPZ, CSV, .mat) and a summary",
         description="Run a scene file or built-in scene and write the paper's figures (time waveforms, spectra, "
@@ -55,22 +56,29 @@ def run(args) -> int:
 
     t0 = time.perf_counter()
     out = out_dir("--out", args.out) if args.out is not None else None  # refused before the scene is read
-    scene = load_scene(args.scene, _settings(args.set))
-    if out is None:
-        out = out_dir("--out", f"rotorred-{scene.name}")
-    budget.check(budget.scene_estimate(scene), force=args.force)
-    with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
+    pool = FigurePool()  # its fork server imports matplotlib while this process reads the scene (imports its schema)
+    try:
+        scene = load_scene(args.scene, _settings(args.set))
+        if out is None:
+            out = out_dir("--out", f"rotorred-{scene.name}")
+        budget.check(budget.scene_estimate(scene), force=args.force)
+        pool = _for_scene(pool, scene)
+    except BaseException:
+        pool.stop()
+        raise
+    with OutputFolder(out) as folder, pool:  # the pool stops before the folder cleans up
         status = _compute_and_write(scene, args, folder, out, pool)
     print(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
 
 
-def _figure_pool(scene):
-    """Workers that import matplotlib now and draw the figures while the data files are written
-    (:class:`rotorred.plots.pool.FigurePool`); none for a scene without figures or a run-up."""
-    from rotorred.plots.pool import FigurePool
-
-    return FigurePool(workers=0 if not scene.output.plots or scene.runup is not None else None)
+def _for_scene(pool, scene):
+    """``pool`` (:class:`rotorred.plots.pool.FigurePool`, its workers drawing the figures while the data files are
+    written), or, for a scene without figures or a run-up (drawn here), an empty pool, ``pool`` stopped."""
+    if scene.output.plots and scene.runup is None:
+        return pool
+    pool.stop()
+    return FigurePool(workers=0)
 
 
 def _settings(items: list[str]) -> dict:

@@ -3,8 +3,9 @@
 Drawing the six figures of ``paper-rub`` takes about as long as everything else of a warm
 ``rotorred run`` (the solve, the line fit, the data files), and matplotlib's import another 0.4 s.
 The pool starts its workers when it is created, so they import matplotlib while the caller
-computes; the caller then submits figure jobs (:func:`rotorred.plots.scene.scene_figures`: a plot
-function and plain arrays) and writes its data files while they are drawn.
+computes (``rotorred run`` creates it before it reads the scene, and stops it, :meth:`FigurePool.stop`, if the scene
+draws no figures); the caller then submits figure jobs (:func:`rotorred.plots.scene.scene_figures`: a plot
+function and plain arrays), which returns at once, and writes its data files while they are drawn.
 
 Workers are forked from a fork server (a fresh interpreter, not the caller: no fork of a process that holds
 numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`), so two workers cost one
@@ -22,7 +23,6 @@ import multiprocessing
 from concurrent.futures.process import BrokenProcessPool
 import os
 import signal
-import threading
 
 __all__ = ["FigurePool", "Drawing", "default_workers"]
 
@@ -63,7 +63,7 @@ class Drawing:
     memory, a script without a ``__main__`` guard that cannot be spawned) or when there is no worker."""
 
     def __init__(self, job, future: concurrent.futures.Future | None):
-        self._job, self._future = job, future
+        self._job, self._future = job, future  # future: of the worker's future (the pool's submitting thread's)
         if future is None:
             self._value = job()
 
@@ -71,8 +71,12 @@ class Drawing:
         if self._future is None:
             return self._value
         try:
-            return self._future.result()
-        except BrokenProcessPool:
+            future = self._future.result()
+        except (BrokenProcessPool, RuntimeError):  # refused: a worker died earlier, or the workers could not start
+            return self._job()
+        try:
+            return future.result()
+        except BrokenProcessPool:  # its worker died
             return self._job()
 
 
@@ -87,50 +91,53 @@ class FigurePool:
 
     def __init__(self, workers: int | None = None):
         self.workers = default_workers() if workers is None else int(workers)
-        self._executor, self._starting = None, None
+        self._executor, self._submitting = None, None
         if self.workers > 0:
             self._executor = concurrent.futures.ProcessPoolExecutor(
                 self.workers, mp_context=_context(), initializer=_start_worker)
-            # one job each starts every worker; from a thread, since the first waits for the fork server to import
-            # matplotlib (0.4 s), which the caller spends computing
-            self._starting = threading.Thread(target=self._start, daemon=True)
-            self._starting.start()
-
-    def _start(self) -> None:
-        try:
+            # jobs reach the workers through one thread, in order: the first submission waits for the fork server
+            # to import matplotlib (0.5 s), which the caller spends computing; one job each starts every worker
+            self._submitting = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="figure-pool")
             for _ in range(self.workers):
-                self._executor.submit(_ready)
-        except (BrokenProcessPool, RuntimeError):  # no workers: submit draws here
-            pass
-
-    def _started(self) -> None:
-        if self._starting is not None:
-            self._starting.join()
-            self._starting = None
+                self._submitting.submit(self._executor.submit, _ready)
 
     def submit(self, job) -> Drawing:
-        """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers."""
-        self._started()
+        """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers. Returns at
+        once: the job is handed to the workers by the pool's thread, once they have started."""
         if self._executor is None:
             return Drawing(job, None)
-        try:
-            return Drawing(job, self._executor.submit(job))
-        except BrokenProcessPool:  # a worker died earlier: draw here
-            return Drawing(job, None)
+        return Drawing(job, self._submitting.submit(self._executor.submit, job))
+
+    def _submitted(self, cancel: bool = False) -> None:
+        """Wait until every job has been handed to the workers (or refused: the pool broke); ``cancel``: those not
+        handed yet are dropped."""
+        if self._submitting is not None:
+            self._submitting.shutdown(wait=True, cancel_futures=cancel)
+            self._submitting = None
+
+    def stop(self) -> None:
+        """Stop the workers now, whatever they draw (the caller is about to remove what they write into)."""
+        self._submitted(cancel=True)
+        if self._executor is None:
+            return
+        for process in list(getattr(self._executor, "_processes", {}).values()):
+            process.terminate()
+        self._executor.shutdown(wait=True, cancel_futures=True)
+        self._executor = None
+        _stop_fork_server()
 
     def __enter__(self) -> FigurePool:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        self._started()
+        if exc_type is not None:  # stop drawing now: the caller is about to remove what the workers write into
+            self.stop()
+            return
+        self._submitted()
         if self._executor is None:
             return
-        if exc_type is not None:  # stop drawing now: the caller is about to remove what the workers write into
-            for process in list(getattr(self._executor, "_processes", {}).values()):
-                process.terminate()
-            self._executor.shutdown(wait=True, cancel_futures=True)
-        else:
-            self._executor.shutdown(wait=True)
+        self._executor.shutdown(wait=True)
+        self._executor = None
         _stop_fork_server()
 
 

@@ -29,7 +29,7 @@ in ``docs/scenes.md``; in short::
     nodes = [13, 14, 18]
     directions = ["x", "y"]
 
-Built-in scenes live in ``rotorred/scenes/*.toml`` (:func:`builtin_scenes`).
+Built-in scenes live in ``rotorred/scenes/builtin/*.toml`` (:func:`builtin_scenes`).
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.rotor import Rotor
 from rotorred.model.rotor_file import load_rotor, presets, read_text_file, read_toml
 from rotorred.model.speeds import SpeedProfile
+from rotorred.scenes.builtin import builtin_scenes
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
 
@@ -290,11 +291,6 @@ class Scene:
 
 
 # --------------------------------------------------------------------------- loading
-def builtin_scenes() -> list[str]:
-    """Names of the built-in scenes (``rotorred/scenes/*.toml``)."""
-    return sorted(p.name[:-5] for p in resources.files("rotorred.scenes.builtin").iterdir() if p.name.endswith(".toml"))
-
-
 def _read(spec: str | Path) -> tuple[dict, str, Path | None]:
     spec_str = str(spec)
     if spec_str in builtin_scenes():

@@ -180,7 +180,7 @@ def contact_residual(z, cond, par, mode, sgn, R, J):
             J[2 * k + 1, 2 * k] = mu * sgn[k]
 
 
-@njit(cache=True, no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def _newton(z, cond, par, mode, sgn, tol, atol, maxiter, counters, wv, wm):
     """Newton with backtracking on the contact residual; returns True on convergence.
 

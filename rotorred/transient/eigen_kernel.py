@@ -184,33 +184,25 @@ def _eigen_predictor(y, y_new, eig, cur, plates, w):
 
 
 @njit(cache=True, inline="always")
-def _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w, ew):
-    """One main step at level 0 in the eigenbasis, into ``y_new`` and ``new`` (the phases of the step's end in
-    ``ew``); RUNNING or a failure code."""
-    _eigen_predictor(y, y_new, eig, cur, plates, w)
-    if plates.par.shape[0] > 0:
-        _matvec(eig.Cr, y_new, w.rlin)
-        for k in range(w.rlin.shape[0]):
-            r = eig.CY0[k]
-            for j in range(eig.omega.shape[0]):
-                r += ew.c[j] * eig.CYr[j, k] - ew.s[j] * eig.CYi[j, k]
-            w.rlin[k] += r
-        touching = _condense_rlin(0, cur, levels, plates, w)
-        cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[0], levels.Jv[0], levels.coef[0, 3])
-        if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
-            for k in range(w.p_lin.shape[0]):
-                if w.p_lin[k] > 0.0:
-                    diag.err[E_PLATE] = k
-                    break
-            return NEWTON_FAILED
-        _disk_forces(new.z, plates.par, w.frot)
-        _add_columns(y_new, w.frot, eig.gS, 1.0)
-        _update_contact_dofs(0, touching, cond, cur, new, levels, plates, w)
-    if not math.isfinite(_sum(y_new)):
-        diag.err[E_DOF] = -1
-        return NONFINITE
-    _stick_reset(new, plates, w)
-    return RUNNING
+def _contact_rlin(y_new, eig, ew, w):
+    """``w.rlin``: the contact DOFs' displacement at zero new contact force, ``C_r y_new`` plus the particular
+    solution's rows at the phases in ``ew``."""
+    _matvec(eig.Cr, y_new, w.rlin)
+    for k in range(w.rlin.shape[0]):
+        r = eig.CY0[k]
+        for j in range(eig.omega.shape[0]):
+            r += ew.c[j] * eig.CYr[j, k] - ew.s[j] * eig.CYi[j, k]
+        w.rlin[k] += r
+
+
+@njit(cache=True, inline="always")
+def _failed_plate(w, diag):
+    """NEWTON_FAILED, with the first touching plate in ``diag.err``."""
+    for k in range(w.p_lin.shape[0]):
+        if w.p_lin[k] > 0.0:
+            diag.err[E_PLATE] = k
+            break
+    return NEWTON_FAILED
 
 
 @njit(**LOOP)
@@ -241,12 +233,26 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
             record.count[0] += 1
         if i == i_end:
             break
+        # one main step at level 0 in the eigenbasis, into y_new and new (written out here, not an inlined function:
+        # numba copies an inlined function's IR block by block with its whole scope, 2.6 s for this step's)
         _forcing_at_step_end(i - i_begin, t0 + (i + 1) * dt, forcing, w)
         _phases_from_forcing(eig, w, ew)
-        status = _eigen_step(extrapolate, y, y_new, eig, cur, new, levels, plates, settings, diag, w, ew)
-        if status != RUNNING:  # the dense step redoes this main step (its halvings, or its failure report)
-            status = NEED_DENSE
+        _eigen_predictor(y, y_new, eig, cur, plates, w)
+        if plates.par.shape[0] > 0:
+            _contact_rlin(y_new, eig, ew, w)
+            touching = _condense_rlin(0, cur, levels, plates, w)
+            cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[0], levels.Jv[0], levels.coef[0, 3])
+            if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
+                status = _failed_plate(w, diag)
+                break
+            _disk_forces(new.z, plates.par, w.frot)
+            _add_columns(y_new, w.frot, eig.gS, 1.0)
+            _update_contact_dofs(0, touching, cond, cur, new, levels, plates, w)
+        if not math.isfinite(_sum(y_new)):
+            diag.err[E_DOF] = -1
+            status = NONFINITE
             break
+        _stick_reset(new, plates, w)
         limit_dof = _beyond_limit(new.xc, settings.limit)
         if limit_dof >= 0:
             status = LIMIT
@@ -256,6 +262,8 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
         extrapolate = True
         diag.counters[C_STEPS] += 1
         i += 1
+    if status == NEWTON_FAILED or status == NONFINITE:
+        status = NEED_DENSE  # the dense step redoes this main step (its halvings, or its failure report)
     _phases_at(t0 + i * dt, eig, ew)
     _to_physical(y, eig, ew, cur.x)
     if status == LIMIT:

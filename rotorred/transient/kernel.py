@@ -655,25 +655,31 @@ def _stop_at_limit(t, j, cur, state, diag):
 
 
 @njit(cache=True, inline="always")
-def _copy_into(src, dst):
-    """``dst[...] = src`` for C-contiguous arrays of one shape, element by element: numba's slice assignment
-    compiles its broadcast error messages (string formatting), which took 6 s of the kernel's compilation."""
-    s = src.reshape(src.size)
-    d = dst.reshape(dst.size)
-    for i in range(s.shape[0]):
-        d[i] = s[i]
+def _copy1(src, dst):
+    """``dst[:] = src`` element by element (1-D): numba's slice assignment compiles its broadcast error messages
+    (string formatting, 6 s of the kernel's compilation once), a flat ``reshape`` its shape checks."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@njit(cache=True, inline="always")
+def _copy2(src, dst):
+    """``dst[:, :] = src`` element by element (2-D)."""
+    for i in range(src.shape[0]):
+        _copy1(src[i], dst[i])
 
 
 @njit(**COLD)
 def _write_state(src, dst):
     """Copy the state ``src`` into ``dst``."""
-    _copy_into(src.x, dst.x)
-    _copy_into(src.xc, dst.xc)
-    _copy_into(src.ps, dst.ps)
-    _copy_into(src.z, dst.z)
-    _copy_into(src.mode, dst.mode)
-    _copy_into(src.sgn, dst.sgn)
-    _copy_into(src.pinfo, dst.pinfo)
+    _copy1(src.x, dst.x)
+    _copy2(src.xc, dst.xc)
+    for k in range(src.ps.shape[0]):
+        _copy2(src.ps[k], dst.ps[k])
+    _copy1(src.z, dst.z)
+    _copy1(src.mode, dst.mode)
+    _copy1(src.sgn, dst.sgn)
+    _copy2(src.pinfo, dst.pinfo)
 
 
 def work_arrays(n: int, n_p: int, nf: int) -> Work:
