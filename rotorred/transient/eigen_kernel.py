@@ -33,9 +33,9 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, E_DOF, E_PLATE, LIMIT, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
-                                       LOOP, Condensed, State, _add_columns, _beyond_limit, _condense_rlin,
-                                       _cos_sin, _disk_forces, _forcing_at_step_end, _matvec, _record,
+from rotorred.transient.kernel import (C_STEPS, E_DOF, LIMIT, LOOP, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
+                                       Condensed, State, _add_columns, _beyond_limit, _condense_rlin,
+                                       _cos_sin, _disk_forces, _failed_plate, _forcing_at_step_end, _matvec, _record,
                                        _solve_contact_forces, _start_forcing, _stick_reset, _stop_at_limit,
                                        _update_contact_dofs, _write_state)
 
@@ -193,16 +193,6 @@ def _contact_rlin(y_new, eig, ew, w):
         for j in range(eig.omega.shape[0]):
             r += ew.c[j] * eig.CYr[j, k] - ew.s[j] * eig.CYi[j, k]
         w.rlin[k] += r
-
-
-@njit(cache=True, inline="always")
-def _failed_plate(w, diag):
-    """NEWTON_FAILED, with the first touching plate in ``diag.err``."""
-    for k in range(w.p_lin.shape[0]):
-        if w.p_lin[k] > 0.0:
-            diag.err[E_PLATE] = k
-            break
-    return NEWTON_FAILED
 
 
 @njit(**LOOP)

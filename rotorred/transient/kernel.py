@@ -13,7 +13,7 @@ few typed containers (namedtuples of arrays; the loop compiles without reference
 * :class:`Record` -- the record buffers and their plan;
 * :class:`Settings` and :class:`Diagnostics` -- the solver's settings, its counters and the failure report.
 
-One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Newmark), :func:`_substep`:
+One (sub)step from ``ta`` to ``tb = ta + h`` (HHT-α form, alpha = 0 is plain Newmark), in :func:`run_steps`:
 
 1. Linear predictor ``q_lin`` (:func:`_linear_predictor`): the step with the new contact force
    set to zero. ``q_new = q_lin + (1+alpha) S f_new`` with ``A = c0 M + (1+alpha)(c3 D + K)`` and
@@ -590,23 +590,13 @@ def _stick_reset(new, plates, w):
 
 
 @njit(cache=True, inline="always")
-def _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w):
-    """One (sub)step at ``level`` ending at ``tb`` (s), from ``cur`` into ``new``; returns RUNNING or a failure."""
-    _linear_predictor(level, tb, cur, levels, forcing, plates, w)
-    if plates.par.shape[0] > 0:
-        touching = _condense_contact(level, cur, levels, plates, w)
-        cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[level], levels.Jv[level], levels.coef[level, 3])
-        if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
-            for k in range(w.p_lin.shape[0]):
-                if w.p_lin[k] > 0.0:
-                    diag.err[E_PLATE] = k
-                    break
-            return NEWTON_FAILED
-        _update_contact(level, touching, cond, cur, new, levels, plates, w)
-    status = _newmark_update(level, cur, new, levels, diag, w)
-    if status == RUNNING and levels.coef[level, 6] == 0.0:
-        _stick_reset(new, plates, w)
-    return status
+def _failed_plate(w, diag):
+    """NEWTON_FAILED, with the first touching plate in ``diag.err``."""
+    for k in range(w.p_lin.shape[0]):
+        if w.p_lin[k] > 0.0:
+            diag.err[E_PLATE] = k
+            break
+    return NEWTON_FAILED
 
 
 @njit(cache=True, inline="always")
@@ -746,7 +736,21 @@ def run_steps(i_begin, i_end, levels, forcing, plates, state, spare, work, recor
             tb = ta + h_units * (dt / units_total)
             if progress + h_units == units_total:
                 tb = t0 + (i + 1) * dt
-            status = _substep(level, tb, extrapolate, cur, new, levels, forcing, plates, settings, diag, w)
+            # one (sub)step at `level` ending at tb, from cur into new (written out, not an inlined function: numba
+            # copies an inlined function's IR block by block with its whole scope, 4 s of this loop's compilation)
+            _linear_predictor(level, tb, cur, levels, forcing, plates, w)
+            status = RUNNING
+            if plates.par.shape[0] > 0:
+                touching = _condense_contact(level, cur, levels, plates, w)
+                cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[level], levels.Jv[level], levels.coef[level, 3])
+                if _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
+                    _update_contact(level, touching, cond, cur, new, levels, plates, w)
+                else:
+                    status = _failed_plate(w, diag)
+            if status == RUNNING:
+                status = _newmark_update(level, cur, new, levels, diag, w)
+                if status == RUNNING and levels.coef[level, 6] == 0.0:
+                    _stick_reset(new, plates, w)
             if status == RUNNING:
                 j = _beyond_limit(new.xc, settings.limit)
                 if j >= 0:

@@ -42,9 +42,9 @@ from numba import njit
 
 from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import C_MAXPASSES, C_PASSES
-from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_PLATE, E_STATUS, E_TIME, LIMIT, LOOP,
-                                       NEWTON_FAILED, P_V, RUNNING, Condensed, _beyond_limit,
-                                       _condense_contact, _disk_forces, _add_columns, _matvec,
+from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_STATUS, E_TIME, LIMIT, LOOP,
+                                       P_V, RUNNING, Condensed, _beyond_limit,
+                                       _condense_contact, _disk_forces, _add_columns, _failed_plate, _matvec,
                                        _newmark_update, _record, _record_step, _solve_contact_forces,
                                        _stick_reset, _update_contact, _write_state, solve_contact)
 
@@ -241,11 +241,7 @@ def _ramp_substep(level, ta, tb, first_try, cur, new, levels, var, plates, setti
                 ok = solve_contact(new.z, cond, plates.par, new.mode, new.sgn, settings.newton_tol, plates.atol,
                                    settings.max_newton, diag.counters, w.wv, w.wm)
             if not ok:
-                for k in range(w.p_lin.shape[0]):
-                    if w.p_lin[k] > 0.0:
-                        diag.err[E_PLATE] = k
-                        break
-                return NEWTON_FAILED
+                return _failed_plate(w, diag)
             _update_contact(level, touching, cond, cur, new, levels, plates, w)
         change = 0.0
         size = 0.0
