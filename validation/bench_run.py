@@ -3,7 +3,8 @@ time goes (the solve, the figures).
 
 * **first run**: ``rotorred run --out DIR`` in a subprocess with empty numba and matplotlib caches
   (``NUMBA_CACHE_DIR``, ``MPLCONFIGDIR`` pointed at new folders): what a fresh install meets, numba's
-  compilation of the step kernel and matplotlib's font cache included;
+  compilation of the step kernel and matplotlib's font cache included (the compilation's share as the command
+  reports it on its summary line);
 * **warm run**: the same command again (caches filled), median of ``--repeats``, and its CPU time (user +
   system, the figure workers included): on 2 cores the wall time cannot fall below half of it;
 * **solve**: :func:`rotorred.scenes.run.run_scene` in this process (model, both transients, spectra, line
@@ -23,6 +24,7 @@ for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MK
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import re  # noqa: E402
 import shutil  # noqa: E402
 import statistics  # noqa: E402
 import subprocess  # noqa: E402
@@ -44,6 +46,8 @@ def cli_run(scene: str, out: Path, env: dict) -> float:
     seconds = time.perf_counter() - t0
     if done.returncode != 0:
         raise SystemExit(f"rotorred run failed:\n{done.stderr}")
+    compiled = re.search(r"step kernel compiled in ([0-9.]+) s", done.stdout + done.stderr)
+    COMPILE.append(float(compiled.group(1)) if compiled else 0.0)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     CPU.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
     return seconds
@@ -51,6 +55,8 @@ def cli_run(scene: str, out: Path, env: dict) -> float:
 
 #: CPU seconds of each command run (user + system, its worker processes included)
 CPU: list[float] = []
+#: seconds each command run compiled the step kernel, as it reports (0: loaded from numba's cache)
+COMPILE: list[float] = []
 
 
 def in_process(scene_name: str, repeats: int, folder: Path) -> dict:
@@ -98,6 +104,7 @@ def main(argv=None) -> int:
     print("| what | seconds |")
     print("|---|---|")
     print(f"| first run after a fresh install (empty numba and matplotlib caches) | {first:.1f} |")
+    print(f"| of it, compiling the step kernel (as the command reports it) | {COMPILE[0]:.1f} |")
     print(f"| warm run (median of {args.repeats}; spread {min(warm_runs):.2f}-{max(warm_runs):.2f}) | {warm:.2f} |")
     print(f"| warm run's CPU time, its figure workers included (median) | {statistics.median(CPU[1:]):.2f} |")
     for k, v in parts.items():

@@ -269,7 +269,7 @@ def record_buffers(plan: RecordPlan, rows: np.ndarray, n_p: int) -> kernel.Recor
 
 
 #: printed on stderr before the step kernel is compiled (not when numba's on-disk cache holds it)
-COMPILING_NOTE = "rotorred: compiling the step kernel, once per install (numba; about a minute, then cached on disk)"
+COMPILING_NOTE = "rotorred: compiling the step kernel, once per install (numba: 10-20 s, then cached on disk)"
 
 
 def load_kernel(args: tuple, dispatcher=None) -> float:
