@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import rotorred.writers as writers
 from rotorred.writers import write_csv
@@ -35,3 +36,34 @@ def test_text_columns_take_the_general_path_and_integers_stay_integers(tmp_path)
     assert write_csv(tmp_path / "m.csv", ["i", "x"], mixed).read_text() == "i,x\n0,0.5\n1,1.5\n2,2.5\n"
     assert write_csv(tmp_path / "t.csv", ["x", "s"], text).read_text() == 'x,s\n1,ok\n2,"failed: a, b"\n'
     assert write_csv(tmp_path / "e.csv", ["x"], [np.zeros(0)]).read_text() == "x\n"
+
+
+def test_an_interrupt_while_the_npz_is_written_waits_for_it(tmp_path, monkeypatch):
+    """SIGTERM (or SIGINT) arriving inside numpy's savez is held back until the archive is complete: cut inside
+    zipfile, a half-built archive object printed a traceback from its destructor on an interrupted run."""
+    import os
+    import signal
+
+    from rotorred import writers
+
+    order = []
+    real = np.savez
+
+    def savez(*args, **kw):
+        os.kill(os.getpid(), signal.SIGTERM)  # delivered now unless held back
+        real(*args, **kw)
+        order.append("written")
+
+    def handler(signum, frame):
+        order.append("signal")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez", savez)
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            writers.write_npz(tmp_path / "a.npz", {"x": np.arange(3.0)})
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert order == ["written", "signal"]
+    assert not list(tmp_path.iterdir())  # interrupted before its commit: no file, no temporary left
