@@ -268,19 +268,29 @@ def _acquire_lock(folder: Path):
 
 @contextmanager
 def _signals_blocked():
-    """SIGINT and SIGTERM held back (delivered on exit) so that a commit is not cut in half."""
+    """SIGINT and SIGTERM held back, then delivered on exit, so that a commit or an archive is not cut in half.
+
+    Held back in Python: while inside, their handlers only note the signal, and the first one noted is raised again
+    on exit, under the handlers restored. Masking them (``pthread_sigmask``) held them back from the calling thread
+    only: the kernel then hands the signal to another thread (the figure pool's, a library's), and Python still runs
+    its handler in the main thread at once. Outside the main thread, where handlers cannot be set, nothing is held.
+    """
     import signal
 
-    held = {signal.SIGINT, signal.SIGTERM}
+    noted: list[int] = []
+    previous = {}
     try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    except (AttributeError, ValueError):
-        old = None
+        for held in (signal.SIGINT, signal.SIGTERM):
+            previous[held] = signal.signal(held, lambda signum, frame: noted.append(signum))
+    except ValueError:  # not the main thread
+        pass
     try:
         yield
     finally:
-        if old is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for held, handler in previous.items():
+            signal.signal(held, signal.SIG_DFL if handler is None else handler)
+        if noted:
+            signal.raise_signal(noted[0])
 
 
 class OutputFolder:

@@ -43,6 +43,7 @@ def test_an_interrupt_while_the_npz_is_written_waits_for_it(tmp_path, monkeypatc
     zipfile, a half-built archive object printed a traceback from its destructor on an interrupted run."""
     import os
     import signal
+    import threading
 
     from rotorred import writers
 
@@ -60,10 +61,15 @@ def test_an_interrupt_while_the_npz_is_written_waits_for_it(tmp_path, monkeypatc
 
     monkeypatch.setattr(np, "savez", savez)
     previous = signal.signal(signal.SIGTERM, handler)
+    other = threading.Event()  # another live thread, as the command has (the figure pool's): the signal may go to it
+    thread = threading.Thread(target=other.wait)
+    thread.start()
     try:
         with pytest.raises(KeyboardInterrupt):
             writers.write_npz(tmp_path / "a.npz", {"x": np.arange(3.0)})
     finally:
         signal.signal(signal.SIGTERM, previous)
+        other.set()
+        thread.join()
     assert order == ["written", "signal"]
     assert not list(tmp_path.iterdir())  # interrupted before its commit: no file, no temporary left
