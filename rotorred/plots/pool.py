@@ -117,26 +117,24 @@ class FigurePool:
 
     def stop(self) -> None:
         """Stop the workers now, whatever they draw (the caller is about to remove what they write into)."""
-        self._submitted(cancel=True)
-        if self._executor is None:
-            return
-        for process in list(getattr(self._executor, "_processes", {}).values()):
-            process.terminate()
-        self._executor.shutdown(wait=True, cancel_futures=True)
-        self._executor = None
-        _stop_fork_server()
+        self._close(now=True)
 
     def __enter__(self) -> FigurePool:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is not None:  # stop drawing now: the caller is about to remove what the workers write into
-            self.stop()
-            return
-        self._submitted()
+        self._close(now=exc_type is not None)  # on an error, stop drawing now: the caller removes what they write into
+
+    def _close(self, now: bool) -> None:
+        """Hand over the jobs submitted (``now``: drop those not handed yet and end the workers), wait for the workers
+        to end, and stop the fork server."""
+        self._submitted(cancel=now)
         if self._executor is None:
             return
-        self._executor.shutdown(wait=True)
+        if now:
+            for process in list(getattr(self._executor, "_processes", {}).values()):
+                process.terminate()
+        self._executor.shutdown(wait=True, cancel_futures=now)
         self._executor = None
         _stop_fork_server()
 

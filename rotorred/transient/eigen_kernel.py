@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, E_DOF, LIMIT, LOOP, NEED_DENSE, NEWTON_FAILED, NONFINITE, RUNNING,
+from rotorred.transient.kernel import (C_STEPS, E_DOF, LIMIT, LOOP, NEED_DENSE, RUNNING,
                                        Condensed, State, _add_columns, _beyond_limit, _condense_rlin,
                                        _cos_sin, _disk_forces, _failed_plate, _forcing_at_step_end, _matvec, _record,
                                        _solve_contact_forces, _start_forcing, _stick_reset, _stop_at_limit,
@@ -233,14 +233,15 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
             touching = _condense_rlin(0, cur, levels, plates, w)
             cond = Condensed(w.p_lin, w.pd_lin, w.v_lin, levels.Jp[0], levels.Jv[0], levels.coef[0, 3])
             if not _solve_contact_forces(touching, extrapolate, cond, cur, new, plates, settings, diag, w):
-                status = _failed_plate(w, diag)
+                _failed_plate(w, diag)
+                status = NEED_DENSE  # the dense step redoes this main step (its halvings, or its failure report)
                 break
             _disk_forces(new.z, plates.par, w.frot)
             _add_columns(y_new, w.frot, eig.gS, 1.0)
             _update_contact_dofs(0, touching, cond, cur, new, levels, plates, w)
         if not math.isfinite(_sum(y_new)):
             diag.err[E_DOF] = -1
-            status = NONFINITE
+            status = NEED_DENSE  # as a failed contact solve
             break
         _stick_reset(new, plates, w)
         limit_dof = _beyond_limit(new.xc, settings.limit)
@@ -252,8 +253,6 @@ def run_eigen_steps(i_begin, i_end, levels, eig, forcing, plates, state, spare, 
         extrapolate = True
         diag.counters[C_STEPS] += 1
         i += 1
-    if status == NEWTON_FAILED or status == NONFINITE:
-        status = NEED_DENSE  # the dense step redoes this main step (its halvings, or its failure report)
     _phases_at(t0 + i * dt, eig, ew)
     _to_physical(y, eig, ew, cur.x)
     if status == LIMIT:

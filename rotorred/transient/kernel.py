@@ -72,10 +72,10 @@ numba_cache.register()
 #: the eigenbasis loop's unoptimised code. ``_nrt`` is the option behind numba's ``nrt`` flag; a loop that
 #: allocated would fail to compile (numba finds no allocation without it), not run wrongly.
 LOOP = {"cache": True, "_nrt": False}
-#: numba options of the loops' cold paths (writing a record, the stick correction, a loop's exits): called, not
-#: inlined, so that each compiles once rather than at every call site (numba types and lowers an inlined function
+#: numba options of a loop's cold path called from several sites (the state copy at a loop's exits): called, not
+#: inlined, so that it compiles once rather than at every call site (numba types and lowers an inlined function
 #: anew at each site: inlining ``_write_state`` at the dense loop's five exits took 5 s of its 19 s compilation);
-#: no CPython wrapper, only compiled callers call them
+#: no CPython wrapper, only compiled callers call it
 COLD = {"cache": True, "no_cpython_wrapper": True}
 
 

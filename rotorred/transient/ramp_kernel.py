@@ -42,11 +42,12 @@ from numba import njit
 
 from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import C_MAXPASSES, C_PASSES
-from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_DOF, E_STATUS, E_TIME, LIMIT, LOOP,
+from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_STATUS, E_TIME, LOOP,
                                        P_V, RUNNING, Condensed, _beyond_limit,
                                        _condense_contact, _disk_forces, _add_columns, _failed_plate, _matvec,
                                        _newmark_update, _record, _record_step, _solve_contact_forces,
-                                       _stick_reset, _update_contact, _write_state, solve_contact)
+                                       _stick_reset, _stop_at_limit, _update_contact, _write_state,
+                                       solve_contact)
 
 numba_cache.register()
 
@@ -293,11 +294,7 @@ def run_ramp_steps(i_begin, i_end, levels, var, plates, state, spare, work, rwor
             if status == RUNNING:
                 j = _beyond_limit(new.xc, settings.limit)
                 if j >= 0:
-                    diag.err[E_TIME] = tb
-                    diag.err[E_DOF] = -1 - j
-                    diag.err[E_STATUS] = LIMIT
-                    _write_state(cur, state)
-                    return LIMIT
+                    return _stop_at_limit(tb, j, cur, state, diag)
                 cur, new = new, cur
                 extrapolate = True
                 progress += h_units
