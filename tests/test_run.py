@@ -330,3 +330,26 @@ def test_a_stopped_figure_pool_ends_its_workers():
     starting = FigurePool(workers=1)
     starting.stop()
     assert starting._executor is None and starting.submit(os.getpid).result() == os.getpid()  # drawn here now
+
+
+def test_a_stopped_figure_pool_leaves_its_workers_cpu_time_to_the_caller():
+    """The fork server leaves without the interpreter's teardown (rotorred.plots._fork_server) once the pool stops, and
+    only after reaping its workers: their CPU time counts as the caller's children's, as ``time`` and the benchmarks
+    read it. A worker sums 2e7 integers (its CPU time measured here, the same sum)."""
+    import functools
+    import resource
+    import time
+    from multiprocessing import forkserver
+
+    from rotorred.plots.pool import FigurePool
+
+    job = functools.partial(sum, range(20_000_000))
+    t0 = time.process_time()
+    expected = job()
+    cpu = time.process_time() - t0
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with FigurePool(workers=1) as pool:
+        assert pool.submit(job).result() == expected
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    assert getattr(forkserver._forkserver, "_forkserver_pid", None) is None  # stopped and waited for
+    assert after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime > 0.5 * cpu

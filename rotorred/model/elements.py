@@ -17,7 +17,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from rotorred import checks
 from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_translational
@@ -612,6 +611,8 @@ class BearingTable:
 
 def _pchip(speeds: np.ndarray, values: tuple[float, ...]):
     """The shape-preserving cubic through ``(speeds, values)`` and its slopes at the two ends."""
+    from scipy.interpolate import PchipInterpolator  # 0.2 s to import (scipy.special, optimize, spatial): when used
+
     curve = PchipInterpolator(speeds, values, extrapolate=False)
     d = curve.derivative()
     return curve, (float(d(speeds[0])), float(d(speeds[-1])))

@@ -8,7 +8,8 @@ draws no figures); the caller then submits figure jobs (:func:`rotorred.plots.sc
 function and plain arrays), which returns at once, and writes its data files while they are drawn.
 
 Workers are forked from a fork server (a fresh interpreter, not the caller: no fork of a process that holds
-numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`), so two workers cost one
+numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`, through
+:mod:`rotorred.plots._fork_server`, which also ends the server without a teardown), so two workers cost one
 import of it, not two: a warm ``rotorred run`` of paper-rub took 3.51 s against 3.87 s with spawned workers
 (medians of 10, alternated). Where there is no fork server (Windows) they are spawned. Workers ignore
 SIGINT: Ctrl-C is the caller's to handle, and leaving the pool stops them before the caller cleans up
@@ -50,7 +51,7 @@ def _context():
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("spawn")
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["rotorred.plots._preload"])
+    context.set_forkserver_preload(["rotorred.plots._fork_server"])
     return context
 
 

@@ -87,11 +87,13 @@ def _stacked(width: float, panel_height: float, n: int) -> tuple[Figure, np.ndar
     return fig, fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
 
 
-def _side_by_side(panel_width: float, height: float, n: int) -> tuple[Figure, np.ndarray]:
-    """A figure of ``n`` panels in a row, each with its own axis labels, with fixed margins (:data:`_MARGINS`)."""
+def _side_by_side(panel_width: float, height: float, n: int,
+                  margins: tuple[float, float, float, float] = _MARGINS) -> tuple[Figure, np.ndarray]:
+    """A figure of ``n`` panels in a row, each with its own axis labels, with fixed ``margins`` (in, as
+    :data:`_MARGINS`)."""
     from matplotlib.figure import Figure
 
-    left, right, bottom, top = _MARGINS
+    left, right, bottom, top = margins
     gap = left  # the next panel's y label and tick labels
     width = panel_width * n + left + right - gap
     fig = Figure(figsize=(width, height))
@@ -378,6 +380,11 @@ def _span_at_least(ax, x: np.ndarray, y: np.ndarray, rel: float) -> None:
             set_lim(mid - need, mid + need)
 
 
+#: margins of a Poincare plot (in, as :data:`_MARGINS`): on the left, velocity tick labels of up to 7 characters
+#: ("−150000" µm/s) and the axis label; at the top, a title of two lines and no panel title
+_POINCARE_MARGINS = (1.05, 0.25, 0.6, 0.75)
+
+
 def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "", scale: float = 1e6,
                   unit: str = "µm") -> Path:
     """Poincare section: the sampled displacement against the sampled velocity, one dot per sample.
@@ -404,10 +411,7 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
     x = checks.vector("x", x, min_len=1)
     velocity = checks.vector("velocity", velocity, min_len=x.size, max_len=x.size)
     path = _path(path)
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(5.6, 5.0), layout="constrained")
-    ax = fig.subplots()
+    fig, (ax,) = _side_by_side(5.35, 5.0, 1, margins=_POINCARE_MARGINS)
     ax.plot(scale * x, scale * velocity, ".", ms=4 if x.size < 200 else 2, label=f"{label} ({x.size} samples)".strip())
     _span_at_least(ax, scale * x, scale * velocity, SPAN_MIN)
     ax.ticklabel_format(useOffset=False)
