@@ -102,10 +102,18 @@ def _side_by_side(panel_width: float, height: float, n: int,
     return fig, fig.subplots(1, n, squeeze=False)[0]
 
 
+#: settings of every figure's drawing: glyphs without FreeType's hinting, the same text to the eye (paper-rub's six
+#: figures, some 360 rotated line labels and the tick labels, drew in 1.27 s, not 1.46 s, with matplotlib 3.11)
+_DRAWING = {"text.hinting": "no_hinting"}
+
+
 def _save(fig: Figure, path: Path, title: str | None) -> Path:
+    import matplotlib
+
     if title:
         fig.suptitle(title)
-    fig.savefig(path, dpi=120, pil_kwargs={"compress_level": 1})  # zlib level 1: PNG encoding 0.13 -> 0.05 s a figure, files 15 % larger
+    with matplotlib.rc_context(_DRAWING):
+        fig.savefig(path, dpi=120, pil_kwargs={"compress_level": 1})  # zlib level 1: PNG encoding 0.13 -> 0.05 s a figure, files 15 % larger
     return path
 
 
