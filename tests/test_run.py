@@ -296,6 +296,81 @@ def test_the_record_figures_are_drawn_before_the_analysis_and_are_the_same(rub, 
             np.testing.assert_array_equal(imread(a), imread(b))
 
 
+def _requested_frames(result, folder, monkeypatch) -> list[tuple]:
+    """The frame keys the figures of ``result`` ask for when drawn (none prepared)."""
+    from rotorred.plots import scene as figures
+
+    asked = []
+    monkeypatch.setattr(figures, "_prepared", lambda key: asked.append(key))
+    figures.plot_scene(result, folder)
+    monkeypatch.undo()
+    return asked
+
+
+@pytest.fixture(scope="module")
+def paper_rub():
+    """paper-rub as ``rotorred run`` solves it (its six figures, the Poincare plot's among them)."""
+    from rotorred.scenes.schema import load_scene
+    sc = load_scene("paper-rub", {})
+    return sc, run_scene(sc)
+
+
+def test_scene_frames_are_the_frames_its_figures_ask_for(paper_rub, rub, tmp_path, monkeypatch):
+    """scene_frames reads from the scene alone (before it is solved) the frames its figures are drawn into: paper-rub's
+    six figures; the Poincare plot's frame unused when the analysis has no samples (a record of 0.2 s: 2 at 10 Hz);
+    a scene of one direction without orbits and Poincare plot."""
+    from rotorred.plots.scene import scene_frames
+
+    sc, res = paper_rub
+    assert sorted(_requested_frames(res, tmp_path / "paper", monkeypatch)) == sorted(scene_frames(sc)) and len(
+        scene_frames(sc)) == 6
+    short, res = rub
+    asked = _requested_frames(res, tmp_path / "short", monkeypatch)
+    assert sorted(asked + [scene_frames(short)[-1]]) == sorted(scene_frames(short)) and scene_frames(short)[-1][:2] == (
+        "side", 5.35)
+    one = _scene(output__directions=["y"], output__plots=["waveforms", "spectra"])
+    asked = _requested_frames(run_scene(one), tmp_path / "one", monkeypatch)
+    assert sorted(asked) == sorted(scene_frames(one)) == [("stacked", 9, 2.6, 2), ("stacked", 10, 3.4, 1),
+                                                          ("stacked", 10, 3.4, 1)]
+
+
+def test_prepared_frames_draw_the_same_figures(paper_rub, tmp_path, monkeypatch):
+    """Figures drawn into frames prepared ahead (prepare_frames, as the figure pool's fork server does) are the
+    figures drawn into new ones, pixel for pixel, and use every frame prepared for them: none is built then."""
+    from matplotlib.image import imread
+
+    from rotorred.plots import scene as figures
+
+    sc, res = paper_rub
+    fresh = figures.plot_scene(res, tmp_path / "fresh")
+    figures.prepare_frames(figures.scene_frames(sc))
+    monkeypatch.setattr(figures, "_stacked_frame", None)  # building a frame now fails
+    monkeypatch.setattr(figures, "_side_by_side_frame", None)
+    prepared = figures.plot_scene(res, tmp_path / "prepared")
+    assert not any(figures._PREPARED.values())
+    assert [f.name for f in fresh] == [f.name for f in prepared] and len(fresh) == 6
+    for a, b in zip(fresh, prepared):
+        np.testing.assert_array_equal(imread(a), imread(b))
+
+
+def test_the_figure_pool_prepares_the_frames_before_its_workers_draw(paper_rub, tmp_path):
+    """FigurePool(frames=...): its workers start with the frames built (by the fork server), and drawing the scene's
+    figures uses them all."""
+    import functools
+
+    from rotorred.plots.pool import FigurePool
+    from rotorred.plots.scene import scene_frames
+
+    sc, res = paper_rub
+    count = functools.partial(eval, "sum(map(len, __import__('rotorred.plots.scene', fromlist=['_']).\
+_PREPARED.values()))")  # a job that counts a worker's prepared frames
+    with FigurePool(workers=1, frames=scene_frames(sc)) as pool:
+        before = pool.submit(count).result()
+        files = write_outputs(res, tmp_path, pool=pool)
+        after = pool.submit(count).result()
+    assert (before, after) == (6, 0) and len([f for f in files if f.suffix == ".png"]) == 6
+
+
 def test_a_dead_figure_worker_costs_no_figure(rub, tmp_path):
     """A worker killed while the figures are drawn (out of memory, a signal): its figures are drawn here instead,
     and the files are all there."""
@@ -313,22 +388,24 @@ def test_a_dead_figure_worker_costs_no_figure(rub, tmp_path):
     assert all(f.stat().st_size > 0 for f in files)
 
 
-def test_a_stopped_figure_pool_ends_its_workers():
-    """``rotorred run`` starts its figure pool before it reads the scene, and stops it (FigurePool.stop) when the scene
-    draws no figures or the scene is refused: its workers end then, drawing or not; a pool stopped while its workers
-    are still starting (the fork server importing matplotlib) stops as well."""
+def test_a_figure_pool_left_on_an_error_ends_its_workers():
+    """Leaving a FigurePool on an error (Ctrl-C, a refused file) ends its workers at once, drawing or not, before the
+    caller removes what they write into; so does leaving one whose workers are still starting (the fork server
+    importing matplotlib), after which it draws in the calling process."""
     import os
 
     from rotorred.plots.pool import FigurePool
 
     pool = FigurePool(workers=1)
-    pid = pool.submit(os.getpid).result()  # handed over by the pool's thread, drawn in a worker
-    processes = list(pool._executor._processes.values())
+    with pytest.raises(KeyboardInterrupt), pool:
+        pid = pool.submit(os.getpid).result()  # handed over by the pool's thread, drawn in a worker
+        processes = list(pool._executor._processes.values())
+        raise KeyboardInterrupt
     assert pid != os.getpid() and [p.pid for p in processes] == [pid]
-    pool.stop()
     assert not any(p.is_alive() for p in processes)
     starting = FigurePool(workers=1)
-    starting.stop()
+    with pytest.raises(RuntimeError), starting:
+        raise RuntimeError("refused")
     assert starting._executor is None and starting.submit(os.getpid).result() == os.getpid()  # drawn here now
 
 

@@ -56,28 +56,24 @@ def run(args) -> int:
 
     t0 = time.perf_counter()
     out = out_dir("--out", args.out) if args.out is not None else None  # refused before the scene is read
-    pool = FigurePool()  # its fork server imports matplotlib while this process reads the scene (imports its schema)
-    try:
-        scene = load_scene(args.scene, _settings(args.set))
-        if out is None:
-            out = out_dir("--out", f"rotorred-{scene.name}")
-        budget.check(budget.scene_estimate(scene), force=args.force)
-        pool = _for_scene(pool, scene)
-    except BaseException:
-        pool.stop()
-        raise
-    with OutputFolder(out) as folder, pool:  # the pool stops before the folder cleans up
+    scene = load_scene(args.scene, _settings(args.set))
+    if out is None:
+        out = out_dir("--out", f"rotorred-{scene.name}")
+    budget.check(budget.scene_estimate(scene), force=args.force)
+    with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
         status = _compute_and_write(scene, args, folder, out, pool)
     print(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
 
 
-def _for_scene(pool, scene):
-    """``pool`` (:class:`rotorred.plots.pool.FigurePool`, its workers drawing the figures while the data files are
-    written), or, for a scene without figures or a run-up (drawn here), an empty pool, ``pool`` stopped."""
+def _figure_pool(scene):
+    """The :class:`rotorred.plots.pool.FigurePool` of ``scene``: its workers draw the figures while the data files are
+    written, their fork server importing matplotlib and preparing the figures' frames while the scene is solved; for
+    a scene without figures or a run-up (drawn here), an empty pool."""
     if scene.output.plots and scene.runup is None:
-        return pool
-    pool.stop()
+        from rotorred.plots.scene import scene_frames  # light: matplotlib is imported when a figure is drawn
+
+        return FigurePool(frames=scene_frames(scene))
     return FigurePool(workers=0)
 
 

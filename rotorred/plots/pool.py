@@ -2,10 +2,11 @@
 
 Drawing the six figures of ``paper-rub`` takes about as long as everything else of a warm
 ``rotorred run`` (the solve, the line fit, the data files), and matplotlib's import another 0.4 s.
-The pool starts its workers when it is created, so they import matplotlib while the caller
-computes (``rotorred run`` creates it before it reads the scene, and stops it, :meth:`FigurePool.stop`, if the scene
-draws no figures); the caller then submits figure jobs (:func:`rotorred.plots.scene.scene_figures`: a plot
-function and plain arrays), which returns at once, and writes its data files while they are drawn.
+The pool starts its workers when it is created, so they import matplotlib and build the empty frames of the figures
+while the caller computes (``rotorred run`` creates it once the scene is read and checked, naming the scene's frames,
+:func:`rotorred.plots.scene.scene_frames`); the caller then submits figure jobs
+(:func:`rotorred.plots.scene.scene_figures`: a plot function and plain arrays), which returns at once, and writes its
+data files while they are drawn.
 
 Workers are forked from a fork server (a fresh interpreter, not the caller: no fork of a process that holds
 numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`, through
@@ -27,6 +28,10 @@ import signal
 
 __all__ = ["FigurePool", "Drawing", "default_workers"]
 
+#: the environment variable that names the frames the fork server prepares (:mod:`rotorred.plots._fork_server`):
+#: ``repr`` of a list of frame keys (:func:`rotorred.plots.scene.scene_frames`)
+FRAMES = "ROTORRED_FIGURE_FRAMES"
+
 
 def default_workers() -> int:
     """Workers of a pool: one per core the process may use, at most 2 (six figures; 0 on one core)."""
@@ -46,12 +51,24 @@ def _start_worker() -> None:
     gc.freeze()  # the imported modules are never garbage: drawing then collects only its own objects
 
 
-def _context():
-    """The fork server's context with matplotlib preloaded, or spawn where there is none."""
+def _context(frames=()):
+    """The fork server's context with matplotlib preloaded and ``frames`` prepared (started now: it is started with
+    the frames named in its environment), or spawn where there is none."""
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("spawn")
+    from multiprocessing import forkserver
+
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(["rotorred.plots._fork_server"])
+    previous = os.environ.get(FRAMES)
+    os.environ[FRAMES] = repr([tuple(key) for key in frames])
+    try:
+        forkserver.ensure_running()
+    finally:
+        if previous is None:
+            del os.environ[FRAMES]
+        else:
+            os.environ[FRAMES] = previous
     return context
 
 
@@ -88,14 +105,17 @@ class FigurePool:
     ----------
     workers : int, optional
         Worker processes (default :func:`default_workers`); 0 draws each job when it is submitted.
+    frames : sequence of tuple, optional
+        Frames the figures will be drawn into (:func:`rotorred.plots.scene.scene_frames`): the fork server prepares
+        them before it forks the workers (:mod:`rotorred.plots._fork_server`).
     """
 
-    def __init__(self, workers: int | None = None):
+    def __init__(self, workers: int | None = None, frames=()):
         self.workers = default_workers() if workers is None else int(workers)
         self._executor, self._submitting = None, None
         if self.workers > 0:
             self._executor = concurrent.futures.ProcessPoolExecutor(
-                self.workers, mp_context=_context(), initializer=_start_worker)
+                self.workers, mp_context=_context(frames), initializer=_start_worker)
             # jobs reach the workers through one thread, in order: the first submission waits for the fork server
             # to import matplotlib (0.5 s), which the caller spends computing; one job each starts every worker
             self._submitting = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="figure-pool")
@@ -115,10 +135,6 @@ class FigurePool:
         if self._submitting is not None:
             self._submitting.shutdown(wait=True, cancel_futures=cancel)
             self._submitting = None
-
-    def stop(self) -> None:
-        """Stop the workers now, whatever they draw (the caller is about to remove what they write into)."""
-        self._close(now=True)
 
     def __enter__(self) -> FigurePool:
         return self
