@@ -11,7 +11,10 @@ time goes (the solve, the figures).
   fit, settling, class), median of ``--repeats`` after a warm-up;
 * **figures**: :func:`rotorred.plots.scene.plot_scene` in this process, one after the other, median of
   ``--repeats`` (the command draws them in worker processes while it writes the data files);
-* **data files**: :func:`rotorred.scenes.outputs.write_data`.
+* **data files**: :func:`rotorred.scenes.outputs.write_data`;
+* **this machine's speed**: CPU seconds of a fixed Python loop (``sum(range(3e7))``, least of 3), before and after
+  the rest: this VM's speed varied by 10-25 % within minutes, every row with it, so the rows are comparable
+  only beside it.
 
 Run: ``python validation/bench_run.py [--scene paper-rub] [--repeats 3]``.
 """
@@ -86,12 +89,23 @@ def in_process(scene_name: str, repeats: int, folder: Path) -> dict:
     return {k: statistics.median(v) for k, v in times.items()}
 
 
+def host_speed() -> float:
+    """CPU seconds of ``sum(range(30_000_000))``, least of 3: this machine's speed at the moment."""
+    best = float("inf")
+    for _ in range(3):
+        t0 = time.process_time()
+        sum(range(30_000_000))
+        best = min(best, time.process_time() - t0)
+    return best
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scene", default="paper-rub")
     p.add_argument("--repeats", type=int, default=3)
     args = p.parse_args(argv)
     work = Path(tempfile.mkdtemp(prefix="rotorred-bench-run-"))
+    speed = [host_speed()]
     try:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(work / "numba"), MPLCONFIGDIR=str(work / "mpl"))
         first = cli_run(args.scene, work / "out", env)
@@ -100,6 +114,7 @@ def main(argv=None) -> int:
         parts = in_process(args.scene, args.repeats, work / "figures")
     finally:
         shutil.rmtree(work, ignore_errors=True)
+    speed.append(host_speed())
     print(f"`rotorred run {args.scene}`, {os.cpu_count()} cores, BLAS/numba threads 1")
     print("| what | seconds |")
     print("|---|---|")
@@ -109,6 +124,7 @@ def main(argv=None) -> int:
     print(f"| warm run's CPU time, its figure workers included (median) | {statistics.median(CPU[1:]):.2f} |")
     for k, v in parts.items():
         print(f"| {k} (in one process, median of {args.repeats}) | {v:.2f} |")
+    print(f"| this machine's speed: CPU seconds of sum(range(3e7)), before and after | {speed[0]:.2f}, {speed[1]:.2f} |")
     return 0
 
 

@@ -64,6 +64,8 @@ def _context(frames=()):
     os.environ[FRAMES] = repr([tuple(key) for key in frames])
     try:
         forkserver.ensure_running()
+    except OSError:  # no server now: the pool starts one when it starts a worker (without the frames), or breaks and
+        pass  # its figures are drawn in the calling process (Drawing)
     finally:
         if previous is None:
             del os.environ[FRAMES]
