@@ -4,7 +4,7 @@ time goes (the solve, the figures).
 * **first run**: ``rotorred run --out DIR`` in a subprocess with empty numba and matplotlib caches
   (``NUMBA_CACHE_DIR``, ``MPLCONFIGDIR`` pointed at new folders): what a fresh install meets, numba's
   compilation of the step kernel and matplotlib's font cache included (the compilation's share as the command
-  reports it on its summary line);
+  reports it on its summary line); ``--first-runs N``, each into new caches, gives their median;
 * **warm run**: the same command again (caches filled), median of ``--repeats``, and its CPU time (user +
   system, the figure workers included): on 2 cores the wall time cannot fall below half of it;
 * **solve**: :func:`rotorred.scenes.run.run_scene` in this process (model, both transients, spectra, line
@@ -18,7 +18,7 @@ time goes (the solve, the figures).
   the rest: this VM's speed varied by 10-25 % within minutes, every row with it, so the rows are comparable
   only beside it.
 
-Run: ``python validation/bench_run.py [--scene paper-rub] [--repeats 3]``.
+Run: ``python validation/bench_run.py [--scene paper-rub] [--repeats 3] [--first-runs 1]``.
 """
 
 from __future__ import annotations
@@ -62,6 +62,8 @@ def cli_run(scene: str, out: Path, env: dict) -> float:
 CPU: list[float] = []
 #: seconds each command run compiled the step kernel, as it reports (0: loaded from numba's cache)
 COMPILE: list[float] = []
+#: wall seconds of each first run (new numba and matplotlib caches)
+FIRST: list[float] = []
 
 
 def in_process(scene_name: str, repeats: int, folder: Path) -> dict:
@@ -109,12 +111,15 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scene", default="paper-rub")
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--first-runs", type=int, default=1, help="first runs, each into new caches (about 15 s each)")
     args = p.parse_args(argv)
     work = Path(tempfile.mkdtemp(prefix="rotorred-bench-run-"))
     speed = [host_speed()]
     try:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(work / "numba"), MPLCONFIGDIR=str(work / "mpl"))
-        first = cli_run(args.scene, work / "out", env)
+        for k in range(args.first_runs):
+            env = dict(os.environ, NUMBA_CACHE_DIR=str(work / f"numba{k}"), MPLCONFIGDIR=str(work / f"mpl{k}"))
+            FIRST.append(cli_run(args.scene, work / "out", env))
+        n_first = len(FIRST)
         warm_runs = [cli_run(args.scene, work / "out", env) for _ in range(args.repeats)]
         warm = statistics.median(warm_runs)
         parts = in_process(args.scene, args.repeats, work / "figures")
@@ -124,10 +129,13 @@ def main(argv=None) -> int:
     print(f"`rotorred run {args.scene}`, {os.cpu_count()} cores, BLAS/numba threads 1")
     print("| what | seconds |")
     print("|---|---|")
-    print(f"| first run after a fresh install (empty numba and matplotlib caches) | {first:.1f} |")
-    print(f"| of it, compiling the step kernel (as the command reports it) | {COMPILE[0]:.1f} |")
+    firsts = f"median of {n_first}; spread {min(FIRST):.1f}-{max(FIRST):.1f}" if n_first > 1 else "one run"
+    print(f"| first run after a fresh install (empty numba and matplotlib caches; {firsts}) | "
+          f"{statistics.median(FIRST):.1f} |")
+    print(f"| of it, compiling the step kernel (as the command reports it; median) | "
+          f"{statistics.median(COMPILE[:n_first]):.1f} |")
     print(f"| warm run (median of {args.repeats}; spread {min(warm_runs):.2f}-{max(warm_runs):.2f}) | {warm:.2f} |")
-    print(f"| warm run's CPU time, its figure workers included (median) | {statistics.median(CPU[1:]):.2f} |")
+    print(f"| warm run's CPU time, its figure workers included (median) | {statistics.median(CPU[n_first:]):.2f} |")
     for k, v in parts.items():
         print(f"| {k} (in one process, median of {args.repeats}) | {v:.2f} |")
     print(f"| this machine's speed: CPU seconds of sum(range(3e7)), before and after | {speed[0]:.2f}, {speed[1]:.2f} |")
