@@ -22,7 +22,6 @@ import time
 
 from rotorred import checks
 from rotorred.cli.options import out_dir
-from rotorred.plots.pool import FigurePool
 from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
@@ -70,6 +69,8 @@ def _figure_pool(scene):
     """The :class:`rotorred.plots.pool.FigurePool` of ``scene``: its workers draw the figures while the data files are
     written, their fork server importing matplotlib and preparing the figures' frames while the scene is solved; for
     a scene without figures or a run-up (drawn here), an empty pool."""
+    from rotorred.plots.pool import FigurePool  # here, not at the top: every command imports this module (its parser)
+
     if scene.output.plots and scene.runup is None:
         from rotorred.plots.scene import scene_frames  # light: matplotlib is imported when a figure is drawn
 
