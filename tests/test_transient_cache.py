@@ -1,5 +1,6 @@
-"""numba's on-disk cache of rotorred's compiled functions follows the generated code and the kernel's sources
-(rotorred.transient.numba_cache), and still works when the package folder is not writable.
+"""numba's on-disk cache of rotorred's compiled functions lives in the user's cache folder, never in the package,
+follows the generated code and the kernel's sources (rotorred.transient.numba_cache), and falls back to the
+temporary folder when the user cache folder is not writable.
 
 Each check runs a copy of the package in fresh subprocesses and calls one small compiled function,
 ``kernel._normal_law`` (defined in transient/contact.py), which compiles in the generated
@@ -19,6 +20,7 @@ from pathlib import Path
 
 import pytest
 
+import rotorred
 from rotorred.transient import numba_cache
 
 PACKAGE = Path(__file__).resolve().parents[1] / "rotorred"
@@ -42,17 +44,24 @@ def package_copy(tmp_path):
 
 def run(root: Path, **env_changes) -> dict:
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "NUMBA_DISABLE_JIT")}
-    env.update(PYTHONPATH=str(root), **env_changes)
+    env.update(PYTHONPATH=str(root), XDG_CACHE_HOME=str(root.parent / "xdg"))
+    env.update(env_changes)
     out = subprocess.run([sys.executable, "-c", SNIPPET], cwd=root, env=env, capture_output=True, text=True, check=True)
     return json.loads(out.stdout.splitlines()[-1])
 
 
-def test_cache_is_reused_and_recompiled_when_the_generated_law_changes(package_copy):
+def _cache_files(folder: Path) -> list[Path]:
+    return [p for p in folder.rglob("*") if p.suffix in (".nbi", ".nbc")]
+
+
+def test_cache_is_reused_and_recompiled_when_the_generated_law_changes(package_copy, tmp_path):
     first = run(package_copy)
     again = run(package_copy)
     assert first["misses"] == 1 and first["hits"] == 0  # compiled into an empty cache
     assert again["hits"] == 1 and again["misses"] == 0 and again["R"] == first["R"]  # unchanged: loaded
-    assert Path(again["path"]).is_relative_to(package_copy / "rotorred")  # the in-tree __pycache__
+    # the user cache folder (XDG_CACHE_HOME on Linux), keyed by the version; nothing written into the package
+    assert Path(again["path"]).is_relative_to(tmp_path / "xdg" / "rotorred" / "numba" / rotorred.__version__)
+    assert _cache_files(tmp_path / "xdg") and not _cache_files(package_copy)
     generated = package_copy / "rotorred" / "_generated" / "contact.py"
     text = generated.read_text()
     hertz = "    _t0 = K_nr*s**3.0\n"
@@ -64,21 +73,29 @@ def test_cache_is_reused_and_recompiled_when_the_generated_law_changes(package_c
     assert changed["R"] == pytest.approx(2 * first["R"] - 10.0, abs=1e-12) and changed["R"] != first["R"]
 
 
-def test_cache_falls_back_when_the_package_is_not_writable(package_copy, tmp_path):
-    """With the package's __pycache__ unusable (a file of that name: even root cannot create the folder) the cache
-    goes to numba's user-wide directory; with that unusable too, under the temporary directory; each is reused."""
-    for sub in ("transient", "_generated"):
-        (package_copy / "rotorred" / sub / "__pycache__").write_text("not a folder")
-    user = run(package_copy, XDG_CACHE_HOME=str(tmp_path / "xdg"))
-    user_again = run(package_copy, XDG_CACHE_HOME=str(tmp_path / "xdg"))
-    assert Path(user["path"]).is_relative_to(tmp_path / "xdg") and user["misses"] == 1
-    assert user_again["hits"] == 1 and user_again["misses"] == 0
+def test_two_installs_keep_apart_and_an_upgrade_recompiles(package_copy, tmp_path):
+    """A second copy of the package (another venv, or an editable checkout beside an installed one) has its own
+    entries in the same user cache folder, and loading one never disturbs the other; a new version recompiles."""
+    other = tmp_path / "other"
+    shutil.copytree(package_copy, other)
+    first, second = run(package_copy), run(other, XDG_CACHE_HOME=str(tmp_path / "xdg"))
+    assert first["misses"] == 1 and second["misses"] == 1 and first["path"] != second["path"]
+    assert run(package_copy)["hits"] == 1 and run(other, XDG_CACHE_HOME=str(tmp_path / "xdg"))["hits"] == 1
+    init = package_copy / "rotorred" / "__init__.py"
+    init.write_text(init.read_text().replace(f'__version__ = "{rotorred.__version__}"', '__version__ = "99.0"'))
+    upgraded = run(package_copy)
+    assert upgraded["misses"] == 1 and upgraded["hits"] == 0 and "99.0" in Path(upgraded["path"]).parts
+
+
+def test_cache_falls_back_when_the_user_cache_is_not_writable(package_copy, tmp_path):
+    """With the user cache folder unusable (a file of that name: even root cannot create the folder) the cache goes
+    under the temporary folder, and is reused there; the package folder is never written."""
     (tmp_path / "no-xdg").write_text("not a folder")
     (tmp_path / "tmp").mkdir()
     env = dict(XDG_CACHE_HOME=str(tmp_path / "no-xdg"), TMPDIR=str(tmp_path / "tmp"))
     temp, temp_again = run(package_copy, **env), run(package_copy, **env)
     assert Path(temp["path"]).is_relative_to(tmp_path / "tmp") and temp["misses"] == 1
-    assert temp_again["hits"] == 1 and temp_again["misses"] == 0 and temp_again["R"] == user["R"]
+    assert temp_again["hits"] == 1 and temp_again["misses"] == 0 and not _cache_files(package_copy)
 
 
 def test_digest_covers_every_module_with_compiled_code():

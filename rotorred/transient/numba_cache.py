@@ -1,25 +1,30 @@
-"""numba's on-disk cache of rotorred's compiled functions, kept in step with the code they inline.
+"""numba's on-disk cache of rotorred's compiled functions: in the user's cache folder, kept in step with the code.
 
-numba keys the cache of an ``njit(cache=True)`` function on the stamp of its own source file
-only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself functions of
-other files: the contact law of :mod:`rotorred.transient.contact` and the sympy-generated code
-of :mod:`rotorred._generated`. Regenerating ``_generated/contact.py`` would then leave the
-cached kernel (keyed on ``kernel.py``) stale, still evaluating the old law.
+**Where.** Never inside the installed package: a cache written into ``site-packages/rotorred/__pycache__`` outlives
+``pip uninstall`` (pip removes the files it installed, not the ones a run wrote), and the folder left behind then
+shadows an editable install of the same package (``import rotorred._generated.tapered`` fails). The cache lives in
+the first of these that can be written:
 
-:func:`register` puts :class:`RotorredCacheLocator` first in numba's list of cache locators.
-For a function defined in a file of the rotorred package it returns the source stamp
+1. ``NUMBA_CACHE_DIR``, if set (numba's own setting);
+2. :func:`user_cache_root`: ``<user cache folder>/numba/<rotorred version>``, the user cache folder from
+   :mod:`platformdirs` (``~/.cache/rotorred`` on Linux, ``~/Library/Caches/rotorred`` on macOS,
+   ``%LOCALAPPDATA%\\rotorred\\Cache`` on Windows; ``XDG_CACHE_HOME`` moves it on Linux);
+3. :func:`temp_cache_root`: ``rotorred-numba-<user>`` under the system's temporary folder (a read-only home),
+   announced by one line on stderr (once per process).
 
-    (numba's stamp of the function's own file, sha256 of source_files(): _generated/*.py and KERNEL_SOURCES)
+Inside it, numba's layout: one sub-folder per source folder (its name and a hash of its absolute path), so two
+installs of rotorred (a venv's and an editable checkout) never share or overwrite each other's entries.
 
-so any change of the generated modules or of the kernel's source modules invalidates every
-rotorred cache entry (numba then recompiles and overwrites it). Functions of other packages are
-left to numba's own locators.
+**When it is stale.** numba keys the cache of an ``njit(cache=True)`` function on the stamp of its own source file
+only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself functions of other files: the
+contact law of :mod:`rotorred.transient.contact` and the sympy-generated code of :mod:`rotorred._generated`.
+:func:`register` puts :class:`RotorredCacheLocator` first in numba's list of cache locators. For a function
+defined in a file of the rotorred package it returns the source stamp
 
-Where the cache lives, first that works: ``NUMBA_CACHE_DIR`` if set; the ``__pycache__`` next to
-the source (numba's default); numba's user-wide cache directory (a read-only install); a
-``rotorred-numba-<uid>`` directory under the system's temporary directory, announced by one line on
-stderr (once per process). A valid cache in a read-only package's ``__pycache__`` is not read (numba
-uses a cache folder only where it can write): such an install compiles once per user.
+    (numba's stamp of the function's own file, sha256 of the rotorred version and of source_files())
+
+so an upgrade, a regeneration of the generated modules or an edit of the kernel's source modules invalidates
+every rotorred cache entry (numba then recompiles and overwrites it, in place).
 """
 
 from __future__ import annotations
@@ -32,6 +37,8 @@ import tempfile
 from pathlib import Path
 
 from numba.core import caching
+
+from rotorred import __version__
 
 #: the package directory whose functions this locator serves
 PACKAGE = Path(__file__).resolve().parent.parent
@@ -51,7 +58,7 @@ def source_files(package: Path = PACKAGE) -> list[Path]:
 
 @functools.lru_cache(maxsize=8)
 def _digest_of(package: str, stamps: tuple) -> str:
-    h = hashlib.sha256()
+    h = hashlib.sha256(__version__.encode())
     for rel, mtime_ns, _size in stamps:
         h.update(rel.encode())
         h.update((Path(package) / rel).read_bytes() if mtime_ns is not None else b"<missing>")
@@ -67,40 +74,68 @@ def _stamp(path: Path, package: Path) -> tuple:
 
 
 def source_digest(package: Path = PACKAGE) -> str:
-    """sha256 of the names and contents of :func:`source_files`, re-read when a file's mtime or size changes."""
+    """sha256 of the rotorred version and of the names and contents of :func:`source_files`, re-read when a file's
+    mtime or size changes."""
     return _digest_of(str(package), tuple(_stamp(p, package) for p in source_files(package)))
 
 
-#: whether the fallback to the temporary directory has been announced in this process
-_ANNOUNCED = []
+def user_cache_root() -> str:
+    """The cache folder of compiled kernels: ``numba/<rotorred version>`` in the user cache folder of
+    :func:`platformdirs.user_cache_dir` (``~/.cache/rotorred`` on Linux)."""
+    import platformdirs
+
+    return os.path.join(platformdirs.user_cache_dir("rotorred", appauthor=False), "numba", __version__)
 
 
 def temp_cache_root() -> str:
-    """The last-resort cache folder: ``rotorred-numba-<uid>`` under the system's temporary directory."""
-    user = str(os.getuid()) if hasattr(os, "getuid") else "user"
+    """The last-resort cache folder: ``rotorred-numba-<user>`` under the system's temporary folder."""
+    user = str(os.getuid()) if hasattr(os, "getuid") else os.environ.get("USERNAME", "user")
     return os.path.join(tempfile.gettempdir(), f"rotorred-numba-{user}")
 
 
-class _TempDirLocator(caching.UserWideCacheLocator):
-    """Last resort: a per-user directory under the system's temporary directory (announced once on stderr)."""
+#: whether the fallback to the temporary folder has been announced in this process
+_ANNOUNCED = []
+
+
+class _FolderLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+    """A function's cache in ``root()/<numba's sub-folder for its source folder>`` (None if it cannot be written)."""
+
+    @staticmethod
+    def root() -> str:
+        raise NotImplementedError
 
     def __init__(self, py_func, py_file):
-        super().__init__(py_func, py_file)
-        self._cache_path = os.path.join(temp_cache_root(), self.get_suitable_cache_subpath(py_file))
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = os.path.join(self.root(), self.get_suitable_cache_subpath(py_file))
+
+    def get_cache_path(self):
+        return self._cache_path
+
+
+class _UserCacheLocator(_FolderLocator):
+    """The user cache folder (:func:`user_cache_root`)."""
+
+    root = staticmethod(user_cache_root)
+
+
+class _TempDirLocator(_FolderLocator):
+    """Last resort: a per-user folder under the system's temporary folder (announced once on stderr)."""
+
+    root = staticmethod(temp_cache_root)
 
     @classmethod
     def from_function(cls, py_func, py_file):
         self = super().from_function(py_func, py_file)
         if self is not None and not _ANNOUNCED:
             _ANNOUNCED.append(True)
-            print(f"rotorred: the package folder and numba's user cache are not writable; compiled kernels are "
+            print(f"rotorred: the user cache folder {user_cache_root()} is not writable; compiled kernels are "
                   f"cached in {temp_cache_root()} (set NUMBA_CACHE_DIR to choose)", file=sys.stderr)
         return self
 
 
-#: where the cache of a rotorred function may live, in order of preference
-FALLBACKS = (caching.UserProvidedCacheLocator, caching.InTreeCacheLocator, caching.UserWideCacheLocator,
-             _TempDirLocator)
+#: where the cache of a rotorred function may live, in order of preference; never the package's own folder
+FALLBACKS = (caching.UserProvidedCacheLocator, _UserCacheLocator, _TempDirLocator)
 
 
 class RotorredCacheLocator(caching._CacheLocator):
