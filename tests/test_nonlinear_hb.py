@@ -1,6 +1,6 @@
 """Nonlinear harmonic balance (issue 20, build items 1, 3, 4) against closed forms and scipy's solve_ivp.
 
-The two reference cases are pyHarm's, with its parameters (../shared/docs/anchors.md): the Duffing oscillator
+The two reference cases are pyHarm's, with its parameters (its published examples): the Duffing oscillator
 x'' + 0.02 x' + x + 0.1 x^3 = 0.1 cos(omega t), and a Jeffcott rotor (m = k = 1, c = 0.02, unbalance e = 0.05) in a
 circular clearance g = 1 with contact stiffness k_c = 100, no friction.
 """

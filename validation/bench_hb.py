@@ -2,9 +2,9 @@
 
 Run (pyHarm installs only on Python >= 3.11, in its own virtual environment; see below)::
 
-    /work/pyharm_env/bin/python validation/bench_hb.py [--repeats 3] [--plot PATH] [--profile]
+    .venv-pyharm/bin/python validation/bench_hb.py [--repeats 3] [--plot PATH] [--profile]
 
-The cases are those of ``../shared/docs/anchors.md`` (and of tests/test_nonlinear_hb.py, whose
+The cases are pyHarm's published examples (and of tests/test_nonlinear_hb.py, whose
 ``duffing(H, N)`` and ``jeffcott(H, N)`` both take from :mod:`rotorred.nonlinear.examples`):
 
 * Duffing ``x'' + 0.02 x' + x + 0.1 x^3 = 0.1 cos(w t)``, w from 0.5 to 2.5, ds0 = ds_max = 0.05,

@@ -1,4 +1,4 @@
-"""The two reference problems of harmonic balance (pyHarm's cases, ../shared/docs/anchors.md), with closed forms.
+"""The two reference problems of harmonic balance (pyHarm's published cases), with closed forms.
 
 * :func:`duffing`: ``x'' + C x' + x + K3 x^3 = F cos(omega t)``; single-term closed form
   ``((1 - w^2 + 3/4 K3 A^2)^2 + (C w)^2) A^2 = F^2``.
