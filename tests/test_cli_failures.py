@@ -32,8 +32,12 @@ SHORT = ["--set", "solver.duration=0.3", "--set", "solver.record_start=0.1", "--
 def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
     out = tmp_path / "div"
     assert main(["run", "paper-rub", "--out", str(out), "--set", "unbalance[1].m_e=4.0", *DIVERGE]) == 3
-    err = capsys.readouterr().err.strip()
-    assert "Traceback" not in err and len(err.splitlines()) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    # one error line, after the run's stage lines (what it was doing when it stopped)
+    errors = [line for line in lines if line.startswith("rotorred run: error: ")]
+    assert len(errors) == 1 and lines[-1] == errors[0] and "Traceback" not in "\n".join(lines), lines
+    assert any(line.startswith("rotorred run: stepping paper-rub") for line in lines[:-1]), lines
+    err = errors[0]
     # when, where and why, in scene key names
     assert "t = 0.3486 s" in err and "rub[0] (node 18, x)" in err and "exceeded 1 m" in err
     assert "displacement_limit" not in err and "INCOMPLETE" in err
@@ -104,12 +108,12 @@ def test_interrupt_leaves_the_earlier_result(earlier, tmp_path, when, sig, statu
     out = tmp_path / "out"
     os.system(f"cp -a {earlier} {out}")
     before = _snapshot(out)
-    if when == "solving":  # 60 s simulated at dt = 1e-6: interrupted once the kernel's progress bar shows
+    if when == "solving":  # 60 s simulated at dt = 1e-6: interrupted once the stepping stage line shows
         proc = _rotorred("run", "paper-rub", "--out", str(out), *SHORT, "--set", "solver.duration=60",
                          "--set", "solver.dt=1e-6", "--set", "solver.record_start=59.7",
                          "--set", "output.plot_window=[59.7, 59.8]")
         line = ""
-        while "rotorred transient" not in line:
+        while "rotorred run: stepping paper-rub" not in line:
             ch = proc.stderr.read(1)
             assert ch, (line, proc.communicate())
             line += ch

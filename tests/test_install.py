@@ -27,7 +27,8 @@ from rotorred.transient.newmark import COMPILING_NOTE
 PACKAGE = Path(__file__).resolve().parents[1] / "rotorred"
 
 TRANSIENT = """
-import json, os
+import json, logging, os
+logging.basicConfig(format="%(message)s", level=logging.INFO)  # rotorred's warnings and stage lines on stderr
 import rotorred
 from rotorred.model.assembly import assemble
 from rotorred.model.loads import Unbalance
@@ -88,7 +89,7 @@ def test_read_only_install_with_unwritable_home_runs(tmp_path):
     assert not report["package_writable"] and not report["home_writable"]  # the test meant what it says
     notes = [line for line in out.stderr.splitlines() if line.strip()]
     # where the cache went, then (a fresh cache) the compilation announced on its own line
-    assert len(notes) == 2 and notes[0].startswith("rotorred: ") and str(tmp) in notes[0], out.stderr
+    assert len(notes) == 2 and notes[0].startswith("the user cache folder ") and str(tmp) in notes[0], out.stderr
     assert notes[1] == COMPILING_NOTE, out.stderr
     assert report["load"] > 100 * report["run"]  # the compilation is timed apart from the 100 steps
     assert any((tmp / f"rotorred-numba-{os.getuid()}").rglob("*.nbi"))  # the cache is there for the next run
@@ -125,9 +126,8 @@ def test_spectra_fall_back_to_numpy_without_pyfftw(no_pyfftw):
     assert report["plan"] == "NumpyPlan"
     # on-bin tones read exactly (rectangular window on a whole number of common periods): round-off only
     assert report["a70"] == pytest.approx(3.0, rel=1e-12) and report["a90"] == pytest.approx(0.5, rel=1e-12)
-    assert out.stderr.strip().splitlines() == [
-        "rotorred: pyFFTW is not installed; spectra use numpy.fft (same results; `pip install pyfftw` for the "
-        "faster FFT)"]
+    assert out.stderr.strip().splitlines() == [  # a logging warning: Python's last-resort handler prints it
+        "pyFFTW is not installed; spectra use numpy.fft (same results; `pip install pyfftw` for the faster FFT)"]
 
 
 def test_run_works_without_pyfftw(no_pyfftw, tmp_path):

@@ -81,7 +81,7 @@ def test_two_installs_keep_apart_and_an_upgrade_recompiles(package_copy, tmp_pat
     first, second = run(package_copy), run(other, XDG_CACHE_HOME=str(tmp_path / "xdg"))
     assert first["misses"] == 1 and second["misses"] == 1 and first["path"] != second["path"]
     assert run(package_copy)["hits"] == 1 and run(other, XDG_CACHE_HOME=str(tmp_path / "xdg"))["hits"] == 1
-    init = package_copy / "rotorred" / "__init__.py"
+    init = package_copy / "rotorred" / "_version.py"
     init.write_text(init.read_text().replace(f'__version__ = "{rotorred.__version__}"', '__version__ = "99.0"'))
     upgraded = run(package_copy)
     assert upgraded["misses"] == 1 and upgraded["hits"] == 0 and "99.0" in Path(upgraded["path"]).parts

@@ -66,20 +66,83 @@ class Terminated(BaseException):
     """SIGTERM arrived (raised in the main thread like ``KeyboardInterrupt`` for SIGINT)."""
 
 
-def _epilog() -> str:
-    return "exit status:\n" + "\n".join(f"  {code:>3}  {text}" for code, text in EXIT_STATUSES.items())
+#: examples of each command, shown by ``rotorred <command> --help`` (tests/test_cli_feedback.py parses each and
+#: checks its scene keys)
+EXAMPLES = {
+    "run": ["rotorred run --out out                                  # the paper's rub scene (paper-rub)",
+            "rotorred run paper-normal --out normal --set speeds.outer=95",
+            "rotorred run out/scene.toml --out again                 # rerun a folder's resolved scene",
+            "rotorred run runup-rub --out runup -q                   # a run-up, printing errors only"],
+    "campbell": ["rotorred campbell seed-rig --speeds 0:12000:61 --out campbell",
+                 "rotorred campbell seed-rig --speeds 3000 --out whirl     # whirl frequencies at one speed",
+                 "rotorred campbell my_rotor.toml --speeds 0:20000:81 --ratio 1.4 --harmonics 1,2 --out cd"],
+    "convert": ["rotorred convert rotor_saved_by_ross.toml rotor.toml"],
+    "harmonic": ["rotorred harmonic seed-rig --speeds 0:12000:241 --out bode"],
+    "map": ["rotorred map paper-rub --vary rub.clearance=10e-6:60e-6:11 --out clearance",
+            "rotorred map paper-rub --vary speeds.outer=60:120:13 --vary rub.clearance=20e-6:50e-6:4 --workers 2 "
+            "--out envelope"],
+    "continue": ["rotorred continue paper-rub --param rub.clearance=45e-6:5e-6 --out branch",
+                 "rotorred continue paper-rub --param speeds.outer=90:110 --no-stability --out speed-branch"],
+}
+
+
+def _epilog(command: str | None = None) -> str:
+    examples = ""
+    if command in EXAMPLES:
+        examples = "examples:\n" + "\n".join(f"  {e}" for e in EXAMPLES[command]) + "\n\n"
+    return examples + "exit status:\n" + "\n".join(f"  {code:>3}  {text}" for code, text in EXIT_STATUSES.items())
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help wrapped to the terminal: the description's paragraphs filled to the width, the epilog's indented lines
+    (examples, exit statuses) kept as written, each exit status's text filled under its number."""
+
+    def _fill_text(self, text, width, indent):
+        import textwrap
+
+        out = []
+        for paragraph in text.split("\n\n"):
+            lines = paragraph.splitlines()
+            if lines and all(line.startswith("  ") for line in lines[1:]) and lines[0].endswith(":"):
+                out.append("\n".join([indent + lines[0]] + [self._hang(line, width, indent) for line in lines[1:]]))
+            else:
+                out.append(textwrap.fill(" ".join(paragraph.split()), width, initial_indent=indent,
+                                         subsequent_indent=indent))
+        return "\n\n".join(out)
+
+    @staticmethod
+    def _hang(line: str, width: int, indent: str) -> str:
+        import re
+        import textwrap
+
+        if line.lstrip().startswith("rotorred "):  # an example: as written
+            return indent + line
+        head = re.match(r"\s*\S+\s+", line)
+        pad = " " * (len(head.group(0)) if head else 2)
+        return textwrap.fill(line, width, initial_indent=indent, subsequent_indent=indent + pad)
+
+
+def _version() -> str:
+    from rotorred._version import __version__
+
+    return __version__
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from rotorred.cli import feedback
+
     parser = argparse.ArgumentParser(
-        prog="rotorred", description="Rotordynamics of dual-rotor machines with rub-impact faults.",
-        epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
+        prog="rotorred", description="Rotordynamics of dual-rotor machines with rub-impact faults. "
+                                     "`rotorred COMMAND --help` describes a command, with examples.",
+        epilog=_epilog(), formatter_class=_Formatter)
+    parser.add_argument("--version", action="version", version=f"rotorred {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         module = importlib.import_module(f"rotorred.cli.{name}")
         p = module.add_parser(sub)
-        p.epilog = _epilog()
-        p.formatter_class = argparse.RawDescriptionHelpFormatter
+        feedback.add_options(p)
+        p.epilog = _epilog(p.prog.split()[-1])
+        p.formatter_class = _Formatter
         p.set_defaults(_run=module.run)
     return parser
 
@@ -118,6 +181,9 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return EXIT_INPUT
+    from rotorred.cli import feedback
+
+    feedback.configure(args.command, feedback.level(args))
     with _sigterm_raises():
         try:
             return int(args._run(args) or 0)

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -43,11 +44,11 @@ def run(args) -> int:
                                         "docs/model.md §14)")
     spool = rotor.spools[0]
     tables = sum(1 for b in document["bearing"] if "speed_rpm" in b)
-    print(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"
-          + (f", {len(spool.sleeves)} sleeves (ROSS layered elements)" if spool.sleeves else "")
-          + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({tables} tabulated against speed)"
-          + (f", {len(rotor.pedestals)} pedestals" if rotor.pedestals else ""))
-    print(f"wrote {target}")
+    report(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"
+           + (f", {len(spool.sleeves)} sleeves (ROSS layered elements)" if spool.sleeves else "")
+           + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({tables} tabulated against speed)"
+           + (f", {len(rotor.pedestals)} pedestals" if rotor.pedestals else ""))
+    report(f"wrote {target}")
     return 0
 
 

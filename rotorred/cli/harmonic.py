@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 from rotorred.cli.options import dof_list, grid, node_list, out_dir, ratio_number, spool_ratios
 from rotorred.writers import OutputFolder
 
@@ -281,15 +282,15 @@ def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[st
 
 def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files) -> None:
     if scene is not None:
-        print(f"scene {scene.name} ({scene.source})")
-    print(f"rotor {rotor.name or args.rotor}: {label}")
-    print("unbalances: " + ", ".join(f"node {u.node} ({rotor.spool_of[u.node]}) {u.m_e:g} kg m at "
-                                     f"{math.degrees(u.phase):g} deg" for u in unbalances))
-    print(f"sweep: {len(speeds)} speeds, {reference} {speeds[0] * _RPM:.0f}-{speeds[-1] * _RPM:.0f} rpm, "
-          f"ratios {ratios}; solved in {elapsed:.2f} s")
+        report(f"scene {scene.name} ({scene.source})")
+    report(f"rotor {rotor.name or args.rotor}: {label}")
+    report("unbalances: " + ", ".join(f"node {u.node} ({rotor.spool_of[u.node]}) {u.m_e:g} kg m at "
+                                      f"{math.degrees(u.phase):g} deg" for u in unbalances))
+    report(f"sweep: {len(speeds)} speeds, {reference} {speeds[0] * _RPM:.0f}-{speeds[-1] * _RPM:.0f} rpm, "
+           f"ratios {ratios}; solved in {elapsed:.2f} s")
     for o in result.outputs:
         k = int(np.argmax(result.peak(o)))
-        print(f"  node {o[0]} {o[1]}: max peak bound {1e6 * result.peak(o)[k]:.4g} um at "
-              f"{speeds[k] * _RPM:.0f} rpm")
+        report(f"  node {o[0]} {o[1]}: max peak bound {1e6 * result.peak(o)[k]:.4g} um at "
+               f"{speeds[k] * _RPM:.0f} rpm")
     for f in files:
-        print(f"wrote {f}")
+        report(f"wrote {f}")

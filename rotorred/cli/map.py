@@ -13,10 +13,13 @@ points are kept in ``DIR/points`` as they finish, and the same command resumes a
 
 from __future__ import annotations
 
-import sys
+import logging
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 from rotorred.cli.options import out_dir, spool_ratios
+
+LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -81,20 +84,20 @@ def run(args) -> int:
 
     out = out_dir("--out", args.out)
     spec = spec_of(args)
-    print(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
-          f"{'/'.join(spec.directions)}, {spec.n_points} points, "
-          f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
+    report(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
+           f"{'/'.join(spec.directions)}, {spec.n_points} points, "
+           f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
     result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler)
-    print(format_map(result.dataset, spec))
+    report(format_map(result.dataset, spec))
     for f in result.files:
-        print(f"wrote {f}")
-    print(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
-          f"wall time {result.wall_time:.2f} s")
+        report(f"wrote {f}")
+    report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
+           f"wall time {result.wall_time:.2f} s")
     if result.incomplete:
-        print(f"rotorred {args.command}: {result.incomplete}", file=sys.stderr)
+        LOG.error(result.incomplete)
         return EXIT_SIGINT
     if result.n_failed:
-        print(f"rotorred {args.command}: error: {result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
-              "points are kept", file=sys.stderr)
+        LOG.error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
+                  "points are kept")
         return EXIT_DIVERGED
     return 0

@@ -17,14 +17,17 @@ Everything is checked before computing (the scene, ``--out``, the size estimate 
 
 from __future__ import annotations
 
-import sys
+import logging
 import time
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 from rotorred.cli.options import out_dir
 from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
+
+LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -59,9 +62,10 @@ def run(args) -> int:
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
     budget.check(budget.scene_estimate(scene), force=args.force)
+    LOG.info("running %s into %s", scene.name, out)  # the first line, once the input is checked: a refusal is one line
     with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
         status = _compute_and_write(scene, args, folder, out, pool)
-    print(f"wall time {time.perf_counter() - t0:.2f} s")
+    report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
 
 
@@ -112,13 +116,12 @@ def _compute_and_write(scene, args, folder, out, pool) -> int:
     except SceneDiverged as exc:
         write_outputs(exc.partial, folder.staging, shown=out, pool=pool)
         files = folder.commit(incomplete=str(exc))
-        print(format_summary(exc.partial, files))
-        print(f"rotorred run: error: {exc}; partial results written to {out} (marked {INCOMPLETE})",
-              file=sys.stderr)
+        report(format_summary(exc.partial, files))
+        LOG.error(f"{exc}; partial results written to {out} (marked {INCOMPLETE})")
         return EXIT_DIVERGED
     files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing)
     folder.commit()
-    print(format_summary(result, files))
+    report(format_summary(result, files))
     return 0
 
 
@@ -132,9 +135,8 @@ def _runup_and_write(scene, folder, out) -> int:
     result = run_runup(scene, progress=None)
     files = write_runup_outputs(result, folder.staging, shown=out)
     committed = folder.commit(incomplete=result.incomplete)
-    print(format_runup_summary(result, committed))
+    report(format_runup_summary(result, committed))
     if result.incomplete:
-        print(f"rotorred run: error: {result.incomplete}; partial results written to {out} (marked {INCOMPLETE})",
-              file=sys.stderr)
+        LOG.error(f"{result.incomplete}; partial results written to {out} (marked {INCOMPLETE})")
         return EXIT_DIVERGED
     return 0

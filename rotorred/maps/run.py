@@ -26,6 +26,7 @@ from rotorred.maps.execute import connect, local_cluster, run_points
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, to_dataset, write_tables
+from rotorred.progress import bar as progress_bar
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
 
@@ -46,25 +47,19 @@ class MapRun:
 
 
 class _Progress:
-    """tqdm bar over the map's points, with the failures in its postfix; silent when off."""
+    """The progress bar over the map's points (:func:`rotorred.progress.bar`), with the failures in its postfix."""
 
-    def __init__(self, total: int, done: int, enabled: bool):
+    def __init__(self, total: int, done: int, progress: bool | None):
         self.failed = 0
-        self.bar = None
-        if enabled:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=total, initial=done, unit="point", desc="map", dynamic_ncols=True)
+        self.bar = progress_bar(total, "map", "point", progress=progress, initial=done)
 
     def __call__(self, direction: str, index: tuple, point) -> None:
         self.failed += point.status != "ok"
-        if self.bar is not None:
-            self.bar.set_postfix(failed=self.failed, refresh=False)
-            self.bar.update(1)
+        self.bar.set_postfix(failed=self.failed, refresh=False)
+        self.bar.update(1)
 
     def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
+        self.bar.close()
 
 
 def _client(workers: int | None, scheduler: str | None):
@@ -77,7 +72,7 @@ def _client(workers: int | None, scheduler: str | None):
 
 
 def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
-            progress: bool = True, figures: bool = True) -> MapRun:
+            progress: bool | None = None, figures: bool = True) -> MapRun:
     """Run a map into ``out`` (module docstring); resumable.
 
     Parameters
@@ -89,8 +84,11 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         Local Dask workers (default: one per core); 0 runs serially in this process.
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:port``), in place of a local cluster.
-    progress, figures : bool
-        Progress bar; figures.
+    progress : bool, optional
+        The progress bar: True always, False never, None (default) on a terminal when the ``"rotorred"`` logger
+        passes INFO (:func:`rotorred.progress.bar`).
+    figures : bool
+        Write the figures.
     """
     t0 = time.perf_counter()
     scenes = spec.scenes()  # 1. every point validated before anything runs

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rotorred.progress import stage
 from rotorred.scenes.run import SceneResult
 from rotorred.scenes.summary import format_summary
 from rotorred.writers import write_csv, write_mat, write_npz, write_text
@@ -168,6 +169,7 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    stage("writing the figures, data and summary into %s", shown if shown is not None else out)
     if drawing is None:
         figures = submit_figures(result, out, pool)
     else:

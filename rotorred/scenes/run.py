@@ -36,6 +36,7 @@ are written by :func:`rotorred.scenes.outputs.write_outputs`.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -43,6 +44,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from rotorred.model.assembly import assemble
+from rotorred.progress import stage
 from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.signals.lines import label_lines
 from rotorred.model.loads import gravity_force
@@ -55,6 +57,8 @@ from rotorred.signals.spectra import settled_spectrum
 __all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "fit_and_settling", "Response", "respond",
            "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
            "harmonic_outputs", "spool_frequencies"]
+
+LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -234,6 +238,7 @@ def build_model(scene: Scene) -> SceneModel:
     from rotorred.scenes.modes import AUTO_TARGET, choose_modes
 
     t0 = time.perf_counter()
+    stage("building the model of %s (%s)", scene.name, scene.solver.model, logger=LOG)
     system = assemble(scene.rotor)
     s = scene.solver
     if s.model == "full":
@@ -252,6 +257,7 @@ def build_model(scene: Scene) -> SceneModel:
         cutoff = None if s.cutoff_hz is None else 2 * math.pi * s.cutoff_hz
         model = reduce_rotor(scene.rotor, extra, n_modes=s.modes, cutoff=cutoff, system=system)
         label = _reduced_label(scene, model, extra, model.selection.describe(), system)
+    LOG.debug("%s: %s, built in %.2f s", scene.name, label, time.perf_counter() - t0)
     return SceneModel(model, label, time.perf_counter() - t0, model_key(scene))
 
 
@@ -382,6 +388,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     if not analyse:
         return result
     d = table_dof(scene)
+    stage("analysing %s: line fit, settling and class of node %d %s", scene.name, *d, logger=LOG)
     try:
         analyses = {d: analyse_lines(response.t, response.outputs[d], f_L, f_H, spectra[d].n_samples, d)}
     except ValueError as exc:  # a record too short to fit (checks' one-line message)
@@ -468,6 +475,7 @@ def _harmonic_response(scene: Scene, model) -> Response:
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
+    stage("solving %s: the settled harmonic response at %d record times", scene.name, n + 1, logger=LOG)
     return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
 
 
@@ -481,6 +489,7 @@ def _balance_response(scene: Scene, model) -> Response:
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
     t = s.record_start + s.dt * np.arange(n + 1)
+    stage("solving %s by harmonic balance: a short transient to start from, then Newton", scene.name, logger=LOG)
     record = start_record(scene, model)
     if s.tolerance is not None:
         rp, z, choice = balance_to_tolerance(scene, model, s.tolerance, scene.output.dofs, record=record)
@@ -533,6 +542,8 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
     s, model = scene.solver, scene_model.model
     q0, v0 = settled_state(scene, model) if s.start == "settled" and initial is None else (None, None)
     kw = {"alpha": s.alpha} if s.method == "hht" else {}
+    stage("stepping %s: %s, %d steps of %g s to %g s (record from %g s)", scene.name, s.method,
+          round(s.duration / s.dt), s.dt, s.duration, s.record_start, logger=LOG)
     try:
         res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
                        rotor=scene.rotor, outputs=scene.output.dofs, record_start=s.record_start, method=s.method,
@@ -544,7 +555,8 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
 
 def _counters(res) -> dict:
     return {"n_newton": res.n_newton, "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
-            "us_per_step": res.us_per_step, "kernel_load_time": res.kernel_load_time}
+            "us_per_step": res.us_per_step, "kernel_load_time": res.kernel_load_time,
+            "kernel_compiled": res.kernel_compiled}
 
 
 # --------------------------------------------------------------------------- divergence

@@ -26,6 +26,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from rotorred.progress import stage
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
 from rotorred.scenes.schema import Scene
 from rotorred.signals.orders import OrderTrack, angle_blocks, order_tracks, overall_amplitude
@@ -280,6 +281,8 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     q0, v0 = settled_state(start, model.model) if s.start == "settled" else (None, None)
     t0 = time.perf_counter()
     incomplete = None
+    stage("stepping %s through its speed profile: %d steps of %g s to %g s", scene.name, round(s.duration / s.dt),
+          s.dt, s.duration)
     try:
         res = simulate(model.model, profile, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
                        rotor=scene.rotor, outputs=scene.output.dofs, decimate=int(round(scene.runup.record_dt / s.dt)),
@@ -287,6 +290,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     except SimulationDiverged as exc:
         res, incomplete = exc.result, explain_divergence(scene, exc)
     solve_time = time.perf_counter() - t0
+    stage("analysing %s: order tracks, critical speeds, rub intervals", scene.name)
     return analyse(scene, model, res, solve_time, incomplete)
 
 
@@ -305,7 +309,7 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
     criticals, ratio = critical_speeds_in_range(scene, speeds)
     counters = {"us_per_step": res.us_per_step, "n_passes": res.n_passes, "n_factorizations": res.n_factorizations,
                 "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
-                "kernel_load_time": res.kernel_load_time}
+                "kernel_load_time": res.kernel_load_time, "kernel_compiled": res.kernel_compiled}
     return RunupResult(scene=scene, t=res.t, speeds=speeds, outputs=res.outputs, contacts=res.contacts, tracks=tracks,
                        track_dofs=track_dofs, overall=overall, waterfall=fall, waterfall_dof=dof,
                        orbits=orbit_snapshots(scene, res.t, speeds, res.outputs),

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rotorred.progress import stage
 from rotorred.scenes.runup import RUB_GAP_REVS, RunupResult
 from rotorred.writers import render_table, write_csv, write_mat, write_npz, write_text
 
@@ -85,6 +86,7 @@ def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path 
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    stage("writing the figures, data and summary into %s", shown if shown is not None else out)
     formats = result.scene.output.formats
     files = plot_runup(result, out) if result.scene.output.plots else []
     arrays = runup_arrays(result)

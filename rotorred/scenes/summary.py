@@ -103,7 +103,7 @@ def _setup(result: SceneResult) -> str:
                      f"{s.duration:g} s ({c.get('us_per_step', 0):.2f} us/step, "
                      f"{c.get('n_contact_steps', 0)} contact steps, {c.get('n_substeps', 0)} half steps), recorded "
                      f"{s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
-        if c.get("kernel_load_time", 0.0) > 1.0:  # a compilation, not numba's cache
+        if c.get("kernel_compiled"):  # a compilation, not numba's cache
             lines.append(f"step kernel compiled in {c['kernel_load_time']:.1f} s (once per install; not in the "
                          "us/step; cached on disk)")
     return "\n".join(lines)

@@ -32,7 +32,7 @@ in an explicit cache (:func:`rfft_plan`, :func:`plan_cache_info`). The pyFFTW
 ``interfaces`` cache is not used: the builders objects are kept here directly, so plan
 reuse is an identity that can be checked (``rfft_plan(n) is rfft_plan(n)``). Without pyFFTW
 the plans are :class:`NumpyPlan` objects over :func:`numpy.fft.rfft`, with a one-line note on
-stderr (:data:`NO_PYFFTW_NOTE`, once per process).
+stderr (:data:`NO_PYFFTW_NOTE`, a logging warning, once per process).
 
 References
 ----------
@@ -49,6 +49,7 @@ References
 
 from __future__ import annotations
 
+import logging
 import math
 import threading
 from dataclasses import dataclass, replace
@@ -83,8 +84,8 @@ def _import_pyfftw():
 
 pyfftw = _import_pyfftw()  # optional: the spectra fall back to numpy.fft (same values, slower for long records)
 
-#: the one-line note printed (once per process) when pyFFTW is missing
-NO_PYFFTW_NOTE = ("rotorred: pyFFTW is not installed; spectra use numpy.fft "
+#: the one-line warning logged (once per process) when pyFFTW is missing
+NO_PYFFTW_NOTE = ("pyFFTW is not installed; spectra use numpy.fft "
                   "(same results; `pip install pyfftw` for the faster FFT)")
 _NOTED = []
 
@@ -205,7 +206,7 @@ def _new_plan(shape: tuple, dtype):
     if pyfftw is None:
         if not _NOTED:
             _NOTED.append(True)
-            print(NO_PYFFTW_NOTE, file=sys.stderr)
+            logging.getLogger(__name__).warning(NO_PYFFTW_NOTE)
         return NumpyPlan(shape, dtype)
     a = pyfftw.empty_aligned(shape, dtype=dtype)
     return pyfftw.builders.rfft(a, axis=0, planner_effort="FFTW_ESTIMATE", threads=1, avoid_copy=False)

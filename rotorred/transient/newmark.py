@@ -49,7 +49,6 @@ K. H. Hunt, F. R. E. Crossley, J. Appl. Mech. 42 (1975) 440-445.
 
 from __future__ import annotations
 
-import sys
 import time
 from typing import Mapping, Sequence
 
@@ -68,13 +67,13 @@ from rotorred.transient.results import ContactHistory, FinalState, SimulationDiv
 from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces, also read as newmark.<name>
     COMPILING_NOTE, METHODS, Loads, RecordPlan, RunOptions, Scheme, check_loads, check_run_options, check_scheme,
     check_start, initial_state, initial_vector, load_kernel, package_result, record_buffers, record_plan,
-    record_rows, show_progress, whole_steps)
+    record_rows, step_bar, whole_steps)
 
 
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
                record: kernel.Record, settings: kernel.Settings, diag: kernel.Diagnostics, n_steps: int,
                chunk: int, progress: bool | None, eig=None, every_level=None,
-               dense_record: kernel.Record | None = None) -> tuple[int, float, float, float]:
+               dense_record: kernel.Record | None = None) -> tuple[int, float, float, float, bool]:
     """Run the compiled loop over ``n_steps`` main steps in chunks of ``chunk``, with an optional progress bar:
     the eigenbasis loop (:mod:`rotorred.transient.eigen_kernel`) when ``eig`` is given (``record.rows`` then act
     on its state y; ``dense_record`` is the same record with the rows on x), else the dense one.
@@ -92,24 +91,23 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
         Wall and CPU time of the loop (s).
     load_time : float
         Time to compile or load the kernels (s, :func:`load_kernel`).
+    compiled : bool
+        Whether a kernel was compiled (not loaded from numba's cache).
     """
     loops = _Loops(levels, forcing, plates, state, record, dense_record or record, settings, diag, eig, every_level)
     t_run, cpu_run = time.perf_counter(), time.process_time()
-    status, i, shown = kernel.RUNNING, 0, False
-    while i < n_steps:
-        i_next = min(n_steps, i + chunk)
-        status = loops.run(i, i_next)
-        if status != kernel.RUNNING:
-            break
-        i = i_next
-        elapsed = time.perf_counter() - t_run
-        if progress or (progress is None and elapsed > 2.0 and i < n_steps):
-            shown = True
-            show_progress(i / n_steps, i * settings.dt, elapsed)
-    if shown:
-        print(file=sys.stderr)
+    status, i = kernel.RUNNING, 0
+    with step_bar(n_steps, settings.dt, progress) as shown:
+        while i < n_steps:
+            i_next = min(n_steps, i + chunk)
+            status = loops.run(i, i_next)
+            if status != kernel.RUNNING:
+                break
+            shown.update((i_next - i) * settings.dt)
+            i = i_next
     run_time = time.perf_counter() - t_run - loops.dense_load_time
-    return status, run_time, time.process_time() - cpu_run - loops.dense_load_time, loops.load_time
+    return (status, run_time, time.process_time() - cpu_run - loops.dense_load_time, loops.load_time,
+            loops.compiled)
 
 
 class _Loops:
@@ -124,7 +122,7 @@ class _Loops:
         self.records, self.settings = (record, dense_record), settings
         self.ework = None if eig is None else eigen_kernel.eigen_work(len(state.x) // 3, len(eig.omega))
         self.dense_loaded, self.dense_load_time = eig is None, 0.0
-        self.load_time = load_kernel((0, 0, *self._args()), self._loop())
+        self.load_time, self.compiled = load_kernel((0, 0, *self._args()), self._loop())
 
     def _loop(self):
         return kernel.run_steps if self.eig is None else eigen_kernel.run_eigen_steps
@@ -160,8 +158,9 @@ class _Loops:
     def _dense_step(self, i: int) -> int:
         """Main step ``i`` by the dense loop (its halvings), recorded on x."""
         if not self.dense_loaded:
-            self.dense_load_time = load_kernel((0, 0, *self._args(dense=True)), kernel.run_steps)
+            self.dense_load_time, compiled = load_kernel((0, 0, *self._args(dense=True)), kernel.run_steps)
             self.load_time += self.dense_load_time
+            self.compiled |= compiled
             self.dense_loaded = True
         while True:
             status = kernel.run_steps(i, i + 1, *self._args(dense=True))
@@ -308,14 +307,14 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
                                max_newton=run.max_newton, limit=run.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
-    status, run_time, run_cpu_time, load_time = run_kernel(
+    status, run_time, run_cpu_time, load_time, compiled = run_kernel(
         levels, forcing, contact, state, record, settings, diag, plan.n_steps,
         run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig,
         every_level=(lambda: step_levels_up_to(run.max_halvings + 1)) if run.max_halvings > 0 else None,
         dense_record=dense_record)
     # 5. recover and package the results
     return package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                          (setup_time, run_time, run_cpu_time, load_time), record_state=record_state,
+                          (setup_time, run_time, run_cpu_time, load_time, compiled), record_state=record_state,
                           step_form=step_form)
 
 

@@ -10,7 +10,7 @@ the first of these that can be written:
    :mod:`platformdirs` (``~/.cache/rotorred`` on Linux, ``~/Library/Caches/rotorred`` on macOS,
    ``%LOCALAPPDATA%\\rotorred\\Cache`` on Windows; ``XDG_CACHE_HOME`` moves it on Linux);
 3. :func:`temp_cache_root`: ``rotorred-numba-<user>`` under the system's temporary folder (a read-only home),
-   announced by one line on stderr (once per process).
+   announced by a logging warning (once per process).
 
 Inside it, numba's layout: one sub-folder per source folder (its name and a hash of its absolute path), so two
 installs of rotorred (a venv's and an editable checkout) never share or overwrite each other's entries.
@@ -31,14 +31,14 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import logging
 import os
-import sys
 import tempfile
 from pathlib import Path
 
 from numba.core import caching
 
-from rotorred import __version__
+from rotorred._version import __version__
 
 #: the package directory whose functions this locator serves
 PACKAGE = Path(__file__).resolve().parent.parent
@@ -129,8 +129,9 @@ class _TempDirLocator(_FolderLocator):
         self = super().from_function(py_func, py_file)
         if self is not None and not _ANNOUNCED:
             _ANNOUNCED.append(True)
-            print(f"rotorred: the user cache folder {user_cache_root()} is not writable; compiled kernels are "
-                  f"cached in {temp_cache_root()} (set NUMBA_CACHE_DIR to choose)", file=sys.stderr)
+            logging.getLogger(__name__).warning(
+                "the user cache folder %s is not writable; compiled kernels are cached in %s (set NUMBA_CACHE_DIR "
+                "to choose)", user_cache_root(), temp_cache_root())
         return self
 
 

@@ -157,6 +157,8 @@ class TransientResult:
     kernel_load_time : float
         Time to compile the step kernel (first run after an install) or load it from numba's cache,
         before the loop (s); not in ``run_time`` nor in µs per step.
+    kernel_compiled : bool
+        Whether the step kernel was compiled for this run (not loaded from numba's on-disk cache).
     n_passes : int
         Fixed-point passes of the steps at varying speeds (0 at constant speeds).
     states : ndarray, shape (n_rec, 2 n), or None
@@ -188,6 +190,7 @@ class TransientResult:
     run_time: float
     run_cpu_time: float = 0.0
     kernel_load_time: float = 0.0
+    kernel_compiled: bool = False
     n_passes: int = 0
     states: np.ndarray | None = None
     step_form: str = ""

@@ -4,8 +4,8 @@ plan and buffers, loading the kernel, the progress bar and the packaging of the 
 
 from __future__ import annotations
 
+import logging
 import math
-import sys
 import time
 from dataclasses import dataclass
 from typing import Mapping, Sequence
@@ -14,6 +14,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
+from rotorred.progress import bar, stage
 from rotorred.transient import kernel
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate, disk_force, normal_force
 from rotorred.transient.contact_solve import C_PASSES
@@ -21,6 +22,8 @@ from rotorred.model.loads import Unbalance
 from rotorred.transient.matrices import ForceColumns
 from rotorred.transient.results import (FinalState, SimulationDiverged, TransientResult, contact_histories,
                                         failure)
+
+LOG = logging.getLogger(__name__)
 
 METHODS = ("newmark", "hht")
 
@@ -268,29 +271,38 @@ def record_buffers(plan: RecordPlan, rows: np.ndarray, n_p: int) -> kernel.Recor
 
 
 
-#: printed on stderr before the step kernel is compiled (not when numba's on-disk cache holds it)
-COMPILING_NOTE = "rotorred: compiling the step kernel, once per install (numba: 10-20 s, then cached on disk)"
+#: the stage line before the step kernel is compiled (not when numba's on-disk cache holds it)
+COMPILING_NOTE = "compiling the step kernel, once per install (numba: 10-20 s, then cached on disk)"
 
 
-def load_kernel(args: tuple, dispatcher=None) -> float:
+def load_kernel(args: tuple, dispatcher=None) -> tuple[float, bool]:
     """Compile the step kernel ``dispatcher`` (default ``kernel.run_steps``) for the types of ``args`` (a call of
-    it), or load it from numba's on-disk cache, before the timed loop; returns the seconds it took (0 when this
-    process has it).
+    it), or load it from numba's on-disk cache, before the timed loop.
 
-    A compilation is announced on its own line (:data:`COMPILING_NOTE`), so neither the wait nor the
-    µs per step of the first run after an install hide it.
+    A compilation is announced by a stage line (:data:`COMPILING_NOTE`, :func:`rotorred.progress.stage`), so
+    neither the wait nor the µs per step of the first run after an install hide it.
+
+    Returns
+    -------
+    seconds : float
+        The time it took (0 when this process has it) (s).
+    compiled : bool
+        Whether it was compiled (False: loaded from the cache, or already in this process).
     """
     import numba
 
     dispatcher = dispatcher or kernel.run_steps
     sig = tuple(numba.typeof(a) for a in args)
     if sig in dispatcher.overloads:
-        return 0.0
+        return 0.0, False
     t0 = time.perf_counter()
-    if not _cached(dispatcher, sig):
-        print(COMPILING_NOTE, file=sys.stderr, flush=True)
+    compiled = not _cached(dispatcher, sig)
+    if compiled:
+        stage(COMPILING_NOTE, logger=LOG)
+    else:
+        LOG.debug("loading the step kernel %s from numba's cache", dispatcher.__name__)
     dispatcher.compile(sig)
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, compiled
 
 
 def _cached(dispatcher, sig) -> bool:
@@ -308,12 +320,11 @@ def _cached(dispatcher, sig) -> bool:
         return True
 
 
-def show_progress(frac: float, t: float, elapsed: float) -> None:
-    """The progress bar on stderr: fraction done, simulated time t (s), estimated time left."""
-    bar = "#" * int(30 * frac)
-    eta = elapsed / frac * (1 - frac)
-    print(f"\rrotorred transient [{bar:<30}] {100 * frac:5.1f} %  t = {t:.4g} s  eta {eta:.0f} s",
-          end="", file=sys.stderr, flush=True)
+def step_bar(n_steps: int, dt: float, progress: bool | None):
+    """The progress bar of a transient (:func:`rotorred.progress.bar`): simulated time against its end, with the
+    time left; ``progress`` None draws it on a terminal once the run has taken 1 s (a short run draws nothing)."""
+    return bar(n_steps * dt, "stepping", "s", progress=progress, delay=0.0 if progress else 1.0,
+               bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.4g} of {total:.4g} s [{elapsed}<{remaining}]")
 
 
 # ----------------------------------------------------------------------------------- 4. result
@@ -323,7 +334,8 @@ def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: R
                    step_form: str = "") -> TransientResult:
     """The :class:`TransientResult` of a run (raises :class:`SimulationDiverged` carrying it if the run failed).
 
-    ``times`` is (setup time, loop wall time, loop CPU time, kernel load time) (s); ``n_factorizations``
+    ``times`` is (setup time, loop wall time, loop CPU time, kernel load time (s), whether the kernel was compiled)
+    (:func:`load_kernel`); ``n_factorizations``
     defaults to one per step size; with ``record_state`` the records after the outputs are (q, v).
     """
     n, n_p, counters = len(state.x) // 3, len(loads.plates), diag.counters
@@ -347,7 +359,7 @@ def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: R
         n_contact_steps=int(counters[kernel.C_CONTACT]), max_newton_per_solve=int(counters[kernel.C_MAXNEWTON]),
         n_factorizations=run.max_halvings + 1 if n_factorizations is None else n_factorizations,
         n_passes=int(counters[C_PASSES]), step_form=step_form, setup_time=times[0], run_time=times[1], run_cpu_time=times[2],
-        kernel_load_time=times[3])
+        kernel_load_time=times[3], kernel_compiled=bool(times[4]))
     if not success:
         raise SimulationDiverged(message, result, float(diag.err[kernel.E_TIME]), dof, cause)
     return result

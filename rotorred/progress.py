@@ -1,0 +1,78 @@
+"""Feedback of long work: stage lines and progress bars, one mechanism for every command and script.
+
+Everything goes through the standard :mod:`logging` module, under the logger ``"rotorred"`` (:data:`LOG`; each
+module logs to its own child, ``logging.getLogger(__name__)``):
+
+* a **stage** is one line at INFO saying what starts now (``compiling the step kernel``, ``stepping``,
+  ``analysing``, ``writing``): :func:`stage`;
+* a **bar** is one :mod:`tqdm` bar on stderr for work counted in steps, points or seconds, with tqdm's rate and time
+  estimate: :func:`bar`.
+
+Whether they show is the logger's decision: the command line sets its level from ``-q``/``-v``
+(:mod:`rotorred.cli.feedback`); a script that configures no logging sees no stage lines and no bars (Python's
+default level, WARNING), unless it asks with ``logging.basicConfig(level=logging.INFO)`` or passes
+``progress=True`` where a function offers it. A bar is drawn on a terminal only: in a log file or a pipe
+(CI, a batch job) its stage line says what runs, without a screenful of carriage returns.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+__all__ = ["LOG", "stage", "bar", "shown"]
+
+#: the package's logger: the parent of every module's logger
+LOG = logging.getLogger("rotorred")
+
+
+def shown(progress: bool | None = None) -> bool:
+    """Whether feedback is wanted: ``progress`` when given, else whether :data:`LOG` passes INFO."""
+    return LOG.isEnabledFor(logging.INFO) if progress is None else bool(progress)
+
+
+def stage(text: str, *args, logger: logging.Logger = LOG) -> None:
+    """Say at INFO what starts now (``logger.info(text, *args)``)."""
+    logger.info(text, *args)
+
+
+def bar(total: float, desc: str, unit: str, *, progress: bool | None = None, initial: float = 0,
+        delay: float = 0.0, unit_scale: bool = False, bar_format: str | None = None):
+    """A tqdm progress bar on stderr, or a disabled one (same methods, draws nothing).
+
+    Parameters
+    ----------
+    total : float
+        The count at the end (steps, points, seconds of simulated time).
+    desc : str
+        What is counted (``"stepping"``, ``"map"``).
+    unit : str
+        The count's unit, as tqdm shows it (``"step"``, ``"point"``, ``"s"``).
+    progress : bool, optional
+        True: draw it even off a terminal; False: never; None (default): on a terminal when :func:`shown`.
+    initial : float
+        The count already done (a resumed map).
+    delay : float
+        Seconds before the bar first appears (work that ends sooner draws nothing) (s).
+    unit_scale, bar_format
+        As tqdm's.
+
+    Returns
+    -------
+    tqdm.tqdm
+    """
+    from tqdm import tqdm
+
+    if progress is None:
+        disable = not shown() or not _terminal()
+    else:
+        disable = not progress
+    return tqdm(total=total, desc=desc, unit=unit, initial=initial, delay=delay, disable=disable, file=sys.stderr,
+                dynamic_ncols=True, leave=False, unit_scale=unit_scale, bar_format=bar_format)
+
+
+def _terminal() -> bool:
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
