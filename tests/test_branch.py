@@ -5,6 +5,10 @@ are classified by the critical multiplier, an interrupt keeps the points, and th
 from __future__ import annotations
 
 import csv
+import os
+import signal
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -123,6 +127,7 @@ def test_an_interrupt_keeps_the_points_so_far():
     branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ds=0.1, stability=False,
                              progress=progress)
     assert len(branch.omega) == 6 and branch.stopped.startswith("interrupted (SIGINT) at omega = ")
+    assert branch.interrupt == "SIGINT"
     assert max(problem.evaluate(z, w).relative for z, w in zip(branch.z, branch.omega)) < 1e-10
 
 
@@ -146,6 +151,109 @@ def test_rotorred_continue_writes_the_branch(tmp_path):
     assert np.isfinite(ds["critical_multiplier_re"].values).all()
     assert "µm (fold)" in (out / "branch.txt").read_text()
     ds.close()
+
+
+#: the child of the interrupt tests: ``rotorred`` with one library function wrapped so that its CALL-th call says so
+#: on stderr ("parked ...") and waits there for the test's signal (up to 60 s), which then arrives in that function,
+#: in that phase, with a known number of points done: no sleep in the test races the command
+PARKED = """
+import signal, sys, time
+import importlib
+from rotorred.cli import main
+module, name, call = sys.argv.pop(1), sys.argv.pop(1), int(sys.argv.pop(1))
+module = importlib.import_module(module)
+original, calls = getattr(module, name), []
+def parked(*args, **kwargs):
+    calls.append(1)
+    if len(calls) == call:
+        print(f"parked at call {call} of {name}", file=sys.stderr, flush=True)
+        end = time.monotonic() + 60
+        while time.monotonic() < end:
+            time.sleep(0.01)
+        sys.exit("no signal came")
+    return original(*args, **kwargs)
+setattr(module, name, parked)
+sys.exit(main())
+"""
+#: a short clearance branch: 45 to 40 um at 20 harmonics, the free orbit (stable) grazing the plate near 43 um, where
+#: it loses stability; about a dozen points
+SHORT_BRANCH = ["paper-rub", "--param", "rub.clearance=45e-6:40e-6", "--harmonics", str(H), "--samples", str(N)]
+
+
+def _interrupted(out, where: tuple[str, str, int], sig) -> tuple[subprocess.CompletedProcess, list, object]:
+    """``rotorred continue SHORT_BRANCH`` parked at ``where`` (module, function, call), sent ``sig`` there: the
+    finished process, branch.csv's rows and branch.nc (loaded)."""
+    import xarray as xr
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "-c", PARKED, *map(str, where), "continue", *SHORT_BRANCH, "--out",
+                             str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # as in a terminal
+    line = proc.stderr.readline()
+    assert line.startswith("parked"), (line, proc.communicate())
+    proc.send_signal(sig)
+    stdout, stderr = proc.communicate(timeout=120)
+    done = subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr)
+    with open(out / "branch.csv", newline="") as f:
+        rows = list(csv.reader(f))[1:]
+    with xr.open_dataset(out / "branch.nc", engine="h5netcdf") as ds:
+        return done, rows, ds.load()
+
+
+def _traced_and_known(text: str) -> tuple[int, int]:
+    """The points traced and those with their stability, as an interrupted branch's summary says."""
+    traced = int(text.split(" points traced")[0].rsplit(" ", 1)[1])
+    known = int(text.split("stability computed for ")[1].split()[0])
+    return traced, known
+
+
+def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
+    """SIGINT while the 6th point's multipliers are computed: exit 130; branch.csv, branch.nc and branch.txt hold every
+    point traced (to the first past 40 um: the whole range), the first 5 with their stability (both stable and
+    unstable: the grazing), the others marked unknown alike in each (CSV "unknown", NetCDF flag -1, NaN multiplier);
+    the printout and branch.txt say the branch was interrupted by SIGINT, where and how many points have their
+    stability, and never that it reached the end."""
+    out = tmp_path / "b"
+    done, rows, ds = _interrupted(out, ("rotorred.scenes.branch", "floquet_by_monodromy", 6), signal.SIGINT)
+    assert done.returncode == 130, done.stderr
+    assert "Traceback" not in done.stderr and "rotorred continue: interrupted (SIGINT)" in done.stderr
+    text = (out / "branch.txt").read_text()
+    for said in (done.stdout, text):
+        assert "reached the end" not in said and "interrupted (SIGINT) while computing stability" in said
+    assert text.startswith("INCOMPLETE: interrupted (SIGINT)") and (out / "INCOMPLETE").exists()
+    traced, known = _traced_and_known(text)
+    values = np.array([float(r[0]) for r in rows])
+    assert (traced, known) == (len(rows), 5) and len(rows) > known
+    assert values[0] == 45e-6 and values[-1] <= 40e-6 < values[-2]  # the whole range traced
+    assert f"at rub.clearance = {values[known]:.9g} m" in text  # the first point without its stability
+    mu = np.array([float(r[-3]) for r in rows])
+    stable = [r[-2] for r in rows]
+    assert np.isfinite(mu[:known]).all() and np.isnan(mu[known:]).all()
+    assert stable[:known] == [str(int(m < 1)) for m in mu[:known]] and {"0", "1"} <= set(stable[:known])
+    assert set(stable[known:]) == {"unknown"}
+    assert np.allclose(ds["rub.clearance"].values, values, rtol=1e-8) and ds.attrs["interrupted"] == "SIGINT"
+    assert list(ds["stable"].values) == [int(s) if s != "unknown" else -1 for s in stable]
+    assert ds["stable"].attrs["flag_meanings"] == "stable unstable unknown"
+    assert np.isnan(ds["critical_multiplier_re"].values[known:]).all()
+    assert np.isnan(ds["critical_multiplier_im"].values[known:]).all()
+    assert text.count("| unknown") == traced - known  # every point shown: fewer than 25
+
+
+def test_sigterm_while_tracing_keeps_the_points_so_far(tmp_path):
+    """SIGTERM in the 6th continuation step: exit 143, the 6 points traced written (the branch short of 40 um), none
+    with its stability (marked unknown), and the printout and branch.txt say SIGTERM ended the tracing there."""
+    out = tmp_path / "b"
+    done, rows, ds = _interrupted(out, ("rotorred.nonlinear.continuation", "_step", 6), signal.SIGTERM)
+    assert done.returncode == 143, done.stderr
+    assert "Traceback" not in done.stderr and "rotorred continue: interrupted (SIGTERM)" in done.stderr
+    text = (out / "branch.txt").read_text()
+    for said in (done.stdout, text):
+        assert "reached the end" not in said and "interrupted (SIGTERM) while tracing" in said
+    values = np.array([float(r[0]) for r in rows])
+    assert _traced_and_known(text) == (len(rows), 0) and len(rows) == 6 and values[-1] > 40e-6
+    assert f"at rub.clearance = {values[-1]:.9g} m" in text
+    assert {r[-2] for r in rows} == {"unknown"} and list(ds["stable"].values) == [-1] * 6
+    assert ds.attrs["interrupted"] == "SIGTERM" and ds.attrs["stopped"] == text.splitlines()[0][len("INCOMPLETE: "):]
 
 
 def test_a_harmonic_balance_scene_records_its_periodic_solution(rig):

@@ -6,12 +6,18 @@ its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.
 each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key, the
 peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of each
 harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png`` (peak
-against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``. An interrupt keeps the
-points so far (written, marked INCOMPLETE; exit 130).
+against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``.
+
+SIGINT or SIGTERM while the branch is traced or its stability computed ends it there and keeps every point traced:
+the files are written with them all (those without their stability marked "unknown", the folder INCOMPLETE, the
+summary saying which signal, where, how many points traced and with their stability), exit 130 or 143. They are
+written with the signals held back (a second signal does not cut them). Before the first point (the cold start), or
+while a complete branch is written, a signal leaves the earlier result, as in every command.
 """
 
 from __future__ import annotations
 
+import contextlib
 import sys
 
 from rotorred import checks
@@ -57,14 +63,13 @@ def _param(text: str) -> tuple[str, float, float]:
 
 
 def run(args) -> int:
-    """Check everything, then follow the branch into ``--out`` (exit 130 when interrupted, its points kept)."""
-    from rotorred.cli import EXIT_SIGINT
+    """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
+    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
     from rotorred.cli.run import _settings
     from rotorred.scenes.branch import check_key, continue_scene
-    from rotorred.scenes.branch_outputs import format_branch, write_branch
+    from rotorred.scenes.branch_outputs import format_branch
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
-    from rotorred.writers import OutputFolder
 
     out = out_dir("--out", args.out)
     key, start, stop = _param(args.param)
@@ -77,20 +82,37 @@ def run(args) -> int:
     check_key(scene, key, start, stop)
     model = build_model(scene).model
     print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
+    interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
     branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
-                            progress=_progress)
+                            progress=_progress, interrupts=interrupts)
     if sys.stdout.isatty():
         print()
     print(format_branch(branch))
-    with OutputFolder(out) as folder:
-        write_branch(branch, folder, scene.name)
-        files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
-    for f in files:
+    for f in _write(branch, out, scene.name, tuple(interrupts)):
         print(f"wrote {f}")
     if branch.interrupted:
-        print(f"rotorred continue: {branch.stopped}; the points so far are written", file=sys.stderr)
-        return EXIT_SIGINT
+        print(f"rotorred continue: {branch.stopped}; every point traced is written, the folder marked INCOMPLETE",
+              file=sys.stderr)
+        return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[branch.interrupt]
     return 0
+
+
+def _write(branch, out, scene_name: str, interrupts: tuple) -> list:
+    """Stage and commit the branch's files into ``out``: those of an interrupted branch with SIGINT and SIGTERM held
+    back (``writers._signals_blocked``, as a commit is), so that a second signal does not cut the points the first
+    one kept; it is dropped once they are committed (the exit status is the first's). The files written."""
+    from rotorred.scenes.branch_outputs import write_branch
+    from rotorred.writers import OutputFolder, _signals_blocked
+
+    folder, files = OutputFolder(out), []
+    try:
+        with _signals_blocked() if branch.interrupted else contextlib.nullcontext(), folder:
+            write_branch(branch, folder, scene_name)
+            files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
+    except interrupts:
+        if not (branch.interrupted and folder.committed):
+            raise
+    return files
 
 
 def _progress(points: int, value) -> None:

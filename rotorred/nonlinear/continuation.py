@@ -13,11 +13,16 @@ back onto its own path stops there (:func:`_retraced`).
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
 point, to ``1e-10`` of the step. Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
+
+An *interrupt* (:data:`INTERRUPTS`, or the exceptions a caller names: the command line's SIGTERM) ends the tracing
+where it is: the points so far are returned, ``stopped`` and ``interrupt`` saying so.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 import scipy.linalg as sla
@@ -28,7 +33,11 @@ from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
 from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
 
-__all__ = ["Fold", "Branch", "continue_branch"]
+__all__ = ["Fold", "Branch", "INTERRUPTS", "continue_branch", "interrupt_name"]
+
+#: the exceptions that end a branch where it is, its points kept, and the signal each stands for (a caller may name
+#: others: ``rotorred continue`` adds the command line's SIGTERM)
+INTERRUPTS = MappingProxyType({KeyboardInterrupt: "SIGINT"})
 
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
@@ -79,6 +88,8 @@ class Branch:
     slope : ndarray, shape (p,)
         d omega / ds of the unit tangent at each point: its sign says which way the branch runs in omega (it
         changes at the folds).
+    interrupt : str
+        The signal that ended the tracing ("SIGINT", ... : :data:`INTERRUPTS`), or "" when nothing interrupted it.
     """
 
     omega: np.ndarray
@@ -88,6 +99,7 @@ class Branch:
     stopped: str
     iterations: np.ndarray
     slope: np.ndarray
+    interrupt: str = ""
 
     @property
     def stable(self) -> np.ndarray:
@@ -113,7 +125,8 @@ class _Point:
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
                     ds: float = 0.05, ds_min: float = 1e-6, ds_max: float = 0.2, max_points: int = 5000,
-                    tol: float = 1e-10, stability: bool = True, progress=None, curved: bool = False) -> Branch:
+                    tol: float = 1e-10, stability: bool = True, progress=None, curved: bool = False,
+                    interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> Branch:
     """Follow the branch through ``z0`` at ``omega_start`` until omega passes ``omega_end`` (either direction).
 
     Parameters
@@ -131,13 +144,16 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     stability : bool
         Compute each point's Floquet exponents (Hill's method).
     progress : callable, optional
-        ``progress(points, omega)`` after each point. An interrupt (SIGINT) ends the branch where it is: the points
-        so far are returned, ``stopped`` saying so.
+        ``progress(points, omega)`` after each point.
     curved : bool
         Predict to second order where the branch is smooth (:func:`_arclength`): fewer corrector iterations a point
         where each costs much (the rig's condensed problem: 2 in place of 3). Off by default: on a small problem with
         kinks it lets the steps grow past what the kinks allow (the Jeffcott rotor at H = 10, N = 1024 then jumped
         from the free branch above resonance to the one below, at ds_max = 0.5, and traced its loop twice).
+    interrupts : mapping of exception type to str
+        The exceptions that end the branch where it is, and the signal each stands for (default SIGINT's
+        ``KeyboardInterrupt``; empty: none, they propagate): the points so far are returned, ``stopped`` and
+        ``interrupt`` saying so.
 
     Returns
     -------
@@ -151,37 +167,47 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
+    try:  # the whole loop: an interrupt anywhere in it leaves ``points`` whole
+        stopped = _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max,
+                         max_points, tol, progress, curved) or stopped
+        interrupt = ""
+    except tuple(interrupts) as exc:
+        interrupt = interrupt_name(exc, interrupts)
+        stopped = f"interrupted ({interrupt}) at {_at(problem, points[-1].y[-1])}, after {len(points)} points"
+    return _branch(problem, points, folds, stopped, stability, interrupt)
+
+
+def interrupt_name(exc: BaseException, interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> str:
+    """The signal ``exc`` stands for in ``interrupts`` (:data:`INTERRUPTS`)."""
+    return next(name for kind, name in interrupts.items() if isinstance(exc, kind))
+
+
+def _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max, max_points,
+           tol, progress, curved) -> str:
+    """Step from ``points[-1]`` on, appending to ``points`` and ``folds`` (``path`` and ``chords`` kept with them),
+    until omega passes ``omega_end``: why it stopped, or "" when it reached the end."""
     while len(points) < max_points:
-        try:
-            if progress is not None:
-                progress(len(points), points[-1].y[-1])
-            nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol,
-                                 curved)
-            if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
-                folds.append(_locate_fold(problem, points[-1], nxt, tol))
-        except KeyboardInterrupt:
-            stopped = f"interrupted (SIGINT) at {_at(problem, points[-1].y[-1])}, after {len(points)} points"
-            break
+        if progress is not None:
+            progress(len(points), points[-1].y[-1])
+        nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol,
+                             curved)
+        if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
+            folds.append(_locate_fold(problem, points[-1], nxt, tol))
         if nxt is None:
-            stopped = why
-            break
+            return why
         points.append(nxt)
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
-            break
+            return ""
         path[len(points) - 1] = nxt.y
         chords[len(points) - 2] = np.linalg.norm(nxt.y - points[-2].y)
         again = _retraced(path[:len(points)], chords[:len(points) - 1], nxt.t)
         if again is not None:
-            stopped = (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
-                       f"{again} to {again + 1} of {len(points)}): a closed loop, followed once")
-            break
+            return (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
+                    f"{again} to {again + 1} of {len(points)}): a closed loop, followed once")
         if direction * (nxt.y[-1] - omega_start) < 0.0:
-            stopped = (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
-                       f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
-            break
-    else:
-        stopped = f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
-    return _branch(problem, points, folds, stopped, stability)
+            return (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
+                    f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
+    return f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
 
 
 def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
@@ -217,13 +243,13 @@ def _at(problem, value: float) -> str:
     return f"{name} = {value:.9g} {unit}"
 
 
-def _branch(problem, points, folds, stopped, stability) -> Branch:
+def _branch(problem, points, folds, stopped, stability, interrupt="") -> Branch:
     y = np.array([p.y for p in points])
     omega, z = y[:, -1], y[:, :-1]
     max_real = np.array([floquet(problem, zi, wi).max_real for zi, wi in zip(z, omega)]) if stability \
         else np.full(len(points), np.nan)
     return Branch(omega, z, max_real, tuple(folds), stopped, np.array([p.iterations for p in points]),
-                  np.array([p.t[-1] for p in points]))
+                  np.array([p.t[-1] for p in points]), interrupt)
 
 
 def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarray:

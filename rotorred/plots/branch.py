@@ -1,5 +1,5 @@
-"""A harmonic-balance branch: the peak response against the varied key, stable solid, unstable dashed, folds and
-corners marked (``rotorred continue``; :class:`rotorred.scenes.branch.SceneBranch`)."""
+"""A harmonic-balance branch: the peak response against the varied key, stable solid, unstable dashed, stability
+not computed grey, folds and corners marked (``rotorred continue``; :class:`rotorred.scenes.branch.SceneBranch`)."""
 
 from __future__ import annotations
 
@@ -24,8 +24,9 @@ def plot_branch(values, peaks, stable, folds, path, *, xlabel: str, ylabel: str,
         The key at each point (SI), p >= 1.
     peaks : array_like, shape (p,)
         The peak response at each point (m).
-    stable : array_like of bool or None, shape (p,)
-        Each point's stability (solid where stable, dashed where not); None: not computed (one grey line).
+    stable : array_like of bool or float, or None, shape (p,)
+        Each point's stability (solid where stable, dashed where not, grey where NaN: not computed); None: not computed
+        anywhere (one grey line).
     folds : sequence of (float, bool)
         Each turn (the key's value, smooth or a corner), marked on the branch.
     path : str or Path
@@ -53,7 +54,7 @@ def plot_branch(values, peaks, stable, folds, path, *, xlabel: str, ylabel: str,
     if stable is None:
         ax.plot(x, y, color="0.4", lw=1.5, label="branch (stability not computed)")
     else:
-        _stability_segments(ax, x, y, np.asarray(stable, bool))
+        _stability_segments(ax, x, y, np.asarray(stable, float))
     for value, smooth in folds:
         i = int(np.argmin(np.abs(values - value)))
         ax.plot(xscale * value, y[i], "o" if smooth else "s", ms=8, mfc="none", mew=1.5,
@@ -73,12 +74,19 @@ def plot_branch(values, peaks, stable, folds, path, *, xlabel: str, ylabel: str,
     return _save(fig, _path(path), title)
 
 
+#: a run of points drawn by their stability (1 stable, 0 unstable, NaN not computed): line style, colour, label
+_RUNS = {1.0: ("-", "tab:blue", "stable"), 0.0: ("--", "tab:blue", "unstable"),
+         None: ("-", "0.6", "stability not computed")}
+
+
 def _stability_segments(ax, x: np.ndarray, y: np.ndarray, stable: np.ndarray) -> None:
-    """The branch as runs of stable (solid) and unstable (dashed) points, each run joined to the next."""
+    """The branch as runs of stable (solid), unstable (dashed) and not computed (grey, ``stable`` NaN) points, each run
+    joined to the next."""
+    state = [None if np.isnan(s) else float(bool(s)) for s in stable]
     start = 0
     for i in range(1, len(x) + 1):
-        if i == len(x) or stable[i] != stable[start]:
+        if i == len(x) or state[i] != state[start]:
             end = min(i + 1, len(x))  # overlap one point so that the runs join
-            ax.plot(x[start:end], y[start:end], "-" if stable[start] else "--", color="tab:blue", lw=1.8,
-                    label="stable" if stable[start] else "unstable")
+            style, colour, label = _RUNS[state[start]]
+            ax.plot(x[start:end], y[start:end], style, color=colour, lw=1.8, label=label)
             start = i

@@ -21,12 +21,19 @@ The first point is found cold (:func:`cold_start`): Newton from the linear respo
 orbit goes deep into the plate), a continuation in the clearance from where the linear orbit just reaches the plate
 down to the plate's clearance. Each point's stability is from the monodromy matrix of the whole linearised system
 (:func:`rotorred.nonlinear.stability.floquet_by_monodromy`, ``STABILITY_SUBSTEPS`` intervals an AFT sample).
+
+An interrupt (SIGINT's ``KeyboardInterrupt``, or the exceptions the caller names: ``interrupts``) while the branch is
+traced or its stability computed ends it there and keeps every point traced: its ``stopped`` says so (the signal,
+where, how many points traced and how many with their stability), ``interrupt`` names the signal, and the points
+whose stability was not computed have a NaN multiplier (:attr:`SceneBranch.known` False). An interrupt during the cold
+start (no point yet) is raised as it came.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,10 +41,11 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
+from rotorred.writers import _signals_blocked
 
 __all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "scene_at"]
 
@@ -177,10 +185,13 @@ class SceneBranch:
         Each turn of the branch: the key's value and whether it is smooth (a saddle-node) or a corner (a contact's
         start or end).
     stopped : str
-        Why the branch ended ("reached the end, ...", or where and why it stopped).
+        Why the branch ended ("reached the end, ...", or where and why it stopped; "interrupted (SIGINT) while ..."
+        with where, the points traced and those with their stability).
     iterations : ndarray, shape (p,)
     start_time, solve_time, stability_time : float
         Seconds: the cold start, the continuation, the stability of every point.
+    interrupt : str
+        The signal that ended the branch ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "".
     """
 
     key: str
@@ -198,6 +209,12 @@ class SceneBranch:
     start_time: float
     solve_time: float
     stability_time: float
+    interrupt: str = ""
+
+    @property
+    def known(self) -> np.ndarray:
+        """Whether each point's stability was computed (its multiplier not NaN)."""
+        return ~np.isnan(self.critical)
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -227,7 +244,8 @@ class SceneBranch:
 
     @property
     def interrupted(self) -> bool:
-        return self.stopped.startswith("interrupted")
+        """Whether a signal ended the branch (:attr:`interrupt`)."""
+        return bool(self.interrupt)
 
 
 def check_key(scene, key: str, start: float, end: float | None = None) -> None:
@@ -281,13 +299,15 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
     clearance = rub.plate.clearance
     scale = max(float(np.linalg.norm(z_lin)), reach)
     branch = continue_branch(family, z_lin, max(1.05 * reach, 1.05 * clearance), clearance, ds=0.05 * scale,
-                             ds_min=1e-10 * scale, ds_max=0.12 * scale, stability=False, tol=tol)
+                             ds_min=1e-10 * scale, ds_max=0.12 * scale, stability=False, tol=tol,
+                             interrupts={})  # no point of the branch yet: an interrupt is raised as it came
     i = int(np.argmin(np.abs(branch.omega - clearance)))
     return solve(family.at(clearance), branch.z[i], omega, tol=tol)[0]
 
 
 def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: int, *, tol: float = 1e-9,
-                   stability: bool = True, max_points: int = 400, progress=None) -> SceneBranch:
+                   stability: bool = True, max_points: int = 400, progress=None,
+                   interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> SceneBranch:
     """The branch of ``scene``'s rub response on ``model`` as ``key`` goes from ``start`` to ``end``.
 
     Parameters
@@ -309,6 +329,9 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     max_points : int
     progress : callable, optional
         ``progress(points, value)`` as the branch grows, then ``progress(i, None)`` per point's stability.
+    interrupts : mapping of exception type to str
+        The exceptions that end the branch where it is (tracing or stability), every point traced kept, and the
+        signal each stands for (default: SIGINT's ``KeyboardInterrupt``).
 
     Returns
     -------
@@ -323,15 +346,27 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     scale = max(float(np.linalg.norm(z0)), abs(s_end - s_start))  # the steps: a few hundred along a branch
     branch = continue_branch(family, z0, s_start, s_end, ds=0.01 * scale,
                              ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=max_points, tol=tol, curved=True,
-                             stability=False, progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
+                             stability=False, progress=None if progress is None else (lambda p, s: progress(p, to_value(s))),
+                             interrupts=interrupts)
     t2 = time.perf_counter()
-    values = np.array([to_value(s) for s in branch.omega])
-    dofs = _output_dofs(scene)
-    f0, peaks, lines, critical, stability_time = _points(rub_at, values, branch.z, dofs,
-                                                         stability and "interrupted" not in branch.stopped, progress)
-    return SceneBranch(key, KEYS.get(key, "Hz"), values, f0, dofs, peaks, branch.z, lines,
-                       critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), branch.stopped,
-                       branch.iterations, t1 - t0, t2 - t1, stability_time)
+    values, dofs, interrupt = np.array([to_value(s) for s in branch.omega]), _output_dofs(scene), branch.interrupt
+    critical, outputs, t3 = np.full(len(values), complex(np.nan, np.nan)), None, None
+    try:
+        with _signals_blocked():  # a few ms a point, and the branch's files need every point's outputs
+            outputs = _outputs(rub_at, values, branch.z, dofs)
+        t3 = time.perf_counter()
+        if stability and not interrupt:
+            _stability(rub_at, values, branch.z, critical, progress)
+    except tuple(interrupts) as exc:
+        if outputs is None:  # before the signals were held: nothing to keep
+            raise
+        interrupt = interrupt_name(exc, interrupts)
+    stability_time = 0.0 if t3 is None else time.perf_counter() - t3
+    stopped = branch.stopped if not interrupt else _interrupted(
+        interrupt, key, values, critical, stability, None if branch.interrupt else branch.stopped)
+    return SceneBranch(key, KEYS.get(key, "Hz"), values, outputs[0], dofs, outputs[1], branch.z, outputs[2],
+                       critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), stopped,
+                       branch.iterations, t1 - t0, t2 - t1, stability_time, interrupt)
 
 
 def scene_at(scene, key: str, value: float):
@@ -368,24 +403,43 @@ def _output_dofs(scene) -> tuple:
     return dofs if table is None else (table,) + tuple(d for d in dofs if d != table)
 
 
-def _points(rub_at, values, z, dofs, stability: bool, progress):
-    """Each point's problem built once (a speed's is built anew): its f_0 (Hz), the peak of each of ``dofs`` (m), the
-    harmonics of ``dofs[0]`` (m), the Floquet multiplier of largest modulus (NaN without ``stability``, and from an
-    interrupt on) and the time the multipliers took (s)."""
+def _outputs(rub_at, values, z, dofs):
+    """Each point's problem built once (a speed's is built anew): its f_0 (Hz), the peak of each of ``dofs`` (m) and
+    the harmonics of ``dofs[0]`` (m)."""
     f0, peaks, lines = np.empty(len(values)), np.empty((len(values), len(dofs))), []
-    critical, stability_time = np.full(len(values), np.nan, dtype=complex), 0.0
     for i, (v, zi) in enumerate(zip(values, z)):
         rp = rub_at(v)
         f0[i], peaks[i] = rp.f0, [np.max(np.abs(rp.waveform(zi, d))) for d in dofs]
         lines.append(list(rp.lines(zi, dofs[0]).values()))
-        if stability:
-            t0 = time.perf_counter()
-            try:
-                mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers
-                critical[i] = mu[np.argmax(np.abs(mu))]
-                if progress is not None:
-                    progress(i + 1, None)
-            except KeyboardInterrupt:
-                stability = False
-            stability_time += time.perf_counter() - t0
-    return f0, peaks, np.array(lines), critical, stability_time
+    return f0, peaks, np.array(lines)
+
+
+def _stability(rub_at, values, z, critical, progress) -> None:
+    """The Floquet multiplier of largest modulus of each point, into ``critical`` as each is found (an interrupt
+    leaves those found)."""
+    for i, (v, zi) in enumerate(zip(values, z)):
+        rp = rub_at(v)
+        mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers
+        critical[i] = mu[np.argmax(np.abs(mu))]
+        if progress is not None:
+            progress(i + 1, None)
+
+
+def _interrupted(signal: str, key: str, values, critical, stability: bool, traced: str | None) -> str:
+    """Why an interrupted branch ended: the ``signal``, the phase and the key's value there (the last point traced, or
+    the first without its stability), the points traced and those with their stability. ``traced``: why the tracing
+    ended (None: the signal ended it)."""
+    unit, known = KEYS.get(key, "Hz"), int(np.count_nonzero(~np.isnan(critical)))
+    if traced is None:
+        phase, at = "tracing", values[-1]
+    else:  # in the stability, or as the points' outputs were computed (the signal held back till then)
+        phase, at = "computing stability" if stability else "after tracing", values[min(known, len(values) - 1)]
+    if not stability:
+        with_stability = "stability not asked"
+    else:
+        with_stability = f"stability computed for {known} ({len(values) - known} unknown)"
+    text = f"interrupted ({signal}) while {phase}, at {key} = {at:.9g} {unit}: {len(values)} points traced, " \
+           f"{with_stability}"
+    if traced is not None and not traced.startswith("reached the end"):
+        text += f"; the tracing had stopped early: {traced}"
+    return text
