@@ -36,14 +36,14 @@ def stage(text: str, *args, logger: logging.Logger = LOG) -> None:
     logger.info(text, *args)
 
 
-def bar(total: float, desc: str, unit: str, *, progress: bool | None = None, initial: float = 0,
+def bar(total: float | None, desc: str, unit: str, *, progress: bool | None = None, initial: float = 0,
         delay: float = 0.0, unit_scale: bool = False, bar_format: str | None = None):
     """A tqdm progress bar on stderr, or a disabled one (same methods, draws nothing).
 
     Parameters
     ----------
-    total : float
-        The count at the end (steps, points, seconds of simulated time).
+    total : float or None
+        The count at the end (steps, points, seconds of simulated time); None: not known (a count and a rate).
     desc : str
         What is counted (``"stepping"``, ``"map"``).
     unit : str

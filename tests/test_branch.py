@@ -190,6 +190,8 @@ def _interrupted(out, where: tuple[str, str, int], sig) -> tuple[subprocess.Comp
                              str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # as in a terminal
     line = proc.stderr.readline()
+    while line.startswith("rotorred continue: "):  # the command's stage lines before it parks
+        line = proc.stderr.readline()
     assert line.startswith("parked"), (line, proc.communicate())
     proc.send_signal(sig)
     stdout, stderr = proc.communicate(timeout=120)
@@ -216,7 +218,7 @@ def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
     out = tmp_path / "b"
     done, rows, ds = _interrupted(out, ("rotorred.scenes.branch", "floquet_by_monodromy", 6), signal.SIGINT)
     assert done.returncode == 130, done.stderr
-    assert "Traceback" not in done.stderr and "rotorred continue: interrupted (SIGINT)" in done.stderr
+    assert "Traceback" not in done.stderr and "rotorred continue: error: interrupted (SIGINT)" in done.stderr
     text = (out / "branch.txt").read_text()
     for said in (done.stdout, text):
         assert "reached the end" not in said and "interrupted (SIGINT) while computing stability" in said
@@ -245,7 +247,7 @@ def test_sigterm_while_tracing_keeps_the_points_so_far(tmp_path):
     out = tmp_path / "b"
     done, rows, ds = _interrupted(out, ("rotorred.nonlinear.continuation", "_step", 6), signal.SIGTERM)
     assert done.returncode == 143, done.stderr
-    assert "Traceback" not in done.stderr and "rotorred continue: interrupted (SIGTERM)" in done.stderr
+    assert "Traceback" not in done.stderr and "rotorred continue: error: interrupted (SIGTERM)" in done.stderr
     text = (out / "branch.txt").read_text()
     for said in (done.stdout, text):
         assert "reached the end" not in said and "interrupted (SIGTERM) while tracing" in said

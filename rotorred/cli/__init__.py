@@ -46,8 +46,9 @@ EXIT_STATUSES = {
                    "the other points and names the failed ones in map.csv and map.txt",
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
                       "an optional library is missing (the message gives its install command)",
-    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result",
-    EXIT_SIGTERM: "terminated (SIGTERM): --out keeps its earlier result",
+    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
+                 "marked INCOMPLETE; `map`: the points done, resumed by the same command)",
+    EXIT_SIGTERM: "terminated (SIGTERM): as 130",
 }
 
 #: optional libraries a command may need -> their install command

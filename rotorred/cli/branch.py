@@ -18,10 +18,14 @@ while a complete branch is written, a signal leaves the earlier result, as in ev
 from __future__ import annotations
 
 import contextlib
-import sys
+import logging
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 from rotorred.cli.options import out_dir
+from rotorred.progress import bar, stage
+
+LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -31,8 +35,7 @@ def add_parser(subparsers):
         description="Follow a rub scene's periodic response by harmonic balance with pseudo-arclength continuation in "
                     "rub.clearance (m), speeds.<spool> (Hz, the speed ratio kept) or a plate number (rub.k_n N/m, "
                     "rub.K_nr, rub.mu_d, ...), through its folds, with each "
-                    "point's stability; write the branch as CSV and NetCDF and plot it. Example: rotorred continue "
-                    "paper-rub --param rub.clearance=20e-6:5e-6 --out branch")
+                    "point's stability; write the branch as CSV and NetCDF and plot it.")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file (with rub plates)")
     p.add_argument("--param", required=True, metavar="KEY=START:STOP",
                    help="the key and its first and last value (scene units: m for rub.clearance, Hz for speeds, "
@@ -81,18 +84,17 @@ def run(args) -> int:
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
     model = build_model(scene).model
-    print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
+    report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
-    branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
-                            progress=_progress, interrupts=interrupts)
-    if sys.stdout.isatty():
-        print()
-    print(format_branch(branch))
+    stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
+    with _Progress(key) as progress:
+        branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
+                                progress=progress, interrupts=interrupts)
+    report(format_branch(branch))
     for f in _write(branch, out, scene.name, tuple(interrupts)):
-        print(f"wrote {f}")
+        report(f"wrote {f}")
     if branch.interrupted:
-        print(f"rotorred continue: {branch.stopped}; every point traced is written, the folder marked INCOMPLETE",
-              file=sys.stderr)
+        LOG.error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
         return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[branch.interrupt]
     return 0
 
@@ -115,10 +117,28 @@ def _write(branch, out, scene_name: str, interrupts: tuple) -> list:
     return files
 
 
-def _progress(points: int, value) -> None:
-    """A line that updates in place on a terminal; every 50th point otherwise (a log)."""
-    tty = sys.stdout.isatty()
-    if not tty and points % 50:
-        return
-    text = f"  stability: {points} points" if value is None else f"  {points} points, at {value:.6g}"
-    print(f"\r{text}" if tty else text, end="" if tty else "\n", flush=True)
+class _Progress:
+    """The progress of :func:`rotorred.scenes.branch.continue_scene` (its ``progress(points, value)``): a bar of the
+    points traced with the key's value, then a stage line and a bar of the points whose stability is computed."""
+
+    def __init__(self, key: str):
+        self.key, self.points, self.bar, self.stability = key, 0, bar(None, "tracing", "point"), False
+
+    def __call__(self, points: int, value) -> None:
+        if value is not None:
+            self.points = points
+            self.bar.set_postfix_str(f"{self.key} = {value:.6g}", refresh=False)
+            self.bar.update(points - self.bar.n)
+            return
+        if not self.stability:
+            self.stability = True
+            self.bar.close()
+            stage("stability of %d points: Floquet multipliers", self.points)
+            self.bar = bar(self.points, "stability", "point")
+        self.bar.update(points - self.bar.n)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.bar.close()
