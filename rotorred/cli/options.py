@@ -158,6 +158,6 @@ def _writable(folder: Path) -> bool:
         return False
     try:
         st = os.statvfs(folder)
-    except OSError:
+    except (OSError, AttributeError):  # no statvfs on Windows: a read-only file system there fails when written
         return True
     return not st.f_flag & os.ST_RDONLY

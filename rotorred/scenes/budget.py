@@ -6,13 +6,12 @@ that states the estimate; the commands' ``--force`` lets the user go on. The lim
 * :data:`MAX_STEPS` time steps (about 100 s at 1 µs per step, the built-in scenes' reduced model);
 * :data:`MAX_DOFS` degrees of freedom of the finite-element model (dense eigen-solves and solves);
 * the memory the run needs (record, its copies for the files, the CSV text, the dense model
-  matrices) at most :data:`MEMORY_FRACTION` of the memory the machine has available
-  (``MemAvailable`` of ``/proc/meminfo``, else ``os.sysconf``).
+  matrices) at most :data:`MEMORY_FRACTION` of the memory the machine has available, as the operating system
+  reports it through psutil (:func:`available_memory`).
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 from rotorred import checks
@@ -39,18 +38,14 @@ def format_bytes(n: float) -> str:
 
 
 def available_memory() -> int:
-    """Memory available to a new computation (bytes): ``MemAvailable``, else free physical pages."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return 1 << 62
+    """Memory available to a new computation without swapping (bytes), as the operating system reports it.
+
+    ``psutil.virtual_memory().available``: ``MemAvailable`` on Linux, free and inactive pages on macOS and the
+    BSDs, the available physical memory on Windows. An error of psutil's is raised, not taken for "unlimited".
+    """
+    import psutil
+
+    return int(psutil.virtual_memory().available)
 
 
 @dataclass(frozen=True)
