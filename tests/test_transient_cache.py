@@ -62,6 +62,10 @@ def test_cache_is_reused_and_recompiled_when_the_generated_law_changes(package_c
     # the user cache folder (XDG_CACHE_HOME on Linux), keyed by the version; nothing written into the package
     assert Path(again["path"]).is_relative_to(tmp_path / "xdg" / "rotorred" / "numba" / rotorred.__version__)
     assert _cache_files(tmp_path / "xdg") and not _cache_files(package_copy)
+    for source in numba_cache.source_files(package_copy / "rotorred"):  # a reinstall: new mtimes, same contents
+        os.utime(source, ns=(source.stat().st_atime_ns, source.stat().st_mtime_ns + 10**9))
+    reinstalled = run(package_copy)
+    assert reinstalled["hits"] == 1 and reinstalled["misses"] == 0
     generated = package_copy / "rotorred" / "_generated" / "contact.py"
     text = generated.read_text()
     hertz = "    _t0 = K_nr*s**3.0\n"

@@ -15,16 +15,18 @@ the first of these that can be written:
 Inside it, numba's layout: one sub-folder per source folder (its name and a hash of its absolute path), so two
 installs of rotorred (a venv's and an editable checkout) never share or overwrite each other's entries.
 
-**When it is stale.** numba keys the cache of an ``njit(cache=True)`` function on the stamp of its own source file
-only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself functions of other files: the
+**When it is stale.** numba keys the cache of an ``njit(cache=True)`` function on the stamp (modification time and size) of its own source
+file only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself functions of other files: the
 contact law of :mod:`rotorred.transient.contact` and the sympy-generated code of :mod:`rotorred._generated`.
 :func:`register` puts :class:`RotorredCacheLocator` first in numba's list of cache locators. For a function
 defined in a file of the rotorred package it returns the source stamp
 
-    (numba's stamp of the function's own file, sha256 of the rotorred version and of source_files())
+    ("rotorred sources", sha256 of the rotorred version and of the contents of source_files())
 
-so an upgrade, a regeneration of the generated modules or an edit of the kernel's source modules invalidates
-every rotorred cache entry (numba then recompiles and overwrites it, in place).
+which covers the function's own file (a test checks that every module with compiled code is in
+:func:`source_files`). An upgrade, a regeneration of the generated modules or an edit of any of those files
+invalidates every rotorred cache entry (numba then recompiles and overwrites it, in place); reinstalling the same
+files (``pip install .`` again: new modification times, the same contents) does not.
 """
 
 from __future__ import annotations
@@ -153,7 +155,7 @@ class RotorredCacheLocator(caching._CacheLocator):
         return self._inner.get_cache_path()
 
     def get_source_stamp(self):
-        return self._inner.get_source_stamp(), source_digest()
+        return "rotorred sources", source_digest()
 
     def get_disambiguator(self):
         return self._inner.get_disambiguator()
