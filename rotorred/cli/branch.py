@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 
 from rotorred import checks
-from rotorred.cli.options import out_dir
+from rotorred.cli.options import out_dir, provenance
 
 
 def add_parser(subparsers):
@@ -62,6 +62,7 @@ def run(args) -> int:
     from rotorred.cli.run import _settings
     from rotorred.scenes.branch import check_key, continue_scene
     from rotorred.scenes.branch_outputs import format_branch, write_branch
+    from rotorred.scenes.resolved import scene_toml
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
     from rotorred.writers import OutputFolder
@@ -75,6 +76,7 @@ def run(args) -> int:
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
+    record = provenance(args, "scene", scene_toml(scene))  # with the base scene; --param in the command line
     model = build_model(scene).model
     print(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
@@ -83,7 +85,7 @@ def run(args) -> int:
         print()
     print(format_branch(branch))
     with OutputFolder(out) as folder:
-        write_branch(branch, folder, scene.name)
+        write_branch(branch, folder, scene.name, record)
         files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     for f in files:
         print(f"wrote {f}")
