@@ -11,7 +11,7 @@ The user-level functions and result types, importable from ``rotorred`` directly
                       plates=[rr.RubPlate.for_rotor(rotor, 18)], outputs=[(18, "y")])
 
 Layers (imports point downwards only; ``tests/test_architecture.py`` checks it):
-``checks``/``writers`` and ``_generated`` at the bottom, then ``model``, ``linear`` and
+``checks``/``writers``/``provenance`` and ``_generated`` at the bottom, then ``model``, ``linear`` and
 ``signals``, ``transient``, ``plots`` (the only layer besides ``cli`` that imports
 matplotlib), ``scenes``, ``cli``. The names below are loaded on first use, so
 ``import rotorred`` costs little and never loads matplotlib or numba.

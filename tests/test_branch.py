@@ -9,6 +9,7 @@ import os
 import signal
 import subprocess
 import sys
+from datetime import datetime, timezone
 
 import numpy as np
 import pytest
@@ -136,17 +137,25 @@ def test_rotorred_continue_writes_the_branch(tmp_path):
     labelled), branch.png and branch.txt (with the folds); the multipliers are computed (finite)."""
     import xarray as xr
 
+    from provenance_checks import assert_provenance
+
     out = tmp_path / "b"
-    assert main(["continue", "paper-rub", "--param", "rub.clearance=45e-6:25e-6", "--harmonics", str(H), "--samples",
-                 str(N), "--out", str(out)]) == 0
+    since = datetime.now(timezone.utc)
+    argv = ["continue", "paper-rub", "--param", "rub.clearance=45e-6:25e-6", "--harmonics", str(H), "--samples", str(N),
+            "--out", str(out)]
+    assert main(argv) == 0
     assert {p.name for p in out.iterdir()} >= {"branch.csv", "branch_lines.csv", "branch.nc", "branch.png",
-                                               "branch.txt"}
+                                               "branch.txt", "scene.toml"}
+    resolved = assert_provenance(out, argv, "branch.txt", "scene", since)  # the base scene: paper-rub's clearance
+    assert load_scene(out / "scene.toml").plates[0].clearance == load_scene("paper-rub").plates[0].clearance
+    assert "rub.clearance=45e-6:25e-6" in (out / "branch.txt").read_text() and resolved
     with open(out / "branch.csv", newline="") as f:
         rows = list(csv.reader(f))
     assert rows[0][0] == "rub.clearance (m)" and rows[0][2] == "peak 14y (um)"
     ds = xr.open_dataset(out / "branch.nc", engine="h5netcdf")
     values = np.array([float(r[0]) for r in rows[1:]])
-    assert np.allclose(ds["rub.clearance"].values, values, rtol=1e-8)
+    assert np.allclose(ds["rub_clearance"].values, values, rtol=1e-8)
+    assert ds["rub_clearance"].attrs["rotorred_key"] == "rub.clearance" and ds["rub_clearance"].attrs["units"] == "m"
     assert np.allclose(ds["peak"].values[:, 0] * 1e6, [float(r[2]) for r in rows[1:]], rtol=1e-8)
     assert np.isfinite(ds["critical_multiplier_re"].values).all()
     assert "µm (fold)" in (out / "branch.txt").read_text()

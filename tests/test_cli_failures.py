@@ -30,8 +30,14 @@ SHORT = ["--set", "solver.duration=0.3", "--set", "solver.record_start=0.1", "--
 
 
 def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
+    from datetime import datetime, timezone
+
+    from provenance_checks import assert_provenance
+
     out = tmp_path / "div"
-    assert main(["run", "paper-rub", "--out", str(out), "--set", "unbalance[1].m_e=4.0", *DIVERGE]) == 3
+    since = datetime.now(timezone.utc)
+    argv = ["run", "paper-rub", "--out", str(out), "--set", "unbalance[1].m_e=4.0", *DIVERGE]
+    assert main(argv) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     # one error line, after the run's stage lines (what it was doing when it stopped)
     errors = [line for line in lines if line.startswith("rotorred run: error: ")]
@@ -49,7 +55,8 @@ def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
     assert 0.34 < npz["t"][-1] < 0.3486 and np.all(np.isfinite(npz["rub_18_x"]))
     assert len((out / "timeseries.csv").read_text().splitlines()) == len(npz["t"]) + 1
     assert sorted((out / ".rotorred-files").read_text().split()) == sorted(
-        ["INCOMPLETE", "result.npz", "summary.txt", "timeseries.csv"])
+        ["INCOMPLETE", "result.npz", "scene.toml", "summary.txt", "timeseries.csv"])
+    assert_provenance(out, argv, "summary.txt", "scene", since)  # under the INCOMPLETE line, which stays first
 
 
 def test_diverging_sweep_point_is_recorded_and_the_others_kept(tmp_path, capsys):

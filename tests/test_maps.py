@@ -48,11 +48,17 @@ def _assert_same(a, b) -> None:
 
 
 @pytest.fixture(scope="module")
-def serial(tmp_path_factory):
+def serial_run(tmp_path_factory):
+    """The map run serially: its spec, dataset and the folder of its points."""
     spec = _spec()
-    store = PointStore(tmp_path_factory.mktemp("serial"), spec)
-    points = run_points(spec, store)
-    return spec, to_dataset(spec, points, (13, 14, 18))
+    folder = tmp_path_factory.mktemp("serial")
+    points = run_points(spec, PointStore(folder, spec))
+    return spec, to_dataset(spec, points, (13, 14, 18)), folder
+
+
+@pytest.fixture(scope="module")
+def serial(serial_run):
+    return serial_run[:2]
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +81,9 @@ def test_the_map_records_every_point(serial):
     assert (start[1, 1, :] == "cold").all() and (start[1, 0, :] == "warm").all()  # down: 90 then 89 Hz
     assert (ds["contact_fraction"].values > 0).all() and (ds["n_impacts"].values > 0).all()
     assert np.isfinite(ds["peak_orbit"].values).all() and (ds["max_contact_force"].values > 0).all()
-    assert ds["rub.clearance"].values.tolist() == [20e-6, 40e-6] and ds["speeds.outer"].attrs["units"] == "Hz"
+    assert ds["rub_clearance"].values.tolist() == [20e-6, 40e-6] and ds["speeds_outer"].attrs["units"] == "Hz"
+    assert ds["rub_clearance"].attrs == {"units": "m", "long_name": "rub.clearance", "rotorred_key": "rub.clearance"}
+    assert ds["status"].dims == ("direction", "speeds_outer", "rub_clearance")
 
 
 def test_a_real_cluster_gives_the_serial_dataset_bit_for_bit(serial, cluster, tmp_path):
@@ -143,6 +151,27 @@ def test_an_interrupted_map_resumes_to_the_same_dataset(serial, tmp_path, monkey
     done = xr.open_dataset(tmp_path / "out" / "map.nc", engine="h5netcdf")
     _assert_same(done, ref)
     done.close()
+
+
+def test_a_map_folder_of_the_older_names_resumes(serial_run, tmp_path):
+    """A folder written before map.nc took CF names (its points and points/spec.json as now; its map.nc with the
+    dimensions named by the dotted keys and a tracker reference) resumes: no point runs again, and its map.nc is
+    written again with the CF names and the same values."""
+    import shutil
+
+    import xarray as xr
+
+    spec, ref, folder = serial_run
+    out = tmp_path / "old"
+    shutil.copytree(folder / "points", out / "points")
+    old = ref.rename({"speeds_outer": "speeds.outer", "rub_clearance": "rub.clearance"})
+    old.assign_attrs(rotorred_map="issue 12").to_netcdf(out / "map.nc", engine="h5netcdf")
+    result = run_map(spec, out, workers=0, progress=False, figures=False)
+    assert (result.n_run, result.n_resumed, result.incomplete) == (0, 8, None)
+    with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
+        assert set(ds.dims) == {"direction", "speeds_outer", "rub_clearance", "line", "sample", "node"}
+        assert "rotorred_map" not in ds.attrs and ds.attrs["Conventions"] == "CF-1.10"
+        _assert_same(ds, ref)
 
 
 def test_a_warm_start_is_the_continuation_of_the_run():

@@ -91,16 +91,32 @@ def test_sweep_files(swept):
 
 
 def test_rotorred_sweep_is_rotorred_map(tmp_path, capsys):
+    """The command: its files, with the provenance (map.txt, map.nc, the base scene as scene.toml), and map.nc opens
+    with xarray with CF names and units."""
+    import xarray as xr
+    from datetime import datetime, timezone
+
+    from provenance_checks import assert_provenance
     from rotorred.cli import main
 
     args = ["sweep", "paper-rub", "--vary", "rub.clearance=60e-6,50e-6", "--cold", "--workers", "0",
             "--out", str(tmp_path)]
     for k, v in SHORT.items():
         args += ["--set", f"{k}={v!r}".replace("'", '"')]
+    since = datetime.now(timezone.utc)
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "map of paper-rub: rub.clearance (2)" in out and "2 points run" in out
     assert (tmp_path / "map.nc").exists() and (tmp_path / "lines.png").exists()
+    assert_provenance(tmp_path, args, "map.txt", "scene", since)
+    base = load_scene(tmp_path / "scene.toml")  # paper-rub with the fixed settings, its own clearance
+    assert base.solver.duration == SHORT["solver.duration"] and base.plates[0].clearance == 13e-6
+    with xr.open_dataset(tmp_path / "map.nc") as ds:
+        assert ds["status"].dims == ("direction", "rub_clearance")
+        assert ds["rub_clearance"].values.tolist() == [60e-6, 50e-6] and ds["rub_clearance"].attrs["units"] == "m"
+        assert all("." not in d for d in ds.dims) and all(v.attrs.get("units") for v in ds.variables.values())
+    header = (tmp_path / "map.csv").read_text().splitlines()[0].split(",")
+    assert header[:3] == ["direction", "rub.clearance (m)", "status"]
 
 
 def test_no_plate_no_reach():

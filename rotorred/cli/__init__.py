@@ -179,6 +179,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault(name, "1")
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the outputs' provenance
     if not getattr(args, "_run", None):
         parser.print_help()
         return EXIT_INPUT

@@ -22,7 +22,7 @@ import logging
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import out_dir
+from rotorred.cli.options import out_dir, provenance
 from rotorred.progress import bar, stage
 
 LOG = logging.getLogger("rotorred.cli")
@@ -71,6 +71,7 @@ def run(args) -> int:
     from rotorred.cli.run import _settings
     from rotorred.scenes.branch import check_key, continue_scene
     from rotorred.scenes.branch_outputs import format_branch
+    from rotorred.scenes.resolved import scene_toml
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
 
@@ -83,6 +84,7 @@ def run(args) -> int:
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
+    record = provenance(args, "scene", scene_toml(scene))  # with the base scene; --param in the command line
     model = build_model(scene).model
     report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
@@ -91,7 +93,7 @@ def run(args) -> int:
         branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
                                 progress=progress, interrupts=interrupts)
     report(format_branch(branch))
-    for f in _write(branch, out, scene.name, tuple(interrupts)):
+    for f in _write(branch, out, scene.name, tuple(interrupts), record):
         report(f"wrote {f}")
     if branch.interrupted:
         LOG.error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
@@ -99,7 +101,7 @@ def run(args) -> int:
     return 0
 
 
-def _write(branch, out, scene_name: str, interrupts: tuple) -> list:
+def _write(branch, out, scene_name: str, interrupts: tuple, record=None) -> list:
     """Stage and commit the branch's files into ``out``: those of an interrupted branch with SIGINT and SIGTERM held
     back (``writers._signals_blocked``, as a commit is), so that a second signal does not cut the points the first
     one kept; it is dropped once they are committed (the exit status is the first's). The files written."""
@@ -109,7 +111,7 @@ def _write(branch, out, scene_name: str, interrupts: tuple) -> list:
     folder, files = OutputFolder(out), []
     try:
         with _signals_blocked() if branch.interrupted else contextlib.nullcontext(), folder:
-            write_branch(branch, folder, scene_name)
+            write_branch(branch, folder, scene_name, record)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except interrupts:
         if not (branch.interrupted and folder.committed):

@@ -1,4 +1,8 @@
-"""``rotorred campbell ROTOR --speeds START:STOP:COUNT --out DIR``: Campbell diagram and critical speeds."""
+"""``rotorred campbell ROTOR --speeds START:STOP:COUNT --out DIR``: Campbell diagram and critical speeds.
+
+Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv``, ``campbell.txt`` (what it prints, under the
+rotorred version, command line and date) and ``rotor.toml`` (the rotor as read, a rotor file that gives it again).
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,7 @@ import math
 import numpy as np
 
 from rotorred import checks
-from rotorred.cli.options import grid, number_list, out_dir, ratio_number, spool_ratios
+from rotorred.cli.options import grid, number_list, out_dir, provenance, ratio_number, spool_ratios, stage_summary
 from rotorred.writers import OutputFolder
 
 
@@ -62,8 +66,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     from rotorred.linear.campbell import campbell
-    from rotorred.model.rotor_file import load_rotor
+    from rotorred.model.rotor_file import read_rotor
     from rotorred.plots.campbell import plot_campbell
+    from rotorred.writers import toml_text
 
     out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
@@ -72,7 +77,8 @@ def run(args) -> int:
     ratio = parse_ratio(args.ratio)
     if args.reduce is not None:
         checks.integer("--reduce", args.reduce, ge=0)
-    rotor = load_rotor(args.rotor)
+    rotor, document = read_rotor(args.rotor)
+    record = provenance(args, "rotor", toml_text(document))
     check_model_size(rotor, args.force)
     if args.reference is not None and args.reference not in rotor.speeds:
         checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
@@ -86,10 +92,11 @@ def run(args) -> int:
             operating = ref_nominal if ref_nominal > 0 else None
             files.append(plot_campbell(result, folder.staged("campbell.png"), operating_speed=operating))
             files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
+        report = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result)]
+                           + ([comparison] if comparison else []))
+        files += stage_summary(folder, "campbell.txt", report, record)
         folder.commit()
-    print(format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result))
-    if comparison:
-        print(comparison)
+    print(report)
     print("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
 

@@ -6,7 +6,9 @@ file, :mod:`rotorred.scenes.schema`). A scene supplies the defaults: its unbalan
 model ("full" or "reduced", with its mode count, cutoff, boundary nodes and rub nodes).
 
 Writes ``response.csv`` (speeds in rpm, amplitudes in µm, phases in deg), ``bode.png`` and
-``polar.png`` into ``--out``; with ``--frf`` also ``frf.csv`` and ``frf.png``.
+``polar.png`` into ``--out``; with ``--frf`` also ``frf.csv`` and ``frf.png``; and ``harmonic.txt`` (what it prints,
+under the rotorred version, command line and date) with the resolved input: ``rotor.toml`` (the rotor as read) or,
+for a scene, ``scene.toml`` (:mod:`rotorred.scenes.resolved`).
 
 Defaults (documented in ``--help``):
 
@@ -28,7 +30,8 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import dof_list, grid, node_list, out_dir, ratio_number, spool_ratios
+from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, spool_ratios,
+                                  stage_summary)
 from rotorred.writers import OutputFolder
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
@@ -117,14 +120,17 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
 
 
 def _load(spec: str):
-    """(rotor, scene or None) for a rotor or scene argument."""
-    from rotorred.model.rotor_file import load_rotor
+    """(rotor, scene or None, resolved input: ("scene" or "rotor", its TOML text)) for a rotor or scene argument."""
+    from rotorred.model.rotor_file import read_rotor
+    from rotorred.scenes.resolved import scene_toml
     from rotorred.scenes.schema import builtin_scenes, load_scene
+    from rotorred.writers import toml_text
 
     if spec in builtin_scenes() or _is_scene_file(spec):
         scene = load_scene(spec)
-        return scene.rotor.with_speeds(scene.speeds), scene
-    return load_rotor(spec), None
+        return scene.rotor.with_speeds(scene.speeds), scene, ("scene", scene_toml(scene))
+    rotor, document = read_rotor(spec)
+    return rotor, None, ("rotor", toml_text(document))
 
 
 def _is_scene_file(spec: str) -> bool:
@@ -226,7 +232,8 @@ def run(args) -> int:
     from rotorred.linear.harmonic import unbalance_response
 
     out = out_dir("--out", args.out)
-    rotor, scene = _load(str(args.rotor))
+    rotor, scene, resolved = _load(str(args.rotor))
+    record = provenance(args, *resolved)
     check_model_size(rotor, args.force)
     reference = args.reference_spool or rotor.spools[0].name
     if reference not in rotor.speeds:
@@ -247,9 +254,12 @@ def run(args) -> int:
         elapsed = time.perf_counter() - t0
         title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
         names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
+        text = _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result)
+        names += [f.name for f in stage_summary(folder, "harmonic.txt", text, record)]
         folder.commit()
-    _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result,
-            [out / n for n in names])
+    report(text)
+    for name in names:
+        report(f"wrote {out / name}")
     return 0
 
 
@@ -280,17 +290,16 @@ def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[st
     return names
 
 
-def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result, files) -> None:
-    if scene is not None:
-        report(f"scene {scene.name} ({scene.source})")
-    report(f"rotor {rotor.name or args.rotor}: {label}")
-    report("unbalances: " + ", ".join(f"node {u.node} ({rotor.spool_of[u.node]}) {u.m_e:g} kg m at "
-                                      f"{math.degrees(u.phase):g} deg" for u in unbalances))
-    report(f"sweep: {len(speeds)} speeds, {reference} {speeds[0] * _RPM:.0f}-{speeds[-1] * _RPM:.0f} rpm, "
-           f"ratios {ratios}; solved in {elapsed:.2f} s")
+def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result) -> str:
+    """What the sweep solved and the peak of each output (printed, and ``harmonic.txt``)."""
+    lines = [f"scene {scene.name} ({scene.source})"] if scene is not None else []
+    lines.append(f"rotor {rotor.name or args.rotor}: {label}")
+    lines.append("unbalances: " + ", ".join(f"node {u.node} ({rotor.spool_of[u.node]}) {u.m_e:g} kg m at "
+                                            f"{math.degrees(u.phase):g} deg" for u in unbalances))
+    lines.append(f"sweep: {len(speeds)} speeds, {reference} {speeds[0] * _RPM:.0f}-{speeds[-1] * _RPM:.0f} rpm, "
+                 f"ratios {ratios}; solved in {elapsed:.2f} s")
     for o in result.outputs:
         k = int(np.argmax(result.peak(o)))
-        report(f"  node {o[0]} {o[1]}: max peak bound {1e6 * result.peak(o)[k]:.4g} um at "
-               f"{speeds[k] * _RPM:.0f} rpm")
-    for f in files:
-        report(f"wrote {f}")
+        lines.append(f"  node {o[0]} {o[1]}: max peak bound {1e6 * result.peak(o)[k]:.4g} um at "
+                     f"{speeds[k] * _RPM:.0f} rpm")
+    return "\n".join(lines)

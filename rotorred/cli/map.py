@@ -7,7 +7,8 @@ Runs the scene at every point of the grid of the varied keys on a Dask cluster (
 LocalCluster, one single-threaded worker per core, unless ``--scheduler`` names one; ``--workers
 0`` runs serially), each point from its neighbour's final state along the first key (``--cold``:
 from the scene's start), up, down or both ways, each until settled or ``--limit`` seconds. Writes
-``map.nc`` (xarray/NetCDF), ``map.csv``, ``map_lines.csv``, ``map.txt`` and the figures; the
+``map.nc`` (xarray/NetCDF), ``map.csv``, ``map_lines.csv``, ``map.txt``, the figures and ``scene.toml`` (the
+resolved base scene; the command line, with the varied keys, is at the top of ``map.txt`` and in ``map.nc``); the
 points are kept in ``DIR/points`` as they finish, and the same command resumes an interrupted map.
 """
 
@@ -17,7 +18,7 @@ import logging
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import out_dir, spool_ratios
+from rotorred.cli.options import out_dir, provenance, spool_ratios
 
 LOG = logging.getLogger("rotorred.cli")
 
@@ -70,6 +71,21 @@ def spec_of(args):
     return spec
 
 
+def base_scene_toml(spec) -> str:
+    """The resolved base scene of a map: its scene with the fixed settings (``--set``), the varied keys as the scene
+    has them (the command line in the provenance names their values). A base scene that is not valid on its own
+    (a varied key makes it so) gives the scene of the map's first grid point."""
+    from rotorred.checks import InputError
+    from rotorred.scenes.resolved import scene_toml
+    from rotorred.scenes.schema import load_scene
+
+    try:
+        scene = load_scene(spec.scene, dict(spec.settings))
+    except InputError:
+        scene = spec.scene_at((0,) * len(spec.axes))
+    return scene_toml(scene)
+
+
 def _values(parsed, item: str) -> tuple[str, tuple]:
     key, values = parsed
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
@@ -87,7 +103,8 @@ def run(args) -> int:
     report(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
            f"{'/'.join(spec.directions)}, {spec.n_points} points, "
            f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
-    result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler)
+    record = provenance(args, "scene", base_scene_toml(spec))
+    result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler, provenance=record)
     report(format_map(result.dataset, spec))
     for f in result.files:
         report(f"wrote {f}")

@@ -13,7 +13,8 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.dofs import parse_dof
 
-__all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "out_dir", "MAX_COUNT"]
+__all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "out_dir", "provenance",
+           "stage_summary", "MAX_COUNT"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -161,3 +162,24 @@ def _writable(folder: Path) -> bool:
     except (OSError, AttributeError):  # no statvfs on Windows: a read-only file system there fails when written
         return True
     return not st.f_flag & os.ST_RDONLY
+
+
+def provenance(args, kind: str, toml: str):
+    """The :class:`rotorred.provenance.Provenance` of this command: its command line (``args.argv``, set by
+    :func:`rotorred.cli.main`; else ``sys.argv``), now, and the resolved ``kind`` ("scene" or "rotor") as ``toml``."""
+    import sys
+
+    from rotorred.provenance import Provenance
+
+    argv = getattr(args, "argv", None)
+    return Provenance.of_command(sys.argv[1:] if argv is None else argv, kind, toml)
+
+
+def stage_summary(folder, name: str, text: str, record) -> list[Path]:
+    """Stage the text summary ``name`` (``record``'s header lines on top of ``text``) and ``record``'s resolved input
+    (``rotor.toml`` or ``scene.toml``) in ``folder`` (:class:`rotorred.writers.OutputFolder`); returns their paths."""
+    from rotorred.writers import write_text
+
+    summary = "\n".join(record.header_lines()) + "\n\n" + text + "\n"
+    return [write_text(folder.staged(name), summary),
+            write_text(folder.staged(record.file_name), record.file_text())]

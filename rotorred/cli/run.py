@@ -3,7 +3,9 @@
 With no scene it runs the built-in ``paper-rub`` (Xu et al. 2016: rub at node 18, 70/90 Hz).
 Writes ``waveforms.png``, ``spectra_node<N>.png``, ``orbits.png``, ``result.npz``,
 ``result.mat``, ``timeseries.csv``, ``spectra.csv``, ``lines.csv`` and ``summary.txt``
-(as the scene's ``[output]`` asks), and prints the summary. A scene with ``[runup]`` (the
+(as the scene's ``[output]`` asks), and ``scene.toml``, the resolved scene, which ``rotorred run DIR/scene.toml``
+runs again to the same bits (:mod:`rotorred.scenes.resolved`; version, command line and date on top of the summary
+and in the NPZ and .mat: :mod:`rotorred.provenance`), and prints the summary. A scene with ``[runup]`` (the
 built-in ``runup``, ``runup-rub``, ``coastdown-rub``) writes ``runup_amplitude.png``,
 ``order_tracks.png``, ``waterfall.png``, ``runup_orbits.png``, their CSV files
 (``runup_amplitude.csv``, ``order_tracks.csv``, ``rub_intervals.csv``, ``critical_speeds.csv``),
@@ -22,7 +24,7 @@ import time
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import out_dir
+from rotorred.cli.options import out_dir, provenance
 from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
@@ -54,17 +56,22 @@ def add_parser(subparsers):
 def run(args) -> int:
     """Check everything, then compute into a locked, staged ``--out`` (exit statuses: :mod:`rotorred.cli`)."""
     from rotorred.scenes import budget
+    from rotorred.scenes.resolved import scene_toml
     from rotorred.scenes.schema import load_scene
 
     t0 = time.perf_counter()
     out = out_dir("--out", args.out) if args.out is not None else None  # refused before the scene is read
-    scene = load_scene(args.scene, _settings(args.set))
+    settings = _settings(args.set)
+    if args.no_normal:  # a key of the scene, so that its scene.toml runs without the normal comparison too
+        settings["output.compare_normal"] = False
+    scene = load_scene(args.scene, settings)
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
     budget.check(budget.scene_estimate(scene), force=args.force)
     LOG.info("running %s into %s", scene.name, out)  # the first line, once the input is checked: a refusal is one line
+    record = provenance(args, "scene", scene_toml(scene))
     with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
-        status = _compute_and_write(scene, args, folder, out, pool)
+        status = _compute_and_write(scene, args, folder, out, pool, record)
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
 
@@ -95,12 +102,13 @@ def _settings(items: list[str]) -> dict:
     return settings
 
 
-def _compute_and_write(scene, args, folder, out, pool) -> int:
-    """Run the scene, stage its files and commit them; a diverged run commits its partial record (exit 3)."""
+def _compute_and_write(scene, args, folder, out, pool, record) -> int:
+    """Run the scene, stage its files and commit them, with the provenance ``record``; a diverged run commits its
+    partial record (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
 
     if scene.runup is not None:
-        return _runup_and_write(scene, folder, out)
+        return _runup_and_write(scene, folder, out, record)
     from rotorred.scenes.outputs import submit_figures, write_outputs
     from rotorred.scenes.run import SceneDiverged
     from rotorred.scenes.summary import format_summary
@@ -111,21 +119,20 @@ def _compute_and_write(scene, args, folder, out, pool) -> int:
     def on_record(partial):
         drawing.extend(submit_figures(partial, folder.staging, pool, "record"))
     try:
-        result = run_to_tolerance(scene, compare_normal=False if args.no_normal else None, progress=None,
-                                  on_record=on_record)
+        result = run_to_tolerance(scene, progress=None, on_record=on_record)
     except SceneDiverged as exc:
-        write_outputs(exc.partial, folder.staging, shown=out, pool=pool)
+        write_outputs(exc.partial, folder.staging, shown=out, pool=pool, provenance=record)
         files = folder.commit(incomplete=str(exc))
         report(format_summary(exc.partial, files))
         LOG.error(f"{exc}; partial results written to {out} (marked {INCOMPLETE})")
         return EXIT_DIVERGED
-    files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing)
+    files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing, provenance=record)
     folder.commit()
     report(format_summary(result, files))
     return 0
 
 
-def _runup_and_write(scene, folder, out) -> int:
+def _runup_and_write(scene, folder, out, record) -> int:
     """A run-up scene: the transient through its speed profile, its figures, data and summary; a diverged run
     writes what it computed up to then, analysed, marked INCOMPLETE (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
@@ -133,7 +140,7 @@ def _runup_and_write(scene, folder, out) -> int:
     from rotorred.scenes.runup_outputs import format_runup_summary, write_runup_outputs
 
     result = run_runup(scene, progress=None)
-    files = write_runup_outputs(result, folder.staging, shown=out)
+    files = write_runup_outputs(result, folder.staging, shown=out, provenance=record)
     committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:

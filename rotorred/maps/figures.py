@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.maps.spec import MapSpec
-from rotorred.scenes.keys import key_unit
+from rotorred.scenes.keys import key_unit, netcdf_name
 from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_lines, plot_waterfall
 
 __all__ = ["map_figures"]
@@ -37,7 +37,7 @@ def map_figures(ds, spec: MapSpec, folder: Path) -> list[Path]:
 
 def _first_of_the_rest(ds, spec: MapSpec, n_kept: int):
     """The dataset at index 0 of every axis after the first ``n_kept``, and a title suffix naming them."""
-    rest = {a.key: 0 for a in spec.axes[n_kept:]}
+    rest = {netcdf_name(a.key): 0 for a in spec.axes[n_kept:]}
     text = ", ".join(f"{a.key} = {key_unit(a.key)[0] * a.values[0]:.4g} {key_unit(a.key)[1]}".rstrip()
                      for a in spec.axes[n_kept:])
     return ds.isel(rest), (f" at {text}" if text else "")

@@ -27,6 +27,7 @@ from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
+from rotorred.provenance import Provenance
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
 
@@ -72,7 +73,7 @@ def _client(workers: int | None, scheduler: str | None):
 
 
 def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
-            progress: bool | None = None, figures: bool = True) -> MapRun:
+            progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None) -> MapRun:
     """Run a map into ``out`` (module docstring); resumable.
 
     Parameters
@@ -89,6 +90,9 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         passes INFO (:func:`rotorred.progress.bar`).
     figures : bool
         Write the figures.
+    provenance : rotorred.provenance.Provenance, optional
+        What made the map (the command line's, with the base scene): written as ``scene.toml``, at the top of
+        ``map.txt`` and as attributes of ``map.nc``.
     """
     t0 = time.perf_counter()
     scenes = spec.scenes()  # 1. every point validated before anything runs
@@ -110,7 +114,7 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         if incomplete is not None:
             points = store.read()
         ds = _dataset(spec, scenes[0], points)
-        files = _write(ds, spec, folder, figures)
+        files = _write(ds, spec, folder, figures, provenance)
         files = tuple(folder.commit(incomplete))
     n_failed = sum(p.status != "ok" for p in points.values())
     return MapRun(ds, files, len(points) - n_resumed, n_resumed, n_failed, incomplete, time.perf_counter() - t0)
@@ -128,18 +132,22 @@ def _dataset(spec: MapSpec, scene, points: dict):
     d = table_dof(scene)
     attrs = {"scene": spec.scene, "settings": repr(dict(spec.settings)), "ratios": repr(dict(spec.ratios)),
              "table_dof": f"{d[0]}:{d[1]}", "continuation": "cold" if spec.cold else "warm",
-             "directions": ",".join(spec.directions), "rotorred_map": "issue 12"}
+             "directions": ",".join(spec.directions)}
     return to_dataset(spec, points, tuple(scene.output.nodes), attrs)
 
 
-def _write(ds, spec: MapSpec, folder: OutputFolder, figures: bool) -> list[Path]:
+def _write(ds, spec: MapSpec, folder: OutputFolder, figures: bool, provenance: Provenance | None) -> list[Path]:
     staging = folder.staging
-    files = [write_netcdf(staging / "map.nc", ds), *write_tables(ds, staging)]
+    attributes = provenance.netcdf_attributes() if provenance is not None else None
+    files = [write_netcdf(staging / "map.nc", ds, attributes), *write_tables(ds, staging)]
     if figures:
         from rotorred.maps.figures import map_figures
 
         files += map_figures(ds, spec, staging)
-    files.append(write_text(staging / "map.txt", format_map(ds, spec) + "\n"))
+    header = "".join(f"{line}\n" for line in provenance.header_lines()) + "\n" if provenance is not None else ""
+    files.append(write_text(staging / "map.txt", header + format_map(ds, spec) + "\n"))
+    if provenance is not None:
+        files.append(write_text(staging / provenance.file_name, provenance.file_text()))
     return files
 
 

@@ -8,11 +8,13 @@ Layout of ``--out``
     ``map.nc``, ``map.csv``, ``map_lines.csv`` and the figures are rebuilt from the points.
 
 Dataset (:func:`to_dataset`, xarray)
-    Dimensions: ``direction`` ("up", "down"), one per varied key (named by the key, values in
-    the scene's units), ``line`` (strongest first), ``sample`` (Poincare samples, the last ones)
-    and ``node`` (output nodes). Points not run (yet) are missing: status "", NaN, -1. Every
-    variable carries ``units`` and ``long_name``; the dataset carries the scene, the fixed
-    settings and the table DOF as attributes.
+    Dimensions: ``direction`` ("up", "down"), one per varied key (named by
+    :func:`rotorred.scenes.keys.netcdf_name`, ``rub.clearance`` -> ``rub_clearance``, the key itself in the
+    coordinate's ``long_name`` and ``rotorred_key``, values in the scene's units), ``line`` (strongest first),
+    ``sample`` (Poincare samples, the last ones) and ``node`` (output nodes). Points not run (yet) are missing:
+    status "", NaN, -1. Every variable and coordinate carries CF ``units`` ("1" when dimensionless, strings
+    included) and ``long_name``; the dataset carries the scene, the fixed settings and the table DOF as attributes.
+    The points on disk hold no names of the dataset, so a folder written before the names changed resumes.
 """
 
 from __future__ import annotations
@@ -25,29 +27,30 @@ import numpy as np
 
 from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult, StartState
 from rotorred.maps.spec import MapSpec
-from rotorred.scenes.keys import key_unit
+from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.transient.results import FinalState
 from rotorred.writers import write_csv, write_npz, write_text
 
 __all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
 
-#: the per-point scalars: name -> (dtype, missing value, units, long name)
+#: the per-point scalars: name -> (dtype, missing value, units, long name). CF units: "1" for every dimensionless
+#: variable, counts and the string variables (status, reason, kind, start) included
 SCALARS = {
-    "status": ("U8", "", "", "ok, diverged or failed"),
-    "reason": ("U1000", "", "", "why the point has no results"),
-    "kind": ("U14", "", "", "response class of the table DOF"),
-    "subharmonic": ("i8", -1, "", "k of a period-k response"),
+    "status": ("U8", "", "1", "ok, diverged or failed"),
+    "reason": ("U1000", "", "1", "why the point has no results"),
+    "kind": ("U14", "", "1", "response class of the table DOF"),
+    "subharmonic": ("i8", -1, "1", "k of a period-k response"),
     "period": ("f8", np.nan, "s", "period of a periodic response"),
     "settling_time": ("f8", np.nan, "s", "measured settling time (NaN: not settled)"),
     "explained_share": ("f8", np.nan, "1", "share of the energy the labelled lines explain"),
-    "torus_k": ("i8", -1, "", "sub-harmonic order of f_H"),
-    "torus_j": ("i8", -1, "", "sub-harmonic order of f_L"),
+    "torus_k": ("i8", -1, "1", "sub-harmonic order of f_H"),
+    "torus_j": ("i8", -1, "1", "sub-harmonic order of f_L"),
     "poincare_frequency": ("f8", np.nan, "Hz", "Poincare section frequency"),
     "contact_fraction": ("f8", np.nan, "1", "fraction of the record in contact (first plate)"),
-    "n_impacts": ("i8", -1, "", "contact onsets in the record (first plate)"),
+    "n_impacts": ("i8", -1, "1", "contact onsets in the record (first plate)"),
     "max_contact_force": ("f8", np.nan, "N", "largest normal contact force (first plate)"),
     "free_reach": ("f8", np.nan, "m", "reach of the settled no-rub orbit towards the first plate"),
-    "start": ("U4", "", "", "cold (scene's start) or warm (neighbour's final state)"),
+    "start": ("U4", "", "1", "cold (scene's start) or warm (neighbour's final state)"),
     "simulated": ("f8", np.nan, "s", "simulated time, segments run until settled included"),
     "wall_time": ("f8", np.nan, "s", "wall time of the point"),
 }
@@ -56,7 +59,7 @@ VECTORS = {
     "line_frequency": ("line", N_LINES, "f8", np.nan, "Hz", "labelled line frequency"),
     "line_amplitude": ("line", N_LINES, "f8", np.nan, "m", "labelled line amplitude"),
     "line_phase": ("line", N_LINES, "f8", np.nan, "rad", "labelled line phase"),
-    "line_label": ("line", N_LINES, "U40", "", "", "labelled line combination"),
+    "line_label": ("line", N_LINES, "U40", "", "1", "labelled line combination"),
     "poincare_x": ("sample", N_SAMPLES, "f8", np.nan, "m", "Poincare samples of the table DOF"),
     "poincare_velocity": ("sample", N_SAMPLES, "f8", np.nan, "m/s", "Poincare samples of its velocity"),
 }
@@ -145,7 +148,7 @@ def to_dataset(spec: MapSpec, points: dict, nodes: tuple[int, ...], attrs: dict 
 
     dirs = spec.directions
     shape = (len(dirs), *spec.shape)
-    dims = ("direction", *(a.key for a in spec.axes))
+    dims = ("direction", *(netcdf_name(a.key) for a in spec.axes))
     data = {name: np.full(shape, missing, dtype=dtype) for name, (dtype, missing, *_) in SCALARS.items()}
     data.update({name: np.full((*shape, n), missing, dtype=dtype) for name, (_, n, dtype, missing, *_) in VECTORS.items()})
     data["peak_orbit"] = np.full((*shape, len(nodes)), np.nan)
@@ -162,20 +165,21 @@ def to_dataset(spec: MapSpec, points: dict, nodes: tuple[int, ...], attrs: dict 
     variables.update({name: ((*dims, dim), data[name], {"units": u, "long_name": ln})
                       for name, (dim, _, _, _, u, ln) in VECTORS.items()})
     variables["peak_orbit"] = ((*dims, "node"), data["peak_orbit"], {"units": "m", "long_name": "largest orbit radius"})
-    coords = {"direction": list(dirs), "node": list(nodes)}
+    coords = {"direction": ("direction", list(dirs), {"units": "1", "long_name": "sweep direction (up, down)"}),
+              "node": ("node", list(nodes), {"units": "1", "long_name": "output node"})}
     for a in spec.axes:
-        scale, unit = key_unit(a.key)
-        coords[a.key] = (a.key, np.array(a.values), {"units": "Hz" if unit == "Hz" else "SI", "long_name": a.key})
+        name = netcdf_name(a.key)
+        coords[name] = (name, np.array(a.values), {"units": cf_units(a.key), "long_name": a.key, "rotorred_key": a.key})
     return xr.Dataset(variables, coords=coords, attrs=dict(attrs or {}))
 
 
 def write_tables(ds, folder: Path) -> list[Path]:
-    """``map.csv`` (one row per point) and ``map_lines.csv`` (one row per point and line), tidy."""
+    """``map.csv`` (one row per point) and ``map_lines.csv`` (one row per point and line), tidy: a varied key's column
+    named by the key (its ``rotorred_key``), a number's with its units (not an integer's, nor a string's)."""
     keys = [k for k in ds.dims if k not in ("direction", "line", "sample", "node")]
     flat = ds.drop_dims(["line", "sample", "node"]).to_dataframe().reset_index()
     flat = flat[flat["status"] != ""]
-    header = [f"{c} ({ds[c].attrs['units']})" if c in ds and ds[c].attrs.get("units") not in (None, "", "SI")
-              else c for c in flat.columns]
+    header = [_column(ds, c) for c in flat.columns]
     orbit = ds["peak_orbit"].stack(point=("direction", *keys)).transpose("point", "node")
     done = (ds["status"] != "").stack(point=("direction", *keys)).values
     extra = [f"peak orbit node {n} (um)" for n in ds["node"].values]
@@ -187,6 +191,15 @@ def write_tables(ds, folder: Path) -> list[Path]:
     header = [c for c in lines.columns if c != "line"]
     named = {"line_frequency": "frequency (Hz)", "line_amplitude": "amplitude (um)", "line_phase": "phase (rad)",
              "line_label": "label"}
-    files.append(write_csv(folder / "map_lines.csv", [named.get(c, c) for c in header],
+    files.append(write_csv(folder / "map_lines.csv", [named.get(c, _column(ds, c)) for c in header],
                            [lines[c].to_numpy() for c in header]))
     return files
+
+
+def _column(ds, name: str) -> str:
+    """A CSV column's header: the varied key as the scene writes it, the units of a float (``"free_reach (m)"``)."""
+    if name not in ds.variables:
+        return name
+    v = ds[name]
+    label = v.attrs.get("rotorred_key", name)
+    return f"{label} ({v.attrs['units']})" if v.dtype.kind == "f" and v.attrs.get("units") else label

@@ -56,11 +56,13 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor_toml", "rotor_document", "rotor_from_toml",
+__all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor", "ROTOR_FILE_KEYS", "read_rotor_toml", "rotor_document", "rotor_from_toml",
            "rotor_from_dict", "read_toml"]
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}
+#: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
+ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
 _SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements", "stations",
                "material", "sleeves"}
@@ -106,14 +108,28 @@ def load_rotor(spec: str | Path) -> Rotor:
     FileNotFoundError
         If ``spec`` is neither a preset nor an existing file.
     """
+    return read_rotor(spec)[0]
+
+
+def read_rotor(spec: str | Path) -> tuple[Rotor, dict[str, Any]]:
+    """The rotor of a preset name or a TOML file (:func:`load_rotor`) and its rotor-file document: the parsed
+    tables as written (a ROSS file's converted, :func:`rotor_document`), which :func:`rotor_from_dict` makes the
+    same rotor again, and :func:`rotorred.writers.toml_text` writes as a rotor file."""
     spec_str = str(spec)
     if spec_str in presets():
         text = resources.files("rotorred.model.presets").joinpath(f"{spec_str}.toml").read_text()
-        return rotor_from_toml(text, source=f"preset {spec_str!r}")
-    path = Path(spec)
-    if not path.exists():
-        raise FileNotFoundError(f"rotor {spec_str!r} is neither a preset ({', '.join(presets())}) nor an existing file")
-    return rotor_from_toml(read_text_file(path, RotorFileError), source=str(path), name=path.stem)
+        source, name = f"preset {spec_str!r}", "ross-rotor"
+    else:
+        path = Path(spec)
+        if not path.exists():
+            raise FileNotFoundError(f"rotor {spec_str!r} is neither a preset ({', '.join(presets())}) nor an "
+                                    "existing file")
+        text, source, name = read_text_file(path, RotorFileError), str(path), path.stem
+    document = rotor_document(read_rotor_toml(text, source), source, name)
+    try:
+        return rotor_from_dict(document), document
+    except RotorFileError as exc:
+        raise exc.from_source(source) from None
 
 
 def read_rotor_toml(text: str, source: str = "<string>") -> dict[str, Any]:

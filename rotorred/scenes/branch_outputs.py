@@ -1,4 +1,5 @@
-"""The files of a harmonic-balance branch (``rotorred continue``): CSV, NetCDF, the figure and a summary.
+"""The files of a harmonic-balance branch (``rotorred continue``): CSV, NetCDF, the figure, a summary and, given a
+provenance, the base scene (``scene.toml``).
 
 A point whose stability was not computed (``--no-stability``, or an interrupt in the stability phase) is marked
 alike in each: stability "unknown" in the CSV and the summary, the NetCDF flag -1 (:data:`STABILITY_FLAGS`), its
@@ -9,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from rotorred.provenance import Provenance
+from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.writers import render_table, write_csv, write_netcdf, write_text
 
 __all__ = ["STABILITY_FLAGS", "format_branch", "branch_dataset", "write_branch"]
@@ -51,9 +54,12 @@ def format_branch(branch) -> str:
 
 
 def branch_dataset(branch, scene_name: str):
-    """The branch as an :class:`xarray.Dataset`: dims point, dof, harmonic."""
+    """The branch as an :class:`xarray.Dataset`: dims point, dof, harmonic; the key's coordinate named
+    :func:`rotorred.scenes.keys.netcdf_name` (``rub_clearance``), the key itself in its ``long_name`` and
+    ``rotorred_key``; CF ``units`` on every variable and coordinate ("1" when dimensionless)."""
     import xarray as xr
 
+    key = netcdf_name(branch.key)
     return xr.Dataset(
         {"peak": (("point", "dof"), branch.peaks, {"units": "m", "long_name": "largest |q(t)| over the period"}),
          "line": (("point", "harmonic"), branch.lines,
@@ -61,19 +67,24 @@ def branch_dataset(branch, scene_name: str):
          "critical_multiplier_re": ("point", branch.critical.real, {"units": "1", "long_name": "Floquet multiplier of largest modulus, real part"}),
          "critical_multiplier_im": ("point", branch.critical.imag, {"units": "1", "long_name": "Floquet multiplier of largest modulus, imaginary part"}),
          "stable": ("point", _stability_flags(branch),
-                    {"long_name": "stability of the point (-1: not computed)", "flag_values": np.array(
+                    {"units": "1", "long_name": "stability of the point (-1: not computed)", "flag_values": np.array(
                         list(STABILITY_FLAGS), np.int8), "flag_meanings": " ".join(STABILITY_FLAGS.values())}),
          "f0": ("point", branch.f0, {"units": "Hz", "long_name": "base frequency"}),
-         "iterations": ("point", branch.iterations)},
-        coords={branch.key: ("point", branch.values, {"units": branch.unit}),
-                "dof": [_dof_name(d) for d in branch.dofs], "harmonic": np.arange(branch.lines.shape[1])},
+         "iterations": ("point", branch.iterations, {"units": "1", "long_name": "Newton iterations of the point"})},
+        coords={key: ("point", branch.values, {"units": cf_units(branch.key), "long_name": branch.key,
+                                               "rotorred_key": branch.key}),
+                "dof": ("dof", [_dof_name(d) for d in branch.dofs], {"units": "1", "long_name": "output DOF"}),
+                "harmonic": ("harmonic", np.arange(branch.lines.shape[1]),
+                             {"units": "1", "long_name": "harmonic k of f0"})},
         attrs={"scene": scene_name, "stopped": branch.stopped, "interrupted": branch.interrupt or "no",
                "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in branch.folds),
                "bifurcations": "; ".join(f"{kind} between {a:.9g} and {b:.9g}" for a, b, kind in branch.bifurcations)})
 
 
-def write_branch(branch, folder, scene_name: str) -> None:
-    """Stage the branch's files in ``folder`` (:class:`rotorred.writers.OutputFolder`)."""
+def write_branch(branch, folder, scene_name: str, provenance: Provenance | None = None) -> None:
+    """Stage the branch's files in ``folder`` (:class:`rotorred.writers.OutputFolder`); a ``provenance``
+    (:class:`rotorred.provenance.Provenance`, with the base scene) is written as ``scene.toml``, on top of
+    ``branch.txt`` and as attributes of ``branch.nc``."""
     from rotorred.plots.branch import plot_branch  # matplotlib only when figures are written
 
     xs, xu = _scale(branch)
@@ -85,10 +96,14 @@ def write_branch(branch, folder, scene_name: str) -> None:
                [STABILITY_FLAGS[f] if f < 0 else int(f) for f in _stability_flags(branch)], branch.iterations])
     write_csv(folder.staged("branch_lines.csv"), [f"{branch.key} ({branch.unit})"] +
               [f"{dof} k={k} (um)" for k in range(branch.lines.shape[1])], [branch.values, *(1e6 * branch.lines.T)])
-    write_netcdf(folder.staged("branch.nc"), branch_dataset(branch, scene_name))
+    write_netcdf(folder.staged("branch.nc"), branch_dataset(branch, scene_name),
+                 provenance.netcdf_attributes() if provenance is not None else None)
     stable = None if not branch.known.any() else np.where(branch.known, branch.stable, np.nan)
     plot_branch(branch.values, branch.peaks[:, 0], stable, branch.folds, folder.staged("branch.png"),
                 xlabel=f"{branch.key} ({xu})", ylabel=f"peak |{dof}| (µm)", changes=branch.bifurcations, xscale=xs,
                 title=f"{scene_name}: harmonic-balance branch"
                       + (f" (INCOMPLETE: interrupted by {branch.interrupt})" if branch.interrupted else ""))
-    write_text(folder.staged("branch.txt"), format_branch(branch) + "\n")
+    top = "".join(f"{line}\n" for line in provenance.header_lines()) + "\n" if provenance is not None else ""
+    write_text(folder.staged("branch.txt"), top + format_branch(branch) + "\n")
+    if provenance is not None:
+        write_text(folder.staged(provenance.file_name), provenance.file_text())

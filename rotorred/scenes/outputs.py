@@ -1,4 +1,4 @@
-"""The files of a scene's result: figures (PNG), data (NPZ, CSV, MATLAB .mat) and ``summary.txt``.
+"""The files of a scene's result: figures (PNG), data (NPZ, CSV, MATLAB .mat), ``summary.txt`` and, given a provenance, ``scene.toml``.
 
 Keys, columns and variables are documented in ``docs/scenes.md``. Every file goes through the
 one writer of its format (:mod:`rotorred.writers`); figures come from
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.progress import stage
+from rotorred.provenance import Provenance
 from rotorred.scenes.run import SceneResult
 from rotorred.scenes.summary import format_summary
 from rotorred.writers import write_csv, write_mat, write_npz, write_text
@@ -111,16 +112,18 @@ def _poincare_csv(result: SceneResult, path: Path) -> Path:
     return write_csv(path, POINCARE_HEADER, [p.times, 1e6 * p.x, 1e6 * p.velocity], digits=17)
 
 
-def write_data(result: SceneResult, out: str | Path) -> list[Path]:
-    """Write the data files the scene's ``output.formats`` asks for; returns their paths."""
+def write_data(result: SceneResult, out: str | Path, provenance: Provenance | None = None) -> list[Path]:
+    """Write the data files the scene's ``output.formats`` asks for, the NPZ and .mat with the ``provenance``'s
+    attributes; returns their paths."""
     out = Path(out)
     formats = result.scene.output.formats
     files = []
     arrays = data_arrays(result) if {"npz", "mat"} & set(formats) else {}
+    attributes = provenance.attributes() if provenance is not None else None
     if "npz" in formats:
-        files.append(write_npz(out / "result.npz", arrays))
+        files.append(write_npz(out / "result.npz", arrays, attributes))
     if "mat" in formats:
-        files.append(write_mat(out / "result.mat", arrays))
+        files.append(write_mat(out / "result.mat", arrays, attributes))
     if "csv" in formats:
         files.append(_timeseries_csv(result, out / "timeseries.csv"))
         if result.spectra:
@@ -148,8 +151,9 @@ def submit_figures(result: SceneResult, out: str | Path, pool, which: str = "all
 
 
 def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None = None, pool=None,
-                  drawing: list | None = None) -> list[Path]:
-    """Write figures, data files and ``summary.txt`` into ``out``; returns the paths written.
+                  drawing: list | None = None, provenance: Provenance | None = None) -> list[Path]:
+    """Write figures, data files and ``summary.txt`` into ``out`` (with ``provenance``, ``scene.toml`` too); returns
+    the paths written.
 
     An incomplete result (a diverged transient, ``result.incomplete``) gets its data files and
     the summary, which says why it stops; no figures or spectra (the record is not settled).
@@ -166,6 +170,9 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
         Draws the figures while the data files are written (default: one after the other, here).
     drawing : list of Drawing, optional
         The record's figures, submitted already (:func:`submit_figures` with "record"): only the others are.
+    provenance : rotorred.provenance.Provenance, optional
+        What made the result (the command line's): its resolved scene written as ``scene.toml``, its header lines on
+        top of ``summary.txt``, its attributes in ``result.npz`` and ``result.mat``.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -174,10 +181,13 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
         figures = submit_figures(result, out, pool)
     else:
         figures = list(drawing) + submit_figures(result, out, pool, "analysis")
-    data = write_data(result, out)
+    data = write_data(result, out, provenance)
     files = [f.result() for f in figures] + data
+    if provenance is not None:
+        files.append(write_text(out / provenance.file_name, provenance.file_text()))
     summary = out / "summary.txt"
     files.append(summary)
     named = [Path(shown) / f.name for f in files] if shown is not None else files
-    write_text(summary, format_summary(result, named) + "\n")
+    header = provenance.header_lines() if provenance is not None else ()
+    write_text(summary, format_summary(result, named, header) + "\n")
     return named

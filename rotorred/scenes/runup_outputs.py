@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.progress import stage
+from rotorred.provenance import Provenance
 from rotorred.scenes.runup import RUB_GAP_REVS, RunupResult
 from rotorred.writers import render_table, write_csv, write_mat, write_npz, write_text
 
@@ -80,8 +81,11 @@ def _criticals_csv(result: RunupResult, path: Path) -> Path:
                                     [c.frequency * HZ for c in cs], [c.log_dec for c in cs]])
 
 
-def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path | None = None) -> list[Path]:
-    """Write figures, data and ``summary.txt`` into ``out``; returns the paths (named in ``shown``)."""
+def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path | None = None,
+                        provenance: Provenance | None = None) -> list[Path]:
+    """Write figures, data and ``summary.txt`` into ``out``; returns the paths (named in ``shown``). A
+    ``provenance`` (:class:`rotorred.provenance.Provenance`) is written as ``scene.toml``, on top of the summary and
+    as attributes of the NPZ and .mat."""
     from rotorred.plots.runup import plot_runup  # matplotlib only when figures are written
 
     out = Path(out)
@@ -90,10 +94,11 @@ def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path 
     formats = result.scene.output.formats
     files = plot_runup(result, out) if result.scene.output.plots else []
     arrays = runup_arrays(result)
+    attributes = provenance.attributes() if provenance is not None else None
     if "npz" in formats:
-        files.append(write_npz(out / "result.npz", arrays))
+        files.append(write_npz(out / "result.npz", arrays, attributes))
     if "mat" in formats:
-        files.append(write_mat(out / "result.mat", arrays))
+        files.append(write_mat(out / "result.mat", arrays, attributes))
     if "csv" in formats:
         keys = list(arrays)
         files.append(write_csv(out / "timeseries.csv", keys, [arrays[k] for k in keys]))
@@ -103,19 +108,23 @@ def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path 
             files.append(_tracks_csv(result, out / "order_tracks.csv"))
         files.append(_rubs_csv(result, out / "rub_intervals.csv"))
         files.append(_criticals_csv(result, out / "critical_speeds.csv"))
+    if provenance is not None:
+        files.append(write_text(out / provenance.file_name, provenance.file_text()))
     summary = out / "summary.txt"
     files.append(summary)
     named = [Path(shown) / f.name for f in files] if shown is not None else files
-    write_text(summary, format_runup_summary(result, named) + "\n")
+    header = provenance.header_lines() + [""] if provenance is not None else []
+    write_text(summary, format_runup_summary(result, named, header) + "\n")
     return named
 
 
-def format_runup_summary(result: RunupResult, files=()) -> str:
-    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files."""
+def format_runup_summary(result: RunupResult, files=(), header: list[str] = ()) -> str:
+    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files; ``header``
+    lines on top."""
     ref, sc = result.reference, result.scene
     c = result.counters
     speeds = " / ".join(f"{s} {w[0] * HZ:.1f} -> {w[-1] * HZ:.1f} Hz" for s, w in result.speeds.items())
-    lines = [f"scene {sc.name}: {sc.description}",
+    lines = [*header, f"scene {sc.name}: {sc.description}",
              f"run-up: {speeds} in {result.t[-1]:.3g} s; {result.model_label}",
              f"steps: {result.n_steps} of {sc.solver.dt:g} s, {c['us_per_step']:.2f} us/step, "
              f"{c['n_passes'] / max(result.n_steps, 1):.2f} passes/step, {c['n_factorizations']} step matrices "

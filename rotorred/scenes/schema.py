@@ -7,7 +7,7 @@ names the file, the key, the value and what is allowed. The format, with every k
 in ``docs/scenes.md``; in short::
 
     name = "paper-rub"
-    [rotor]                 # preset = "seed-rig" or file = "rig.toml"; optional Rayleigh override
+    [rotor]                 # preset = "seed-rig", file = "rig.toml" or the rotor inline; optional Rayleigh override
     preset = "seed-rig"
     rayleigh_alpha = 40.0   # 1/s
     rayleigh_beta = 1e-4    # s
@@ -47,7 +47,7 @@ from rotorred.checks import InputError, fail
 from rotorred.model.dofs import DIRECTIONS, parse_dof
 from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.rotor import Rotor
-from rotorred.model.rotor_file import load_rotor, presets, read_text_file, read_toml
+from rotorred.model.rotor_file import ROTOR_FILE_KEYS, presets, read_rotor, read_text_file, read_toml, rotor_from_dict
 from rotorred.model.speeds import SpeedProfile
 from rotorred.scenes.builtin import builtin_scenes
 from rotorred.transient.contact import RubPlate
@@ -260,6 +260,9 @@ class Scene:
         Where the scene came from (file, built-in name or "<string>").
     data : dict
         The parsed TOML tables (for :func:`apply_settings` and re-loading).
+    rotor_data : dict
+        The rotor's rotor-file document, as its preset, file or inline ``[rotor]`` tables hold it (without the
+        scene's Rayleigh override): the rotor of the resolved scene (:mod:`rotorred.scenes.resolved`).
     """
 
     name: str
@@ -274,6 +277,7 @@ class Scene:
     runup: RunupSpec | None = None
     source: str = "<string>"
     data: dict = field(default_factory=dict, repr=False, compare=False)
+    rotor_data: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def frequencies_hz(self) -> dict[str, float]:
@@ -467,21 +471,27 @@ def _node_of(rotor: Rotor):
 
 
 # --------------------------------------------------------------------------- build
-def _rotor(value, base: Path | None) -> tuple[Rotor, str]:
+def _rotor(value, base: Path | None, source: str) -> tuple[Rotor, str, dict]:
+    """``[rotor]``: a preset, a file or the rotor's own tables inline, with the Rayleigh override; returns the rotor,
+    where it came from and its rotor-file document (before the override)."""
     table = checks.table("rotor", value)
-    checks.keys("rotor", table, _ROTOR_KEYS)
-    if ("preset" in table) == ("file" in table):
-        fail("rotor", table, f"must hold exactly one of preset ({', '.join(presets())}) or file (a rotor TOML path)")
+    checks.keys("rotor", table, _ROTOR_KEYS | ROTOR_FILE_KEYS)
+    inline = {k: v for k, v in table.items() if k in ROTOR_FILE_KEYS}
+    if ("preset" in table) + ("file" in table) + bool(inline) != 1:
+        fail("rotor", table, f"must hold exactly one of preset ({', '.join(presets())}) or file (a rotor TOML path), "
+             "or the rotor itself (the tables of a rotor file: spool, disk, bearing, ...)")
     if "preset" in table:
         name = checks.choice("rotor.preset", table["preset"], presets())
-        rotor, source = load_rotor(name), name
-    else:
+        (rotor, document), rotor_source = read_rotor(name), name
+    elif "file" in table:
         path = Path(checks.string("rotor.file", table["file"], empty=False))
         if not path.is_absolute() and base is not None:
             path = base / path
         if not path.is_file():
             fail("rotor.file", table["file"], f"must be an existing rotor TOML file ({str(path)!r} is not)")
-        rotor, source = load_rotor(path), str(path)
+        (rotor, document), rotor_source = read_rotor(path), str(path)
+    else:
+        rotor, document, rotor_source = _inline_rotor(inline), inline, f"{source} [rotor]"
     alpha, beta = rotor.rayleigh
     if "rayleigh_alpha" in table:
         alpha = checks.non_negative("rotor.rayleigh_alpha", table["rayleigh_alpha"], "1/s")
@@ -489,7 +499,15 @@ def _rotor(value, base: Path | None) -> tuple[Rotor, str]:
         beta = checks.non_negative("rotor.rayleigh_beta", table["rayleigh_beta"], "s")
     if (alpha, beta) != tuple(rotor.rayleigh):
         rotor = dataclasses.replace(rotor, rayleigh=(alpha, beta))
-    return rotor, source
+    return rotor, rotor_source, copy.deepcopy(document)
+
+
+def _inline_rotor(tables: dict) -> Rotor:
+    """The rotor of ``[rotor]``'s own tables (a rotor file's keys), its errors named under ``rotor``."""
+    try:
+        return rotor_from_dict(tables)
+    except InputError as exc:
+        raise exc.within("rotor") from None
 
 
 def _speeds(value, rotor: Rotor) -> dict[str, float]:
@@ -755,7 +773,7 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     checks.keys("", data, _TOP_KEYS, required={"rotor"})
     name = checks.string("name", data.get("name", Path(source).stem if base is not None else source))
     description = checks.string("description", data.get("description", ""))
-    rotor, rotor_source = _rotor(data["rotor"], base)
+    rotor, rotor_source, rotor_data = _rotor(data["rotor"], base, source)
     speeds = _speeds(data.get("speeds"), rotor)
     unbalances = _unbalances(data.get("unbalance", []), rotor)
     plates = _plates(data.get("rub", []), rotor)
@@ -772,7 +790,7 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
              "the scene has no load")
     return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source, speeds=speeds,
                  unbalances=unbalances, plates=plates, solver=solver, output=output, runup=runup, source=source,
-                 data=data)
+                 data=data, rotor_data=rotor_data)
 
 
 def _check_balance(speeds: dict, plates, solver: SolverSpec) -> None:
