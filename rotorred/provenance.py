@@ -14,7 +14,6 @@ imports neither; the writers take its attributes as a plain mapping.
 from __future__ import annotations
 
 import shlex
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone

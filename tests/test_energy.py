@@ -48,7 +48,7 @@ def full_state_run(model, scene, t_end: float, dt: float) -> dict:
     record = record_buffers(plan, np.eye(2 * n), len(plates))  # rows on x = (q, v, a): q and v
     settings = kernel.Settings(t0=0.0, dt=dt, n_halvings=4, newton_tol=1e-10, max_newton=50, limit=1.0)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
-    status, _, _, _ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), kernel_plates(M, B, par, atol),
+    status, *_ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), kernel_plates(M, B, par, atol),
                               state, record, settings, diag, plan.n_steps, 100_000, False)
     assert status == kernel.RUNNING and diag.counters[kernel.C_SUBSTEPS] == 0  # main steps only
     return dict(M=M, K=K, D=D, B=B, forces=forces, plates=plates, t=record.t, q=record.y[:, :n], v=record.y[:, n:],

@@ -201,7 +201,7 @@ def test_one_compiled_step_is_the_newmark_step():
         settings = kernel.Settings(t0=0.0, dt=h, n_halvings=0, newton_tol=1e-10, max_newton=10, limit=1.0)
         diag = kernel.Diagnostics(np.zeros(kernel.N_COUNTERS, dtype=np.int64), np.zeros(4))
         plates = kernel_plates(system.M, contact_rows(system, []), np.zeros((0, kernel.N_PLATE_PAR)), np.zeros(0))
-        status, _, _, _ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), plates, state, record, settings,
+        status, *_ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), plates, state, record, settings,
                                   diag, 2, 1, False)
         assert status == kernel.RUNNING and diag.counters[kernel.C_STEPS] == 2
         Ainv, Hq, Hv, Ha = step_matrices(system.M, D, system.K, h, sch.gamma, sch.beta, sch.alpha)
