@@ -679,3 +679,116 @@ def test_cli_campbell_of_a_rotor_file_with_bearing_tables(tmp_path, capsys):
     assert [float(r[0]) for r in rows] == pytest.approx([9330.8, 10992.8], abs=0.06)  # printed to 0.1 rpm
     within = campbell(load_rotor(path), np.linspace(0.0, 20000 * math.pi / 30, 41), n_modes=6)
     assert within.beyond_tables == ()
+
+
+# --- the default number of tracked modes (issue 34 item 5) ------------------------------------------------------
+def _critical_speed_rows(tmp_path, capsys, name, argv):
+    """``rotorred campbell`` with ``argv``: (the rows of critical_speeds.csv, the printout)."""
+    from rotorred.cli import main
+
+    out = tmp_path / name
+    assert main(["campbell", *argv, "--out", str(out)]) == 0
+    return list(csv.reader((out / "critical_speeds.csv").open())), capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv", [
+    ["seed-rig", "--speeds", "0:12000:61"],
+    ["seed-rig", "--speeds", "0:12000:61", "--ratio", "1"],  # a backward mode drops below a forward one
+    ["seed-rig", "--speeds", "0:12000:31", "--ratio", "outer=1.5", "--harmonics", "0.5,1,2"],
+    ["nelson-mcvaugh", "--speeds", "0:40000:41", "--harmonics", "1,3"],
+])
+def test_default_lists_the_critical_speeds_of_thirty_modes(tmp_path, capsys, argv):
+    """The default number of modes lists the same critical speeds as ``--modes 30`` (every mode to several times
+    the highest excitation frequency): the same critical_speeds.csv, row by row (the same solves: measured
+    byte-identical; 1e-9 allowed for the Brent refinement's round-off). The former default of 6 modes dropped some in each case (measured:
+    12 of 16, 6 of 8, 34 of 54, 8 of 9). The printout says how many modes and why."""
+    default, printed = _critical_speed_rows(tmp_path, capsys, "default", argv)
+    thirty, _ = _critical_speed_rows(tmp_path, capsys, "thirty", [*argv, "--modes", "30"])
+    n = int(re.search(r"^tracked (\d+) modes: every mode below 1\.25 × ", printed, re.M).group(1))
+    assert n < 30 and len(default) == len(thirty) > 1
+    assert default[0] == thirty[0]
+    for a, b in zip(default[1:], thirty[1:]):
+        assert a[1:2] + a[3:4] + a[5:6] == b[1:2] + b[3:4] + b[5:6]  # excitation, mode, whirl
+        np.testing.assert_allclose([float(v) for v in a[:1] + a[2:3] + a[4:5] + a[6:8]],
+                                   [float(v) for v in b[:1] + b[2:3] + b[4:5] + b[6:8]], rtol=1e-9)
+    six, _ = _critical_speed_rows(tmp_path, capsys, "six", [*argv, "--modes", "6"])
+    assert len(six) < len(default)
+
+
+def _coverage_cases():
+    rig = load_rotor("seed-rig")
+    rpm = math.pi / 30
+    return [(rig, np.linspace(0.0, 12000 * rpm, 61), {}),
+            (rig, np.linspace(0.0, 12000 * rpm, 61), dict(ratio=1.0)),
+            (rig, np.linspace(3000 * rpm, 9000 * rpm, 25), dict(harmonics=(1, 2), reference="outer")),
+            (load_rotor("nelson-mcvaugh"), np.linspace(0.0, 40000 * rpm, 41), dict(harmonics=(0.5, 1)))]
+
+
+@pytest.mark.parametrize("case", range(4))
+def test_default_tracks_every_mode_below_the_highest_excitation_frequency(case):
+    """The rule, against an independent full eigen-solve (modal.eigen, every mode) at each grid speed: every whirl
+    frequency below the highest excitation frequency h_max x max_s(r_s) x top speed is one of the tracked
+    frequencies there (to 1e-9); the count is the most modes below 1.25 x that frequency at the first and last
+    speed (at least 6), or more where that count left one out (the rig at ratio 1: its 254 Hz backward mode drops
+    below the 206 Hz forward one, so 8 counted modes miss the critical speed at 9588 rpm that the default finds)."""
+    from rotorred.linear.campbell import DEFAULT_MARGIN, MIN_DEFAULT_MODES, default_mode_count, speed_ratios
+    from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO
+
+    rotor, speeds, kw = _coverage_cases()[case]
+    result = campbell(rotor, speeds, **kw)
+    ratios = speed_ratios(rotor, kw.get("ratio"), kw.get("reference"))
+    limit = max(kw.get("harmonics", (1,))) * max(ratios.values()) * speeds[-1]
+    mc = result.mode_count
+    assert mc.limit == pytest.approx(limit, rel=1e-14) and mc.margin == DEFAULT_MARGIN
+    sm = assemble(rotor)
+    below_ends = []
+    for i, W in enumerate(speeds):
+        D = sm.damping({s: r * W for s, r in ratios.items()})
+        K = sm.stiffness({s: r * W for s, r in ratios.items()})
+        f = eigen(sm.M, D, K, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
+        for w in f[f < limit]:
+            assert np.min(np.abs(result.frequencies[i] / w - 1)) < 1e-9, (i, w)
+        if i in (0, len(speeds) - 1):
+            below_ends.append(int(np.sum(f < DEFAULT_MARGIN * limit)))
+    counted = max(MIN_DEFAULT_MODES, *below_ends)
+    assert mc.below == tuple(below_ends)
+    assert default_mode_count(rotor, speeds, **kw) == dataclasses.replace(mc, n_modes=counted, grown_at=None)
+    if mc.grown_at is None:
+        assert result.n_modes == counted
+    else:
+        assert result.n_modes > counted
+        fewer = campbell(rotor, speeds, n_modes=counted, **kw)
+        assert {c.speed for c in fewer.critical_speeds} < {c.speed for c in result.critical_speeds}
+    assert (mc.grown_at is not None) == (kw == dict(ratio=1.0))
+
+
+def test_modes_option_overrides_the_default(tmp_path, capsys):
+    """``--modes N`` (``n_modes=N``) tracks N modes, whatever the rule gives (more or fewer), and says so."""
+    from rotorred.cli import main
+
+    rig = load_rotor("seed-rig")
+    speeds = np.linspace(0.0, 12000 * math.pi / 30, 13)
+    default = campbell(rig, speeds)
+    for n in (3, default.n_modes + 2):
+        given = campbell(rig, speeds, n_modes=n)
+        assert given.n_modes == n and given.mode_count is None
+    assert main(["campbell", "seed-rig", "--speeds", "0:12000:13", "--modes", "3", "--out", str(tmp_path)]) == 0
+    assert "tracked 3 modes (--modes)" in capsys.readouterr().out
+    rows = list(csv.reader((tmp_path / "campbell.csv").open()))[1:]
+    assert {int(r[1]) for r in rows} == {0, 1, 2}
+
+
+def test_default_mode_count_at_rest_and_bad_margin():
+    """No spool turning at the top speed (one speed, at rest) gives no excitation line: the default's minimum of
+    6 modes; a margin below 1 would leave out modes the lines cross."""
+    from rotorred.cli.campbell import format_mode_count
+    from rotorred.linear.campbell import default_mode_count
+
+    rig = load_rotor("seed-rig")
+    rest = campbell(rig, [0.0])
+    assert rest.n_modes == 6 and rest.mode_count.limit == 0.0 and rest.mode_count.below == (0,)
+    assert format_mode_count(rest).startswith("tracked 6 modes: the default's minimum (6), as no spool turns at 0 rpm")
+    with pytest.raises(InputError, match=r"^margin = 0\.5: must be >= 1$"):
+        default_mode_count(rig, [0.0, 100.0], margin=0.5)
+    wide = default_mode_count(rig, [0.0, 600.0], margin=2.0)
+    assert wide.n_modes > default_mode_count(rig, [0.0, 600.0]).n_modes

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from rotorred import checks
+from rotorred.cli.feedback import report
 from rotorred.cli.options import grid, number_list, out_dir, provenance, ratio_number, spool_ratios, stage_summary
 from rotorred.writers import OutputFolder
 
@@ -53,7 +54,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         "one number R: speed of the second spool / speed of the first (Omega_H/Omega_L for the seed "
                         "rig); default: the ratios of the nominal speeds")
     p.add_argument("--reference", default=None, metavar="SPOOL", help="spool on the x-axis (default: the first)")
-    p.add_argument("--modes", type=int, default=6, metavar="N", help="number of tracked modes (default 6)")
+    p.add_argument("--modes", type=int, default=None, metavar="N",
+                   help="number of tracked modes (default: every mode below 1.25 x the highest excitation frequency, "
+                        "the top speed x the highest harmonic on the fastest spool, at least 6; the printout says "
+                        "how many and why)")
     p.add_argument("--harmonics", default="1", metavar="H1,H2",
                    help="multiples of each spool's speed used as excitation lines (default 1)")
     p.add_argument("--reduce", type=int, default=None, metavar="MODES",
@@ -73,7 +77,8 @@ def run(args) -> int:
     out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
     harmonics = parse_harmonics(args.harmonics)
-    checks.integer("--modes", args.modes, ge=1)
+    if args.modes is not None:
+        checks.integer("--modes", args.modes, ge=1)
     ratio = parse_ratio(args.ratio)
     if args.reduce is not None:
         checks.integer("--reduce", args.reduce, ge=0)
@@ -85,20 +90,49 @@ def run(args) -> int:
     with OutputFolder(out) as folder:
         kw = dict(ratio=ratio, reference=args.reference, n_modes=args.modes, harmonics=harmonics)
         result = campbell(rotor, speeds, **kw, model=_reduced(rotor, args.reduce))
-        comparison = None if args.reduce is None else format_reduction_error(result, campbell(rotor, speeds, **kw))
+        # the full model tracks as many modes as the reduced one, whose frequencies it is compared with
+        comparison = None if args.reduce is None else format_reduction_error(
+            result, campbell(rotor, speeds, **{**kw, "n_modes": result.n_modes}))
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
             operating = ref_nominal if ref_nominal > 0 else None
             files.append(plot_campbell(result, folder.staged("campbell.png"), operating_speed=operating))
             files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
-        report = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result)]
-                           + ([comparison] if comparison else []))
-        files += stage_summary(folder, "campbell.txt", report, record)
+        text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
+                          format_mode_count(result)] + ([comparison] if comparison else []))
+        files += stage_summary(folder, "campbell.txt", text, record)
         folder.commit()
-    print(report)
-    print("wrote " + " and ".join(str(out / f.name) for f in files))
+    report(text)
+    report("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
+
+
+def format_mode_count(result) -> str:
+    """How many modes were tracked and why: ``--modes``, or the default rule (:func:`rotorred.linear.campbell.default_mode_count`)."""
+    from rotorred.linear.campbell import MIN_DEFAULT_MODES
+
+    mc = result.mode_count
+    if mc is None:
+        return f"tracked {result.n_modes} modes (--modes)"
+    rpm = 30.0 / math.pi
+    if mc.limit <= 0:
+        return (f"tracked {result.n_modes} modes: the default's minimum ({MIN_DEFAULT_MODES}), as no spool turns at "
+                f"{mc.top_speed * rpm:.6g} rpm (no excitation line). --modes N sets the number")
+    ratio = result.speed_ratios[mc.spool]
+    line = (f"{mc.harmonic:g}× {mc.spool} at {mc.top_speed * rpm:.6g} rpm of {result.reference}"
+            + (f", {mc.spool} at {ratio * mc.top_speed * rpm:.6g} rpm" if mc.spool != result.reference else ""))
+    at = " and ".join(f"{w * rpm:.6g} rpm ({n})" for n, w in zip(mc.below, mc.speeds))
+    text = (f"tracked {result.n_modes} modes: every mode below {mc.margin:g} × {mc.limit_hz:.4g} Hz, the highest "
+            f"excitation frequency ({line}); modes below that at {at}")
+    if mc.grown_at is not None:
+        text += (f"; more, as a mode below {mc.limit_hz:.4g} Hz at {mc.grown_at * rpm:.6g} rpm was not among the "
+                 "lowest at the first speed")
+    elif result.n_modes > max(mc.below):
+        text += f"; at least {MIN_DEFAULT_MODES}"
+    elif result.n_modes < max(mc.below):
+        text += "; all the oscillating modes"
+    return text + ". --modes N sets the number"
 
 
 def _reduced(rotor, modes: int | None):

@@ -16,6 +16,11 @@ tracked mode's log decrement changes sign (it becomes unstable, or stable again)
 way, on Re(lambda) = 0 (:class:`StabilityChange`). Rigid-body modes of a free or singly supported
 spool (:func:`rigid_body_share`) give neither.
 
+By default (``n_modes=None``) the tracked modes are every mode below ``DEFAULT_MARGIN`` times the highest
+excitation frequency of the sweep (the largest ``h r_s Omega`` at the top speed), counted from the eigenvalues at
+the first and the last speed, at least ``MIN_DEFAULT_MODES`` (:func:`default_mode_count`); the tracked curves are
+then checked at every grid speed to leave no untracked mode below that frequency, and more are tracked if one does.
+
 Whirl direction (spin about +z): at a node with complex amplitudes X, Y of x and y,
 ``x + i y = (X + iY)/2 e^{i w t} + conj(X - iY)/2 e^{-i w t}``, so the forward (counter-clockwise,
 with the spin) amplitude is |X + iY| and the backward one |X - iY|. A mode is forward (backward) if
@@ -25,7 +30,8 @@ rotated into the forward/backward pair that the gyroscopic split selects as Omeg
 
 Cost: one dense eigen-solve of the 2n state matrix per grid speed (modes for the MAC); crossings are
 refined by Newton iterations on the quadratic eigenproblem (one (n+1)^2 complex solve each), with
-the full eigen-solve as fallback.
+the full eigen-solve as fallback. The default number of modes costs two more eigen-solves (the first and
+last speed), and the tracking of the extra modes (their MAC and critical speeds).
 
 References
 ----------
@@ -65,6 +71,14 @@ _DEGENERATE_RTOL = 1e-7
 #: weight of the frequency jump (relative) added to -MAC in the tracking cost, only to break ties
 #: between candidates of equal MAC (e.g. inside a multiple eigenvalue).
 _FREQ_TIEBREAK = 1e-3
+#: the default number of tracked modes covers every mode below this multiple of the highest excitation
+#: frequency at the top speed (docs/model.md §16): a curve just above that frequency at the first and the last
+#: speed, where the modes are counted, may dip below it between them (gyroscopics, speed-dependent bearings),
+#: and the diagram also shows the modes whose critical speeds lie up to ~25 % beyond the top speed
+DEFAULT_MARGIN = 1.25
+#: the default tracks at least this many modes (the former fixed default): a diagram over a low speed range,
+#: or the whirl table at one speed (at rest: no excitation at all), still shows the lowest modes
+MIN_DEFAULT_MODES = 6
 
 
 class _PointOnTheDiagram:
@@ -160,6 +174,53 @@ class StabilityChange(_PointOnTheDiagram):
 
 
 @dataclass(frozen=True)
+class ModeCount:
+    """How many modes :func:`campbell` tracks by default, and why (:func:`default_mode_count`).
+
+    Attributes
+    ----------
+    n_modes : int
+        Modes to track: the most of ``below`` (at least ``MIN_DEFAULT_MODES``), at most the number of
+        oscillating modes at the first and the last speed.
+    limit : float
+        Highest excitation frequency of the sweep, ``harmonic`` x the speed of ``spool`` at the top speed
+        (rad/s); 0 if no spool turns there.
+    margin : float
+        The count covers every mode below ``margin`` x ``limit`` (-).
+    spool : str
+        Spool whose excitation line is the highest ("" if none turns).
+    harmonic : float
+        Highest excitation order (multiple of the spool speed).
+    top_speed : float
+        Top speed of the reference spool (rad/s).
+    speeds : tuple of float
+        Reference speeds where the modes were counted: the first and the last (one if the sweep has one
+        speed) (rad/s).
+    below : tuple of int
+        Number of modes below ``margin`` x ``limit`` at each of ``speeds``.
+    grown_at : float or None
+        Set by :func:`campbell` if a mode below ``limit`` was left untracked at this reference speed (rad/s)
+        with the counted modes (their order changed along the sweep), so more were tracked; ``n_modes``
+        is then the number finally tracked.
+    """
+
+    n_modes: int
+    limit: float
+    margin: float
+    spool: str
+    harmonic: float
+    top_speed: float
+    speeds: tuple[float, ...]
+    below: tuple[int, ...]
+    grown_at: float | None = None
+
+    @property
+    def limit_hz(self) -> float:
+        """Highest excitation frequency (Hz)."""
+        return self.limit / (2.0 * math.pi)
+
+
+@dataclass(frozen=True)
 class CampbellResult:
     """Whirl frequencies of tracked modes against the speed of a reference spool.
 
@@ -196,6 +257,8 @@ class CampbellResult:
     beyond_tables : tuple of (int, float, float, str)
         Speed-dependent bearings (:class:`rotorred.model.elements.BearingTable`) whose table the sweep leaves:
         (node, the table's lowest and highest speed (rad/s), its ``extrapolate``: "hold" or "linear").
+    mode_count : ModeCount or None
+        Why ``n_modes`` modes were tracked, when chosen by default (``n_modes=None``); None when given.
     """
 
     speeds: np.ndarray
@@ -211,6 +274,7 @@ class CampbellResult:
     rigid_modes: tuple[int, ...] = ()
     stability_changes: tuple[StabilityChange, ...] = ()
     beyond_tables: tuple[tuple[int, float, float, str], ...] = ()
+    mode_count: ModeCount | None = None
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -496,7 +560,7 @@ def _assign(prev_modes, prev_freq, lam, modes):
 
 def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
              reference: str | None = None,
-             n_modes: int = 6, harmonics: Sequence[float] = (1,), model=None) -> CampbellResult:
+             n_modes: int | None = None, harmonics: Sequence[float] = (1,), model=None) -> CampbellResult:
     """Campbell diagram of ``rotor`` with critical speeds.
 
     Parameters
@@ -512,8 +576,11 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
         of the nominal spool speeds (:func:`speed_ratios`).
     reference : str, optional
         Spool whose speed is the x-axis (default the first spool).
-    n_modes : int
-        Number of modes tracked: the lowest ``n_modes`` at ``speeds[0]``.
+    n_modes : int, optional
+        Number of modes tracked: the lowest ``n_modes`` at ``speeds[0]``. Default: every mode below
+        ``DEFAULT_MARGIN`` x the highest excitation frequency at the top speed (:func:`default_mode_count`),
+        and more if, at a grid speed, a mode below that frequency (without the margin) is not among them;
+        the result's ``mode_count`` says how many and why.
     harmonics : sequence of float
         Excitation lines h x Omega_s for each h and each spinning spool s (default 1x).
     model : ReducedSystem, optional
@@ -524,37 +591,31 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
     -------
     CampbellResult
     """
-    Omega = checks.vector("speeds", speeds, "rad/s", min_len=1, ge=0.0, increasing=True)
-    n_modes = checks.integer("n_modes", n_modes, ge=1)
-    h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
-    ratios = speed_ratios(rotor, ratio, reference)
-    reference = reference or rotor.spools[0].name
-    sm = assemble(rotor) if model is None else _checked_model(model, rotor)
+    Omega, h, ratios, reference, sm = _setup(rotor, speeds, ratio, reference, harmonics, model)
     n_available = sm.n_dof  # at most one frequency per DOF
-    if n_modes > n_available:
-        checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
+    count = None
+    if n_modes is None:
+        count = _mode_count(sm, ratios, Omega, h, DEFAULT_MARGIN)
+        n_modes = count.n_modes
+    else:
+        n_modes = checks.integer("n_modes", n_modes, ge=1)
+        if n_modes > n_available:
+            checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
     solver = _Solver(sm, ratios, min(n_available, 2 * n_modes + 4))
+    solved = {}  # eigen-solves of the grid speeds, kept for a second tracking with more modes
+    while True:
+        cover = None if count is None else (count.limit, count.margin * count.limit)
+        lam_all, shapes, tracking, missed = _track(solver, Omega, n_modes, cover, solved)
+        if missed is None or n_modes >= n_available:
+            break
+        i, needed = missed  # a mode below the limit left out (the modes' order changed): track more
+        n_modes = min(n_available, max(n_modes + 1, needed))
+        count = replace(count, n_modes=n_modes, grown_at=float(Omega[i]))
+        if n_modes + 4 > solver.n_candidates < n_available:  # too few candidates kept: solve again
+            solver.n_candidates = min(n_available, 2 * n_modes + 4)
+            solved.clear()
 
     n_s = len(Omega)
-    lam_all = np.empty((n_s, n_modes), complex)
-    shapes = []
-    tracking = np.ones((n_s - 1, n_modes))
-    lam, modes = solver.solve(Omega[0])
-    if len(lam) < n_modes:
-        checks.fail("n_modes", n_modes, f"must be <= {len(lam)}, the number of oscillating modes at "
-                    f"{Omega[0]:g} rad/s")
-    lam_all[0], cur = lam[:n_modes], modes[:, :n_modes]
-    shapes.append(cur)
-    for i in range(1, n_s):
-        lam, modes = solver.solve(Omega[i])
-        if len(lam) < n_modes:
-            checks.fail("n_modes", n_modes, f"must be <= {len(lam)}, the number of oscillating modes at "
-                        f"{Omega[i]:g} rad/s")
-        cols, m = _assign(cur, lam_all[i - 1].imag, lam, modes)
-        lam_all[i], cur = lam[cols], modes[:, cols]
-        tracking[i - 1] = m
-        shapes.append(cur)
-
     freq = lam_all.imag
     log_dec = -2.0 * np.pi * lam_all.real / freq
     whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
@@ -580,7 +641,101 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
                           critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
                           harmonics=h, rotor_name=rotor.name,
                           rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])),
-                          stability_changes=changes, beyond_tables=_beyond_tables(sm, ratios, Omega))
+                          stability_changes=changes, beyond_tables=_beyond_tables(sm, ratios, Omega),
+                          mode_count=count)
+
+
+def default_mode_count(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
+                       reference: str | None = None, harmonics: Sequence[float] = (1,), model=None,
+                       margin: float = DEFAULT_MARGIN) -> ModeCount:
+    """How many modes :func:`campbell` tracks by default: every mode below ``margin`` x the highest excitation
+    frequency of the sweep.
+
+    The highest excitation frequency is the largest h r_s Omega_top over the harmonics h and the turning spools
+    s at the top speed Omega_top. A whirl frequency moves with speed (gyroscopic stiffening of forward whirl and
+    softening of backward whirl, speed-dependent bearings), so the modes below ``margin`` x that frequency are
+    counted from the eigenvalues at the first and at the last speed, and the larger count is kept (at least
+    ``MIN_DEFAULT_MODES``, at most the number of oscillating modes at those speeds). :func:`campbell` then checks
+    at every grid speed that no untracked mode lies below the highest excitation frequency, and tracks more if one
+    does (:attr:`ModeCount.grown_at`); this function solves the two speeds only.
+
+    Parameters
+    ----------
+    rotor, speeds, ratio, reference, harmonics, model
+        As for :func:`campbell` (speeds in rad/s).
+    margin : float
+        Multiple of the highest excitation frequency below which every mode is counted (>= 1, -);
+        default ``DEFAULT_MARGIN``.
+
+    Returns
+    -------
+    ModeCount
+    """
+    Omega, h, ratios, _, sm = _setup(rotor, speeds, ratio, reference, harmonics, model)
+    return _mode_count(sm, ratios, Omega, h, checks.number("margin", margin, ge=1.0))
+
+
+def _setup(rotor: Rotor, speeds, ratio, reference, harmonics, model):
+    """The checked speeds (rad/s), harmonics (sorted, distinct), speed ratios, reference spool and model."""
+    Omega = checks.vector("speeds", speeds, "rad/s", min_len=1, ge=0.0, increasing=True)
+    h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
+    ratios = speed_ratios(rotor, ratio, reference)
+    reference = reference or rotor.spools[0].name
+    sm = assemble(rotor) if model is None else _checked_model(model, rotor)
+    return Omega, h, ratios, reference, sm
+
+
+def _mode_count(sm, ratios: Mapping[str, float], Omega: np.ndarray, h: tuple[float, ...], margin: float) -> ModeCount:
+    """:func:`default_mode_count` of the model ``sm`` (one full eigen-solve at the first and at the last speed)."""
+    spool, r = max(((s, r) for s, r in ratios.items() if r > 0), key=lambda sr: sr[1], default=("", 0.0))
+    top = float(Omega[-1])
+    limit = max(h) * r * top
+    solver = _Solver(sm, ratios, sm.n_dof)
+    ends = tuple(sorted({float(Omega[0]), top}))
+    below, available = [], []
+    for W in ends:
+        lam = eigen(solver.M, *solver.matrices(W), max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues
+        below.append(int(np.sum(lam.imag < margin * limit)))
+        available.append(len(lam))
+    n = max(1, min(max(MIN_DEFAULT_MODES, *below), *available))
+    return ModeCount(n_modes=n, limit=limit, margin=margin, spool=spool, harmonic=max(h), top_speed=top,
+                     speeds=ends, below=tuple(below))
+
+
+def _track(solver: _Solver, Omega: np.ndarray, n_modes: int, cover: tuple[float, float] | None, solved: dict):
+    """The lowest ``n_modes`` modes at ``Omega[0]`` followed by MAC (:func:`_assign`) along ``Omega``; ``solved``
+    holds the eigen-solve of each grid speed (index: (eigenvalues, modes)) and is filled where it has none.
+
+    Returns (eigenvalues (n_s, n_modes), shapes per speed, tracking MAC (n_s - 1, n_modes), missed). With
+    ``cover`` = (limit, covered) (rad/s), ``missed`` is (first speed index where an untracked mode lies below
+    ``limit``, the most modes below ``covered`` at a speed), or None if every mode below ``limit`` is tracked.
+    """
+    n_s = len(Omega)
+    lam_all = np.empty((n_s, n_modes), complex)
+    shapes = []
+    tracking = np.ones((n_s - 1, n_modes))
+    first, needed = None, 0
+    cur = None
+    for i in range(n_s):
+        if i not in solved:
+            solved[i] = solver.solve(Omega[i])
+        lam, modes = solved[i]
+        if len(lam) < n_modes:
+            checks.fail("n_modes", n_modes, f"must be <= {len(lam)}, the number of oscillating modes at "
+                        f"{Omega[i]:g} rad/s")
+        if i == 0:
+            cols = np.arange(n_modes)
+        else:
+            cols, tracking[i - 1] = _assign(cur, lam_all[i - 1].imag, lam, modes)
+        lam_all[i], cur = lam[cols], modes[:, cols]
+        shapes.append(cur)
+        if cover is not None:
+            untracked = np.ones(len(lam), bool)
+            untracked[cols] = False
+            if first is None and np.any(lam.imag[untracked] < cover[0]):
+                first = i
+            needed = max(needed, int(np.sum(lam.imag < cover[1])))
+    return lam_all, shapes, tracking, None if first is None else (first, needed)
 
 
 def _beyond_tables(sm, ratios: Mapping[str, float], Omega: np.ndarray) -> tuple[tuple[int, float, float, str], ...]:
