@@ -242,7 +242,7 @@ def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
     assert np.isfinite(mu[:known]).all() and np.isnan(mu[known:]).all()
     assert stable[:known] == [str(int(m < 1)) for m in mu[:known]] and {"0", "1"} <= set(stable[:known])
     assert set(stable[known:]) == {"unknown"}
-    assert np.allclose(ds["rub.clearance"].values, values, rtol=1e-8) and ds.attrs["interrupted"] == "SIGINT"
+    assert np.allclose(ds["rub_clearance"].values, values, rtol=1e-8) and ds.attrs["interrupted"] == "SIGINT"
     assert list(ds["stable"].values) == [int(s) if s != "unknown" else -1 for s in stable]
     assert ds["stable"].attrs["flag_meanings"] == "stable unstable unknown"
     assert np.isnan(ds["critical_multiplier_re"].values[known:]).all()

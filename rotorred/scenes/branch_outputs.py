@@ -103,7 +103,15 @@ def write_branch(branch, folder, scene_name: str, provenance: Provenance | None 
                 xlabel=f"{branch.key} ({xu})", ylabel=f"peak |{dof}| (µm)", changes=branch.bifurcations, xscale=xs,
                 title=f"{scene_name}: harmonic-balance branch"
                       + (f" (INCOMPLETE: interrupted by {branch.interrupt})" if branch.interrupted else ""))
-    top = "".join(f"{line}\n" for line in provenance.header_lines()) + "\n" if provenance is not None else ""
-    write_text(folder.staged("branch.txt"), top + format_branch(branch) + "\n")
+    write_text(folder.staged("branch.txt"), _with_header(format_branch(branch), provenance) + "\n")
     if provenance is not None:
         write_text(folder.staged(provenance.file_name), provenance.file_text())
+
+
+def _with_header(text: str, provenance: Provenance | None) -> str:
+    """``text`` under the provenance's header lines; an "INCOMPLETE: " line stays the first, as in every summary."""
+    if provenance is None:
+        return text
+    first, _, rest = text.partition("\n") if text.startswith("INCOMPLETE: ") else ("", "", text)
+    header = "\n".join(provenance.header_lines()) + "\n\n"
+    return (first + "\n" if first else "") + header + rest
