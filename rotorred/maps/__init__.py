@@ -1,1 +1,1 @@
-"""Maps of the operating envelope: a scene over a grid of keys, with continuation, on Dask (issue 12)."""
+"""Maps of the operating envelope: a scene over a grid of keys, with continuation, on Dask."""

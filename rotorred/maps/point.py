@@ -47,7 +47,7 @@ from rotorred.transient.results import FinalState
 
 __all__ = ["N_LINES", "N_SAMPLES", "StartState", "PointResult", "run_point"]
 
-N_LINES = 60  #: lines kept per point, the strongest (issue 19: 60 lines explain >= 90 % off 70/90 Hz)
+N_LINES = 60  #: lines kept per point, the strongest (60 lines explain >= 90 % off 70/90 Hz)
 N_SAMPLES = 400  #: Poincare samples kept per point, the last ones
 
 

@@ -1,5 +1,5 @@
 """Branches of a rub scene's periodic response: harmonic balance with pseudo-arclength continuation in a scene key,
-its folds, and the stability of each point (issue 20; docs/model.md §15).
+its folds, and the stability of each point (docs/model.md §15).
 
 Keys (:data:`KEYS`):
 

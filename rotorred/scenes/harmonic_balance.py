@@ -1,5 +1,5 @@
 """Harmonic balance of a rub scene: the periodic response of the (reduced) rotor with its rub plates at commensurate
-spool speeds (issue 20; docs/model.md §15).
+spool speeds (docs/model.md §15).
 
 The base frequency is ``f_0 = gcd(f_L, f_H)`` (10 Hz at the paper's 70/90 Hz): every spool's unbalance force is a
 harmonic ``k_s = f_s / f_0`` of it, and so is every combination line ``m f_H + n f_L``. The linear system is the

@@ -22,7 +22,7 @@ used (amplitude error below 0.0045 dB) and the spectrum's ``note`` says so. Line
 peaks above ``output.line_threshold`` of the largest, labelled by
 :func:`rotorred.signals.lines.label_lines` within half a bin.
 
-Line fit, settling and class (issue 19) of the table DOF (:func:`table_dof`): the lines
+Line fit, settling and class of the table DOF (:func:`table_dof`): the lines
 ``(m/k) f_H + (n/j) f_L`` are fitted by least squares (:func:`rotorred.signals.linefit.fit_lines`,
 torus found by the fit) on the same samples as the spectrum (the last whole common periods when
 the speeds are commensurate, where the fitted amplitudes equal the rectangular FFT's on-bin values;
@@ -85,7 +85,7 @@ class SceneModel:
 
 @dataclass(frozen=True)
 class LineAnalysis:
-    """Line fit, measured settling and class of one recorded DOF (issue 19).
+    """Line fit, measured settling and class of one recorded DOF.
 
     Attributes
     ----------

@@ -719,7 +719,7 @@ def _solver_times(table: dict, d: SolverSpec) -> tuple[float, float, float]:
         if not is_whole_steps(value, dt):
             fail(f"solver.{name}", value, f"must be a whole number of steps of solver.dt = {dt:g}; it is "
                  f"{value / dt:.6g} steps", "s")
-    # Any record length is accepted at any speeds (issue 19): the line fit needs no whole common
+    # Any record length is accepted at any speeds: the line fit needs no whole common
     # period, and the spectrum uses a window when the record holds none (signals.spectra.settled_spectrum).
     return dt, duration, record_start
 

@@ -1,5 +1,5 @@
 """Quasi-periodic harmonic balance of a rub scene: the response on a two-dimensional torus at incommensurate spool
-speeds (issue 20; docs/model.md §15).
+speeds (docs/model.md §15).
 
 The two base frequencies are the spools' or their sub-harmonics: near 88-95 Hz on the outer spool of ``paper-rub``
 the impacts lock to ``f_H / 3``, and the torus is ``(f_L, f_H / 3)``. They come from the torus the signal layer finds

@@ -30,7 +30,7 @@ Every rule works on the settled part of the record (from the settling time of
    ``1/g``, k > 1 is **period-k**, period ``k/g``. For speeds that are not commensurate the same
    holds along the one combination ``a f_H + b f_L`` (a, b coprime integers) the lines lie on.
    The 0.9 threshold: the tori that describe the rig's response off 70/90 Hz explain 91-97 %
-   of its energy (issue 19), the ones that do not describe it at most 84 %.
+   of its energy, the ones that do not describe it at most 84 %.
 4. **quasi-periodic**: the lines explain at least ``explained_min`` and span a two-dimensional
    lattice (two incommensurate base frequencies ``f_H/k``, ``f_L/j``), confirmed on the Poincare
    section: the samples taken once per period of ``f_H/k`` (every k revolutions of the outer

@@ -3,7 +3,7 @@
 A dual rotor driven by two spools at f_L and f_H (Hz) responds at combinations of them:
 ``m f_H + n f_L`` for the forced response (Xu et al. 2016, Table 1), and ``(m/k) f_H + (n/j) f_L``
 with sub-harmonic orders k, j > 1 when rub impacts lock to a fraction of a spool frequency
-(issue 19: near 88-95 Hz the plate is struck once per three outer revolutions, f_H/3).
+(near 88-95 Hz the plate is struck once per three outer revolutions, f_H/3).
 :func:`fit_lines` estimates the amplitude and phase of each such line by linear least squares on
 the time record itself, not on FFT bins: the frequencies are exact by construction (they come
 from the labels) and a line between bins loses nothing to scalloping. It finds the torus (k, j)
