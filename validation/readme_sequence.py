@@ -7,6 +7,8 @@ The steps, each printed with its exit status and wall time:
 3. ``rotorred run --out o2`` (the editable install, after the first install's run);
 4. ``pip install .`` again, then ``rotorred run --out o3``.
 
+With ``--reverse``: the test command first, then the first command, then ``rotorred run --out o2``.
+
 The commands are read from the README's "Two commands" section (its two ``bash`` blocks), not copied here, so
 this checks what a user reads. Every step runs even if an earlier one failed; the exit status is that of the first
 failed step (0 if all passed). ``.ci/run`` runs this script on its clean checkout.
@@ -39,9 +41,12 @@ def readme_commands(readme: Path = ROOT / "README.md") -> list[str]:
             for b in blocks]
 
 
-def steps() -> list[tuple[str, str]]:
-    """(name, shell text) of each step, in order."""
+def steps(reverse: bool = False) -> list[tuple[str, str]]:
+    """(name, shell text) of each step, in order (``reverse``: the test command first)."""
     first, tests = readme_commands()
+    if reverse:
+        return [("README's test command", tests), ("README's first command", first),
+                ("rotorred run --out o2", "rotorred run --out o2")]
     return [("README's first command", first), ("README's test command", tests),
             ("rotorred run --out o2", "rotorred run --out o2"),
             ("pip install . again, then rotorred run --out o3", "pip install . && rotorred run --out o3")]
@@ -62,7 +67,7 @@ def _quote(text: str) -> str:
 
 
 def main() -> int:
-    named = steps()
+    named = steps(reverse="--reverse" in sys.argv[1:])
     proc = subprocess.Popen(["bash", "-c", script(named)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             bufsize=1)
     results = {}
