@@ -17,7 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rotorred"
 
 #: the layers, bottom first; a module may import modules of its own layer package or of a lower layer
 LAYERS = {
-    "rotorred.checks": 0, "rotorred.writers": 0, "rotorred.progress": 0, "rotorred._version": 0,
+    "rotorred.checks": 0, "rotorred.writers": 0, "rotorred.progress": 0, "rotorred._version": -1,
     "rotorred.provenance": 0, "rotorred._generated": 0,
     "rotorred.model": 1,
     "rotorred.linear": 2, "rotorred.signals": 2,
