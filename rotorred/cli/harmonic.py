@@ -32,6 +32,7 @@ from rotorred import checks
 from rotorred.cli.feedback import report
 from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, spool_ratios,
                                   stage_summary)
+from rotorred.progress import stage
 from rotorred.writers import OutputFolder
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
@@ -246,6 +247,7 @@ def run(args) -> int:
     frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
     _check_model_options(args)
 
+    stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds")
     with OutputFolder(out) as folder:
         t0 = time.perf_counter()
         model, label, kind = _model(args, rotor, scene, speeds, ratios)

@@ -140,7 +140,7 @@ def _runup_and_write(scene, folder, out, record) -> int:
     from rotorred.scenes.runup_outputs import format_runup_summary, write_runup_outputs
 
     result = run_runup(scene, progress=None)
-    files = write_runup_outputs(result, folder.staging, shown=out, provenance=record)
+    write_runup_outputs(result, folder.staging, shown=out, provenance=record)
     committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:
