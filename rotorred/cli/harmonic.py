@@ -247,10 +247,10 @@ def run(args) -> int:
     frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
     _check_model_options(args)
 
-    stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds")
     with OutputFolder(out) as folder:
         t0 = time.perf_counter()
-        model, label, kind = _model(args, rotor, scene, speeds, ratios)
+        model, label, kind = _model(args, rotor, scene, speeds, ratios)  # checks the model's options against the rotor
+        stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds ({kind} model)")
         result = unbalance_response(model, unbalances, speeds, ratios=ratios, outputs=outputs,
                                     spool_of=rotor.spool_of, reference_spool=reference)
         elapsed = time.perf_counter() - t0
