@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import logging
 import sys
+from contextlib import contextmanager
 
-__all__ = ["LOG", "stage", "bar", "shown"]
+__all__ = ["LOG", "stage", "bar", "shown", "muted"]
 
 #: the package's logger: the parent of every module's logger
 LOG = logging.getLogger("rotorred")
@@ -69,6 +70,19 @@ def bar(total: float | None, desc: str, unit: str, *, progress: bool | None = No
         disable = not progress
     return tqdm(total=total, desc=desc, unit=unit, initial=initial, delay=delay, disable=disable, file=sys.stderr,
                 dynamic_ncols=True, leave=False, unit_scale=unit_scale, bar_format=bar_format)
+
+
+@contextmanager
+def muted():
+    """No stage lines or bars within the block, for work that is one step of a larger one with its own progress (a
+    map's point: its segments would say "stepping" again and again); with ``-v`` (DEBUG) they still show."""
+    level = LOG.level
+    if logging.DEBUG < LOG.getEffectiveLevel() < logging.WARNING:
+        LOG.setLevel(logging.WARNING)
+    try:
+        yield
+    finally:
+        LOG.setLevel(level)
 
 
 def _terminal() -> bool:

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "write_toml", "toml_text", "atomic_path",
-           "render_table", "OutputFolder", "CF_CONVENTIONS",
+           "render_table", "OutputFolder", "CF_CONVENTIONS", "read_netcdf", "LABELS_OF",
            "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
 
 
@@ -175,6 +175,11 @@ def write_netcdf(path: str | Path, dataset, attributes: Mapping[str, str] | None
     variable and coordinate ("1" for a dimensionless one), and variable and dimension names of letters, digits and
     underscores, starting with a letter (CF 2.3: no dots, so ``rub_clearance`` for the key ``rub.clearance``).
 
+    Two rules of CF are applied here, in the file only: a coordinate variable holds no ``_FillValue`` (CF 5; xarray
+    writes NaN by default), and a dimension labelled by strings (``direction``: up, down; ``dof``) has no coordinate
+    variable, which CF 1.2 wants numeric, but a string label variable ``<dim>_label`` (CF 6.1), marked with the
+    attribute :data:`LABELS_OF`. :func:`read_netcdf` gives the dataset back as it was written.
+
     Raises
     ------
     ValueError
@@ -182,10 +187,43 @@ def write_netcdf(path: str | Path, dataset, attributes: Mapping[str, str] | None
     """
     _check_cf(dataset)
     attrs = {**dataset.attrs, **dict(attributes or {}), "Conventions": CF_CONVENTIONS}
+    cf = _labels_apart(dataset).assign_attrs(attrs)
+    encoding = {name: {"_FillValue": None} for name in cf.coords}
     path = Path(path)
     with atomic_path(path, ".nc") as tmp:
-        dataset.assign_attrs(attrs).to_netcdf(tmp, engine="h5netcdf")
+        cf.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
     return path
+
+
+#: the attribute of a label variable ``<dim>_label`` that names the dimension it labels (:func:`write_netcdf`)
+LABELS_OF = "rotorred_labels"
+
+
+def _labels_apart(dataset):
+    """``dataset`` with each string dimension coordinate ``d`` renamed ``d_label`` (an auxiliary coordinate)."""
+    labels = {d: f"{d}_label" for d in dataset.dims if d in dataset.coords and dataset[d].dtype.kind in "OUS"}
+    out = dataset.drop_vars(list(labels))
+    for d, name in labels.items():
+        out = out.assign_coords({name: (d, dataset[d].values.astype(str), {**dataset[d].attrs, LABELS_OF: d})})
+    return out
+
+
+def read_netcdf(path: str | Path):
+    """A NetCDF file of :func:`write_netcdf`, loaded, with each label variable a dimension coordinate again.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    import xarray as xr
+
+    ds = xr.load_dataset(path, engine="h5netcdf")
+    for name, var in list(ds.coords.items()):
+        if LABELS_OF in var.attrs:
+            dim = var.attrs[LABELS_OF]
+            attrs = {k: v for k, v in var.attrs.items() if k != LABELS_OF}
+            ds = ds.drop_vars(name).assign_coords({dim: (dim, var.values.astype(object), attrs)})
+    return ds
 
 
 def _check_cf(dataset) -> None:

@@ -73,4 +73,10 @@ def _assert_netcdf(path: Path, expected: dict) -> None:
         assert not missing, (path, missing)
         bad = [n for n in [*ds.variables, *ds.dims] if not CF_NAME.fullmatch(str(n))]
         assert not bad, (path, bad)
+    import h5netcdf
+
+    with h5netcdf.File(path, "r") as f:  # the file as CF reads it, without xarray's decoding
+        coordinates = [v for n, v in f.variables.items() if v.dimensions == (n,)]
+        assert all(v.dtype.kind in "fiu" for v in coordinates), (path, [v.name for v in coordinates])  # CF 1.2
+        assert not [v.name for v in coordinates if "_FillValue" in v.attrs], path  # CF 5
         assert not any(TRACKER.search(str(v)) for v in ds.attrs.values()), path

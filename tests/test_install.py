@@ -45,7 +45,7 @@ except OSError:
     writable = False
 print(json.dumps({"ok": bool(res.success), "steps": res.n_steps, "contact": res.n_contact_steps,
                   "package_writable": writable, "home_writable": os.access(os.environ["HOME"], os.W_OK),
-                  "load": res.kernel_load_time, "run": res.run_time}))
+                  "load": res.kernel_load_time, "run": res.run_time, "compiled": res.kernel_compiled}))
 """
 
 SETPRIV = ["setpriv", "--bounding-set=-dac_override,-dac_read_search,-fowner", "--"]
@@ -96,6 +96,25 @@ def test_read_only_install_with_unwritable_home_runs(tmp_path):
     # the next run loads the cache: no compilation note, and loading takes a fraction of compiling
     assert again.returncode == 0 and "compiling" not in again.stderr, again.stderr
     assert json.loads(again.stdout.splitlines()[-1])["load"] < 0.2 * report["load"]
+    assert report["compiled"] and not json.loads(again.stdout.splitlines()[-1])["compiled"]
+
+
+def test_a_cache_entry_that_cannot_be_loaded_is_compiled_and_said_so(tmp_path):
+    """The kernel's cache index lists it but its code file is gone: numba compiles it again; the result and a stage
+    line say it was compiled (it was predicted from the index alone, and a 9 s compilation went unsaid)."""
+    env = _clean_env(NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    run = lambda: subprocess.run([sys.executable, "-c", TRANSIENT], capture_output=True, text=True, env=env,
+                                 timeout=300)
+    cold = run()
+    assert cold.returncode == 0 and json.loads(cold.stdout.splitlines()[-1])["compiled"], cold.stderr
+    code = list((tmp_path / "cache").rglob("*.nbc"))
+    assert code and list((tmp_path / "cache").rglob("*.nbi"))
+    for f in code:
+        f.unlink()
+    again = run()
+    assert again.returncode == 0 and json.loads(again.stdout.splitlines()[-1])["compiled"], again.stderr
+    assert COMPILING_NOTE not in again.stderr  # the index said cached ...
+    assert "compiled the step kernel: its cache entry could not be loaded" in again.stderr  # ... and it was not
 
 
 @pytest.fixture()

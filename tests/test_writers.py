@@ -73,3 +73,25 @@ def test_an_interrupt_while_the_npz_is_written_waits_for_it(tmp_path, monkeypatc
         thread.join()
     assert order == ["written", "signal"]
     assert not list(tmp_path.iterdir())  # interrupted before its commit: no file, no temporary left
+
+
+def test_netcdf_is_cf_in_the_file_and_reads_back_as_written(tmp_path):
+    """A string dimension coordinate is written as a label variable (CF 6.1; a coordinate variable is numeric,
+    CF 1.2), no coordinate variable has a _FillValue (CF 5), and read_netcdf gives the dataset back identical."""
+    import h5netcdf
+    import xarray as xr
+
+    from rotorred.writers import LABELS_OF, read_netcdf, write_netcdf
+
+    ds = xr.Dataset({"peak": (("direction", "rub_clearance"), np.array([[1.0, np.nan], [3.0, 4.0]]), {"units": "m"}),
+                     "status": ("direction", np.array(["ok", "diverged"], dtype=object), {"units": "1"})},
+                    coords={"direction": ("direction", np.array(["up", "down"], dtype=object), {"units": "1"}),
+                            "rub_clearance": ("rub_clearance", [1e-5, 2e-5], {"units": "m"})})
+    write_netcdf(tmp_path / "a.nc", ds)
+    with h5netcdf.File(tmp_path / "a.nc", "r") as f:
+        assert "direction" not in f.variables and f.variables["direction_label"].attrs[LABELS_OF] == "direction"
+        assert "_FillValue" not in f.variables["rub_clearance"].attrs
+        assert "_FillValue" in f.variables["peak"].attrs  # data keep xarray's NaN fill
+    back = read_netcdf(tmp_path / "a.nc")
+    assert back.identical(ds.assign_attrs(Conventions="CF-1.10"))
+    assert back.sel(direction="down")["peak"].values.tolist() == [3.0, 4.0]

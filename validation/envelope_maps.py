@@ -26,6 +26,7 @@ import numpy as np
 
 from rotorred.maps.run import run_map
 from rotorred.maps.spec import Axis, MapSpec
+from rotorred.scenes.keys import netcdf_name
 
 SPEEDS = tuple(60.0 + (110.0 - 60.0) * i / 100 for i in range(101))  #: Hz, as the CLI's 60:110:101
 CLEARANCES = tuple(0.0 + (45e-6 - 0.0) * i / 9 for i in range(10))  #: m, as the CLI's 0:45e-6:10
@@ -47,7 +48,7 @@ def clearance_map(out: Path, report=sys.stdout):
 
 
 def report_speed(ds, out=sys.stdout) -> None:
-    f = ds["speeds.outer"].values
+    f = ds[netcdf_name("speeds.outer")].values
     up, down = (ds["kind"].sel(direction=d).values for d in ("up", "down"))
     k_up, k_down = (ds["subharmonic"].sel(direction=d).values for d in ("up", "down"))
     contact = ds["contact_fraction"].values
@@ -63,7 +64,7 @@ def report_speed(ds, out=sys.stdout) -> None:
 
 
 def report_clearance(ds, out=sys.stdout) -> None:
-    c = ds["rub.clearance"].values
+    c = ds[netcdf_name("rub.clearance")].values
     last = int(np.argmax(c))
     for d in ("up", "down"):
         one = ds.sel(direction=d)

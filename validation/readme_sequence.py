@@ -23,10 +23,11 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-#: marks the end of a step in the shell's output: step number, exit status, seconds
+#: marks a step's start (``MARK k``) and end (``MARK k status``) in the shell's output; the steps are timed here
 MARK = "@@rotorred-step"
 
 
@@ -54,11 +55,11 @@ def steps(reverse: bool = False) -> list[tuple[str, str]]:
 
 def script(named_steps: list[tuple[str, str]]) -> str:
     """One bash script running every step in the same shell (a ``{ ...; }`` group, not a subshell, so that the
-    venv's ``activate`` carries over), printing a :data:`MARK` line with each step's status and milliseconds."""
+    venv's ``activate`` carries over), printing :data:`MARK` lines at each step's start and end (with its status)."""
     lines = ["cd " + _quote(str(ROOT))]
     for k, (name, text) in enumerate(named_steps, 1):
-        lines += [f"echo {_quote(f'=== step {k}: {name}')}", "_t0=${EPOCHREALTIME/./}", "{", text, "}", "_rc=$?",
-                  f'echo "{MARK} {k} $_rc $(( (${{EPOCHREALTIME/./}} - _t0) / 1000 ))"']
+        lines += [f"echo {_quote(f'=== step {k}: {name}')}", f"echo {MARK} {k}", "{", text, "}",
+                  f'echo "{MARK} {k} $?"']
     return "\n".join(lines) + "\n"
 
 
@@ -70,12 +71,15 @@ def main() -> int:
     named = steps(reverse="--reverse" in sys.argv[1:])
     proc = subprocess.Popen(["bash", "-c", script(named)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             bufsize=1)
-    results = {}
+    results, started = {}, {}
     for line in proc.stdout:
         if line.startswith(MARK):
-            _, k, rc, ms = line.split()
-            results[int(k)] = (int(rc), int(ms) / 1000)
-            print(f"=== step {k}: exit {rc} ({int(ms) / 1000:.1f} s)", flush=True)
+            _, k, *rc = line.split()
+            if not rc:
+                started[int(k)] = time.perf_counter()
+                continue
+            results[int(k)] = (int(rc[0]), time.perf_counter() - started[int(k)])
+            print(f"=== step {k}: exit {rc[0]} ({results[int(k)][1]:.1f} s)", flush=True)
         else:
             print(line, end="", flush=True)
     proc.wait()

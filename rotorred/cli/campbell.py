@@ -14,7 +14,6 @@ import numpy as np
 from rotorred import checks
 from rotorred.cli.feedback import report
 from rotorred.cli.options import grid, number_list, out_dir, provenance, ratio_number, spool_ratios, stage_summary
-from rotorred.progress import stage
 from rotorred.writers import OutputFolder
 
 
@@ -88,8 +87,6 @@ def run(args) -> int:
     check_model_size(rotor, args.force)
     if args.reference is not None and args.reference not in rotor.speeds:
         checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
-    stage(f"whirl frequencies of {args.rotor} at {len(speeds)} speed{'s' * (len(speeds) > 1)}"
-          + ("" if args.reduce is None else ", reduced and full"))
     with OutputFolder(out) as folder:
         kw = dict(ratio=ratio, reference=args.reference, n_modes=args.modes, harmonics=harmonics)
         result = campbell(rotor, speeds, **kw, model=_reduced(rotor, args.reduce))

@@ -58,6 +58,17 @@ class _LineHandler(logging.StreamHandler):
             self.handleError(record)
 
 
+class _ReportHandler(logging.StreamHandler):
+    """The report's handler: a failed write (a closed pipe: ``rotorred run | head``) is raised, so that the command's
+    one error path says so (exit 4), where logging would print its own traceback and go on."""
+
+    def handleError(self, record: logging.LogRecord) -> None:
+        exc = sys.exc_info()[1]
+        if isinstance(exc, OSError):
+            raise exc
+        super().handleError(record)
+
+
 class _Format(logging.Formatter):
     """``rotorred <command>: [warning: ]<message>``, with ``[12.34 s]`` since the start at DEBUG."""
 
@@ -79,7 +90,7 @@ def configure(command: str | None, lvl: int) -> None:
         for old in list(logger.handlers):
             if getattr(old, "_rotorred_cli", False):
                 logger.removeHandler(old)
-        handler = (_LineHandler if logger is LOG else logging.StreamHandler)(stream)
+        handler = (_LineHandler if logger is LOG else _ReportHandler)(stream)
         handler._rotorred_cli = True
         handler.setFormatter(fmt)
         logger.addHandler(handler)

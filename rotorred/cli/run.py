@@ -68,9 +68,9 @@ def run(args) -> int:
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
     budget.check(budget.scene_estimate(scene), force=args.force)
-    LOG.info("running %s into %s", scene.name, out)  # the first line, once the input is checked: a refusal is one line
     record = provenance(args, "scene", scene_toml(scene))
     with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
+        LOG.info("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
         status = _compute_and_write(scene, args, folder, out, pool, record)
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status

@@ -54,6 +54,7 @@ from rotorred import checks, writers
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, assemble
 from rotorred.model.rotor import Rotor
+from rotorred.progress import stage
 
 WHIRL_LABELS = ("forward", "backward", "mixed", "planar")
 
@@ -601,6 +602,8 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
         n_modes = checks.integer("n_modes", n_modes, ge=1)
         if n_modes > n_available:
             checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
+    stage("whirl frequencies of %s at %d speed%s, %d modes tracked (%d DOFs)", rotor.name or "the rotor", len(Omega),
+          "s" * (len(Omega) > 1), n_modes, n_available)
     solver = _Solver(sm, ratios, min(n_available, 2 * n_modes + 4))
     solved = {}  # eigen-solves of the grid speeds, kept for a second tracking with more modes
     while True:

@@ -23,6 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from rotorred.maps.point import PointResult, StartState, run_point
+from rotorred.progress import muted
 from rotorred.maps.spec import Chain, MapSpec
 from rotorred.maps.store import PointStore
 from rotorred.scenes.run import SceneModel, build_model, model_key
@@ -71,7 +72,8 @@ def _local(model: SceneModel) -> SceneModel:
 def _point_task(scene, model: SceneModel, previous, cold: bool, limit: float | None) -> PointResult:
     """Run one point from the previous point's final state (a StartState, a PointResult, or None)."""
     start = previous.final if isinstance(previous, PointResult) else previous
-    return run_point(scene, _local(model), None if cold else start, limit)
+    with muted():  # the map's bar counts the points; a point's segments say nothing
+        return run_point(scene, _local(model), None if cold else start, limit)
 
 
 def run_points(spec: MapSpec, store: PointStore, client=None,

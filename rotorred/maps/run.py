@@ -27,6 +27,7 @@ from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
+from rotorred.progress import stage
 from rotorred.provenance import Provenance
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
@@ -101,6 +102,8 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         store = PointStore(out, spec)
         n_resumed = len(store.read())
         client = _client(workers, scheduler) if n_resumed < spec.n_points else None
+        stage("running %d of %d points (%d kept from an earlier run) %s", spec.n_points - n_resumed, spec.n_points,
+              n_resumed, "in this process" if client is None else "on Dask")
         bar = _Progress(spec.n_points, n_resumed, progress)
         incomplete = None
         try:

@@ -328,7 +328,8 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
         Floquet multipliers of every point (monodromy).
     max_points : int
     progress : callable, optional
-        ``progress(points, value)`` as the branch grows, then ``progress(i, None)`` per point's stability.
+        ``progress(points, value)`` as the branch grows (last with every point traced), then ``progress(0, None)`` as
+        the stability starts and ``progress(i, None)`` as each point's is found.
     interrupts : mapping of exception type to str
         The exceptions that end the branch where it is (tracing or stability), every point traced kept, and the
         signal each stands for (default: SIGINT's ``KeyboardInterrupt``).
@@ -351,6 +352,8 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     t2 = time.perf_counter()
     values, dofs, interrupt = np.array([to_value(s) for s in branch.omega]), _output_dofs(scene), branch.interrupt
     critical, outputs, t3 = np.full(len(values), complex(np.nan, np.nan)), None, None
+    if progress is not None and len(values):
+        progress(len(values), values[-1])  # the points traced, the last one included
     try:
         with _signals_blocked():  # a few ms a point, and the branch's files need every point's outputs
             outputs = _outputs(rub_at, values, branch.z, dofs)
@@ -417,6 +420,8 @@ def _outputs(rub_at, values, z, dofs):
 def _stability(rub_at, values, z, critical, progress) -> None:
     """The Floquet multiplier of largest modulus of each point, into ``critical`` as each is found (an interrupt
     leaves those found)."""
+    if progress is not None:
+        progress(0, None)
     for i, (v, zi) in enumerate(zip(values, z)):
         rp = rub_at(v)
         mu = floquet_by_monodromy(rp.problem, zi, rp.omega, STABILITY_SUBSTEPS).multipliers

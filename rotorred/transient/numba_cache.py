@@ -138,7 +138,8 @@ class _TempDirLocator(_FolderLocator):
 
 
 #: where the cache of a rotorred function may live, in order of preference; never the package's own folder
-FALLBACKS = (caching.UserProvidedCacheLocator, _UserCacheLocator, _TempDirLocator)
+FALLBACKS = (getattr(caching, "UserProvidedCacheLocator", None) or caching._UserProvidedCacheLocator,  # numba 0.58-0.61
+             _UserCacheLocator, _TempDirLocator)
 
 
 class RotorredCacheLocator(caching._CacheLocator):

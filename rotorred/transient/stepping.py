@@ -296,13 +296,25 @@ def load_kernel(args: tuple, dispatcher=None) -> tuple[float, bool]:
     if sig in dispatcher.overloads:
         return 0.0, False
     t0 = time.perf_counter()
-    compiled = not _cached(dispatcher, sig)
-    if compiled:
+    expected = not _cached(dispatcher, sig)  # said before the wait; what happened is read from numba's counters
+    if expected:
         stage(COMPILING_NOTE, logger=LOG)
     else:
         LOG.debug("loading the step kernel %s from numba's cache", dispatcher.__name__)
+    misses = _misses(dispatcher)
     dispatcher.compile(sig)
+    compiled = expected if misses is None else _misses(dispatcher) > misses
+    if compiled and not expected:
+        stage("compiled the step kernel: its cache entry could not be loaded", logger=LOG)
     return time.perf_counter() - t0, compiled
+
+
+def _misses(dispatcher) -> int | None:
+    """numba's count of the dispatcher's compilations that its cache could not serve (None if it keeps none)."""
+    try:
+        return sum(dispatcher.stats.cache_misses.values())
+    except AttributeError:
+        return None
 
 
 def _cached(dispatcher, sig) -> bool:
