@@ -38,7 +38,7 @@ def stage(text: str, *args, logger: logging.Logger = LOG) -> None:
 
 
 def bar(total: float | None, desc: str, unit: str, *, progress: bool | None = None, initial: float = 0,
-        delay: float = 0.0, unit_scale: bool = False, bar_format: str | None = None):
+        delay: float = 0.0, bar_format: str | None = None):
     """A tqdm progress bar on stderr, or a disabled one (same methods, draws nothing).
 
     Parameters
@@ -55,7 +55,7 @@ def bar(total: float | None, desc: str, unit: str, *, progress: bool | None = No
         The count already done (a resumed map).
     delay : float
         Seconds before the bar first appears (work that ends sooner draws nothing) (s).
-    unit_scale, bar_format
+    bar_format : str, optional
         As tqdm's.
 
     Returns
@@ -69,7 +69,7 @@ def bar(total: float | None, desc: str, unit: str, *, progress: bool | None = No
     else:
         disable = not progress
     return tqdm(total=total, desc=desc, unit=unit, initial=initial, delay=delay, disable=disable, file=sys.stderr,
-                dynamic_ncols=True, leave=False, unit_scale=unit_scale, bar_format=bar_format)
+                dynamic_ncols=True, leave=False, bar_format=bar_format)
 
 
 @contextmanager

@@ -98,6 +98,13 @@ class Provenance:
                 f"command: {self.command}",
                 f"resolved {self.kind}: {self.file_name}"]
 
+    def on_top(self, text: str) -> str:
+        """A text summary under :meth:`header_lines` and a blank line; its first line stays first when it says the
+        result is incomplete (``"INCOMPLETE: ..."``), as the first line of every summary does."""
+        first, rest = ("", text) if not text.startswith("INCOMPLETE: ") else text.partition("\n")[::2]
+        block = "\n".join(self.header_lines()) + "\n\n" + rest.lstrip("\n")
+        return first + "\n\n" + block if first else block
+
     def file_text(self) -> str:
         """The text of :attr:`file_name`: the header lines as TOML comments, then :attr:`toml`."""
         return "".join(f"# {line}\n" for line in self.header_lines()[:2]) + "\n" + self.toml

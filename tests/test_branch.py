@@ -218,6 +218,17 @@ def _traced_and_known(text: str) -> tuple[int, int]:
     return traced, known
 
 
+def _said_interrupted(done, out, signal_name: str, status: int, phase: str) -> str:
+    """Checks of what an interrupted ``continue`` says (exit status, one error line, no "reached the end" in the
+    printout or branch.txt, the signal and the phase in both); branch.txt's text."""
+    assert done.returncode == status, done.stderr
+    assert "Traceback" not in done.stderr and f"rotorred continue: error: interrupted ({signal_name})" in done.stderr
+    text = (out / "branch.txt").read_text()
+    for said in (done.stdout, text):
+        assert "reached the end" not in said and f"interrupted ({signal_name}) while {phase}" in said
+    return text
+
+
 def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
     """SIGINT while the 6th point's multipliers are computed: exit 130; branch.csv, branch.nc and branch.txt hold every
     point traced (to the first past 40 um: the whole range), the first 5 with their stability (both stable and
@@ -226,11 +237,7 @@ def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
     stability, and never that it reached the end."""
     out = tmp_path / "b"
     done, rows, ds = _interrupted(out, ("rotorred.scenes.branch", "floquet_by_monodromy", 6), signal.SIGINT)
-    assert done.returncode == 130, done.stderr
-    assert "Traceback" not in done.stderr and "rotorred continue: error: interrupted (SIGINT)" in done.stderr
-    text = (out / "branch.txt").read_text()
-    for said in (done.stdout, text):
-        assert "reached the end" not in said and "interrupted (SIGINT) while computing stability" in said
+    text = _said_interrupted(done, out, "SIGINT", 130, "computing stability")
     assert text.startswith("INCOMPLETE: interrupted (SIGINT)") and (out / "INCOMPLETE").exists()
     traced, known = _traced_and_known(text)
     values = np.array([float(r[0]) for r in rows])
@@ -255,11 +262,7 @@ def test_sigterm_while_tracing_keeps_the_points_so_far(tmp_path):
     with its stability (marked unknown), and the printout and branch.txt say SIGTERM ended the tracing there."""
     out = tmp_path / "b"
     done, rows, ds = _interrupted(out, ("rotorred.nonlinear.continuation", "_step", 6), signal.SIGTERM)
-    assert done.returncode == 143, done.stderr
-    assert "Traceback" not in done.stderr and "rotorred continue: error: interrupted (SIGTERM)" in done.stderr
-    text = (out / "branch.txt").read_text()
-    for said in (done.stdout, text):
-        assert "reached the end" not in said and "interrupted (SIGTERM) while tracing" in said
+    text = _said_interrupted(done, out, "SIGTERM", 143, "tracing")
     values = np.array([float(r[0]) for r in rows])
     assert _traced_and_known(text) == (len(rows), 0) and len(rows) == 6 and values[-1] > 40e-6
     assert f"at rub.clearance = {values[-1]:.9g} m" in text

@@ -700,8 +700,8 @@ def _critical_speed_rows(tmp_path, capsys, name, argv):
 def test_default_lists_the_critical_speeds_of_thirty_modes(tmp_path, capsys, argv):
     """The default number of modes lists the same critical speeds as ``--modes 30`` (every mode to several times
     the highest excitation frequency): the same critical_speeds.csv, row by row (the same solves: measured
-    byte-identical; 1e-9 allowed for the Brent refinement's round-off). The former default of 6 modes dropped some in each case (measured:
-    12 of 16, 6 of 8, 34 of 54, 8 of 9). The printout says how many modes and why."""
+    byte-identical; 1e-9 allowed for the Brent refinement's round-off). The former default of 6 modes dropped some
+    in each case (measured: 12 of 16, 6 of 8, 34 of 54, 8 of 9). The printout says how many modes and why."""
     default, printed = _critical_speed_rows(tmp_path, capsys, "default", argv)
     thirty, _ = _critical_speed_rows(tmp_path, capsys, "thirty", [*argv, "--modes", "30"])
     n = int(re.search(r"^tracked (\d+) modes: every mode below 1\.25 × ", printed, re.M).group(1))

@@ -35,7 +35,8 @@ def test_quiet_prints_nothing_but_errors(tmp_path, capsys):
     assert (tmp_path / "q" / "result.npz").exists() and (tmp_path / "q" / "summary.txt").exists()
     assert main(["run", "paper-rub", "--out", str(tmp_path / "bad"), "-q", "--set", "rub.clearance=-1e-6"]) == 2
     captured = capsys.readouterr()
-    assert captured.out == "" and captured.err.startswith("rotorred run: error: ") and "rub[0].clearance" in captured.err
+    assert captured.out == "" and captured.err.startswith("rotorred run: error: ")
+    assert "rub[0].clearance" in captured.err
 
 
 def test_run_says_what_it_does_in_order_and_verbose_adds_timings(tmp_path, capsys):

@@ -80,6 +80,7 @@ EXAMPLES = {
     "convert": ["rotorred convert rotor_saved_by_ross.toml rotor.toml"],
     "harmonic": ["rotorred harmonic seed-rig --speeds 0:12000:241 --out bode"],
     "map": ["rotorred map paper-rub --vary rub.clearance=10e-6:60e-6:11 --out clearance",
+            "rotorred map paper-rub --vary speeds.outer=60:110:51 --direction both --out envelope",
             "rotorred map paper-rub --vary speeds.outer=60:120:13 --vary rub.clearance=20e-6:50e-6:4 --workers 2 "
             "--out envelope"],
     "continue": ["rotorred continue paper-rub --param rub.clearance=45e-6:5e-6 --out branch",
@@ -123,20 +124,15 @@ class _Formatter(argparse.RawDescriptionHelpFormatter):
         return textwrap.fill(line, width, initial_indent=indent, subsequent_indent=indent + pad)
 
 
-def _version() -> str:
-    from rotorred._version import __version__
-
-    return __version__
-
-
 def build_parser() -> argparse.ArgumentParser:
     from rotorred.cli import feedback
+    from rotorred.provenance import package_version
 
     parser = argparse.ArgumentParser(
         prog="rotorred", description="Rotordynamics of dual-rotor machines with rub-impact faults. "
                                      "`rotorred COMMAND --help` describes a command, with examples.",
         epilog=_epilog(), formatter_class=_Formatter)
-    parser.add_argument("--version", action="version", version=f"rotorred {_version()}")
+    parser.add_argument("--version", action="version", version=f"rotorred {package_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         module = importlib.import_module(f"rotorred.cli.{name}")

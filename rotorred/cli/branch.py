@@ -18,14 +18,11 @@ while a complete branch is written, a signal leaves the earlier result, as in ev
 from __future__ import annotations
 
 import contextlib
-import logging
 
 from rotorred import checks
-from rotorred.cli.feedback import report
+from rotorred.cli.feedback import error, report
 from rotorred.cli.options import out_dir, provenance
 from rotorred.progress import bar, stage
-
-LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -96,7 +93,7 @@ def run(args) -> int:
     for f in _write(branch, out, scene.name, tuple(interrupts), record):
         report(f"wrote {f}")
     if branch.interrupted:
-        LOG.error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
+        error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
         return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[branch.interrupt]
     return 0
 

@@ -109,7 +109,8 @@ def run(args) -> int:
 
 
 def format_mode_count(result) -> str:
-    """How many modes were tracked and why: ``--modes``, or the default rule (:func:`rotorred.linear.campbell.default_mode_count`)."""
+    """How many modes were tracked and why: ``--modes``, or the default rule
+    (:func:`rotorred.linear.campbell.default_mode_count`)."""
     from rotorred.linear.campbell import MIN_DEFAULT_MODES
 
     mc = result.mode_count

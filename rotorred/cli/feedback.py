@@ -19,7 +19,7 @@ import sys
 
 from rotorred.progress import LOG
 
-__all__ = ["REPORT", "report", "configure", "add_options", "level"]
+__all__ = ["REPORT", "report", "error", "configure", "add_options", "level"]
 
 #: the command's result, on stdout
 REPORT = logging.getLogger("rotorred.report")
@@ -28,6 +28,12 @@ REPORT = logging.getLogger("rotorred.report")
 def report(text: str = "") -> None:
     """One piece of the command's result, on stdout (silent with ``-q``)."""
     REPORT.info(text)
+
+
+def error(text: str) -> None:
+    """An error the command ends with after its work (a diverged run, failed points, an interrupt), on stderr as
+    ``rotorred <command>: error: <text>``, whatever ``-q`` says."""
+    LOG.error(text)
 
 
 def add_options(parser) -> None:

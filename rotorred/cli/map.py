@@ -14,13 +14,9 @@ points are kept in ``DIR/points`` as they finish, and the same command resumes a
 
 from __future__ import annotations
 
-import logging
-
 from rotorred import checks
-from rotorred.cli.feedback import report
+from rotorred.cli.feedback import error, report
 from rotorred.cli.options import out_dir, provenance, spool_ratios
-
-LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -29,8 +25,7 @@ def add_parser(subparsers):
         description="Run a scene at every point of a grid of one or more keys, each point continued from its "
                     "neighbour's final state along the first key, and write the classes, labelled lines, "
                     "Poincare samples, orbits and contact as NetCDF and CSV with a bifurcation diagram, a waterfall "
-                    "and heat maps. Example: rotorred map paper-rub --vary speeds.outer=60:110:51 --direction both "
-                    "--out envelope")
+                    "and heat maps.")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
                    help="KEY=START:STOP:N or KEY=v1,v2,... (scene units: speeds in Hz, clearance in m); repeat for "
@@ -111,10 +106,10 @@ def run(args) -> int:
     report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
            f"wall time {result.wall_time:.2f} s")
     if result.incomplete:
-        LOG.error(result.incomplete)
+        error(result.incomplete)
         return EXIT_SIGINT
     if result.n_failed:
-        LOG.error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
-                  "points are kept")
+        error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
+              "points are kept")
         return EXIT_DIVERGED
     return 0

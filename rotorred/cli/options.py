@@ -180,6 +180,5 @@ def stage_summary(folder, name: str, text: str, record) -> list[Path]:
     (``rotor.toml`` or ``scene.toml``) in ``folder`` (:class:`rotorred.writers.OutputFolder`); returns their paths."""
     from rotorred.writers import write_text
 
-    summary = "\n".join(record.header_lines()) + "\n\n" + text + "\n"
-    return [write_text(folder.staged(name), summary),
+    return [write_text(folder.staged(name), record.on_top(text) + "\n"),
             write_text(folder.staged(record.file_name), record.file_text())]

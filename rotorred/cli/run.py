@@ -19,17 +19,15 @@ Everything is checked before computing (the scene, ``--out``, the size estimate 
 
 from __future__ import annotations
 
-import logging
 import time
 
 from rotorred import checks
-from rotorred.cli.feedback import report
+from rotorred.cli.feedback import error, report
 from rotorred.cli.options import out_dir, provenance
+from rotorred.progress import stage
 from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
-
-LOG = logging.getLogger("rotorred.cli")
 
 
 def add_parser(subparsers):
@@ -70,7 +68,7 @@ def run(args) -> int:
     budget.check(budget.scene_estimate(scene), force=args.force)
     record = provenance(args, "scene", scene_toml(scene))
     with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
-        LOG.info("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
+        stage("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
         status = _compute_and_write(scene, args, folder, out, pool, record)
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
@@ -124,7 +122,7 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
         write_outputs(exc.partial, folder.staging, shown=out, pool=pool, provenance=record)
         files = folder.commit(incomplete=str(exc))
         report(format_summary(exc.partial, files))
-        LOG.error(f"{exc}; partial results written to {out} (marked {INCOMPLETE})")
+        error(f"{exc}; partial results written to {out} (marked {INCOMPLETE})")
         return EXIT_DIVERGED
     files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing, provenance=record)
     folder.commit()
@@ -144,6 +142,6 @@ def _runup_and_write(scene, folder, out, record) -> int:
     committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:
-        LOG.error(f"{result.incomplete}; partial results written to {out} (marked {INCOMPLETE})")
+        error(f"{result.incomplete}; partial results written to {out} (marked {INCOMPLETE})")
         return EXIT_DIVERGED
     return 0

@@ -147,8 +147,8 @@ def _write(ds, spec: MapSpec, folder: OutputFolder, figures: bool, provenance: P
         from rotorred.maps.figures import map_figures
 
         files += map_figures(ds, spec, staging)
-    header = "".join(f"{line}\n" for line in provenance.header_lines()) + "\n" if provenance is not None else ""
-    files.append(write_text(staging / "map.txt", header + format_map(ds, spec) + "\n"))
+    text = format_map(ds, spec)
+    files.append(write_text(staging / "map.txt", (text if provenance is None else provenance.on_top(text)) + "\n"))
     if provenance is not None:
         files.append(write_text(staging / provenance.file_name, provenance.file_text()))
     return files

@@ -56,8 +56,8 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor", "ROTOR_FILE_KEYS", "read_rotor_toml", "rotor_document", "rotor_from_toml",
-           "rotor_from_dict", "read_toml"]
+__all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor", "ROTOR_FILE_KEYS", "read_rotor_toml",
+           "rotor_document", "rotor_from_toml", "rotor_from_dict", "read_toml"]
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}

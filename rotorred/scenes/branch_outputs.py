@@ -103,15 +103,7 @@ def write_branch(branch, folder, scene_name: str, provenance: Provenance | None 
                 xlabel=f"{branch.key} ({xu})", ylabel=f"peak |{dof}| (µm)", changes=branch.bifurcations, xscale=xs,
                 title=f"{scene_name}: harmonic-balance branch"
                       + (f" (INCOMPLETE: interrupted by {branch.interrupt})" if branch.interrupted else ""))
-    write_text(folder.staged("branch.txt"), _with_header(format_branch(branch), provenance) + "\n")
+    text = format_branch(branch)
+    write_text(folder.staged("branch.txt"), (text if provenance is None else provenance.on_top(text)) + "\n")
     if provenance is not None:
         write_text(folder.staged(provenance.file_name), provenance.file_text())
-
-
-def _with_header(text: str, provenance: Provenance | None) -> str:
-    """``text`` under the provenance's header lines; an "INCOMPLETE: " line stays the first, as in every summary."""
-    if provenance is None:
-        return text
-    first, _, rest = text.partition("\n") if text.startswith("INCOMPLETE: ") else ("", "", text)
-    header = "\n".join(provenance.header_lines()) + "\n\n"
-    return (first + "\n" if first else "") + header + rest

@@ -1,4 +1,5 @@
-"""The files of a scene's result: figures (PNG), data (NPZ, CSV, MATLAB .mat), ``summary.txt`` and, given a provenance, ``scene.toml``.
+"""The files of a scene's result: figures (PNG), data (NPZ, CSV, MATLAB .mat), ``summary.txt`` and, given a
+provenance, ``scene.toml``.
 
 Keys, columns and variables are documented in ``docs/scenes.md``. Every file goes through the
 one writer of its format (:mod:`rotorred.writers`); figures come from
@@ -188,6 +189,6 @@ def write_outputs(result: SceneResult, out: str | Path, shown: str | Path | None
     summary = out / "summary.txt"
     files.append(summary)
     named = [Path(shown) / f.name for f in files] if shown is not None else files
-    header = provenance.header_lines() if provenance is not None else ()
-    write_text(summary, format_summary(result, named, header) + "\n")
+    text = format_summary(result, named)
+    write_text(summary, (text if provenance is None else provenance.on_top(text)) + "\n")
     return named

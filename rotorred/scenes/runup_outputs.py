@@ -113,18 +113,17 @@ def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path 
     summary = out / "summary.txt"
     files.append(summary)
     named = [Path(shown) / f.name for f in files] if shown is not None else files
-    header = provenance.header_lines() + [""] if provenance is not None else []
-    write_text(summary, format_runup_summary(result, named, header) + "\n")
+    text = format_runup_summary(result, named)
+    write_text(summary, (text if provenance is None else provenance.on_top(text)) + "\n")
     return named
 
 
-def format_runup_summary(result: RunupResult, files=(), header: list[str] = ()) -> str:
-    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files; ``header``
-    lines on top."""
+def format_runup_summary(result: RunupResult, files=()) -> str:
+    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files."""
     ref, sc = result.reference, result.scene
     c = result.counters
     speeds = " / ".join(f"{s} {w[0] * HZ:.1f} -> {w[-1] * HZ:.1f} Hz" for s, w in result.speeds.items())
-    lines = [*header, f"scene {sc.name}: {sc.description}",
+    lines = [f"scene {sc.name}: {sc.description}",
              f"run-up: {speeds} in {result.t[-1]:.3g} s; {result.model_label}",
              f"steps: {result.n_steps} of {sc.solver.dt:g} s, {c['us_per_step']:.2f} us/step, "
              f"{c['n_passes'] / max(result.n_steps, 1):.2f} passes/step, {c['n_factorizations']} step matrices "

@@ -27,12 +27,10 @@ def table_dof(result) -> tuple[int, str]:
     return _scene_table_dof(getattr(result, "scene", result))
 
 
-def format_summary(result: SceneResult, files: list[Path] = (), header: list[str] = ()) -> str:
-    """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form).
-
-    ``header``: lines put on top (:meth:`rotorred.provenance.Provenance.header_lines`), under the INCOMPLETE line of
-    an incomplete result, which stays the first."""
-    parts = [_incomplete(result), "\n".join(header), _setup(result), _peaks(result), _range_warnings(result),
+def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
+    """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form); an incomplete result's
+    first line says so (:meth:`rotorred.provenance.Provenance.on_top` keeps it first under the provenance)."""
+    parts = [_incomplete(result), _setup(result), _peaks(result), _range_warnings(result),
              _contacts(result), _lines(result) if result.spectra else "", _line_fit(result)]
     if files:
         parts.append("\n".join(f"wrote {f}" for f in files))

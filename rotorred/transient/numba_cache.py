@@ -15,9 +15,10 @@ the first of these that can be written:
 Inside it, numba's layout: one sub-folder per source folder (its name and a hash of its absolute path), so two
 installs of rotorred (a venv's and an editable checkout) never share or overwrite each other's entries.
 
-**When it is stale.** numba keys the cache of an ``njit(cache=True)`` function on the stamp (modification time and size) of its own source
-file only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself functions of other files: the
-contact law of :mod:`rotorred.transient.contact` and the sympy-generated code of :mod:`rotorred._generated`.
+**When it is stale.** numba keys the cache of an ``njit(cache=True)`` function on the stamp (modification time and
+size) of its own source file only. The step kernel (:mod:`rotorred.transient.kernel`) compiles into itself
+functions of other files: the contact law of :mod:`rotorred.transient.contact` and the sympy-generated code of
+:mod:`rotorred._generated`.
 :func:`register` puts :class:`RotorredCacheLocator` first in numba's list of cache locators. For a function
 defined in a file of the rotorred package it returns the source stamp
 

@@ -231,15 +231,15 @@ def run_profile(model, profile: SpeedProfile, scheme, run, loads, rotor, x0, sta
                                    settings, diag, plan.n_steps, n_levels, run.chunk_steps, progress)
     # 5. package (the state-recording rows after the outputs)
     result = stepping.package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                                    (setup_time + times[3], *times[:3], times[4]), n_factorizations=len(intervals) * n_levels,
+                                    (setup_time + times[0], *times[1:]), n_factorizations=len(intervals) * n_levels,
                                     record_state=record_state)
     return result
 
 
 def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, record, settings, diag, n_steps,
                    n_levels, chunk_steps, progress):
-    """The compiled loop over every interval, in chunks, with a progress bar; (status, (wall, cpu, load, build,
-    compiled))."""
+    """The compiled loop over every interval, in chunks, with a progress bar; (status, (build, wall, cpu, load,
+    compiled)): the intervals' set-up, the loop's wall and CPU time, the kernel's load (s), whether it compiled."""
     spare = kernel.spare_state(state)
     n, n_s = len(ops.M), len(ops.G)
     work = kernel.work_arrays(n, len(plates), len(forces.kind))
@@ -247,28 +247,27 @@ def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, re
     chunk = chunk_steps or max(2000, min(n_steps, 100_000))
     status, build, load, compiled = kernel.RUNNING, 0.0, 0.0, False
     wall = cpu = 0.0
-    shown = stepping.step_bar(n_steps, settings.dt, progress)
-    for interval in intervals:
-        t_build = time.perf_counter()
-        levels, R, rho = interval_state(ops, B, forces, plates, interval, settings.dt, n_levels)
-        var = ramp_kernel.Varying(R=R, rho=rho, ref=np.ascontiguousarray(interval.ref), **tables)
-        build += time.perf_counter() - t_build
-        args = (0, 0, levels, var, contact, state, spare, work, rwork, record, settings, diag)
-        seconds, new = stepping.load_kernel(args, ramp_kernel.run_ramp_steps)
-        load, compiled = load + seconds, compiled or new
-        t_run, cpu_run = time.perf_counter(), time.process_time()
-        i = interval.begin
-        while i < interval.end:
-            i_next = min(interval.end, i + chunk)
-            status = ramp_kernel.run_ramp_steps(i, i_next, levels, var, contact, state, spare, work, rwork, record,
-                                                settings, diag)
+    with stepping.step_bar(n_steps, settings.dt, progress) as shown:
+        for interval in intervals:
+            t_build = time.perf_counter()
+            levels, R, rho = interval_state(ops, B, forces, plates, interval, settings.dt, n_levels)
+            var = ramp_kernel.Varying(R=R, rho=rho, ref=np.ascontiguousarray(interval.ref), **tables)
+            build += time.perf_counter() - t_build
+            args = (0, 0, levels, var, contact, state, spare, work, rwork, record, settings, diag)
+            seconds, new = stepping.load_kernel(args, ramp_kernel.run_ramp_steps)
+            load, compiled = load + seconds, compiled or new
+            t_run, cpu_run = time.perf_counter(), time.process_time()
+            i = interval.begin
+            while i < interval.end:
+                i_next = min(interval.end, i + chunk)
+                status = ramp_kernel.run_ramp_steps(i, i_next, levels, var, contact, state, spare, work, rwork,
+                                                    record, settings, diag)
+                if status != kernel.RUNNING:
+                    break
+                shown.update((i_next - i) * settings.dt)
+                i = i_next
+            wall += time.perf_counter() - t_run
+            cpu += time.process_time() - cpu_run
             if status != kernel.RUNNING:
                 break
-            shown.update((i_next - i) * settings.dt)
-            i = i_next
-        wall += time.perf_counter() - t_run
-        cpu += time.process_time() - cpu_run
-        if status != kernel.RUNNING:
-            break
-    shown.close()
-    return status, (wall, cpu, load, build, compiled)
+    return status, (build, wall, cpu, load, compiled)
