@@ -1,0 +1,34 @@
+"""The two steps every drawing shares: axes to draw into, and a figure written to a file.
+
+A result's ``plot(ax=None, **options)`` (:class:`rotorred.results.Result`) draws into the given axes,
+or into a new figure from :func:`axes`, and returns the Figure; writing it is the caller's
+step (:func:`save`), so that a script, a notebook and the CLI share one drawing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+#: resolution of the PNG files (dots per inch)
+DPI = 120
+
+
+def axes(ax=None, figsize: tuple[float, float] = (8.0, 5.0)):
+    """``(figure, ax)``: the figure of the given axes, or a new figure of ``figsize`` (in) with one axes.
+
+    A new figure is a :class:`matplotlib.figure.Figure` attached to no window manager (pyplot is not
+    involved), so that drawing works without a display and leaves no figure open.
+    """
+    if ax is not None:
+        return ax.figure, ax
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, dpi=DPI)
+    return fig, fig.subplots()
+
+
+def save(fig, path: str | Path) -> Path:
+    """Write ``fig`` to ``path`` (PNG at :data:`DPI`, or the format of the suffix); return the path."""
+    path = Path(path)
+    fig.savefig(path, dpi=DPI)
+    return path

@@ -1,0 +1,44 @@
+"""What every result type shows of itself: a short repr, a figure and a labelled dataset.
+
+A result type of rotorred (a Campbell diagram, an unbalance response, a transient record, a
+branch, ...) derives from :class:`Result` and gives three things:
+
+- :meth:`Result.summary` -- at most :data:`MAX_REPR_LINES` - 1 short lines: what was computed, on
+  what, and the headline numbers; never an array. ``repr()`` is the type's name followed by them.
+- :meth:`Result.plot` -- ``plot(ax=None, **options)`` draws the result into ``ax`` (a new figure
+  when ``None``) and returns the matplotlib ``Figure``. The drawing lives in :mod:`rotorred.plots`;
+  ``plot`` imports it when called, so that building a result never loads matplotlib.
+- :meth:`Result.to_xarray` -- an :class:`xarray.Dataset` with named dimensions and a ``units``
+  attribute on every variable and coordinate (``"1"`` for a dimensionless one), so that
+  :func:`rotorred.writers.write_netcdf` writes it as CF NetCDF and reads it back as it was.
+
+A dataclass result is declared ``@dataclass(frozen=True, repr=False)`` so that the generated
+repr, which prints every array, does not replace :meth:`Result.__repr__`.
+"""
+
+from __future__ import annotations
+
+#: longest repr of a result (lines, the type's name included)
+MAX_REPR_LINES = 15
+
+
+class Result:
+    """Base of the result types: a short :func:`repr`, :meth:`plot` and :meth:`to_xarray`."""
+
+    def summary(self) -> list[str]:
+        """What was computed, on what, and the headline numbers: a few short lines without arrays."""
+        raise NotImplementedError(f"{type(self).__name__}.summary")
+
+    def __repr__(self) -> str:
+        lines = [str(line) for line in self.summary()]
+        if len(lines) > MAX_REPR_LINES - 1:  # a bug of the type's summary: keep the repr short all the same
+            lines = lines[: MAX_REPR_LINES - 2] + [f"... ({len(lines) - MAX_REPR_LINES + 2} more lines)"]
+        return "\n".join([f"{type(self).__name__}:"] + [f"  {line}" for line in lines])
+
+    def plot(self, ax=None, **options):
+        """Draw the result into ``ax`` (a new figure when None); return the matplotlib Figure."""
+        raise NotImplementedError(f"{type(self).__name__}.plot")
+
+    def to_xarray(self):
+        """The result as an :class:`xarray.Dataset` with named dimensions and ``units`` on every variable."""
+        raise NotImplementedError(f"{type(self).__name__}.to_xarray")
