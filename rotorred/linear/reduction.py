@@ -190,6 +190,8 @@ class ReducedSystem(SpoolSpeedMixin):
         do not depend on a boundary node's supports.
     supported_weight : ndarray, shape (m,), or None
         ``T^T`` times the full model's ``supported_weight`` (a rotor with pinned or clamped supports).
+    rotor : Rotor or None
+        The rotor of the full model (:class:`rotorred.model.assembly.SpoolSpeedMixin`).
     """
 
     M: np.ndarray
@@ -206,6 +208,7 @@ class ReducedSystem(SpoolSpeedMixin):
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
     tables: tuple[TabulatedSupport, ...] = ()
     supported_weight: np.ndarray | None = None
+    rotor: Rotor | None = field(default=None, compare=False, repr=False)
     _bpos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -546,7 +549,8 @@ def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
                          boundary_dofs=basis.b.copy(), n_modes=n_modes,
                          interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr,
                          tables=tuple(t.on(T) for t in system.tables),
-                         supported_weight=None if system.supported_weight is None else T.T @ system.supported_weight)
+                         supported_weight=None if system.supported_weight is None else T.T @ system.supported_weight,
+                         rotor=system.rotor)
 
 
 def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,

@@ -29,7 +29,7 @@ from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIREC
 from rotorred.model.elements import Bearing, BearingTable
 from rotorred.model.rotor import Rotor
 
-__all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "DofMap", "DIRECTIONS"]
+__all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "system_of", "DofMap", "DIRECTIONS"]
 
 
 @dataclass(frozen=True)
@@ -66,15 +66,34 @@ class TabulatedSupport:
 
 
 class SpoolSpeedMixin:
-    """``spools``, ``gyroscopic(speeds)``, ``stiffness(speeds)`` and ``damping(speeds)`` of a model with attributes
-    ``M``, ``K``, ``C``, ``G`` (dict spool -> gyroscopic matrix per unit speed) and ``tables`` (its
-    :class:`TabulatedSupport` s); shared by the full :class:`SystemMatrices` and the reduced model
-    (:class:`rotorred.linear.reduction.ReducedSystem`)."""
+    """The model protocol every analysis reads: ``spools``, ``nominal_speeds``, ``spool_of``, ``name``,
+    ``gyroscopic(speeds)``, ``stiffness(speeds)`` and ``damping(speeds)`` of a model with attributes ``M``, ``K``,
+    ``C``, ``G`` (dict spool -> gyroscopic matrix per unit speed), ``tables`` (its :class:`TabulatedSupport` s) and
+    ``rotor`` (the rotor it was built from, or None); shared by the full :class:`SystemMatrices` and the reduced
+    model (:class:`rotorred.linear.reduction.ReducedSystem`). :func:`system_of` turns a rotor into one."""
 
     @property
     def spools(self) -> tuple[str, ...]:
         """Spool names, in the order of ``G``."""
         return tuple(self.G)
+
+    @property
+    def name(self) -> str:
+        """The rotor's name ("" for a model built by hand)."""
+        return self.rotor.name if self.rotor is not None else ""
+
+    @property
+    def nominal_speeds(self) -> dict[str, float]:
+        """The rotor's nominal spool speeds (rad/s); empty for a model built by hand."""
+        return dict(self.rotor.speeds) if self.rotor is not None else {}
+
+    @property
+    def spool_of(self) -> dict[int, str]:
+        """Spool of each node: the rotor's, or every node on the one spool of a single-spool model built by hand
+        (empty for a model of several spools built by hand)."""
+        if self.rotor is not None:
+            return self.rotor.spool_of
+        return {n: self.spools[0] for n in self.full_dofs.nodes} if len(self.spools) == 1 else {}
 
     def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
         """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
@@ -139,6 +158,9 @@ class SystemMatrices(SpoolSpeedMixin):
     supported_weight : ndarray, shape (n,), or None
         With supports: ``M e_y`` of the model before the fixed DOFs were removed (kg), e_y the unit rigid
         translation in y, on the remaining DOFs; gravity's consistent load is ``-g`` times it. None without supports.
+    rotor : Rotor or None
+        The rotor assembled (:func:`assemble`): its nominal speeds, spools and disks (:class:`SpoolSpeedMixin`);
+        None for a model built by hand.
     """
 
     M: np.ndarray
@@ -149,6 +171,7 @@ class SystemMatrices(SpoolSpeedMixin):
     K_G: Mapping[str, np.ndarray] = field(default_factory=dict)
     tables: tuple[TabulatedSupport, ...] = ()
     supported_weight: np.ndarray | None = None
+    rotor: Rotor | None = field(default=None, compare=False, repr=False)
 
     @property
     def n_dof(self) -> int:
@@ -199,6 +222,25 @@ class _Triplets:
             return np.zeros((n, n))
         rows, cols, vals = (np.concatenate(x) for x in (self.rows, self.cols, self.vals))
         return coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
+
+
+def system_of(model, field_name: str = "model"):
+    """The model of an analysis: a :class:`Rotor` assembled (:func:`assemble`), or a :class:`SystemMatrices` or a
+    reduced model (:class:`rotorred.linear.reduction.ReducedSystem`) as given.
+
+    Every analysis reads its model through this one protocol (:class:`SpoolSpeedMixin`).
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For anything else, naming ``field_name``.
+    """
+    if isinstance(model, Rotor):
+        return assemble(model)
+    if isinstance(model, SpoolSpeedMixin):
+        return model
+    checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a ReducedSystem "
+                "(reduce_rotor)")
 
 
 def assemble(rotor: Rotor) -> SystemMatrices:
@@ -264,7 +306,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     if alpha or beta:
         Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
     free = SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
-                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables))
+                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor)
     return _supported(free, rotor.supports)
 
 
@@ -293,4 +335,4 @@ def _supported(system: SystemMatrices, supports) -> SystemMatrices:
     return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
                           dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
                           tables=tuple(dataclasses.replace(t, rows=t.rows[:, keep]) for t in system.tables),
-                          supported_weight=(system.M @ e_y)[keep])
+                          supported_weight=(system.M @ e_y)[keep], rotor=system.rotor)

@@ -1,0 +1,93 @@
+"""The one operating-point type (rotorred.model.operating.Operating) and its ratio rule."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import rotorred as rr
+from rotorred.checks import InputError
+from rotorred.model.assembly import system_of
+from rotorred.model.elements import Bearing, Disk, Material, ShaftElement
+from rotorred.model.operating import Operating, from_rad_s, to_rad_s
+from rotorred.model.rotor import Rotor, Spool
+from rotorred.model.speeds import SpeedProfile
+
+
+def three_spools(speeds=(100.0, 150.0, 50.0)) -> Rotor:
+    """Three coaxial-free spools a, b, c of four elements, a disk and two bearings each (nominal speeds rad/s)."""
+    steel = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
+    spools = tuple(Spool(name, tuple(ShaftElement(first + i, first + i + 1, 0.1, 0.03, 0.0, steel) for i in range(4)),
+                         speed=w) for name, first, w in zip(("a", "b", "c"), (0, 10, 20), speeds))
+    disks = tuple(Disk(first + 2, 5.0, 0.02, 0.04) for first in (0, 10, 20))
+    bearings = tuple(Bearing(k_xx=1e7, k_yy=1e7, c_xx=50.0, c_yy=50.0, node=n) for n in (0, 4, 10, 14, 20, 24))
+    return Rotor(spools, disks=disks, bearings=bearings, name="three")
+
+
+def test_units_convert_exactly_both_ways():
+    """rpm, Hz and rad/s: 30/pi and 2 pi, and back to the same number."""
+    assert to_rad_s(3000.0, "rpm") == pytest.approx(100 * math.pi, rel=1e-15)
+    assert to_rad_s(50.0, "Hz") == pytest.approx(100 * math.pi, rel=1e-15)
+    np.testing.assert_allclose(from_rad_s(to_rad_s(np.array([0.0, 1234.5]), "rpm"), "rpm"), [0.0, 1234.5], rtol=1e-15)
+    with pytest.raises(InputError, match=r"^unit = 'rps': must be one of 'rad/s', 'rpm', 'Hz'"):
+        to_rad_s(1.0, "rps")
+
+
+def test_line_follows_nominal_ratios_stated_ratios_and_fixed_speeds():
+    """Omega_s = a_s Omega + b_s: the nominal ratio where nothing is stated, a stated ratio, a fixed speed."""
+    rotor = three_spools()
+    W = np.array([0.0, 10.0, 20.0])
+    assert {s: v.tolist() for s, v in Operating.line(W).speeds(rotor).items()} == \
+        {"a": [0.0, 10.0, 20.0], "b": [0.0, 15.0, 30.0], "c": [0.0, 5.0, 10.0]}
+    op = Operating.line(W, "b", ratios={"a": 2.0}, fixed={"c": 7.0})
+    assert {s: v.tolist() for s, v in op.speeds(rotor).items()} == \
+        {"a": [0.0, 20.0, 40.0], "b": [0.0, 10.0, 20.0], "c": [7.0, 7.0, 7.0]}
+    assert [line.how for line in op.lines(rotor).values()] == ["ratio", "reference", "fixed"]
+    # the same through an assembled and a reduced model: the protocol carries the rotor's nominal speeds
+    for model in (system_of(rotor), rr.reduce_rotor(rotor, n_modes=4)):
+        assert {s: v.tolist() for s, v in Operating.line(W).speeds(model).items()}["b"] == [0.0, 15.0, 30.0]
+
+
+def test_zero_reference_speed():
+    """A reference at rest: a stated ratio gives 0, a fixed spool keeps its speed; a point can hold the reference at
+    0 with the others turning; when the nominal reference speed is 0 every other spool must be stated."""
+    rotor = three_spools((0.0, 150.0, 50.0))
+    assert Operating.point({"a": 0.0, "b": 300.0, "c": 20.0}).at(rotor) == {"a": 0.0, "b": 300.0, "c": 20.0}
+    assert Operating.line([0.0, 5.0], ratios={"b": 2.0}, fixed={"c": 3.0}).at(rotor, 0) == \
+        {"a": 0.0, "b": 0.0, "c": 3.0}
+    with pytest.raises(InputError, match=r"must state the speed of spool\(s\) \['c'\] \(ratios= or fixed=\): the "
+                                         r"nominal speed of the reference spool 'a' is 0"):
+        Operating.line([0.0, 5.0], ratios={"b": 2.0}).speeds(rotor)
+
+
+def test_point_line_profile_and_their_errors():
+    rotor = three_spools()
+    p = Operating.point({"b": 3000.0, "a": 1500.0}, unit="rpm")
+    assert p.kind == "point" and p.reference_of(rotor) == "b"
+    assert p.single(rotor) == pytest.approx({"a": 50 * math.pi, "b": 100 * math.pi, "c": 100 * math.pi / 3}, rel=1e-14)
+    line = Operating.line([0.0, 100.0])
+    assert line.kind == "line"
+    with pytest.raises(InputError, match=r"^operating = 'line of 2 speeds: first spool 0-100 rad/s': must be one "
+                                         r"operating point"):
+        line.single(rotor)
+    with pytest.raises(InputError, match=r"^ratios spool = 'd': must be one of 'b', 'c'"):
+        Operating.line([1.0], ratios={"d": 1.0}).speeds(rotor)
+    with pytest.raises(InputError, match=r"^fixed = .*must not name a spool that ratios also names \(b\)"):
+        Operating.line([1.0], ratios={"b": 1.0}, fixed={"b": 2.0})
+    with pytest.raises(InputError, match=r"^Omega = .*must hold values >= 0 only \(rpm\)"):
+        Operating.line([-1.0], unit="rpm")
+    ramp = Operating.ramp({"a": 0.0}, {"a": 100.0}, 2.0)
+    assert ramp.kind == "profile"
+    full = ramp.profile_for(rotor)
+    assert {s: w.tolist() for s, w in full.speeds.items()} == {"a": [0.0, 100.0], "b": [0.0, 150.0], "c": [0.0, 50.0]}
+    with pytest.raises(InputError, match=r"must be a point or a speed line for speeds\(\)"):
+        ramp.speeds(rotor)
+    const = Operating.point({"a": 10.0}).profile_for(rotor)
+    assert isinstance(const, SpeedProfile) and const.speeds_at(5.0) == {"a": 10.0, "b": 15.0, "c": 5.0}
+
+
+def test_repr_is_one_short_line():
+    text = repr(Operating.line(np.linspace(0, 12000, 61), "inner", ratios={"outer": 1.3}, unit="rpm"))
+    assert text == "Operating(line of 61 speeds: inner 0-12000 rpm; outer at ratio 1.3)"
