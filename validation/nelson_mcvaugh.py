@@ -94,9 +94,9 @@ def main(argv=None) -> int:
     if args.plot:
         result = campbell(rotor("isotropic"), np.linspace(0, 40000, 81) * math.pi / 30, n_modes=N_MODES,
                           harmonics=(1, 2))
-        from rotorred.plots.campbell import plot_campbell
+        from rotorred.plots.axes import save
 
-        print(f"wrote {plot_campbell(result, args.plot)}")
+        print(f"wrote {save(result.plot(), args.plot)}")
     return 0
 
 

@@ -69,9 +69,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
+    import matplotlib  # noqa: F401 - a missing matplotlib fails before any work
+
     from rotorred.linear.campbell import campbell
     from rotorred.model.rotor_file import read_rotor
-    from rotorred.plots.campbell import plot_campbell
+    from rotorred.plots.axes import save
     from rotorred.writers import toml_text
 
     out = out_dir("--out", args.out)
@@ -97,7 +99,7 @@ def run(args) -> int:
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
             operating = ref_nominal if ref_nominal > 0 else None
-            files.append(plot_campbell(result, folder.staged("campbell.png"), operating_speed=operating))
+            files.append(save(result.plot(operating_speed=operating), folder.staged("campbell.png")))
             files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
                           format_mode_count(result)] + ([comparison] if comparison else []))

@@ -276,18 +276,18 @@ def _check_model_options(args) -> None:
 def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[str]:
     """Stage response.csv, bode.png, polar.png (and frf.csv, frf.png); returns their names."""
     from rotorred.linear.harmonic import frequency_response
-    from rotorred.plots.harmonic import plot_bode, plot_frf, plot_polar
+    from rotorred.plots.axes import save
 
     result.write_csv(folder.staged("response.csv"))
-    plot_bode(result, folder.staged("bode.png"), title)
-    plot_polar(result, folder.staged("polar.png"), title)
+    save(result.plot(kind="bode", title=title), folder.staged("bode.png"))
+    save(result.plot(kind="polar", title=title), folder.staged("polar.png"))
     names = ["response.csv", "bode.png", "polar.png"]
     if frf_pairs:
         inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
         frf = frequency_response(model, inputs, list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs,
                                  speeds=rotor.speeds)
         frf.write_csv(folder.staged("frf.csv"))
-        plot_frf(frf, folder.staged("frf.png"))
+        save(frf.plot(), folder.staged("frf.png"))
         names += ["frf.csv", "frf.png"]
     return names
 

@@ -55,6 +55,7 @@ from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, assemble
 from rotorred.model.rotor import Rotor
 from rotorred.progress import stage
+from rotorred.results import Result
 
 WHIRL_LABELS = ("forward", "backward", "mixed", "planar")
 
@@ -99,8 +100,8 @@ class _PointOnTheDiagram:
         return self.frequency / (2.0 * math.pi)
 
 
-@dataclass(frozen=True)
-class CriticalSpeed(_PointOnTheDiagram):
+@dataclass(frozen=True, repr=False)
+class CriticalSpeed(_PointOnTheDiagram, Result):
     """A crossing of a whirl curve with an excitation line h x Omega_s.
 
     Attributes
@@ -147,6 +148,37 @@ class CriticalSpeed(_PointOnTheDiagram):
     def damping_ratio(self) -> float:
         """Damping ratio of the mode at the crossing, delta / sqrt(delta^2 + 4 pi^2) (-)."""
         return self.log_dec / math.sqrt(self.log_dec ** 2 + 4.0 * math.pi ** 2)
+
+    def summary(self) -> list[str]:
+        """Where the curve meets which line, and the mode there."""
+        lines = [f"{self.speed_rpm:.6g} rpm of the reference spool on {self.line} "
+                 f"({self.spool} at {self.spool_speed * 30.0 / math.pi:.6g} rpm)",
+                 f"mode {self.mode}, {self.whirl} whirl at {self.frequency_hz:.6g} Hz",
+                 f"log dec {self.log_dec:.4g}, damping ratio {self.damping_ratio:.4g}"]
+        return lines
+
+    def plot(self, ax=None, **options):
+        """Mark the crossing (rpm, Hz) with its excitation line; into a Campbell diagram's axes it annotates
+        that critical speed (:func:`rotorred.plots.campbell.draw_critical_speed`, its options). Returns the
+        Figure."""
+        from rotorred.plots.campbell import draw_critical_speed
+
+        return draw_critical_speed(self, ax, **options)
+
+    def to_xarray(self):
+        """Scalars ``speed`` (reference spool, rad/s), ``spool_speed`` (rad/s), ``frequency`` (Hz), ``harmonic``,
+        ``mode``, ``whirl`` (:data:`WHIRL_LABELS` flags), ``log_dec``; the line and spool as attributes."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"speed": ((), self.speed, {"units": "rad/s", "long_name": "speed of the reference spool"}),
+             "spool_speed": ((), self.spool_speed, {"units": "rad/s", "long_name": f"speed of the {self.spool} spool"}),
+             "frequency": ((), self.frequency_hz, {"units": "Hz", "long_name": "whirl frequency"}),
+             "harmonic": ((), self.harmonic, {"units": "1", "long_name": f"multiple of the {self.spool} speed"}),
+             "mode": ((), self.mode, {"units": "1", "long_name": "tracked mode (column of the Campbell result)"}),
+             "whirl": ((), _whirl_codes(self.whirl), _WHIRL_ATTRS),
+             "log_dec": ((), self.log_dec, {"units": "1", "long_name": "logarithmic decrement"})},
+            attrs={"title": "critical speed", "line": self.line, "spool": self.spool})
 
 
 @dataclass(frozen=True)
@@ -221,8 +253,8 @@ class ModeCount:
         return self.limit / (2.0 * math.pi)
 
 
-@dataclass(frozen=True)
-class CampbellResult:
+@dataclass(frozen=True, repr=False)
+class CampbellResult(Result):
     """Whirl frequencies of tracked modes against the speed of a reference spool.
 
     Attributes
@@ -330,12 +362,95 @@ class CampbellResult:
         """Damping ratio zeta = -Re(lambda) / |lambda| = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
         return self.log_dec / np.sqrt(self.log_dec ** 2 + 4.0 * np.pi ** 2)
 
+    def summary(self) -> list[str]:
+        """The sweep, the modes tracked, the frequency range, the first critical speeds and the stability."""
+        rpm = self.speeds_rpm
+        others = [f"{s}/{self.reference} = {r:.4g}" for s, r in self.speed_ratios.items() if s != self.reference]
+        sweep = f"{len(rpm)} speeds of the {self.reference} spool, {rpm[0]:.6g}-{rpm[-1]:.6g} rpm" if len(rpm) > 1 \
+            else f"{rpm[0]:.6g} rpm of the {self.reference} spool"
+        lines = [f"{self.rotor_name or 'rotor'}: {self.n_modes} modes tracked at {sweep}",
+                 (f"speed ratios {', '.join(others)}; " if others else "") + "excitation lines "
+                 + ", ".join(excitation_label(h, s) for s, h, _ in self.excitation_lines)]
+        if self.mode_count is not None:
+            mc = self.mode_count
+            lines.append(f"modes: every mode below {mc.margin:g} x {mc.limit_hz:.4g} Hz "
+                         f"({excitation_label(mc.harmonic, mc.spool)} at the top speed), at least {MIN_DEFAULT_MODES}")
+        f = self.frequencies_hz
+        lines.append(f"whirl frequencies {f.min():.4g}-{f.max():.4g} Hz")
+        lines += self._critical_lines(5) + [self._stability_line()]
+        if self.rigid_modes:
+            lines.append("rigid-body modes (no critical speeds): " + ", ".join(map(str, self.rigid_modes)))
+        if self.beyond_tables:
+            lines.append(f"the speeds leave the table of {len(self.beyond_tables)} speed-dependent bearing(s)")
+        return lines
+
+    def _critical_lines(self, most: int) -> list[str]:
+        """The number of critical speeds and the first ``most`` of them, a line each."""
+        cs = self.critical_speeds
+        lines = [f"{len(cs)} critical speeds" + (":" if cs else " in the speed range")]
+        lines += [f"  {c.speed_rpm:.6g} rpm: {c.line}, mode {c.mode} {c.whirl} at {c.frequency_hz:.4g} Hz, "
+                  f"log dec {c.log_dec:.3g}" for c in cs[:most]]
+        if len(cs) > most:
+            lines.append(f"  ... {len(cs) - most} more (critical_speeds)")
+        return lines
+
+    def _stability_line(self) -> str:
+        """Stable over the sweep, or where which modes change stability."""
+        if self.stability_changes:
+            return "stability: " + "; ".join(
+                f"mode {c.mode} {'unstable above' if c.onset else 'stable above'} {c.speed_rpm:.6g} rpm"
+                for c in self.stability_changes[:3]) + ("; ..." if len(self.stability_changes) > 3 else "")
+        if np.any(self.unstable):
+            return f"UNSTABLE: modes {', '.join(map(str, np.flatnonzero(self.unstable.any(axis=0))))} (log dec < 0)"
+        return "stable over the sweep (no log dec < 0)"
+
+    def plot(self, ax=None, **options):
+        """Draw the Campbell diagram (:func:`rotorred.plots.campbell.draw_campbell`, whose options it takes:
+        ``operating_speed`` (rad/s), ``title``, ``max_frequency_hz``, ``figsize``); return the Figure."""
+        from rotorred.plots.campbell import draw_campbell
+
+        return draw_campbell(self, ax, **options)
+
+    def to_xarray(self):
+        """The diagram as an :class:`xarray.Dataset`.
+
+        Dimensions ``speed`` (coordinate: the reference spool's speed, rad/s), ``mode`` (0-based tracked mode),
+        ``spool``, ``critical`` (the critical speeds) and ``stability_change``. Variables ``frequency``
+        (speed, mode) in Hz (:attr:`frequencies_hz`), ``log_dec``, ``whirl`` (flags of :data:`WHIRL_LABELS`),
+        ``tracking_mac`` (MAC with the previous speed, NaN at the first), ``rigid`` (mode), ``speed_ratio``
+        (spool), and ``critical_*`` / ``stability_*`` per crossing (speeds in rad/s of the reference spool,
+        frequencies in Hz).
+        """
+        import xarray as xr
+
+        mac = np.vstack([np.full((1, self.n_modes), np.nan), self.tracking_mac])
+        sm, one = ("speed", "mode"), {"units": "1"}
+        data = {
+            "frequency": (sm, self.frequencies_hz, {"units": "Hz", "long_name": "damped whirl frequency"}),
+            "log_dec": (sm, self.log_dec, {**one, "long_name": "logarithmic decrement"}),
+            "whirl": (sm, _whirl_codes(self.whirl), _WHIRL_ATTRS),
+            "tracking_mac": (sm, mac, {**one, "long_name": "MAC of the mode's shape with the previous speed"}),
+            "rigid": ("mode", np.isin(np.arange(self.n_modes), self.rigid_modes).astype(np.int8),
+                      {**one, "long_name": "rigid-body mode of a free or singly supported spool (1)"}),
+            "speed_ratio": ("spool", np.array(list(self.speed_ratios.values()), float),
+                            {**one, "long_name": f"speed over the {self.reference} spool's speed"}),
+            **_critical_variables(self.critical_speeds, self.reference),
+            **_stability_variables(self.stability_changes, self.reference),
+        }
+        coords = {"speed": ("speed", self.speeds,
+                            {"units": "rad/s", "long_name": f"speed of the {self.reference} spool"}),
+                  "mode": ("mode", np.arange(self.n_modes), {**one, "long_name": "tracked mode"}),
+                  "spool": ("spool", np.array(list(self.speed_ratios), dtype=object), {**one, "long_name": "spool"})}
+        return xr.Dataset(data, coords, attrs={
+            "title": "Campbell diagram", "rotor": self.rotor_name, "reference_spool": self.reference,
+            "harmonics": np.array(self.harmonics, float)})
+
     def to_csv(self, path: str | Path) -> Path:
         """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec,stable``
         (``stable``: ``no`` where the log dec is below ``-NEUTRAL_LOG_DEC``).
 
         Speeds with 10 significant digits, frequencies with 9, log decrements with 6. The
-        diagram itself is drawn by :func:`rotorred.plots.campbell.plot_campbell`.
+        diagram itself is drawn by :meth:`plot`.
         """
         n_s, n_m = self.frequencies.shape
         speed = np.repeat(self.speeds_rpm, n_m)
@@ -346,6 +461,49 @@ class CampbellResult:
         stable = ["no" if v < -NEUTRAL_LOG_DEC else "yes" for v in self.log_dec.ravel()]
         return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"],
                                  [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec, stable], digits=10)
+
+
+#: attributes of a whirl-direction variable: CF flags, the codes' meanings in :data:`WHIRL_LABELS` order
+_WHIRL_ATTRS = {"units": "1", "long_name": "whirl direction",
+                "flag_values": np.arange(len(WHIRL_LABELS), dtype=np.int8), "flag_meanings": " ".join(WHIRL_LABELS)}
+
+
+def _whirl_codes(whirl) -> np.ndarray:
+    """The index in :data:`WHIRL_LABELS` of each whirl label, same shape (int8)."""
+    return np.vectorize(WHIRL_LABELS.index, otypes=[np.int8])(np.asarray(whirl, dtype=object)) if np.size(whirl) \
+        else np.zeros(np.shape(whirl), np.int8)
+
+
+def _critical_variables(cs: Sequence[CriticalSpeed], reference: str) -> dict:
+    """The ``critical_*`` variables of :meth:`CampbellResult.to_xarray`, along the dimension ``critical``."""
+    one = {"units": "1"}
+    return {
+        "critical_speed": ("critical", np.array([c.speed for c in cs], float),
+                           {"units": "rad/s", "long_name": f"critical speed of the {reference} spool"}),
+        "critical_frequency": ("critical", np.array([c.frequency_hz for c in cs], float),
+                               {"units": "Hz", "long_name": "whirl frequency at the critical speed"}),
+        "critical_spool": ("critical", np.array([c.spool for c in cs], dtype=object),
+                           {**one, "long_name": "spool whose excitation line is crossed"}),
+        "critical_harmonic": ("critical", np.array([c.harmonic for c in cs], float),
+                              {**one, "long_name": "multiple of that spool's speed"}),
+        "critical_mode": ("critical", np.array([c.mode for c in cs], np.int64), {**one, "long_name": "mode"}),
+        "critical_whirl": ("critical", _whirl_codes([c.whirl for c in cs]), _WHIRL_ATTRS),
+        "critical_log_dec": ("critical", np.array([c.log_dec for c in cs], float),
+                             {**one, "long_name": "logarithmic decrement at the critical speed"}),
+    }
+
+
+def _stability_variables(sc: Sequence[StabilityChange], reference: str) -> dict:
+    """The ``stability_*`` variables of :meth:`CampbellResult.to_xarray`, along the dimension ``stability_change``."""
+    one = {"units": "1"}
+    return {
+        "stability_speed": ("stability_change", np.array([c.speed for c in sc], float),
+                            {"units": "rad/s", "long_name": f"speed of the {reference} spool where a mode's log dec "
+                                                            "crosses zero"}),
+        "stability_mode": ("stability_change", np.array([c.mode for c in sc], np.int64), {**one, "long_name": "mode"}),
+        "stability_onset": ("stability_change", np.array([c.onset for c in sc], np.int8),
+                            {**one, "long_name": "1: unstable above, 0: stable above"}),
+    }
 
 
 def excitation_label(harmonic: float, spool: str) -> str:

@@ -42,14 +42,18 @@ import scipy.linalg as sla
 
 from rotorred import checks, writers
 from rotorred.model.loads import Unbalance
+from rotorred.results import Result
 
 Output = tuple[int, str]
 #: significant digits of the CSV files
 CSV_DIGITS = 10
+#: most outputs (or FRF pairs) a repr lists, a line each
+_LISTED = 8
+_RPM = 60.0 / (2.0 * math.pi)
 
 
-@dataclass(frozen=True)
-class UnbalanceResponse:
+@dataclass(frozen=True, repr=False)
+class UnbalanceResponse(Result):
     """Steady-state unbalance response over a speed sweep.
 
     Attributes
@@ -132,9 +136,68 @@ class UnbalanceResponse:
             cols.append(1e6 * self.peak(o))
         return writers.write_csv(path, header, cols, digits=CSV_DIGITS)
 
+    def summary(self) -> list[str]:
+        """The sweep, the excited spools, and the largest peak bound of each output."""
+        rpm = self.speeds * _RPM
+        top = int(np.argmax(self.speeds))
+        ratios = [f"{s}/{self.reference_spool} = {w[top] / self.speeds[top]:.4g}" for s, w in self.spool_speeds.items()
+                  if s != self.reference_spool and self.speeds[top] > 0]
+        lines = [f"unbalances on the {', '.join(self.excited_spools)} spool(s); {len(rpm)} speeds of the "
+                 f"{self.reference_spool} spool, {rpm.min():.6g}-{rpm.max():.6g} rpm"
+                 + (f"; speed ratios {', '.join(ratios)}" if ratios else "")]
+        for o in self.outputs[:_LISTED]:
+            peak = self.peak(o)
+            k = int(np.argmax(peak))
+            lines.append(f"node {o[0]} {o[1]}: largest peak bound {1e6 * peak[k]:.4g} µm at {rpm[k]:.6g} rpm")
+        if len(self.outputs) > _LISTED:
+            lines.append(f"... {len(self.outputs) - _LISTED} more outputs")
+        return lines
 
-@dataclass(frozen=True)
-class FrequencyResponse:
+    def plot(self, ax=None, kind: str = "bode", **options):
+        """Draw the response; return the Figure.
+
+        ``kind="bode"`` (default): amplitude (µm, log) and phase (deg) against the reference speed (rpm), a
+        column per output (:func:`rotorred.plots.harmonic.draw_bode`); ``kind="polar"``: the phasor tips
+        (:func:`rotorred.plots.harmonic.draw_polar`). Into a given ``ax`` (one panel), Bode draws the
+        amplitudes and polar the phasor tips of every output. ``options``: ``title``.
+        """
+        from rotorred.plots.harmonic import draw_bode, draw_polar
+
+        draw = {"bode": draw_bode, "polar": draw_polar}[checks.choice("kind", kind, ("bode", "polar"))]
+        return draw(self, ax, **options)
+
+    def to_xarray(self):
+        """The sweep as an :class:`xarray.Dataset`.
+
+        Dimensions ``speed`` (coordinate: the reference spool's speed, rad/s), ``spool``, ``excited_spool``
+        (spools carrying an unbalance) and ``output`` (labels ``"13:x"``, with coordinates ``node`` and
+        ``direction``). Variables ``spool_speed`` (spool, speed) in rad/s, ``amplitude`` |Q| (m) and ``phase``
+        arg Q (rad) (excited_spool, speed, output), and ``peak_bound`` (speed, output) in m (:meth:`peak`).
+        """
+        import xarray as xr
+
+        excited, dims = self.excited_spools, ("excited_spool", "speed", "output")
+        amplitude = np.array([[self.amplitude(o, s) for o in self.outputs] for s in excited]).transpose(0, 2, 1)
+        phase = np.array([[self.phase(o, s) for o in self.outputs] for s in excited]).transpose(0, 2, 1)
+        data = {
+            "spool_speed": (("spool", "speed"), np.array([self.spool_speeds[s] for s in self.spool_speeds], float),
+                            {"units": "rad/s", "long_name": "speed of the spool"}),
+            "amplitude": (dims, amplitude, {"units": "m", "long_name": "amplitude |Q| of the response to the "
+                                                                      "spool's unbalances, at the spool's speed"}),
+            "phase": (dims, phase, {"units": "rad", "long_name": "phase arg Q, q(t) = |Q| cos(Omega t + arg Q)"}),
+            "peak_bound": (("speed", "output"), np.array([self.peak(o) for o in self.outputs]).T,
+                           {"units": "m", "long_name": "peak bound: sum of the magnitudes over distinct frequencies"}),
+        }
+        coords = {"speed": ("speed", self.speeds, {"units": "rad/s", "long_name": f"speed of the "
+                                                                                  f"{self.reference_spool} spool"}),
+                  "spool": _labels("spool", list(self.spool_speeds), "spool"),
+                  "excited_spool": _labels("excited_spool", list(excited), "spool carrying an unbalance"),
+                  **_output_coords("output", self.outputs, "response DOF")}
+        return xr.Dataset(data, coords, attrs={"title": "unbalance response", "reference_spool": self.reference_spool})
+
+
+@dataclass(frozen=True, repr=False)
+class FrequencyResponse(Result):
     """Frequency response functions between physical DOFs at fixed spool speeds.
 
     Attributes
@@ -171,9 +234,66 @@ class FrequencyResponse:
                 cols += [np.abs(self.h(o, i)), np.degrees(np.angle(self.h(o, i)))]
         return writers.write_csv(path, header, cols, digits=CSV_DIGITS)
 
+    def summary(self) -> list[str]:
+        """The sweep, the spool speeds, and the largest |H| of each pair."""
+        f = self.frequencies / (2 * math.pi)
+        lines = [f"receptance of {len(self.outputs)} output(s) x {len(self.inputs)} input(s) at {len(f)} frequencies, "
+                 f"{f.min():.4g}-{f.max():.4g} Hz",
+                 "spool speeds: " + (", ".join(f"{s} {w * _RPM:.6g} rpm" for s, w in self.speeds.items())
+                                     or "not spinning")]
+        pairs = [(o, i) for o in self.outputs for i in self.inputs]
+        for o, i in pairs[:_LISTED]:
+            h = np.abs(self.h(o, i))
+            k = int(np.argmax(h))
+            lines.append(f"node {o[0]} {o[1]} / node {i[0]} {i[1]}: largest |H| {h[k]:.4g} m/N at {f[k]:.4g} Hz")
+        if len(pairs) > _LISTED:
+            lines.append(f"... {len(pairs) - _LISTED} more pairs")
+        return lines
 
-@dataclass(frozen=True)
-class SteadyState:
+    def plot(self, ax=None, **options):
+        """Bode plot of every pair, |H| (m/N, log) above the phase (deg) against frequency (Hz)
+        (:func:`rotorred.plots.harmonic.draw_frf`; into a given ``ax``, |H| only); ``options``: ``title``.
+        Returns the Figure."""
+        from rotorred.plots.harmonic import draw_frf
+
+        return draw_frf(self, ax, **options)
+
+    def to_xarray(self):
+        """The FRFs as an :class:`xarray.Dataset`: dimensions ``frequency`` (coordinate in Hz), ``output`` and
+        ``input`` (labels ``"13:x"``, with ``*_node`` and ``*_direction``), ``spool``; variables ``amplitude``
+        |H| (m/N) and ``phase`` arg H (rad) (frequency, output, input), and ``spool_speed`` (spool) in rad/s."""
+        import xarray as xr
+
+        dims = ("frequency", "output", "input")
+        data = {"amplitude": (dims, np.abs(self.H), {"units": "m/N", "long_name": "receptance |H|"}),
+                "phase": (dims, np.angle(self.H), {"units": "rad", "long_name": "phase of the receptance, arg H"}),
+                "spool_speed": ("spool", np.array(list(self.speeds.values()), float),
+                                {"units": "rad/s", "long_name": "spool speed held during the sweep"})}
+        coords = {"frequency": ("frequency", self.frequencies / (2 * math.pi),
+                                {"units": "Hz", "long_name": "excitation frequency"}),
+                  "spool": _labels("spool", list(self.speeds), "spool"),
+                  **_output_coords("output", self.outputs, "response DOF"),
+                  **_output_coords("input", self.inputs, "force DOF")}
+        return xr.Dataset(data, coords, attrs={"title": "receptance FRF"})
+
+
+def _labels(dim: str, labels: Sequence[str], long_name: str) -> tuple:
+    """A dimension coordinate of string labels (``units`` "1")."""
+    return (dim, np.array(labels, dtype=object), {"units": "1", "long_name": long_name})
+
+
+def _output_coords(dim: str, outputs: Sequence[Output], long_name: str) -> dict:
+    """Coordinates of a dimension of (node, direction) pairs: labels ``"13:x"``, and the node and the direction
+    (``<dim>_node``, ``<dim>_direction``; ``node`` and ``direction`` for ``output``)."""
+    prefix = "" if dim == "output" else f"{dim}_"
+    return {dim: _labels(dim, [f"{n}:{d}" for n, d in outputs], long_name),
+            f"{prefix}node": (dim, np.array([n for n, _ in outputs], np.int64), {"units": "1", "long_name": "node"}),
+            f"{prefix}direction": (dim, np.array([d for _, d in outputs], dtype=object),
+                                   {"units": "1", "long_name": "direction (x, y, tx, ty)"})}
+
+
+@dataclass(frozen=True, repr=False)
+class SteadyState(Result):
     """Steady-state unbalance response at one operating point, in the model's own coordinates.
 
     Use it as the initial condition of a transient run, so the start-up transient of lightly
@@ -199,6 +319,49 @@ class SteadyState:
         """q'(t) = sum_s Re(i Omega_s Q_s e^{i Omega_s t}), shape (n,)."""
         return sum(np.real(1j * self.speeds[s] * Q * np.exp(1j * self.speeds[s] * t))
                    for s, Q in self.phasors.items())
+
+    def summary(self) -> list[str]:
+        """The spool speeds, and the largest amplitude per excited spool."""
+        lines = ["spool speeds: " + ", ".join(f"{s} {w * _RPM:.6g} rpm" for s, w in self.speeds.items())]
+        for s, Q in self.phasors.items():
+            k = int(np.argmax(np.abs(Q)))
+            lines.append(f"{s} unbalance: {len(Q)} model coordinates, largest |Q| {abs(Q[k]):.4g} at coordinate {k}")
+        return lines
+
+    def plot(self, ax=None, **options):
+        """Draw the steady state (:func:`rotorred.plots.harmonic.draw_steady_state`, its options); return the Figure.
+
+        With ``model=`` and ``node=``, the node's orbit (µm) over a few revolutions, its start q(0) marked:
+        what a rotordynamics engineer checks of a steady state (its size and shape, the rosette of two spools,
+        the initial condition a transient starts from). By default, without a model (the result holds only
+        model coordinates): the amplitude |Q| of every model coordinate per excited spool.
+        """
+        from rotorred.plots.harmonic import draw_steady_state
+
+        return draw_steady_state(self, ax, **options)
+
+    def to_xarray(self):
+        """The phasors as an :class:`xarray.Dataset`: dimensions ``coordinate`` (index of the model's coordinate),
+        ``excited_spool`` and ``spool``; variables ``amplitude`` |Q| and ``phase`` arg Q (rad) (excited_spool,
+        coordinate), and ``spool_speed`` (spool) in rad/s. The amplitudes have the units of the model's
+        coordinates, m and rad for a full model (its DOF order), those of the recovery map for a reduced one:
+        the ``units`` attribute says "1" and ``comment`` says so."""
+        import xarray as xr
+
+        Q = np.array(list(self.phasors.values()))
+        n = Q.shape[1] if Q.ndim == 2 else 0
+        dims = ("excited_spool", "coordinate")
+        comment = "in the units of each model coordinate: m (translations), rad (rotations) of a full model"
+        data = {"amplitude": (dims, np.abs(Q), {"units": "1", "long_name": "amplitude |Q| of the model coordinate",
+                                                "comment": comment}),
+                "phase": (dims, np.angle(Q), {"units": "rad", "long_name": "phase arg Q, "
+                                                                            "q(t) = |Q| cos(Omega t + arg Q)"}),
+                "spool_speed": ("spool", np.array(list(self.speeds.values()), float),
+                                {"units": "rad/s", "long_name": "spool speed"})}
+        coords = {"coordinate": ("coordinate", np.arange(n), {"units": "1", "long_name": "model coordinate"}),
+                  "spool": _labels("spool", list(self.speeds), "spool"),
+                  "excited_spool": _labels("excited_spool", list(self.phasors), "spool carrying an unbalance")}
+        return xr.Dataset(data, coords, attrs={"title": "steady unbalance response"})
 
 
 def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, float],

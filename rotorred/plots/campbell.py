@@ -1,13 +1,11 @@
-"""Campbell diagram figure: whirl curves by direction, excitation lines, critical speeds."""
+"""Campbell diagram figure: whirl curves by direction, excitation lines, critical speeds (rpm, Hz)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
-from matplotlib.figure import Figure
 
-from rotorred.linear.campbell import CampbellResult, excitation_label
+from rotorred.linear.campbell import CampbellResult, CriticalSpeed, excitation_label
+from rotorred.plots.axes import axes
 
 #: colour and line style of each whirl direction
 WHIRL_STYLE = {
@@ -16,39 +14,49 @@ WHIRL_STYLE = {
     "mixed": dict(color="tab:purple", linestyle="-."),
     "planar": dict(color="tab:gray", linestyle=":"),
 }
+#: marker of a critical speed
+CRITICAL_STYLE = dict(marker="o", linestyle="none", mfc="none", mec="black", ms=8, mew=1.5, zorder=5)
 
 
-def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: float | None = None,
-                  title: str | None = None, max_frequency_hz: float | None = None) -> Path:
-    """Write the Campbell diagram of ``result`` as a PNG.
+def draw_campbell(result: CampbellResult, ax=None, *, operating_speed: float | None = None, title: str | None = None,
+                  max_frequency_hz: float | None = None, figsize: tuple[float, float] = (11.0, 6.0)):
+    """Draw the Campbell diagram of ``result`` (:meth:`CampbellResult.plot`); return the Figure.
+
+    Whirl curves coloured by whirl direction (mode number at the right end), the excitation lines labelled
+    inline, the critical speeds (circles), grid points where a mode is unstable (crosses) and the stability
+    limits (diamonds); speeds in rpm, frequencies in Hz, the other spool's speed on the top axis.
 
     Parameters
     ----------
     result : CampbellResult
-    path : str or Path
-        Output file (PNG).
+    ax : matplotlib Axes, optional
+        Axes to draw into; default a new figure of ``figsize`` (in), laid out tight.
     operating_speed : float, optional
         Reference-spool operating speed (rad/s), drawn as a vertical line.
     title : str, optional
         Default: "Campbell diagram - <rotor name>" with the speed ratios.
     max_frequency_hz : float, optional
         Upper limit of the frequency axis (Hz); default 10 % above the highest tracked curve.
+    figsize : (float, float)
+        Size of a new figure (in); the legend sits beside the diagram.
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
-    path = Path(path)
-    fig = Figure(figsize=(11, 6), dpi=120)
-    ax = fig.subplots()
+    new = ax is None
+    fig, ax = axes(ax, figsize)
     top = max_frequency_hz or 1.1 * float(result.frequencies_hz.max())
     _whirl_curves(ax, result, max_frequency_hz)
-    ax.set_xlim(float(result.speeds_rpm[0]), float(result.speeds_rpm[-1]))
+    rpm = result.speeds_rpm
+    lo, hi = (float(rpm[0]), float(rpm[-1])) if len(rpm) > 1 else (0.0, 1.1 * float(rpm[0]))  # one: from rest
+    if hi > lo:
+        ax.set_xlim(lo, hi)
     ax.set_ylim(0, top)
     _excitation_lines(ax, result, top)
     if result.critical_speeds:
         ax.plot([c.speed_rpm for c in result.critical_speeds], [c.frequency_hz for c in result.critical_speeds],
-                "o", mfc="none", mec="black", ms=8, mew=1.5, label="critical speed", zorder=5)
+                **CRITICAL_STYLE, label="critical speed")
     unstable = result.unstable
     if np.any(unstable):  # grid points where a mode's own motion grows
         ax.plot(np.broadcast_to(result.speeds_rpm[:, None], unstable.shape)[unstable], result.frequencies_hz[unstable],
@@ -60,9 +68,47 @@ def plot_campbell(result: CampbellResult, path: str | Path, *, operating_speed: 
         op = operating_speed * 30 / np.pi
         ax.axvline(op, color="tab:green", lw=1.2, label=f"operating point {op:.0f} rpm")
     _axes_and_legend(ax, result, title)
-    fig.tight_layout()
-    fig.savefig(path)
-    return path
+    if new:
+        fig.tight_layout()
+    return fig
+
+
+def draw_critical_speed(critical: CriticalSpeed, ax=None, *, figsize: tuple[float, float] = (6.0, 4.5)):
+    """Mark a critical speed (:meth:`CriticalSpeed.plot`) at (rpm, Hz) with its excitation line and a label;
+    return the Figure.
+
+    Drawn into the axes of a Campbell diagram (:func:`draw_campbell`, same units) it annotates that crossing;
+    into a new figure it shows the excitation line from rest to twice the critical speed and the crossing on it.
+
+    Parameters
+    ----------
+    critical : CriticalSpeed
+    ax : matplotlib Axes, optional
+        Axes to draw into; default a new figure of ``figsize`` (in).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    new = ax is None
+    fig, ax = axes(ax, figsize)
+    x, y = critical.speed_rpm, critical.frequency_hz
+    if new:
+        ax.plot([0.0, 2.0 * x], [0.0, 2.0 * y], color="0.2", lw=1.0, linestyle=(0, (6, 2)), label=critical.line)
+        ax.set_xlim(0.0, 2.0 * x)
+        ax.set_ylim(0.0, 2.0 * y)
+        ax.set_xlabel("speed of the reference spool (rpm)")
+        ax.set_ylabel("whirl frequency (Hz)")
+        ax.grid(True, alpha=0.3)
+    ax.plot([x], [y], **CRITICAL_STYLE, label=None if not new else "critical speed")
+    ax.annotate(f"{x:.0f} rpm, {y:.4g} Hz\nmode {critical.mode} {critical.whirl}, log dec {critical.log_dec:.3g}",
+                (x, y), xytext=(6, -6), textcoords="offset points", fontsize=8, va="top", zorder=6,
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
+    if new:
+        ax.set_title(f"critical speed on {critical.line}")
+        ax.legend(loc="upper left", fontsize=8)
+        fig.tight_layout()
+    return fig
 
 
 def _whirl_curves(ax, result: CampbellResult, max_frequency_hz: float | None) -> None:
@@ -78,7 +124,7 @@ def _whirl_curves(ax, result: CampbellResult, max_frequency_hz: float | None) ->
                 label = w[start] if w[start] not in seen else None
                 seen.add(w[start])
                 ax.plot(rpm[start:stop], f_hz[start:stop, j], lw=1.8, label=f"{label} whirl" if label else None,
-                        **WHIRL_STYLE[str(w[start])])
+                        marker="o" if len(rpm) == 1 else None, **WHIRL_STYLE[str(w[start])])
                 start = i
         if f_hz[-1, j] <= (max_frequency_hz or np.inf):
             ax.annotate(f"{j}", (rpm[-1], f_hz[-1, j]), xytext=(3, 0), textcoords="offset points", fontsize=8,
@@ -86,24 +132,30 @@ def _whirl_curves(ax, result: CampbellResult, max_frequency_hz: float | None) ->
 
 
 def _excitation_lines(ax, result: CampbellResult, top: float) -> None:
-    """The excitation lines, each labelled inline where it is farthest from the curves and other labels."""
+    """The excitation lines, each labelled inline where it is farthest from the curves and other labels; at
+    one speed (a whirl table), drawn from rest to it."""
     rpm, f_hz = result.speeds_rpm, result.frequencies_hz
     x_max = float(rpm[-1])
+    x0 = float(rpm[0]) if len(rpm) > 1 else 0.0
+    line_rpm, line_speeds = (rpm, result.speeds) if len(rpm) > 1 else (np.array([0.0, x_max]),
+                                                                       np.array([0.0, result.speeds[0]]))
     placed: list[tuple[float, float]] = []
     dashes = [(0, (6, 2)), (0, (1, 1.5)), (0, (6, 2, 1, 2)), (0, (3, 3)), (0, (8, 2, 1, 2, 1, 2))]
     for k, (spool, h, slope) in enumerate(result.excitation_lines):
         label = excitation_label(h, spool)
-        ax.plot(rpm, slope * result.speeds / (2 * np.pi), color="0.2", lw=1.0, linestyle=dashes[k % len(dashes)],
+        ax.plot(line_rpm, slope * line_speeds / (2 * np.pi), color="0.2", lw=1.0, linestyle=dashes[k % len(dashes)],
                 label=label)
+        if x_max <= x0:
+            continue
         # distances in axes fractions
         hz_per_rpm = slope * np.pi / 30 / (2 * np.pi)
         x_end = min(x_max, top / hz_per_rpm) if hz_per_rpm > 0 else x_max
-        best, x = -1.0, 0.5 * (float(rpm[0]) + x_end)
+        best, x = -1.0, 0.5 * (x0 + x_end)
         for t in np.linspace(0.2, 0.9, 15):
-            xc = float(rpm[0]) + t * (x_end - float(rpm[0]))
+            xc = x0 + t * (x_end - x0)
             yc = hz_per_rpm * xc
             gaps = [abs(np.interp(xc, rpm, f_hz[:, j]) - yc) / top for j in range(result.n_modes)]
-            gaps += [np.hypot((xc - xp) / (x_max - rpm[0]), (yc - yp) / top) for xp, yp in placed]
+            gaps += [np.hypot((xc - xp) / (x_max - x0), (yc - yp) / top) for xp, yp in placed]
             if min(gaps) > best:
                 best, x = min(gaps), xc
         placed.append((x, hz_per_rpm * x))

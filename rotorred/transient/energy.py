@@ -28,12 +28,13 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.loads import Unbalance
 from rotorred.model.speeds import SpeedProfile
+from rotorred.results import Result
 from rotorred.transient.matrices import contact_rows, force_columns
 from rotorred.transient.ramp import forces_at, profile_table
 
 
-@dataclass(frozen=True)
-class EnergyBalance:
+@dataclass(frozen=True, repr=False)
+class EnergyBalance(Result):
     """Energies and works of a transient at its record times (J), each shape (n_rec,), from 0 at t = 0.
 
     Attributes
@@ -64,6 +65,41 @@ class EnergyBalance:
         """Largest |residual| over the largest of |W_drive|, W_damping and |E - E0| (-)."""
         scale = max(np.max(np.abs(self.drive)), np.max(np.abs(self.damping)), np.max(np.abs(self.energy)))
         return float(np.max(np.abs(self.residual)) / scale) if scale > 0 else 0.0
+
+    def summary(self) -> list[str]:
+        """The span, the final energy and works, and the residual of the balance."""
+        lines = [f"{len(self.t)} records, t = {self.t[0]:.6g}-{self.t[-1]:.6g} s",
+                 f"at the end: E - E0 = {self.energy[-1]:.4g} J, W_drive = {self.drive[-1]:.4g} J, "
+                 f"W_damping = {self.damping[-1]:.4g} J"]
+        others = [f"{name} = {w[-1]:.4g} J" for name, w in (("W_gravity", self.gravity), ("W_contact", self.contact))
+                  if np.any(w != 0)]
+        if others:
+            lines.append("at the end: " + ", ".join(others))
+        lines.append(f"residual: largest {np.max(np.abs(self.residual)):.3g} J, relative {self.relative_residual:.3g}")
+        return lines
+
+    def plot(self, ax=None, **options):
+        """The terms of the balance (J) against time (s) (:func:`rotorred.plots.energy.draw_energy`, its options:
+        ``title``, ``figsize``); return the Figure."""
+        from rotorred.plots.energy import draw_energy
+
+        return draw_energy(self, ax, **options)
+
+    def to_xarray(self):
+        """The balance as an :class:`xarray.Dataset`: dimension ``time`` (coordinate, s); variables ``energy``,
+        ``drive``, ``damping``, ``gravity``, ``contact`` and ``residual`` (J), as the attributes of the same names."""
+        import xarray as xr
+
+        terms = {"energy": "E - E0: kinetic (with the spin coupling) plus strain energy",
+                 "drive": "work of the drive W_drive (unbalances and spin coupling)",
+                 "damping": "energy dissipated by damping W_damping", "gravity": "work of gravity W_gravity",
+                 "contact": "work of the contact forces W_contact",
+                 "residual": "E - E0 - (W_drive - W_damping + W_gravity + W_contact)"}
+        return xr.Dataset({name: ("time", getattr(self, name), {"units": "J", "long_name": text})
+                           for name, text in terms.items()},
+                          {"time": ("time", self.t, {"units": "s", "long_name": "record time"})},
+                          attrs={"title": "energy balance of a transient",
+                                 "relative_residual": self.relative_residual})
 
 
 def _trapezoid_work(force: np.ndarray, q: np.ndarray) -> np.ndarray:
