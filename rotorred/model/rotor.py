@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Mapping
 
 from rotorred import checks
@@ -321,6 +322,28 @@ class Rotor:
     def mass(self) -> float:
         """Total mass of shafts and disks (kg)."""
         return sum(e.mass for s in self.spools for e in s.all_elements) + sum(d.m for d in self.disks)
+
+    # --- writing --------------------------------------------------------------------
+    def to_toml(self, path: str | Path, header: str = "") -> Path:
+        """Write the rotor as a rotor file, which :func:`rotorred.load_rotor` reads back to an equal rotor (every
+        number to the bit; :func:`rotorred.model.rotor_file.rotor_table` says how).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (.toml), replaced atomically.
+        header : str, optional
+            Text written on top as comment lines (``# ...``).
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
+        from rotorred.model.rotor_file import rotor_table  # it imports this module
+        from rotorred.writers import write_toml
+
+        return write_toml(path, rotor_table(self), header)
 
     # --- derived models -------------------------------------------------------------
     def refined(self, n: int) -> Rotor:

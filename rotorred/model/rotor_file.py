@@ -36,6 +36,7 @@ key path, the value and what is allowed, e.g.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from importlib import resources
@@ -47,9 +48,10 @@ from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
                                      Material, Pedestal, ShaftElement, Support)
-from rotorred.model.loads import unbalance_from_table
+from rotorred.model.loads import Unbalance, unbalance_from_table
 from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
+from rotorred.writers import exact_in_unit
 
 try:  # Python >= 3.11
     import tomllib
@@ -57,14 +59,14 @@ except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
 __all__ = ["RotorFileError", "presets", "load_rotor", "read_rotor", "ROTOR_FILE_KEYS", "read_rotor_toml",
-           "rotor_document", "rotor_from_toml", "rotor_from_dict", "read_toml"]
+           "rotor_document", "rotor_from_toml", "rotor_from_dict", "read_toml", "rotor_table", "rpm_to_rad_s"]
 
 _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "intershaft_bearing", "support", "pedestal",
              "damping", "defaults"}
 #: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
 ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
-_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements", "stations",
+_SPOOL_KEYS = {"name", "first_node", "nodes", "z0", "speed_rpm", "speed_rad_s", "shear", "element", "rotary_inertia", "elements", "stations",
                "material", "sleeves"}
 _SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
 _STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
@@ -270,13 +272,15 @@ def _spools(value, materials: dict[str, Material]) -> tuple[Spool, ...]:
 
 
 def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
-    checks.keys(where, s, _SPOOL_KEYS, required={"name", "first_node"})
+    checks.keys(where, s, _SPOOL_KEYS, required={"name"})
+    _one_of(where, s, ("first_node", "nodes"))
+    _one_of(where, s, ("speed_rpm", "speed_rad_s"), required=False)
     if ("elements" in s) == ("stations" in s):
         checks.fail(where, sorted(k for k in ("elements", "stations") if k in s) or "neither",
                     "must give the shaft either as elements (a list of L, D_o, D_i, ...) or as stations (a list of z, D_o, "
                     "D_i, ...), one of the two")
     name = checks.string(f"{where}.name", s["name"], empty=False)
-    node = checks.integer(f"{where}.first_node", s["first_node"], ge=0)
+    node = checks.integer(f"{where}.first_node", s["first_node"], ge=0) if "first_node" in s else 0
     defaults = dict(shear=checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS),
                     element=checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS),
                     rotary_inertia=s.get("rotary_inertia", True))
@@ -298,10 +302,36 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
                            **{k: v for k, v in section.items() if k not in defaults})
             elements.extend(whole.split(n, list(range(node + 1, node + n))))
             node += n
-    speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
+    if "nodes" in s:
+        elements = _numbered(f"{where}.nodes", s["nodes"], elements)
+    if "speed_rad_s" in s:
+        speed = checks.non_negative(f"{where}.speed_rad_s", s["speed_rad_s"], "rad/s")
+    else:
+        speed = rpm_to_rad_s(checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm"))
     sleeves = _sleeves(where, s, elements, defaults, materials)
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0,
-                  sleeves=sleeves)
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves)
+
+
+def rpm_to_rad_s(rpm):
+    """A speed in rpm in rad/s, ``rpm * pi / 30`` (a float or an array): the one conversion of the file's speeds,
+    which the writer inverts exactly (:func:`rotor_table`)."""
+    return rpm * math.pi / 30.0
+
+
+def _one_of(where: str, table: dict, names: tuple[str, str], required: bool = True) -> None:
+    """At most one of the two keys ``names`` (the same quantity in two forms), and one if ``required``."""
+    given = [k for k in names if k in table]
+    if len(given) == 2:
+        checks.fail(f"{where}.{given[1]}", table[given[1]], f"must not be given with {given[0]}: give one of the two")
+    if required and not given:
+        raise InputError(f"{where}.{names[0]}", checks.MISSING, f"required (or {names[1]})")
+
+
+def _numbered(where: str, value, chain: list[ShaftElement]) -> list[ShaftElement]:
+    """The chain on the node numbers ``value``, one a node along the chain (a chain numbered 0, 1, ... on input)."""
+    nodes = checks.sequence(where, value, lambda f, v: checks.integer(f, v, ge=0), min_len=len(chain) + 1,
+                            max_len=len(chain) + 1, unique=True)
+    return [dataclasses.replace(e, left=nodes[e.left], right=nodes[e.right]) for e in chain]
 
 
 def _sleeves(where: str, s: dict, chain: list[ShaftElement], defaults: dict, materials: dict[str, Material]):
@@ -406,15 +436,21 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link"} | _TABLE_KEYS, required={"node"})
-    if "speed_rpm" not in b:
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "speed_rad_s", "link"} | _TABLE_KEYS,
+                required={"node"})
+    _one_of(where, b, ("speed_rpm", "speed_rad_s"), required=False)
+    if "speed_rpm" not in b and "speed_rad_s" not in b:
         for key in sorted(_TABLE_KEYS & set(b)):
             checks.fail(f"{where}.{key}", b[key], "needs speed_rpm: only a table against speed interpolates and "
                         "extrapolates")
         return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
-    rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
-    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(rpm * math.pi / 30.0),
-                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(rpm)))
+    if "speed_rad_s" in b:
+        speeds = checks.vector(f"{where}.speed_rad_s", b["speed_rad_s"], "rad/s", min_len=2, ge=0.0, increasing=True)
+    else:
+        speeds = rpm_to_rad_s(checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0,
+                                            increasing=True))
+    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(speeds),
+                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(speeds)))
 
 
 def _pedestal(where: str, p: dict) -> Pedestal:
@@ -469,3 +505,192 @@ def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
     boundary = checks.sequence("defaults.boundary_nodes", table.get("boundary_nodes", []),
                                lambda f, v: checks.node(f, v, nodes), unique=True)
     return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary)
+
+
+# --- writing: the one rotor-file writer ------------------------------------------------------
+def rotor_table(rotor: Rotor) -> dict[str, Any]:
+    """The rotor-file document of ``rotor``, which :func:`rotor_from_dict` makes the same rotor again, to the bit.
+
+    Every float is the stored one (``rotorred.writers.toml_text`` writes ``repr``), except speeds and phases, which
+    are written in rpm and degrees when such a number reads back to the stored rad/s and rad exactly
+    (:func:`rotorred.writers.exact_in_unit`), else in SI (``speed_rad_s``, ``phase_rad``). A spool on consecutive
+    node numbers has a ``first_node``, any other the list ``nodes``; equal consecutive elements are one entry with
+    ``repeat``. A material keeps the modulus it was given by (``G`` or ``nu``).
+
+    Parameters
+    ----------
+    rotor : Rotor
+
+    Returns
+    -------
+    dict
+        The rotor file's tables (``rotorred.writers.toml_text`` writes it).
+
+    Notes
+    -----
+    Materials are named by their names, made unique (``steel-2``) and non-empty (``material``) where the rotor's
+    are not: only then does the rotor read back differ (in those names).
+    """
+    names = _material_names(rotor)
+    document: dict[str, Any] = {"name": rotor.name,
+                                "material": [_material_table(m, name) for m, name in names.items()],
+                                "spool": [_spool_table(s, names) for s in rotor.spools]}
+    for key, items, table in (("disk", rotor.disks, _disk_table), ("bearing", rotor.bearings, _bearing_table),
+                              ("intershaft_bearing", rotor.intershaft_bearings, _intershaft_table),
+                              ("support", rotor.supports, _support_table), ("pedestal", rotor.pedestals, _pedestal_table)):
+        if items:
+            document[key] = [table(item) for item in items]
+    if rotor.rayleigh != (0.0, 0.0):
+        document["damping"] = {"rayleigh_alpha": rotor.rayleigh[0], "rayleigh_beta": rotor.rayleigh[1]}
+    defaults = _defaults_table(rotor.defaults)
+    if defaults:
+        document["defaults"] = defaults
+    return document
+
+
+def _material_names(rotor: Rotor) -> dict[Material, str]:
+    """Each material of the shaft elements, in order of first use, and its name in the file (unique, non-empty)."""
+    names: dict[Material, str] = {}
+    for e in (e for s in rotor.spools for e in s.all_elements):
+        if e.material not in names:
+            base, taken = e.material.name or "material", set(names.values())
+            names[e.material] = base if base not in taken else next(f"{base}-{i}" for i in range(2, len(taken) + 2)
+                                                                     if f"{base}-{i}" not in taken)
+    return names
+
+
+def _material_table(m: Material, name: str) -> dict[str, Any]:
+    return {"name": name, "E": m.E, "rho": m.rho, **({"G": m.G} if m.G is not None else {"nu": m.nu})}
+
+
+def _spool_table(s: Spool, names: dict[Material, str]) -> dict[str, Any]:
+    nodes = s.nodes
+    consecutive = nodes == tuple(range(nodes[0], nodes[0] + len(nodes)))
+    table: dict[str, Any] = {"name": s.name, **({"first_node": nodes[0]} if consecutive else {"nodes": list(nodes)}),
+                             "z0": s.z0}
+    if s.speed != 0.0:
+        table.update(_speeds_in_rpm("speed", [s.speed], single=True))
+    materials = {names[e.material] for e in s.all_elements}
+    common = materials.pop() if len(materials) == 1 else None
+    if common is not None:
+        table["material"] = common
+    entries = [{"L": e.L, **_section(e, names, common)} for e in s.elements]
+    table["elements"] = [dict(entry, **({"repeat": n} if n > 1 else {})) for entry, n in _runs(entries, dict.__eq__)]
+    if s.sleeves:
+        sleeves = [{"left": e.left, **_section(e, names, common), "_right": e.right} for e in s.sleeves]
+        runs = _runs(sleeves, lambda a, b: b["left"] == a["_right"] and _without(a) == _without(b))
+        table["sleeves"] = [dict(_without(entry), **({"repeat": n} if n > 1 else {})) for entry, n in runs]
+    return table
+
+
+def _section(e: ShaftElement, names: dict[Material, str], common: str | None) -> dict[str, Any]:
+    """The keys of an element or sleeve entry but its length and nodes: the diameters, and what differs from the
+    defaults (the spool's material, shear "cowper", element "nelson", rotary inertia)."""
+    out: dict[str, Any] = {"D_o": e.D_o, "D_i": e.D_i}
+    if e.tapered:
+        out.update(D_o_right=e.D_o_right, D_i_right=e.D_i_right)
+    if names[e.material] != common:
+        out["material"] = names[e.material]
+    for key, default in (("shear", "cowper"), ("element", "nelson"), ("rotary_inertia", True)):
+        if getattr(e, key) != default:
+            out[key] = getattr(e, key)
+    return out
+
+
+def _without(sleeve: dict[str, Any]) -> dict[str, Any]:
+    """A sleeve entry without the right node it was grouped by."""
+    return {k: v for k, v in sleeve.items() if k != "_right"}
+
+
+def _runs(entries: list[dict], continues) -> list[tuple[dict, int]]:
+    """The entries grouped into runs, each its first entry and its length: ``continues(previous, next)`` says whether
+    the next entry repeats the run (a ``repeat`` in the file)."""
+    runs: list[list] = []
+    for entry in entries:
+        if runs and continues(runs[-1][2], entry):
+            runs[-1][1] += 1
+            runs[-1][2] = entry
+        else:
+            runs.append([entry, 1, entry])
+    return [(first, n) for first, n, _ in runs]
+
+
+def _speeds_in_rpm(key: str, speeds, single: bool = False) -> dict[str, Any]:
+    """``{key_rpm: ...}`` when each speed (rad/s) is exactly an rpm number read back, else ``{key_rad_s: ...}``."""
+    rpm = [exact_in_unit(w, rpm_to_rad_s, w * 30.0 / math.pi) for w in speeds]
+    if None in rpm:
+        return {f"{key}_rad_s": speeds[0] if single else list(speeds)}
+    return {f"{key}_rpm": rpm[0] if single else rpm}
+
+
+def _disk_table(d: Disk) -> dict[str, Any]:
+    return {"node": d.node, **_named(d), "m": d.m, "I_d": d.I_d, "I_p": d.I_p,
+            **({"radius": d.radius} if d.radius != 0.0 else {})}
+
+
+def _named(item) -> dict[str, str]:
+    return {"name": item.name} if item.name else {}
+
+
+def _bearing_table(b: Bearing | BearingTable) -> dict[str, Any]:
+    table: dict[str, Any] = {"node": b.node, **_named(b), **({"link": b.link} if b.link is not None else {})}
+    if isinstance(b, BearingTable):
+        table.update(_speeds_in_rpm("speed", b.speeds))
+        table.update({k: getattr(b, k) for k, default in (("interpolation", "linear"), ("extrapolate", "hold"))
+                      if getattr(b, k) != default})
+    return table | _coefficient_entries(b)
+
+
+def _intershaft_table(b: IntershaftBearing) -> dict[str, Any]:
+    return {"node_a": b.node_a, "node_b": b.node_b, **_named(b), **_coefficient_entries(b)}
+
+
+def _coefficient_entries(b) -> dict[str, Any]:
+    """The non-zero coefficients: ``k`` / ``c`` for equal direct terms; a column of a table equal at every speed as
+    one number."""
+    out: dict[str, Any] = {}
+    for kind in ("k", "c"):
+        xx, yy = getattr(b, f"{kind}_xx"), getattr(b, f"{kind}_yy")
+        pairs = [(kind, xx)] if xx == yy else [(f"{kind}_xx", xx), (f"{kind}_yy", yy)]
+        pairs += [(f"{kind}_{d}", getattr(b, f"{kind}_{d}")) for d in ("xy", "yx")]
+        out.update({key: _column(value) for key, value in pairs if any(v != 0.0 for v in _values(value))})
+    return out
+
+
+def _values(value) -> tuple[float, ...]:
+    return tuple(value) if isinstance(value, tuple) else (value,)
+
+
+def _column(value):
+    """A coefficient as written: a number, or a table's column (one number when equal at every speed)."""
+    if isinstance(value, tuple):
+        return value[0] if len(set(value)) == 1 else list(value)
+    return value
+
+
+def _support_table(sp: Support) -> dict[str, Any]:
+    return {"node": sp.node, "kind": sp.kind, **_named(sp)}
+
+
+def _pedestal_table(p: Pedestal) -> dict[str, Any]:
+    return {"node": p.node, **_named(p), "m": p.m}
+
+
+def _defaults_table(d: AnalysisDefaults) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if d.unbalances:
+        out["unbalance"] = [_unbalance_table(u) for u in d.unbalances]
+    if d.outputs:
+        out["outputs"] = [f"{node}:{direction}" for node, direction in d.outputs]
+    if d.boundary_nodes:
+        out["boundary_nodes"] = list(d.boundary_nodes)
+    return out
+
+
+def _unbalance_table(u: Unbalance) -> dict[str, Any]:
+    """An unbalance entry, its phase in degrees when such a number reads back to the phase (rad) exactly."""
+    out: dict[str, Any] = {"node": u.node, "m_e": u.m_e}
+    if u.phase != 0.0:
+        deg = exact_in_unit(u.phase, math.radians, math.degrees(u.phase))
+        out.update({"phase_deg": deg} if deg is not None else {"phase_rad": u.phase})
+    return out
