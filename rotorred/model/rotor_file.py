@@ -6,7 +6,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     name = "my-rotor"
     [[material]]                       # E (Pa), rho (kg/m^3), nu (-) or G (Pa, shear modulus)
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
-    [[spool]]                          # a chain of elements on consecutive node numbers
+    [[spool]]                          # a chain of elements on consecutive node numbers (or nodes = [1, 2, 7, ...])
     name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
     elements = [ { L = 0.08, D_o = 0.02, D_i = 0.0, material = "steel", repeat = 12 } ]
     [[disk]]                           # either m, I_d, I_p (kg, kg m^2) or D_o, D_i, thickness, material
@@ -27,6 +27,9 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     unbalance = [ { node = 11, m_e = 1e-5, phase_deg = 0.0 } ]   # kg m, deg
     outputs = ["13:x", "13:y"]         # NODE:DIRECTION, DIRECTION x, y, theta_x (tx), theta_y (ty)
     boundary_nodes = [18]              # extra boundary nodes of a reduced model
+
+Speeds and phases may also be given in SI (``speed_rad_s``, ``phase_rad``), as :func:`rotor_table` writes those
+that no rpm or degree number reads back to exactly (docs/model.md §17).
 
 Every value is checked as written, in the file's units (speeds in rpm), before it is converted;
 an error is a :class:`RotorFileError` (a :class:`rotorred.checks.InputError`) naming the file, the
