@@ -18,7 +18,8 @@ from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBear
                                      Support)
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
-from rotorred.model.rotor_file import load_rotor, rpm_to_rad_s
+from rotorred.model.rotor_file import load_rotor
+from rotorred.model.rotor_writer import rotor_table, rpm_to_rad_s
 from rotorred.writers import exact_in_unit
 
 ROSS3 = Path(__file__).resolve().parents[1] / "validation" / "reference" / "ross3"
@@ -153,8 +154,6 @@ def test_a_material_read_from_g_keeps_g_and_a_preset_is_written_in_its_own_units
 def test_materials_with_one_name_are_written_apart():
     """Two different materials of one name (possible in Python, not in a file) get names that differ: the second
     ``steel-2``; a material with no name is ``material``."""
-    from rotorred.model.rotor_file import rotor_table
-
     a, b, c = Material("steel", 2.1e11, 7850.0), Material("steel", 2.0e11, 7800.0), Material("", 1e11, 3000.0)
     spool = Spool("s", (ShaftElement(0, 1, 0.1, 0.02, 0.0, a), ShaftElement(1, 2, 0.1, 0.02, 0.0, b),
                         ShaftElement(2, 3, 0.1, 0.02, 0.0, c)))

@@ -27,7 +27,8 @@ from scipy.sparse import coo_matrix
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
 from rotorred.model.elements import Bearing, BearingTable
-from rotorred.model.rotor import Rotor
+from rotorred.model.rotor import Rotor, node_ranges, plural
+from rotorred.results import Result
 
 __all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "system_of", "DofMap", "DIRECTIONS"]
 
@@ -203,6 +204,29 @@ class SystemMatrices(SpoolSpeedMixin):
         for i, (node, direction) in enumerate(outputs):
             rows[i, self.dofs.index(node, direction)] = 1.0
         return rows
+
+    def summary(self) -> list[str]:
+        """DOFs, spools and speed-dependent bearings: at most 4 lines, no arrays (``repr``)."""
+        return model_summary(self.dofs, self.n_dof, self.G, self.K_G, self.tables)
+
+    __repr__ = Result.__repr__
+
+
+def model_summary(dofs: DofMap, n: int, G: Mapping, K_G: Mapping, tables: tuple) -> list[str]:
+    """The lines of a model's ``repr`` (:class:`SystemMatrices` and the reduced model): its physical ``dofs`` (two
+    lines), its ``n`` x ``n`` matrices and spools (``G``, ``K_G``) and its bearing ``tables``."""
+    shaft = [node for node in dofs.nodes if node not in dofs.translational]
+    parts = [f"{plural(len(shaft), 'shaft node')} x 4"]
+    parts += [f"{plural(len(dofs.translational), 'pedestal node')} x 2"] if dofs.translational else []
+    parts += [f"less {len(dofs.fixed)} fixed by supports"] if dofs.fixed else []
+    parts += [f"plus {dofs.n_internal} internal"] if dofs.n_internal else []
+    lines = [f"{dofs.n_dof} physical DOFs: " + ", ".join(parts), f"nodes {node_ranges(dofs.nodes, 80)}",
+             f"M, K, C of shape ({n}, {n}); a G{' and a K_G' if K_G else ''} per spool: "
+             + ", ".join(repr(name) for name in G)]
+    if tables:
+        lines.append(f"{plural(len(tables), 'bearing')} tabulated against speed, at nodes "
+                     f"{node_ranges(t.table.node for t in tables)}: K and C at the nominal speeds")
+    return lines
 
 
 class _Triplets:

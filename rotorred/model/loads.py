@@ -53,7 +53,8 @@ def unbalance_from_table(field: str, table, nodes: Collection[int]) -> Unbalance
     m_e = checks.non_negative(f"{field}.m_e", table["m_e"], "kg m")
     if "phase_rad" in table:
         if "phase_deg" in table:
-            checks.fail(f"{field}.phase_rad", table["phase_rad"], "must not be given with phase_deg: give one of the two")
+            checks.fail(f"{field}.phase_rad", table["phase_rad"],
+                        "must not be given with phase_deg: give one of the two")
         return Unbalance(node, m_e, checks.number(f"{field}.phase_rad", table["phase_rad"], "rad"))
     phase_deg = checks.number(f"{field}.phase_deg", table.get("phase_deg", 0.0), "deg")
     return Unbalance(node, m_e, math.radians(phase_deg))
