@@ -186,11 +186,13 @@ def test_the_input_objects_show_themselves_in_a_few_lines_without_arrays(rig):
     assert "4 disks, 3 bearings (0 tabulated against speed), 1 inter-shaft bearing" in repr(rig)
     assert "'low': nodes 1-2, 4-5, 9, 40; 5 elements (+ 3 sleeves)" in assert_short_repr(built.spool("low"))
     system = assemble(rig)
-    assert "80 physical DOFs: 20 shaft nodes x 4" in assert_short_repr(system)
+    assert "80 physical DOFs of rotor 'seed-rig'\n  20 shaft nodes x 4" in assert_short_repr(system)
+    assert "spool 'outer', nominal 5400 rpm (565.487 rad/s)" in repr(system)
     assert "2 bearings tabulated against speed, at nodes 25, 40" in assert_short_repr(assemble(built))
     reduced = reduce(system, boundary_nodes=[1, 9, 13, 14, 18, 20], n_modes=6)
     text = assert_short_repr(reduced)
     assert "30 coordinates = 24 boundary DOFs + 6 modes" in text and "kept nodes 1, 9, 13-14, 18, 20" in text
+    assert "of 80 physical DOFs of rotor 'seed-rig'" in text and "M, K, C of shape (30, 30)" in text
     scene = load_scene("paper-rub")
     text = assert_short_repr(scene)
     assert "'paper-rub': rotor 'seed-rig'" in text and "contact: rub at node 18" in text and "duration" in text

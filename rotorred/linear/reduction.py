@@ -266,15 +266,15 @@ class ReducedSystem(SpoolSpeedMixin):
         return self.T.T @ F
 
     def summary(self) -> list[str]:
-        """Size, kept nodes and modes, how the modes were chosen: at most 11 lines, no arrays (``repr``)."""
+        """Size, kept nodes and modes, how they were chosen, the full model: at most 12 lines, no arrays (``repr``)."""
         f = self.interior_frequencies / (2 * math.pi)
-        full = model_summary(self.full_dofs, self.n_dof, self.G, self.K_G, self.tables)
         lines = [f"Craig-Bampton model: {self.n_dof} coordinates = {self.n_boundary_dofs} boundary DOFs + "
                  f"{self.n_modes} modes",
-                 f"of the full model's {self.full_dofs.n_dof} physical DOFs",
                  f"kept nodes {node_ranges(self.boundary_nodes, 80)}",
                  f"fixed-interface modes at {f[0]:.4g}-{f[-1]:.4g} Hz" if len(f) else "no fixed-interface mode"]
-        return lines + textwrap.wrap(self.selection.describe(), 100)[:4] + full[2:]
+        lines += textwrap.wrap(self.selection.describe(), 100)[:3]
+        full = model_summary(self)
+        return lines + [f"of {full[0]}"] + full[3:]
 
     __repr__ = Result.__repr__
 
