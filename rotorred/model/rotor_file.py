@@ -29,7 +29,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     boundary_nodes = [18]              # extra boundary nodes of a reduced model
 
 Speeds and phases may also be given in SI (``speed_rad_s``, ``phase_rad``), as :meth:`Rotor.to_toml` writes those
-that no rpm or degree number reads back to exactly (docs/model.md §17).
+that no rpm or degree number reads back to exactly (docs/model.md §18).
 
 Every value is checked as written, in the file's units (speeds in rpm), before it is converted;
 an error is a :class:`RotorFileError` (a :class:`rotorred.checks.InputError`) naming the file, the
@@ -502,4 +502,3 @@ def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
     boundary = checks.sequence("defaults.boundary_nodes", table.get("boundary_nodes", []),
                                lambda f, v: checks.node(f, v, nodes), unique=True)
     return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary)
-

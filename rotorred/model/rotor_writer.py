@@ -2,7 +2,7 @@
 
 :func:`rotor_table` is the one writer of rotor files (``rotorred convert`` writes a ROSS rotor through it); the
 reader, :mod:`rotorred.model.rotor_file`, makes the same rotor of it again, every number to the bit
-(docs/model.md §17). This module does not import :mod:`rotorred.model.rotor` (which calls it), so it takes the rotor
+(docs/model.md §18). This module does not import :mod:`rotorred.model.rotor` (which calls it), so it takes the rotor
 as it is given.
 """
 
