@@ -58,7 +58,8 @@ def python_rotor() -> Rotor:
     speeds = (0.0, 157.3, 1e3 / 3, 2 * math.pi * 97.1)
     return Rotor(
         spools=(low, high, fan),
-        disks=(Disk(9, 3.3, 0.011, 0.02, name="fan", radius=0.11), Disk(22, 1.7, 4e-3, 7.9e-3), Disk(56, 0.4, 0.0, 0.0)),
+        disks=(Disk(9, 3.3, 0.011, 0.02, name="fan", radius=0.11), Disk(22, 1.7, 4e-3, 7.9e-3),
+               Disk(56, 0.4, 0.0, 0.0)),
         bearings=(Bearing(k_xx=3.1e7, k_yy=2.9e7, k_xy=-1.1e6, c_xx=410.0, c_yy=410.0, node=1, name="front"),
                   BearingTable(40, speeds, k_xx=(1e7, 2e7, 3e7, 3.5e7), k_yy=(1e7, 2e7, 3e7, 3.5e7), c_xx=300.0,
                                c_yy=(300.0, 280.0, 250.0, 240.0), k_yx=(0.0, 1e5, 4e5, 6e5), interpolation="pchip",
