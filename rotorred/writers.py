@@ -28,14 +28,14 @@ import math
 import os
 import re
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "write_toml", "toml_text", "atomic_path",
-           "render_table", "OutputFolder", "CF_CONVENTIONS", "read_netcdf", "LABELS_OF",
+__all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "write_toml", "toml_text",
+           "exact_in_unit", "atomic_path", "render_table", "OutputFolder", "CF_CONVENTIONS", "read_netcdf", "LABELS_OF",
            "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
 
 
@@ -323,6 +323,35 @@ def _toml_value(value) -> str:
     if isinstance(value, (list, tuple, np.ndarray)):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
     raise TypeError(f"TOML value {value!r}: a {type(value).__name__} has no TOML form")
+
+
+def exact_in_unit(value: float, to_si: Callable[[float], float], estimate: float) -> float | None:
+    """The number in another unit that reads back to ``value`` to the last bit, for writing it in that unit.
+
+    Parameters
+    ----------
+    value : float
+        The value as stored (SI, e.g. rad/s).
+    to_si : callable
+        The reader's conversion from the other unit (e.g. rpm to rad/s), exactly as the reader applies it.
+    estimate : float
+        ``value`` in the other unit, computed (e.g. ``value * 30 / pi``).
+
+    Returns
+    -------
+    float or None
+        Of the floats within 8 ulps of ``estimate`` that ``to_si`` takes to ``value``, the one of shortest ``repr``
+        (the nearest to ``estimate`` among those); None when none does: a conversion by a factor below 1 misses
+        some floats, whose value must then be written in SI.
+    """
+    candidates = [estimate]
+    for direction in (math.inf, -math.inf):
+        c = estimate
+        for _ in range(8):
+            c = math.nextafter(c, direction)
+            candidates.append(c)
+    exact = [c for c in candidates if to_si(c) == value]
+    return min(exact, key=lambda c: (len(repr(c)), abs(c - estimate), c)) if exact else None
 
 
 def render_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

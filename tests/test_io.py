@@ -159,6 +159,16 @@ BAD = [
     ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_rpm = [0.0, 1.0]\nnode_a = 12",
      "bad.toml: intershaft_bearing[0].speed_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_xx, c_xy, c_yx, "
      "c_yy, k, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b"),
+    ("first_node = 1\n", "first_node = 1\nnodes = [1, 2, 3, 4, 5]\n",
+     "bad.toml: spool[0].nodes = [1, 2, 3, 4, 5]: must not be given with first_node: give one of the two"),
+    ("first_node = 1\n", "", "bad.toml: spool[0].first_node: missing; required (or nodes)"),
+    ("first_node = 1\n", "nodes = [1, 2, 3, 4]\n",
+     "bad.toml: spool[0].nodes = [1, 2, 3, 4]: must hold 5 entries, not 4"),
+    ("first_node = 1\n", "nodes = [1, 2, 7, 2, 5]\n",
+     "bad.toml: spool[0].nodes = [1, 2, 7, 2, 5]: must not list an entry twice"),
+    ("speed_rpm = 4200.0", "speed_rpm = 4200.0\nspeed_rad_s = 440.0",
+     "bad.toml: spool[0].speed_rad_s = 440.0: must not be given with speed_rpm: give one of the two"),
+    ("speed_rpm = 4200.0", "speed_rad_s = -1.0", "bad.toml: spool[0].speed_rad_s = -1.0: must be >= 0 (rad/s)"),
     ("D_o = 0.2", "D_o = 0.2\nshape = 1", "bad.toml: disk[1].shape = 1: unknown key; allowed keys are D_i, D_o, I_d, "
      "I_p, m, material, name, node, radius, thickness"),
 ]
@@ -167,6 +177,17 @@ BAD = [
 @pytest.mark.parametrize("old, new, message", BAD, ids=[b[2][10:50] for b in BAD])
 def test_bad_files(old, new, message):
     assert_refused(GOOD, old, new, message)
+
+
+def test_nodes_and_speeds_in_si_as_a_written_rotor_gives_them():
+    """A spool may list its node numbers in place of first_node (any order, as a refined rotor's), its speed and a
+    bearing table's speeds may be given in rad/s (speed_rad_s), the same rotor as in rpm."""
+    text = GOOD.replace("first_node = 10\n", "nodes = [10, 12, 11]\n").replace(
+        "k = 1e7\nc = 100.0", "speed_rad_s = [0.0, 300.0]\nk = [1e7, 2e7]", 1)
+    r = rotor_from_toml(text.replace("speed_rpm = 4200.0", f"speed_rad_s = {4200 * math.pi / 30!r}"))
+    assert r.spool("outer").nodes == (10, 12, 11) and r.positions[11] == pytest.approx(0.3)
+    assert r.bearings[0].speeds == (0.0, 300.0) and r.bearings[0].k_yy == (1e7, 2e7)
+    assert r.spool("inner").speed == rotor_from_toml(GOOD).spool("inner").speed
 
 
 def test_shear_modulus_in_place_of_poisson_ratio():

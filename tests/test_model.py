@@ -162,3 +162,40 @@ def test_dofmap_errors(rig):
     with pytest.raises(InputError, match=r"^dof = 80: must be an integer in \[0, 79\]$"):
         S.dofs.label(80)
     assert S.dofs.index(18, "ty") == S.dofs.index(18, "theta_y")
+
+
+def test_the_input_objects_show_themselves_in_a_few_lines_without_arrays(rig):
+    """repr of a Rotor, a Spool, the assembled and the reduced system and a Scene: at most 15 lines, the type's name
+    first, no array (printing a Rotor or a Scene dumped 6-7 kB before); they say what they are (names, node ranges,
+    nominal speeds in rpm and rad/s, counts, DOFs, kept nodes, modes, contact, duration). The dataclass equality is
+    kept."""
+    import dataclasses
+
+    from rotorred.linear.reduction import reduce
+    from rotorred.scenes.schema import load_scene
+
+    from results_checks import assert_short_repr
+    from test_rotor_toml import python_rotor
+
+    built = python_rotor()
+    for rotor in (rig, built, rig.refined(3), load_rotor("ross-coaxial")):
+        text = assert_short_repr(rotor)
+        assert f"{rotor.name!r}" in text and "rpm" in text and "rad/s" in text
+        assert all(f"spool {s.name!r}" in text for s in rotor.spools)
+    assert "spool 'inner': nodes 1-13; 12 elements; 4200 rpm (439.823 rad/s)" in repr(rig)
+    assert "4 disks, 3 bearings (0 tabulated against speed), 1 inter-shaft bearing" in repr(rig)
+    assert "'low': nodes 1-2, 4-5, 9, 40; 5 elements (+ 3 sleeves)" in assert_short_repr(built.spool("low"))
+    system = assemble(rig)
+    assert "80 physical DOFs of rotor 'seed-rig'\n  20 shaft nodes x 4" in assert_short_repr(system)
+    assert "spool 'outer', nominal 5400 rpm (565.487 rad/s)" in repr(system)
+    assert "2 bearings tabulated against speed, at nodes 25, 40" in assert_short_repr(assemble(built))
+    reduced = reduce(system, boundary_nodes=[1, 9, 13, 14, 18, 20], n_modes=6)
+    text = assert_short_repr(reduced)
+    assert "30 coordinates = 24 boundary DOFs + 6 modes" in text and "kept nodes 1, 9, 13-14, 18, 20" in text
+    assert "of 80 physical DOFs of rotor 'seed-rig'" in text and "M, K, C of shape (30, 30)" in text
+    scene = load_scene("paper-rub")
+    text = assert_short_repr(scene)
+    assert "'paper-rub': rotor 'seed-rig'" in text and "contact: rub at node 18" in text and "duration" in text
+    assert len(repr(rig)) < 1000 and len(repr(scene)) < 1000
+    assert rig == load_rotor("seed-rig") and rig != dataclasses.replace(rig, name="other")
+    assert scene == load_scene("paper-rub")

@@ -22,10 +22,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
+    from rotorred.model.elements import BearingTable
     from rotorred.model.rotor_file import (RotorFileError, read_rotor_toml, read_text_file, rotor_document,
                                            rotor_from_dict)
     from rotorred.model.ross_file import is_ross_document
-    from rotorred.writers import write_toml
 
     source, target = Path(args.source), _target(args.target, args.source)
     if not source.is_file():
@@ -34,16 +34,15 @@ def run(args) -> int:
     if not is_ross_document(data):
         checks.fail("ROSS_FILE", args.source, "must be a rotor saved by ROSS (it has no ross_version line); it reads "
                     "as a rotorred rotor file already")
-    document = rotor_document(data, str(source), name=source.stem)
     try:
-        rotor = rotor_from_dict(document)
+        rotor = rotor_from_dict(rotor_document(data, str(source), name=source.stem))
     except RotorFileError as exc:
         raise exc.from_source(str(source)) from None
-    write_toml(target, document, header=f"rotorred rotor file converted from {source.name} by `rotorred convert`\n"
-                                        "(axial and torsional coefficients of ROSS's 6-DOF model are not read: "
-                                        "docs/model.md §14)")
+    rotor.to_toml(target, header=f"rotorred rotor file converted from {source.name} (saved by ROSS "
+                                 f"{data.get('ross_version')}) by `rotorred convert`\n(axial and torsional "
+                                 "coefficients of ROSS's 6-DOF model are not read: docs/model.md §14)")
     spool = rotor.spools[0]
-    tables = sum(1 for b in document["bearing"] if "speed_rpm" in b)
+    tables = sum(1 for b in rotor.bearings if isinstance(b, BearingTable))
     report(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"
            + (f", {len(spool.sleeves)} sleeves (ROSS layered elements)" if spool.sleeves else "")
            + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({tables} tabulated against speed)"

@@ -29,6 +29,7 @@ frequencies meet a relative error ``target`` against the full model over a frequ
 from __future__ import annotations
 
 import math
+import textwrap
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
@@ -38,9 +39,10 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
-from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble
+from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble, model_summary
 from rotorred.model.dofs import DofMap
-from rotorred.model.rotor import Rotor
+from rotorred.model.rotor import Rotor, node_ranges
+from rotorred.results import Result
 
 #: default relative whirl-frequency error target of the automatic mode count (0.1 %)
 DEFAULT_TARGET = 1e-3
@@ -262,6 +264,19 @@ class ReducedSystem(SpoolSpeedMixin):
     def project(self, F: np.ndarray) -> np.ndarray:
         """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k)."""
         return self.T.T @ F
+
+    def summary(self) -> list[str]:
+        """Size, kept nodes and modes, how they were chosen, the full model: at most 12 lines, no arrays (``repr``)."""
+        f = self.interior_frequencies / (2 * math.pi)
+        lines = [f"Craig-Bampton model: {self.n_dof} coordinates = {self.n_boundary_dofs} boundary DOFs + "
+                 f"{self.n_modes} modes",
+                 f"kept nodes {node_ranges(self.boundary_nodes, 80)}",
+                 f"fixed-interface modes at {f[0]:.4g}-{f[-1]:.4g} Hz" if len(f) else "no fixed-interface mode"]
+        lines += textwrap.wrap(self.selection.describe(), 100)[:3]
+        full = model_summary(self)
+        return lines + [f"of {full[0]}"] + full[3:]
+
+    __repr__ = Result.__repr__
 
 
 def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:

@@ -27,7 +27,8 @@ from scipy.sparse import coo_matrix
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
 from rotorred.model.elements import Bearing, BearingTable
-from rotorred.model.rotor import Rotor
+from rotorred.model.rotor import Rotor, node_ranges, plural, speed_text
+from rotorred.results import Result
 
 __all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "system_of", "DofMap", "DIRECTIONS"]
 
@@ -203,6 +204,32 @@ class SystemMatrices(SpoolSpeedMixin):
         for i, (node, direction) in enumerate(outputs):
             rows[i, self.dofs.index(node, direction)] = 1.0
         return rows
+
+    def summary(self) -> list[str]:
+        """Rotor, DOFs, spools and speed-dependent bearings: at most 9 lines, no arrays (``repr``)."""
+        return model_summary(self)
+
+    __repr__ = Result.__repr__
+
+
+def model_summary(model) -> list[str]:
+    """The lines of a model's ``repr`` (:class:`SystemMatrices` and the reduced model): its rotor and physical DOFs
+    (three lines), its matrices, its spools' nominal speeds (at most 3 lines) and its bearing tables."""
+    dofs = model.full_dofs
+    shaft = [node for node in dofs.nodes if node not in dofs.translational]
+    parts = [f"{plural(len(shaft), 'shaft node')} x 4"]
+    parts += [f"{plural(len(dofs.translational), 'pedestal node')} x 2"] if dofs.translational else []
+    parts += [f"less {len(dofs.fixed)} fixed by supports"] if dofs.fixed else []
+    parts += [f"plus {dofs.n_internal} internal"] if dofs.n_internal else []
+    of = f"rotor {model.name!r}" if model.rotor is not None else "a model built by hand"
+    lines = [f"{dofs.n_dof} physical DOFs of {of}", ", ".join(parts), f"nodes {node_ranges(dofs.nodes, 80)}",
+             f"M, K, C of shape ({model.n_dof}, {model.n_dof}); a G{' and a K_G' if model.K_G else ''} per spool"]
+    speeds = [f"spool {s!r}, nominal {speed_text(w)}" for s, w in model.nominal_speeds.items()]
+    lines += speeds if len(speeds) <= 3 else speeds[:2] + [f"... and {len(speeds) - 2} more spools"]
+    if model.tables:
+        lines.append(f"{plural(len(model.tables), 'bearing')} tabulated against speed, at nodes "
+                     f"{node_ranges(t.table.node for t in model.tables)}: K and C at the nominal speeds")
+    return lines
 
 
 class _Triplets:

@@ -11,7 +11,7 @@ import numpy as np
 from rotorred import checks
 
 #: keys of an unbalance table (a scene's ``[[unbalance]]``, a rotor file's ``[defaults]`` ``unbalance``)
-UNBALANCE_KEYS = ("node", "m_e", "phase_deg")
+UNBALANCE_KEYS = ("node", "m_e", "phase_deg", "phase_rad")
 
 
 @dataclass(frozen=True)
@@ -43,13 +43,19 @@ class Unbalance:
 def unbalance_from_table(field: str, table, nodes: Collection[int]) -> Unbalance:
     """An :class:`Unbalance` from a file table ``{node = 11, m_e = 1e-5, phase_deg = 90.0}``.
 
-    ``m_e`` in kg m, ``phase_deg`` in degrees (default 0); ``node`` must be one of ``nodes``.
+    ``m_e`` in kg m, ``phase_deg`` in degrees (default 0) or ``phase_rad`` in radians (what a written rotor holds
+    when no degree value reads back to its phase exactly); ``node`` must be one of ``nodes``.
     Values are checked as written (degrees) before the phase is converted to radians.
     """
     table: Mapping = checks.table(field, table)
     checks.keys(field, table, UNBALANCE_KEYS, required=("node", "m_e"))
     node = checks.node(f"{field}.node", table["node"], nodes)
     m_e = checks.non_negative(f"{field}.m_e", table["m_e"], "kg m")
+    if "phase_rad" in table:
+        if "phase_deg" in table:
+            checks.fail(f"{field}.phase_rad", table["phase_rad"],
+                        "must not be given with phase_deg: give one of the two")
+        return Unbalance(node, m_e, checks.number(f"{field}.phase_rad", table["phase_rad"], "rad"))
     phase_deg = checks.number(f"{field}.phase_deg", table.get("phase_deg", 0.0), "deg")
     return Unbalance(node, m_e, math.radians(phase_deg))
 

@@ -13,8 +13,10 @@ renames them to the file's keys (``disk[0].node``).
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Mapping
 
 from rotorred import checks
@@ -22,6 +24,9 @@ from rotorred.model.dofs import checked_dof
 from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Pedestal, ShaftElement,
                                      Support)
 from rotorred.model.loads import Unbalance
+from rotorred.model.rotor_writer import rotor_table
+from rotorred.results import Result
+from rotorred.writers import write_toml
 
 
 @dataclass(frozen=True)
@@ -158,6 +163,32 @@ class Spool:
         for e in self.elements:
             z[e.right] = z[e.left] + e.L
         return z
+
+    def summary(self) -> list[str]:
+        """Its name, nodes, elements, length and nominal speed: two lines, no arrays (``repr``)."""
+        sleeves = f" (+ {len(self.sleeves)} sleeves)" if self.sleeves else ""
+        length = sum(e.L for e in self.elements)
+        return [f"{self.name!r}: nodes {node_ranges(self.nodes)}; {len(self.elements)} elements{sleeves}; "
+                f"{length:.4g} m from z0 = {self.z0:.4g} m",
+                f"nominal speed {speed_text(self.speed)}"]
+
+    __repr__ = Result.__repr__
+
+
+def speed_text(Omega: float) -> str:
+    """A spool speed for people: ``"4200 rpm (439.8 rad/s)"`` of ``Omega`` (rad/s)."""
+    return f"{Omega * 30.0 / math.pi:.6g} rpm ({Omega:.6g} rad/s)"
+
+
+def plural(n: int, noun: str) -> str:
+    """``"1 disk"``, ``"3 disks"``: a count for people."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
+def node_ranges(nodes, width: int = 48) -> str:
+    """Node numbers as runs (``"1-13, 21-44"``, :func:`rotorred.checks.ranges_text`), cut to ``width`` characters."""
+    text = checks.ranges_text(nodes)
+    return text if len(text) <= width else text[:width - 4].rsplit(", ", 1)[0] + ", ..."
 
 
 @dataclass(frozen=True)
@@ -321,6 +352,52 @@ class Rotor:
     def mass(self) -> float:
         """Total mass of shafts and disks (kg)."""
         return sum(e.mass for s in self.spools for e in s.all_elements) + sum(d.m for d in self.disks)
+
+    # --- showing and writing ---------------------------------------------------------
+    def summary(self) -> list[str]:
+        """Name, spools (nodes, nominal speeds), counts of elements, disks and bearings, damping and defaults: at
+        most 13 lines, no arrays (``repr``)."""
+        elements = sum(len(s.elements) for s in self.spools)
+        lines = [f"{self.name!r}: {plural(len(self.spools), 'spool')}, {len(self.nodes)} shaft nodes, {elements} shaft "
+                 f"elements, mass {self.mass:.4g} kg"]
+        spools = [f"spool {s.name!r}: nodes {node_ranges(s.nodes)}; {len(s.elements)} elements; {speed_text(s.speed)}"
+                  for s in self.spools]
+        lines += spools if len(spools) <= 6 else spools[:5] + [f"... and {len(spools) - 5} more spools"]
+        tables = sum(isinstance(b, BearingTable) for b in self.bearings)
+        lines.append(f"{plural(len(self.disks), 'disk')}, {plural(len(self.bearings), 'bearing')} ({tables} tabulated "
+                     f"against speed), {plural(len(self.intershaft_bearings), 'inter-shaft bearing')}")
+        if self.supports or self.pedestals:
+            lines.append(f"{plural(len(self.supports), 'support')} (pinned or clamped nodes), "
+                         f"{plural(len(self.pedestals), 'pedestal')}")
+        if self.rayleigh != (0.0, 0.0):
+            lines.append(f"shaft damping: Rayleigh alpha {self.rayleigh[0]:.4g} 1/s, beta {self.rayleigh[1]:.4g} s")
+        d = self.defaults
+        if d.unbalances or d.outputs or d.boundary_nodes:
+            lines.append(f"defaults: {plural(len(d.unbalances), 'unbalance')}, {plural(len(d.outputs), 'output')}, "
+                         "boundary nodes "
+                         f"{node_ranges(d.boundary_nodes)}")
+        return lines
+
+    __repr__ = Result.__repr__
+
+    # --- writing --------------------------------------------------------------------
+    def to_toml(self, path: str | Path, header: str = "") -> Path:
+        """Write the rotor as a rotor file, which :func:`rotorred.load_rotor` reads back to an equal rotor (every
+        number to the bit; :func:`rotorred.model.rotor_writer.rotor_table` says how).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (.toml), replaced atomically.
+        header : str, optional
+            Text written on top as comment lines (``# ...``).
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
+        return write_toml(path, rotor_table(self), header)
 
     # --- derived models -------------------------------------------------------------
     def refined(self, n: int) -> Rotor:

@@ -6,7 +6,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     name = "my-rotor"
     [[material]]                       # E (Pa), rho (kg/m^3), nu (-) or G (Pa, shear modulus)
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
-    [[spool]]                          # a chain of elements on consecutive node numbers
+    [[spool]]                          # a chain of elements on consecutive node numbers (or nodes = [1, 2, 7, ...])
     name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
     elements = [ { L = 0.08, D_o = 0.02, D_i = 0.0, material = "steel", repeat = 12 } ]
     [[disk]]                           # either m, I_d, I_p (kg, kg m^2) or D_o, D_i, thickness, material
@@ -28,6 +28,9 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     outputs = ["13:x", "13:y"]         # NODE:DIRECTION, DIRECTION x, y, theta_x (tx), theta_y (ty)
     boundary_nodes = [18]              # extra boundary nodes of a reduced model
 
+Speeds and phases may also be given in SI (``speed_rad_s``, ``phase_rad``), as :meth:`Rotor.to_toml` writes those
+that no rpm or degree number reads back to exactly (docs/model.md §18).
+
 Every value is checked as written, in the file's units (speeds in rpm), before it is converted;
 an error is a :class:`RotorFileError` (a :class:`rotorred.checks.InputError`) naming the file, the
 key path, the value and what is allowed, e.g.
@@ -36,6 +39,7 @@ key path, the value and what is allowed, e.g.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from importlib import resources
@@ -50,6 +54,7 @@ from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, Beari
 from rotorred.model.loads import unbalance_from_table
 from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
+from rotorred.model.rotor_writer import rpm_to_rad_s
 
 try:  # Python >= 3.11
     import tomllib
@@ -64,8 +69,8 @@ _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "int
 #: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
 ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
-_SPOOL_KEYS = {"name", "first_node", "z0", "speed_rpm", "shear", "element", "rotary_inertia", "elements", "stations",
-               "material", "sleeves"}
+_SPOOL_KEYS = {"name", "first_node", "nodes", "z0", "speed_rpm", "speed_rad_s", "shear", "element", "rotary_inertia",
+               "elements", "stations", "material", "sleeves"}
 _SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
 _STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
 _ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
@@ -270,13 +275,15 @@ def _spools(value, materials: dict[str, Material]) -> tuple[Spool, ...]:
 
 
 def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
-    checks.keys(where, s, _SPOOL_KEYS, required={"name", "first_node"})
+    checks.keys(where, s, _SPOOL_KEYS, required={"name"})
+    _one_of(where, s, ("first_node", "nodes"))
+    _one_of(where, s, ("speed_rpm", "speed_rad_s"), required=False)
     if ("elements" in s) == ("stations" in s):
         checks.fail(where, sorted(k for k in ("elements", "stations") if k in s) or "neither",
                     "must give the shaft either as elements (a list of L, D_o, D_i, ...) or as stations (a list of z, D_o, "
                     "D_i, ...), one of the two")
     name = checks.string(f"{where}.name", s["name"], empty=False)
-    node = checks.integer(f"{where}.first_node", s["first_node"], ge=0)
+    node = checks.integer(f"{where}.first_node", s["first_node"], ge=0) if "first_node" in s else 0
     defaults = dict(shear=checks.choice(f"{where}.shear", s.get("shear", "cowper"), SHEAR_METHODS),
                     element=checks.choice(f"{where}.element", s.get("element", "nelson"), FORMULATIONS),
                     rotary_inertia=s.get("rotary_inertia", True))
@@ -298,10 +305,30 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
                            **{k: v for k, v in section.items() if k not in defaults})
             elements.extend(whole.split(n, list(range(node + 1, node + n))))
             node += n
-    speed_rpm = checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm")
+    if "nodes" in s:
+        elements = _numbered(f"{where}.nodes", s["nodes"], elements)
+    if "speed_rad_s" in s:
+        speed = checks.non_negative(f"{where}.speed_rad_s", s["speed_rad_s"], "rad/s")
+    else:
+        speed = rpm_to_rad_s(checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm"))
     sleeves = _sleeves(where, s, elements, defaults, materials)
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed_rpm * math.pi / 30.0, z0=z0,
-                  sleeves=sleeves)
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves)
+
+
+def _one_of(where: str, table: dict, names: tuple[str, str], required: bool = True) -> None:
+    """At most one of the two keys ``names`` (the same quantity in two forms), and one if ``required``."""
+    given = [k for k in names if k in table]
+    if len(given) == 2:
+        checks.fail(f"{where}.{given[1]}", table[given[1]], f"must not be given with {given[0]}: give one of the two")
+    if required and not given:
+        raise InputError(f"{where}.{names[0]}", checks.MISSING, f"required (or {names[1]})")
+
+
+def _numbered(where: str, value, chain: list[ShaftElement]) -> list[ShaftElement]:
+    """The chain on the node numbers ``value``, one a node along the chain (a chain numbered 0, 1, ... on input)."""
+    nodes = checks.sequence(where, value, lambda f, v: checks.integer(f, v, ge=0), min_len=len(chain) + 1,
+                            max_len=len(chain) + 1, unique=True)
+    return [dataclasses.replace(e, left=nodes[e.left], right=nodes[e.right]) for e in chain]
 
 
 def _sleeves(where: str, s: dict, chain: list[ShaftElement], defaults: dict, materials: dict[str, Material]):
@@ -406,15 +433,21 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
     """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "link"} | _TABLE_KEYS, required={"node"})
-    if "speed_rpm" not in b:
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "speed_rad_s", "link"} | _TABLE_KEYS,
+                required={"node"})
+    _one_of(where, b, ("speed_rpm", "speed_rad_s"), required=False)
+    if "speed_rpm" not in b and "speed_rad_s" not in b:
         for key in sorted(_TABLE_KEYS & set(b)):
             checks.fail(f"{where}.{key}", b[key], "needs speed_rpm: only a table against speed interpolates and "
                         "extrapolates")
         return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
-    rpm = checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0, increasing=True)
-    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(rpm * math.pi / 30.0),
-                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(rpm)))
+    if "speed_rad_s" in b:
+        speeds = checks.vector(f"{where}.speed_rad_s", b["speed_rad_s"], "rad/s", min_len=2, ge=0.0, increasing=True)
+    else:
+        speeds = rpm_to_rad_s(checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0,
+                                            increasing=True))
+    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(speeds),
+                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(speeds)))
 
 
 def _pedestal(where: str, p: dict) -> Pedestal:

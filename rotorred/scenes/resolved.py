@@ -80,7 +80,9 @@ def _exact_hz(w: float) -> float | None:
 
 
 def _unbalance(u, written: dict) -> dict:
-    return {"node": u.node, "m_e": u.m_e, "phase_deg": written.get("phase_deg", PHASE_DEG)}
+    phase = {"phase_rad": written["phase_rad"]} if "phase_rad" in written else {
+        "phase_deg": written.get("phase_deg", PHASE_DEG)}
+    return {"node": u.node, "m_e": u.m_e, **phase}
 
 
 def _rub(plate, written: dict) -> dict:

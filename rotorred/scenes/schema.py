@@ -46,9 +46,10 @@ from rotorred import checks
 from rotorred.checks import InputError, fail
 from rotorred.model.dofs import DIRECTIONS, parse_dof
 from rotorred.model.loads import Unbalance, unbalance_from_table
-from rotorred.model.rotor import Rotor
+from rotorred.model.rotor import Rotor, node_ranges, plural, speed_text
 from rotorred.model.rotor_file import ROTOR_FILE_KEYS, presets, read_rotor, read_text_file, read_toml, rotor_from_dict
 from rotorred.model.speeds import SpeedProfile
+from rotorred.results import Result
 from rotorred.scenes.builtin import builtin_scenes
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate, RigidPlate
@@ -292,6 +293,25 @@ class Scene:
     def without_rub(self) -> Scene:
         """The same scene without rub plates (the "normal" state)."""
         return dataclasses.replace(self, plates=(), name=f"{self.name} (normal)")
+
+    def summary(self) -> list[str]:
+        """Name, rotor, speeds, unbalances, contact and the run's length: at most 14 lines, no arrays (``repr``)."""
+        lines = [f"{self.name!r}: rotor {self.rotor.name!r} ({self.rotor_source})"]
+        lines += [f"speed {spool!r}: {speed_text(w)}" for spool, w in list(self.speeds.items())[:4]]
+        if self.runup is not None:
+            p, ref = self.runup.profile, self.runup.reference
+            lines.append(f"run-up of {ref!r} from {speed_text(p.speeds[ref][0])} to {speed_text(p.speeds[ref][-1])} "
+                         f"in {p.t[-1]:.4g} s")
+        lines.append(f"{plural(len(self.unbalances), 'unbalance')} at nodes "
+                     f"{node_ranges(u.node for u in self.unbalances)}" if self.unbalances else "no unbalance")
+        lines += [f"contact: rub at node {c.node}, clearance {c.clearance * 1e6:.4g} µm, K_nr {c.K_nr:.4g} N/m^1.5"
+                  for c in self.plates[:3]] if self.plates else ["no contact (linear)"]
+        s = self.solver
+        lines.append(f"solver: {s.model} model, {s.method}, dt {s.dt:.4g} s, duration {s.duration:.4g} s "
+                     f"(recorded from {s.record_start:.4g} s)")
+        return lines
+
+    __repr__ = Result.__repr__
 
 
 # --------------------------------------------------------------------------- loading
