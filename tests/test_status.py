@@ -37,7 +37,7 @@ def test_each_code_has_its_own_message():
 
 def _status_literals(tree: ast.Module) -> list[str]:
     """Where a module writes a status code as a number: a status name defined at module level, a literal assigned to
-    ``status`` or to ``...[E_STATUS]``, compared with ``status``, or returned by a function that returns status names."""
+    ``status`` or to ``...[E_STATUS]``, compared with ``status``, or returned by a function returning status names."""
     found = []
     for node in tree.body:
         if isinstance(node, ast.Assign):

@@ -35,16 +35,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING, Iterable, Sequence
+from typing import Iterable, Sequence
 
 import numpy as np
 
 from rotorred import checks
 from rotorred.signals.spectra import Spectrum
 from rotorred.writers import render_table
-
-if TYPE_CHECKING:
-    from rotorred.signals.linefit import FittedLine, LineFit
 
 __all__ = [
     "UNLABELLED",
@@ -209,7 +206,7 @@ def find_peaks(spectrum: Spectrum, threshold: float = 0.005) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- tables
-def format_table(fit: LineFit, *, amplitude_scale: float | None = None, amplitude_unit: str = "µm") -> str:
+def format_table(fit, *, amplitude_scale: float | None = None, amplitude_unit: str = "µm") -> str:
     """Table in the form of the paper's Table 1: ``Frequency (Hz) | Component``, the fit's lines then the peaks
     it left unlabelled (:data:`UNLABELLED`), by increasing frequency.
 
@@ -250,13 +247,13 @@ class LineMatch:
         Expected frequency (Hz).
     expected_label : str or None
         Expected component (:func:`line_label` form), if given.
-    found : FittedLine or None
+    found : rotorred.signals.linefit.FittedLine or None
         Nearest found line within the tolerance, None if there is none.
     """
 
     expected_hz: float
     expected_label: str | None
-    found: FittedLine | None
+    found: object | None
 
     @property
     def found_hz(self) -> float | None:
@@ -275,7 +272,7 @@ class LineMatch:
 
 
 def compare_with_expected(
-    lines: Sequence[FittedLine],
+    lines: Sequence,
     expected: Iterable[float | tuple[float, str]],
     tol_hz: float = 1.0,
 ) -> list[LineMatch]:
@@ -283,7 +280,7 @@ def compare_with_expected(
 
     Parameters
     ----------
-    lines : sequence of FittedLine
+    lines : sequence of rotorred.signals.linefit.FittedLine
         Found lines (``LineFit.lines``).
     expected : iterable of float or (float, str)
         Expected frequencies (Hz), optionally with their component label
