@@ -25,6 +25,7 @@ import pytest
 from rotorred.scenes.run import build_model, settled_state
 from rotorred.scenes.schema import load_scene
 from rotorred.transient import kernel
+from rotorred.transient.status import RUNNING
 from rotorred.transient.matrices import contact_rows, force_columns, kernel_plates, plate_parameters, step_levels
 from rotorred.transient.newmark import check_scheme, initial_state, initial_vector, record_buffers, record_plan, \
     run_kernel
@@ -50,7 +51,7 @@ def full_state_run(model, scene, t_end: float, dt: float) -> dict:
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
     status, *_ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), kernel_plates(M, B, par, atol),
                               state, record, settings, diag, plan.n_steps, 100_000, False)
-    assert status == kernel.RUNNING and diag.counters[kernel.C_SUBSTEPS] == 0  # main steps only
+    assert status == RUNNING and diag.counters[kernel.C_SUBSTEPS] == 0  # main steps only
     return dict(M=M, K=K, D=D, B=B, forces=forces, plates=plates, t=record.t, q=record.y[:, :n], v=record.y[:, n:],
                 plate=record.plate, state=record.state, dt=dt)
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rotorred.plots.scene import plot_label, plot_orbits, plot_spectra, plot_waveforms
-from rotorred.signals.lines import label_lines
+from rotorred.signals.linefit import fit_peaks
 from rotorred.signals.spectra import settled_spectrum
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -60,7 +60,7 @@ def test_plot_waveforms(tmp_path):
 def test_plot_spectra_with_labels_linear_and_log(tmp_path):
     s_rub = settled_spectrum(_signal(), DT, 70.0, 90.0)
     s_normal = settled_spectrum(60e-6 * np.cos(2 * np.pi * 90.0 * T), DT, 70.0, 90.0)
-    lines = label_lines(s_rub, 70.0, 90.0)
+    lines = fit_peaks(T, _signal(), 70.0, 90.0, spectrum=s_rub).lines
     assert len(lines) == len(COMBOS)
     out = plot_spectra(
         {"normal": s_normal, "rub": s_rub}, tmp_path / "spectra.png",
@@ -110,5 +110,5 @@ def test_plot_orbits(tmp_path):
 
 def test_line_labels_are_plain_text_with_subscripts():
     """Spectrum annotations are ordinary text (no mathtext): f_H and f_L with Unicode subscripts h and l."""
-    assert plot_label("2f_H\u2212f_L") == "2f\u2095\u2212f\u2097"
+    assert plot_label("2f_H-f_L") == "2f\u2095\u2212f\u2097"
     assert plot_label("f_H+3f_L/2") == "f\u2095+3f\u2097/2" and "$" not in plot_label("f_H")

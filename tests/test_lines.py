@@ -1,24 +1,20 @@
-"""Line labelling: the rule reproduces the paper's Table 1, peaks are found and labelled."""
+"""Line labels: one text form, the fit's rule reproduces the paper's Table 1, FFT peaks propose the lines."""
 
-import re
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
 from rotorred.checks import InputError
+from rotorred.signals.linefit import fit_peaks
 from rotorred.signals.lines import (
-    MINUS,
-    UNKNOWN,
+    UNLABELLED,
     XU2016_TABLE1,
-    combination_label,
-    combinations_near,
     compare_with_expected,
     find_peaks,
     format_comparison,
     format_table,
-    label_frequency,
-    label_lines,
+    line_label,
     parse_label,
 )
 from rotorred.signals.spectra import amplitude_spectrum, settled_spectrum
@@ -32,33 +28,30 @@ def _table1_combinations():
 
 
 # --------------------------------------------------------------------------- labels
-def test_label_text_both_minus_signs():
-    assert combination_label(1, -1) == "f_H" + MINUS + "f_L"
-    assert combination_label(1, -1, minus="-") == "f_H-f_L"
-    assert combination_label(0, 2) == "2f_L"
-    assert combination_label(3, -2, minus="-") == "3f_H-2f_L"
-    assert combination_label(1, Fraction(3, 2), minus="-") == "f_H+3f_L/2"
-    assert combination_label(-1, 2, minus="-") == "2f_L-f_H"  # positive term first
-    assert combination_label(2, 0) == "2f_H"
-    assert combination_label(2, -1, math_text=True) == "$2f_H-f_L$"
-    for m in range(-4, 5):
-        for k in range(-8, 9):
-            n = Fraction(k, 2)
-            if m == 0 and n == 0:
-                continue
-            for minus in (MINUS, "-"):
-                assert parse_label(combination_label(m, n, minus=minus)) == (m, n)
-    for bad in ["", "2f_H+3f_H", "f_H/2", "f_L/3", "f_H-", "3 Hz"]:
-        with pytest.raises(InputError, match=f"^label = {re.escape(repr(bad))}: must look like 'f_H-f_L', "):
+def test_label_text():
+    assert line_label(1, -1) == "f_H-f_L"
+    assert line_label(0, 2) == "2f_L"
+    assert line_label(3, -2) == "3f_H-2f_L"
+    assert line_label(1, Fraction(3, 2)) == "f_H+3f_L/2"
+    assert line_label(-1, 2) == "2f_L-f_H"  # positive term first
+    assert line_label(2, 0) == "2f_H" and line_label(0, 0) == "0"
+    assert line_label(Fraction(1, 3), Fraction(-2, 3)) == "f_H/3-2f_L/3"
+
+
+def test_labels_parse_back_and_bad_input_is_refused():
+    for m in (-3, 0, 1, 2, Fraction(1, 3), Fraction(-5, 6)):
+        for n in (Fraction(-5, 2), -1, 0, 1, Fraction(3, 2), Fraction(2, 3)):
+            if m or n:
+                assert parse_label(line_label(m, n)) == (m, n)
+    for bad in ("", "f_X", "2f_H2f_L", "f_H+f_H", "f_L/0", "3", "f_H−f_L"):
+        with pytest.raises(InputError, match="^label = .*: must look like"):
             parse_label(bad)
-    with pytest.raises(InputError, match="^label = 3: must be a string$"):
+    with pytest.raises(InputError, match="^label = 3: must be a string"):
         parse_label(3)
     with pytest.raises(InputError, match=r"^m = 1\.5: must be an integer$"):
-        combination_label(1.5, 1)
-    with pytest.raises(InputError, match=r"^n = 0\.25: must be an integer or half-integer$"):
-        combination_label(1, 0.25)
-    with pytest.raises(InputError, match=r"^n = nan: must be a finite number$"):
-        combination_label(1, float("nan"))
+        line_label(1.5, 1)
+    with pytest.raises(InputError, match=r"^n = 0\.25: must be an integer$"):
+        line_label(1, 0.25)
 
 
 def test_table1_data_is_consistent_with_70_90_hz():
@@ -74,22 +67,16 @@ def test_table1_data_is_consistent_with_70_90_hz():
 
 
 def test_rule_reproduces_all_24_table1_labels():
-    """At the exact grid frequency of each row, the rule picks the paper's combination, and
-    the lowest order alone decides (no tie among the candidates within |m|, |n| <= 8)."""
-    tol = 0.5  # half the 1 Hz bin of a 1 s record; the grid is exact at 70/90 Hz
-    n_ambiguous = 0
+    """Each Table 1 line of a synthetic signal is labelled with the paper's combination by the fit's rule, and the
+    ambiguity of the 10 Hz grid is real: the 140 Hz line also carries 7f_H-7f_L."""
+    x, dt, mns, freqs, amps = _synthetic()
+    t = np.arange(x.size) * dt
+    fit = fit_peaks(t, x, F_L, F_H)
+    first = {ln.frequency_hz: ln.orders[0] for ln in fit.lines}
     for (m, n), (_, label) in zip(_table1_combinations(), XU2016_TABLE1):
-        f = m * F_H + float(n) * F_L
-        for half in (False, True):
-            cands = combinations_near(f, F_L, F_H, tol, half_integer=half)
-            assert cands[0] == (m, n), (label, cands[:3])
-            order = [abs(a) + abs(b) for a, b in cands]
-            assert len(order) == 1 or order[0] < order[1], (label, cands[:2])  # no tie
-            n_ambiguous += len(cands) > 1
-    # The grid ambiguity is real: for half the rows other (m, n) within the bounds give the
-    # same frequency, e.g. 140 Hz = 2f_L = 7f_H-7f_L.
-    assert n_ambiguous == 24
-    assert combinations_near(140.0, F_L, F_H, tol) == [(0, 2), (7, -7)]
+        assert first[m * F_H + n * F_L] == (m, n), label
+    line_140 = next(ln for ln in fit.lines if ln.frequency_hz == 140.0)
+    assert line_140.labels == ("2f_L", "7f_H-7f_L")
 
 
 def test_rule_beyond_table1():
@@ -97,18 +84,19 @@ def test_rule_beyond_table1():
     the latter has fewer multiples of f_L ("fewest f_L" alone would also reproduce Table 1,
     whose lines all have |n| <= 3). Where the order ties, fewer multiples of f_L wins
     (f_H is the rubbing spool)."""
-    assert combinations_near(440.0, F_L, F_H, 0.5) == [(1, 5), (8, -4)]
-    assert combinations_near(80.0, F_L, F_H, 0.5)[:2] == [(4, -4), (-3, 5)]
-    assert combinations_near(560.0, F_L, F_H, 0.5)[:2] == [(7, -1), (0, 8)]
-    assert label_frequency(650.0, F_L, F_H, 0.5) == (8, -1)  # not f_H+8f_L
-    assert label_frequency(333.0, F_L, F_H, 0.5) is None  # off the 10 Hz grid
-    assert label_frequency(20.0, F_L, F_H, 0.5, max_m=0) is None  # bound respected
-    with pytest.raises(InputError, match=r"^tol_hz = 0\.0: must be > 0 \(Hz\)$"):
-        label_frequency(20.0, F_L, F_H, 0.0)
+    dt = 1e-4
+    t = np.arange(10_000) * dt  # 1 s: df = 1 Hz
+    tones = (80.0, 333.0, 440.0, 560.0, 650.0)
+    x = sum(np.cos(2 * np.pi * f * t + k) for k, f in enumerate(tones))
+    fit = fit_peaks(t, x, F_L, F_H)
+    assert [ln.labels[:2] for ln in fit.lines] == [("4f_H-4f_L", "5f_L-3f_H"), ("f_H+5f_L", "8f_H-4f_L"),
+                                                    ("7f_H-f_L", "8f_L"), ("8f_H-f_L", "f_H+8f_L")]
+    assert [p.frequency_hz for p in fit.unlabelled] == [333.0]  # off the 10 Hz grid
+    assert [p.frequency_hz for p in fit_peaks(t, x, F_L, F_H, max_m=0).unlabelled] == [80.0, 333.0, 440.0, 650.0]
     with pytest.raises(InputError, match=r"^f_H = nan: must be a finite number > 0 \(Hz\)$"):
-        label_frequency(20.0, F_L, float("nan"), 0.5)
+        fit_peaks(t, x, F_L, float("nan"))
     with pytest.raises(InputError, match=r"^max_m = -1: must be an integer >= 0$"):
-        label_frequency(20.0, F_L, F_H, 0.5, max_m=-1)
+        fit_peaks(t, x, F_L, F_H, max_m=-1)
 
 
 # --------------------------------------------------------------------------- synthetic
@@ -131,22 +119,19 @@ def test_synthetic_table1_signal_every_line_found_and_labelled():
     x, dt, mns, freqs, amps = _synthetic(extra_hz=[333.0])
     s = settled_spectrum(x, dt, F_L, F_H)
     assert s.window == "rectangular" and s.df == pytest.approx(1.0)
-    lines = label_lines(s, F_L, F_H)
-    by_freq = {round(line.frequency_hz, 6): line for line in lines}
-    assert len(lines) == len(freqs)  # no spurious peaks, none missed
+    fit = fit_peaks(np.arange(x.size) * dt, x, F_L, F_H, spectrum=s)
+    by_freq = {line.frequency_hz: line for line in fit.lines}
+    assert len(fit.lines) == len(freqs) - 1  # no spurious lines, none missed
     for (m, n), f, a in zip(mns, freqs, amps):
-        line = by_freq[round(f, 6)]
-        assert (line.m, line.n) == (m, n)
-        assert line.label == combination_label(m, n)
-        assert line.amplitude * 1e6 == pytest.approx(a, rel=1e-9)  # exact on-bin
-    # The paper's labels, in both spellings (520 Hz as corrected).
-    labelled = {line.label_ascii for line in lines}
-    assert {label for _, label in XU2016_TABLE1} <= labelled
-    assert by_freq[20.0].label == "f_H" + MINUS + "f_L"
-    assert by_freq[520.0].label_ascii == "5f_H+f_L"
+        if f == 333.0:
+            continue
+        line = by_freq[f]
+        assert (line.m, line.n) == (m, n) and line.label == line_label(m, n)
+        assert line.amplitude * 1e6 == pytest.approx(a, rel=1e-11)  # exact on-bin; measured 7.8e-13
+    assert {label for _, label in XU2016_TABLE1} <= {line.label for line in fit.lines}  # 520 Hz as corrected
     # The off-grid line is found but not labelled.
-    off = by_freq[333.0]
-    assert off.label == UNKNOWN and off.m is None and not off.known
+    at_bin = pytest.approx(1e-6 * amps[-1], rel=1e-13)  # the peak's bin value; measured 1e-14
+    assert [(p.frequency_hz, p.amplitude) for p in fit.unlabelled] == [(333.0, at_bin)]
 
 
 def test_threshold_and_peaks():
@@ -166,62 +151,56 @@ def test_threshold_and_peaks():
         find_peaks(s, threshold=1.5)
 
 
-def test_half_integer_only_when_enabled():
+def test_half_integer_only_on_the_half_torus():
     x, dt, mns, freqs, _ = _synthetic(extra_hz=[F_H + 1.5 * F_L], seed=5)
-    s = settled_spectrum(x, dt, F_L, F_H)
-    off = {line.frequency_hz: line for line in label_lines(s, F_L, F_H)}
-    assert off[195.0].label == UNKNOWN
-    on_lines = label_lines(s, F_L, F_H, half_integer=True)
-    on = {line.frequency_hz: line for line in on_lines}
-    assert on[195.0].label == "f_H+3f_L/2"
-    assert (on[195.0].m, on[195.0].n) == (1, Fraction(3, 2))
-    # Enabling half-integers changes no other label (integer lines have integer n first).
-    for f, line in off.items():
-        if f != 195.0:
-            assert on[f].label == line.label
+    t = np.arange(x.size) * dt
+    off = fit_peaks(t, x, F_L, F_H)
+    assert [p.frequency_hz for p in off.unlabelled] == [195.0]
+    on = fit_peaks(t, x, F_L, F_H, torus=(1, 2))
+    assert on.unlabelled == ()
+    line = next(ln for ln in on.lines if ln.frequency_hz == 195.0)
+    assert line.label == "f_H+3f_L/2" and (line.m, line.n) == (1, Fraction(3, 2))
+    # The half torus changes no other label (integer lines have integer n first).
+    assert [ln.label for ln in on.lines if ln.frequency_hz != 195.0] == [ln.label for ln in off.lines]
 
 
 def test_table_and_comparison_output():
-    x, dt, *_ = _synthetic()
-    s = settled_spectrum(x, dt, F_L, F_H)
-    lines = label_lines(s, F_L, F_H)
-    text = format_table(lines)
+    x, dt, *_ = _synthetic(extra_hz=[333.0])
+    fit = fit_peaks(np.arange(x.size) * dt, x, F_L, F_H)
+    text = format_table(fit)
     assert text.splitlines()[0].split(" | ") == ["Frequency (Hz)", "Component"]
-    assert "20.00 " in text and "f_H" + MINUS + "f_L" in text
-    ascii_text = format_table(lines, ascii=True, amplitude_scale=1e6)
-    assert MINUS not in ascii_text and "Amplitude (µm)" in ascii_text
-    matches = compare_with_expected(lines, XU2016_TABLE1)
+    rows = [[cell.strip() for cell in row.split("|")] for row in text.splitlines()[2:]]
+    assert ["20.00", "f_H-f_L"] in rows and ["333.00", UNLABELLED] in rows
+    assert "Amplitude (µm)" in format_table(fit, amplitude_scale=1e6)
+    matches = compare_with_expected(fit.lines, XU2016_TABLE1)
     assert len(matches) == 24
     assert all(mt.found is not None and mt.label_agrees for mt in matches)
     assert [mt.found_hz for mt in matches][:2] == [20.0, 110.0]
     # The label as printed at 520 Hz does not agree; a missing line is reported.
-    bad = compare_with_expected(lines, [(520.0, "5f_H+2f_L"), 600.5])
+    bad = compare_with_expected(fit.lines, [(520.0, "5f_H+2f_L"), 600.5])
     assert bad[0].label_agrees is False
     assert bad[1].found is None and bad[1].label_agrees is None
-    table = format_comparison(bad, ascii=True)
+    table = format_comparison(bad)
     assert "NO" in table and "not found" in table
     with pytest.raises(InputError, match="^label = 'nonsense': must look like"):
-        compare_with_expected(lines, [(20.0, "nonsense")])
+        compare_with_expected(fit.lines, [(20.0, "nonsense")])
     with pytest.raises(InputError, match=r"^expected\[1\] = -5\.0: must be > 0 \(Hz\)$"):
-        compare_with_expected(lines, [20.0, -5.0])
+        compare_with_expected(fit.lines, [20.0, -5.0])
 
 
 def test_labels_on_flattop_fallback_for_incommensurate_speeds():
     """The paper's read-off speeds 69.58/90.33 Hz have no common period: the spectrum falls
-    back to the flat-top window, peaks lie within half a bin of the true frequencies, and
-    the default tolerance (half a bin) still labels each line."""
+    back to the flat-top window, its peaks lie within half a bin of the true frequencies, so
+    each proposes its line, fitted at its exact frequency."""
     f_L, f_H, dt = 69.58, 90.33, 1e-4
     t = np.arange(20_000) * dt  # 2 s: df = 0.5 Hz, lines >= 20 Hz = 40 bins apart
     combos = [(0, 1, 0.3), (1, 0, 1.0), (1, -1, 0.05), (2, -1, 0.1), (3, -2, 0.04), (2, 1, 0.08)]
     x = sum(a * np.cos(2 * np.pi * (m * f_H + n * f_L) * t + m) for m, n, a in combos)
     s = settled_spectrum(x, dt, f_L, f_H)
     assert s.window == "flattop"
-    lines = label_lines(s, f_L, f_H)
-    assert [(ln.m, ln.n) for ln in lines] == sorted(
-        [(m, n) for m, n, _ in combos], key=lambda mn: mn[0] * f_H + mn[1] * f_L
-    )
-    for ln, (m, n, a) in zip(lines, sorted(combos, key=lambda c: c[0] * f_H + c[1] * f_L)):
-        assert abs(ln.frequency_hz - (m * f_H + n * f_L)) <= 0.5 * s.df
-        # HFT95: within 0.0045 dB, plus leakage < 1e-4 absolute (5 other lines of amplitude
-        # <= 1 times sidelobes below -95 dB = 1.8e-5).
-        assert abs(20 * np.log10(ln.amplitude / a)) <= 0.0045 + 20 * np.log10(1 + 1e-4 / a)
+    fit = fit_peaks(t, x, f_L, f_H, spectrum=s)
+    ordered = sorted(combos, key=lambda c: c[0] * f_H + c[1] * f_L)
+    assert [(ln.m, ln.n) for ln in fit.lines] == [(m, n) for m, n, _ in ordered] and fit.unlabelled == ()
+    for ln, (m, n, a) in zip(fit.lines, ordered):
+        assert ln.frequency_hz == m * f_H + n * f_L
+        assert ln.amplitude == pytest.approx(a, rel=3e-14)  # every line fitted: measured 3.1e-15

@@ -278,7 +278,7 @@ def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced
     records = unknown_records(scene.plates, result)
     sol = solve_torus(rp.problem, rp.start_from_record(result.t, records, within=(4, 30)))
     assert sol.iterations <= 10 and sol.residual < 1e-10
-    largest = {ln.label_ascii: ln for ln in fit.lines}
+    largest = {ln.label: ln for ln in fit.lines}
     for label, tol in (("f_H", 1.5e-2), ("4f_H/3", 3.5e-2), ("f_L", 2e-3)):
         ln = largest[label]
         assert rp.amplitudes_at(sol.z, (14, "y"), [ln.frequency_hz])[0] == pytest.approx(ln.amplitude, rel=tol)

@@ -89,7 +89,7 @@ def test_linefit_csv_and_poincare_arrays_read_back(rub):
     unlabelled = [r for r in body if r[1] == "unlabelled"]
     assert len(labelled) == len(fit.lines) and len(unlabelled) == len(fit.unlabelled)
     for r, ln in zip(labelled, fit.lines):  # 17 significant digits: floats read back exactly
-        assert float(r[0]) == ln.frequency_hz and r[1] == ln.label_ascii and r[2] == ";".join(ln.labels)
+        assert float(r[0]) == ln.frequency_hz and r[1] == ln.label and r[2] == ";".join(ln.labels)
         assert (Fraction(r[3]), Fraction(r[4])) == ln.orders[0] and (int(r[5]), int(r[6])) == (fit.torus.k, fit.torus.j)
         assert float(r[7]) == 1e6 * ln.amplitude and float(r[8]) == ln.phase
         assert float(r[9]) == 1e6 * ln.standard_error and float(r[10]) == ln.share

@@ -11,8 +11,8 @@ from scipy.signal import butter, lfilter
 
 from rotorred.checks import InputError
 from rotorred.signals import linefit
-from rotorred.signals.linefit import fit_frequencies, fit_lines, fraction_label
-from rotorred.signals.lines import combination_label
+from rotorred.signals.linefit import fit_frequencies, fit_lines, fit_peaks
+from rotorred.signals.lines import line_label
 from rotorred.signals.spectra import settled_spectrum
 
 F_L = 70.0
@@ -193,7 +193,7 @@ def test_commensurate_whole_periods_equal_fft_on_bin_amplitudes():
     assert fit.torus.bases == (10.0,) and fit.torus.ratio == Fraction(9, 7)
     # Every label of a line on the 10 Hz grid is carried, first the lowest order (lines.py's rule).
     line_140 = next(ln for ln in fit.lines if ln.frequency_hz == 140.0)
-    assert line_140.label_ascii == "2f_L" and "9f_H-9f_L" not in line_140.labels  # |m| <= 8
+    assert line_140.label == "2f_L" and "9f_H-9f_L" not in line_140.labels  # |m| <= 8
     assert len(line_140.labels) > 1
 
 
@@ -213,12 +213,64 @@ def test_candidates_closer_than_the_resolution_merge_into_one_line_with_both_lab
 
 
 # --------------------------------------------------------------------------- labels, inputs, cost
-def test_fraction_labels_extend_the_table_1_labels():
-    assert fraction_label(Fraction(1, 3), 0) == "f_H/3"
-    assert fraction_label(Fraction(2, 3), -1, minus="-") == "2f_H/3-f_L"
-    assert fraction_label(-1, Fraction(4, 3), minus="-") == "4f_L/3-f_H"
-    for m, n in ((3, -2), (1, Fraction(3, 2)), (0, 2), (-1, 2)):
-        assert fraction_label(m, n) == combination_label(m, n)
+def test_fractional_orders_are_labelled_by_the_one_label_function():
+    assert line_label(Fraction(1, 3), 0) == "f_H/3"
+    assert line_label(Fraction(2, 3), -1) == "2f_H/3-f_L"
+    assert line_label(-1, Fraction(4, 3)) == "4f_L/3-f_H"
+    line = linefit.FittedLine(100.0, 1.0, 0.0, 0.1, 0.1, 0.5, ((Fraction(2, 3), Fraction(-1)), (Fraction(0), 2)))
+    assert line.label == "2f_H/3-f_L" and line.labels == ("2f_H/3-f_L", "2f_L")
+
+
+# --------------------------------------------------------------------------- FFT peaks as candidates
+def _known_lines(t, f_L, f_H, orders, seed):
+    rng = np.random.default_rng(seed)
+    amplitudes = rng.uniform(0.1, 1.0, len(orders))
+    x = sum(a * np.cos(2 * np.pi * (m * f_H + n * f_L) * t + p)
+            for (m, n), a, p in zip(orders, amplitudes, rng.uniform(-np.pi, np.pi, len(orders))))
+    return x, dict(zip(orders, amplitudes))
+
+
+@pytest.mark.parametrize("f_H", [90.0, 70.0 * math.sqrt(2.0)])
+def test_fft_peaks_feed_the_fit_two_paths_one_answer(f_H):
+    """The lines proposed by the FFT's peaks and fitted (fit_peaks) are those fit_lines finds, with the same labels,
+    frequencies and amplitudes, and both recover the known lines of a sum of sinusoids at m f_H + n f_L: at 70/90 Hz
+    (commensurate, rectangular spectrum on bins) and 70/99 Hz (not commensurate: flat-top spectrum)."""
+    f_L, dt = 70.0, 1e-4
+    t = np.arange(6000) * dt  # 0.6 s: 6 common periods of 70/90 Hz
+    orders = [(1, 0), (0, 1), (1, -1), (2, -1), (3, -2), (2, 0), (1, 1), (0, 2), (2, 1)]
+    x, truth = _known_lines(t, f_L, f_H, orders, 3)
+    peaks, full = fit_peaks(t, x, f_L, f_H), fit_lines(t, x, f_L, f_H, max_subharmonic=1)
+    assert peaks.unlabelled == () and len(peaks.lines) == len(full.lines) == len(orders)
+    for a, b in zip(peaks.lines, full.lines):
+        m, n = a.orders[0]
+        assert a.label == b.label == line_label(m, n) and a.frequency_hz == b.frequency_hz == m * f_H + n * f_L
+        # the same least squares on the same samples: identical; against the truth measured 8.7e-15 (70/90 Hz) and
+        # 4.4e-15 (70/99 Hz)
+        assert a.amplitude == b.amplitude and a.phase == b.phase
+        assert a.amplitude == pytest.approx(truth[(int(m), int(n))], rel=1e-13)
+    assert peaks.explained_share == pytest.approx(1.0, abs=1e-12)
+
+
+def test_fft_peaks_choose_the_lines_and_keep_the_unexplained_peaks():
+    """Lines below the threshold are not fitted; a tone at no combination is an unlabelled peak at its bin; a
+    half-integer multiple of f_L is labelled on the torus (1, 2) (the paper's experiment, f_H + 3f_L/2)."""
+    f_L, f_H, dt = 70.0, 90.0, 1e-4
+    t = np.arange(6000) * dt
+    x = np.cos(2 * np.pi * 90.0 * t) + 0.3 * np.cos(2 * np.pi * 20.0 * t) + 0.001 * np.cos(2 * np.pi * 160.0 * t) \
+        + 0.05 * np.cos(2 * np.pi * 195.0 * t)
+    fit = fit_peaks(t, x, f_L, f_H)
+    assert [ln.label for ln in fit.lines] == ["f_H-f_L", "f_H"]
+    assert fit.lines[0].amplitude == pytest.approx(0.3, rel=1e-14)
+    assert [(p.frequency_hz, round(p.amplitude, 12)) for p in fit.unlabelled] == [(195.0, 0.05)]
+    half = fit_peaks(t, x, f_L, f_H, torus=(1, 2))
+    assert [ln.label for ln in half.lines] == ["f_H-f_L", "f_H", "f_H+3f_L/2"] and half.unlabelled == ()
+    assert half.lines[-1].amplitude == pytest.approx(0.05, rel=1e-13)  # measured 6e-15; 0.3: 4e-16
+    low = fit_peaks(t, x, f_L, f_H, threshold=1e-4)
+    assert "f_H+f_L" in [ln.label for ln in low.lines]  # 160 Hz at 0.1 %
+    with pytest.raises(InputError, match="^spectrum = .*: must be a Spectrum of the last samples of x"):
+        fit_peaks(t[:100], x[:100], f_L, f_H, spectrum=settled_spectrum(x, dt, f_L, f_H))
+    silent = fit_peaks(t, np.zeros_like(t), f_L, f_H)
+    assert silent.lines == () and silent.unlabelled == ()
 
 
 def test_inputs_are_refused_with_the_one_message_form():

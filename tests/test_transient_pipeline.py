@@ -14,6 +14,7 @@ from rotorred.model.elements import Bearing, Disk, Material, ShaftElement
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.transient import kernel
+from rotorred.transient.status import RUNNING
 from rotorred.transient.contact import RubPlate, disk_force
 from rotorred.transient.matrices import (contact_rows, fold_forcing, force_columns, kernel_plates,
                                          newmark_coefficients, plate_parameters, scalar_step, step_levels,
@@ -203,7 +204,7 @@ def test_one_compiled_step_is_the_newmark_step():
         plates = kernel_plates(system.M, contact_rows(system, []), np.zeros((0, kernel.N_PLATE_PAR)), np.zeros(0))
         status, *_ = run_kernel(levels, kernel.Forcing(forces.kind, forces.omega), plates, state, record, settings,
                                   diag, 2, 1, False)
-        assert status == kernel.RUNNING and diag.counters[kernel.C_STEPS] == 2
+        assert status == RUNNING and diag.counters[kernel.C_STEPS] == 2
         Ainv, Hq, Hv, Ha = step_matrices(system.M, D, system.K, h, sch.gamma, sch.beta, sch.alpha)
         c = newmark_coefficients(h, sch.gamma, sch.beta)
         for step in (1, 2):

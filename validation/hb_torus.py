@@ -151,7 +151,7 @@ def main() -> Comparison:
     print(f"transient {RECORD_START:g}-{DURATION:g} s (solve {result.solve_time:.2f} s): torus {torus.label}, class "
           f"{analysis.classification.label}, {analysis.settling.reason}; lines explain "
           f"{analysis.fit.explained_share:.4f}")
-    print("  10 largest lines at node 14 Y: " + ", ".join(f"{ln.label_ascii} {ln.frequency_hz:.2f} Hz "
+    print("  10 largest lines at node 14 Y: " + ", ".join(f"{ln.label} {ln.frequency_hz:.2f} Hz "
                                                           f"{1e6 * ln.amplitude:.4f} um" for ln in largest))
     print(f"torus harmonic balance on ({torus.f_L / torus.j:.6g} Hz, {torus.f_H / torus.k:.6g} Hz), band "
           f"<= {F_MAX:g} Hz:")

@@ -30,7 +30,8 @@ import numpy as np
 from rotorred.scenes.outputs import write_outputs
 from rotorred.scenes.run import run_scene
 from rotorred.scenes.schema import load_scene
-from rotorred.signals.lines import XU2016_TABLE1, compare_with_expected, format_comparison, label_lines
+from rotorred.signals.linefit import fit_peaks
+from rotorred.signals.lines import XU2016_TABLE1, compare_with_expected, format_comparison, parse_label
 
 #: threshold of the normal-state check (fraction of the largest line), from the issue
 NORMAL_THRESHOLD = 0.01
@@ -50,16 +51,22 @@ def reproduce(settings: tuple = ()):
     return normal, rub
 
 
+def peak_lines(result, dof: tuple, threshold: float):
+    """The lines at the peaks of ``result``'s spectrum at ``dof`` above ``threshold`` of the largest (a LineFit)."""
+    return fit_peaks(result.t, result.outputs[dof], result.f_L, result.f_H, spectrum=result.spectra[dof],
+                     threshold=threshold)
+
+
 def normal_lines(node: int, direction: str):
-    """Lines of the normal-state spectrum at (node, direction) above 1 % of the largest."""
+    """Lines of the normal-state spectrum at (node, direction) above 1 % of the largest (tuple of FittedLine)."""
     normal, _ = reproduce()
-    return label_lines(normal.spectra[(node, direction)], normal.f_L, normal.f_H, threshold=NORMAL_THRESHOLD)
+    return peak_lines(normal, (node, direction), NORMAL_THRESHOLD).lines
 
 
 def table1_matches(settings: tuple = ()):
     """The paper's Table 1 paired with our node 14 Y lines above 0.5 % (list of LineMatch)."""
     _, rub = reproduce(settings)
-    lines = label_lines(rub.spectra[(14, "y")], rub.f_L, rub.f_H, threshold=TABLE1_THRESHOLD)
+    lines = peak_lines(rub, (14, "y"), TABLE1_THRESHOLD).lines
     return compare_with_expected(lines, XU2016_TABLE1, tol_hz=PAIR_TOL_HZ)
 
 
@@ -109,9 +116,8 @@ def reference_line_error(settings: tuple) -> tuple[float, int]:
 
 
 def _mn(label: str):
-    from rotorred.signals.lines import parse_label
     m, n = parse_label(label)
-    return m, int(n)
+    return int(m), int(n)
 
 
 def main(argv=None) -> int:
@@ -128,7 +134,7 @@ def main(argv=None) -> int:
     ok1 = True
     for node in (13, 14):
         for d in ("x", "y"):
-            labels = [ln.label_ascii for ln in normal_lines(node, d)]
+            labels = [ln.label for ln in normal_lines(node, d)]
             ok = set(labels) <= {"f_L", "f_H"} and "f_H" in labels
             ok1 &= ok
             spec = normal.spectra[(node, d)]
@@ -140,7 +146,7 @@ def main(argv=None) -> int:
     found = n_table1_found()
     print(f"\n2. Rub: node 14 Y lines above 0.5 % of the largest against the paper's Table 1 "
           f"({found} of 24 found with the paper's label; needed 18)")
-    print(format_comparison(matches, ascii=True))
+    print(format_comparison(matches))
 
     r18, n18 = plate_side_reach(18)
     r14, n14 = plate_side_reach(14)

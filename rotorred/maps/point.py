@@ -232,7 +232,7 @@ def _recorded(a, scene: Scene, res) -> PointResult:
         explained_share=float(c.explained_share), torus=(a.fit.torus.k, a.fit.torus.j),
         line_frequency=np.array([ln.frequency_hz for ln in lines]),
         line_amplitude=np.array([ln.amplitude for ln in lines]), line_phase=np.array([ln.phase for ln in lines]),
-        line_label=tuple(ln.label_ascii for ln in lines),
+        line_label=tuple(ln.label for ln in lines),
         poincare_x=c.poincare.x[-N_SAMPLES:], poincare_velocity=c.poincare.velocity[-N_SAMPLES:],
         poincare_frequency=float(c.poincare.frequency_hz), peak_orbit=_peak_orbits(scene, res),
         **_contact(res))

@@ -28,7 +28,7 @@ from rotorred.model.dofs import direction_name
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from rotorred.signals.lines import SpectralLine
+    from rotorred.signals.linefit import FittedLine
 
 __all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures",
            "record_figures", "analysis_figures", "scene_frames", "prepare_frames"]
@@ -240,7 +240,7 @@ def plot_spectra(
     spectra,
     path,
     *,
-    lines: Mapping[str, Sequence[SpectralLine]] | None = None,
+    lines: Mapping[str, Sequence[FittedLine]] | None = None,
     title: str | None = None,
     f_max: float | None = None,
     log_y: bool = False,
@@ -258,8 +258,8 @@ def plot_spectra(
     path : str or Path
         Output file.
     lines : mapping, optional
-        ``{label: [SpectralLine, ...]}`` (from :func:`rotorred.signals.lines.label_lines`) for the
-        series of the same label; each known line is marked and labelled ("2f_H−f_L").
+        ``{label: [FittedLine, ...]}`` (``LineFit.lines``, e.g. of :func:`rotorred.signals.linefit.fit_peaks`) for
+        the series of the same label; each line is marked and labelled ("2f_H−f_L").
     title : str, optional
     f_max : float, optional
         Upper frequency shown (Hz); default: the largest labelled line plus 10 %, or all.
@@ -284,7 +284,7 @@ def plot_spectra(
         if str(key) not in all_labels:
             checks.fail(f"lines[{key!r}]", key, f"lines key must be a series of spectra ({sorted(all_labels)})")
     if f_max is None:
-        known = [ln.frequency_hz for seq in lines.values() for ln in seq if ln.known]
+        known = [ln.frequency_hz for seq in lines.values() for ln in seq]
         f_max = 1.1 * max(known) if known else None
     else:
         checks.positive("f_max", f_max, "Hz")
@@ -301,8 +301,7 @@ def plot_spectra(
             lw = 0.9 + 1.6 * (n_series - 1 - i)
             (handle,) = ax.plot(f[show], scale * a[show], lw=lw, label=str(label))
             top = max(top, float(np.max(scale * a[show][f[show] > 0], initial=0.0)))
-            shown = [ln for ln in lines.get(str(label), ())
-                     if ln.known and (f_max is None or ln.frequency_hz <= f_max)]
+            shown = [ln for ln in lines.get(str(label), ()) if f_max is None or ln.frequency_hz <= f_max]
             _label_lines(ax, shown, scale, handle.get_color())
         if log_y:
             ax.set_yscale("log")
@@ -319,7 +318,7 @@ def plot_spectra(
     return _save(fig, path, title)
 
 
-def _label_lines(ax, lines: Sequence[SpectralLine], scale: float, color) -> None:
+def _label_lines(ax, lines: Sequence[FittedLine], scale: float, color) -> None:
     """Mark ``lines`` (one marker artist for all) and write each one's label above it, rotated."""
     if not lines:
         return
@@ -335,12 +334,13 @@ def _label_lines(ax, lines: Sequence[SpectralLine], scale: float, color) -> None
 
 
 def plot_label(label: str) -> str:
-    """A line label as plain text with Unicode subscripts, ``"2f_H−f_L"`` -> ``"2fₕ−fₗ"``.
+    """A line label (:func:`rotorred.signals.lines.line_label`) as plain text with Unicode subscripts and minus,
+    ``"2f_H-f_L"`` -> ``"2fₕ−fₗ"``.
 
-    Rendered as ordinary text: the mathtext labels (``label_math``) took about 1.2 s of the 4.4 s
-    that the figures of ``paper-rub`` took (some 330 labels).
+    Rendered as ordinary text: mathtext labels took about 1.2 s of the 4.4 s that the figures of
+    ``paper-rub`` took (some 330 labels).
     """
-    return label.replace("f_H", "f\u2095").replace("f_L", "f\u2097")
+    return label.replace("f_H", "f\u2095").replace("f_L", "f\u2097").replace("-", "\u2212")
 
 
 # --------------------------------------------------------------------------- orbits
@@ -492,17 +492,16 @@ def plot_scene(result, out: str | Path) -> list[Path]:
 
 
 class LineMark(NamedTuple):
-    """What a spectrum plot shows of a :class:`rotorred.signals.lines.SpectralLine` (a figure job carries these, so
+    """What a spectrum plot shows of a :class:`rotorred.signals.linefit.FittedLine` (a figure job carries these, so
     a worker needs neither the signals modules nor pyFFTW to draw it)."""
 
     frequency_hz: float
     amplitude: float
     label: str
-    known: bool
 
 
-def _marks(lines) -> list[LineMark]:
-    return [LineMark(float(ln.frequency_hz), float(ln.amplitude), ln.label, bool(ln.known)) for ln in lines]
+def _marks(fit) -> list[LineMark]:
+    return [LineMark(float(ln.frequency_hz), float(ln.amplitude), ln.label) for ln in fit.lines]
 
 
 def _pair(spectrum) -> tuple[np.ndarray, np.ndarray]:
@@ -573,7 +572,7 @@ def record_figures(result, out: str | Path) -> list[partial]:
                 spectra[panel] = {f"{label} {direction_name(d)}": _pair(r.spectra[(n, d)]) for label, r in pairs}
                 lines[f"{case} {direction_name(d)}"] = _marks(result.lines[(n, d)])
             if f_max is None:
-                known = [ln.frequency_hz for ls in lines.values() for ln in ls if ln.known]
+                known = [ln.frequency_hz for ls in lines.values() for ln in ls]
                 f_max_n = max(1.1 * max(known, default=0.0), 3.0 * result.f_H)
             else:
                 f_max_n = f_max

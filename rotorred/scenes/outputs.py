@@ -16,6 +16,7 @@ from rotorred.progress import stage
 from rotorred.provenance import Provenance
 from rotorred.scenes.run import SceneResult
 from rotorred.scenes.summary import format_summary
+from rotorred.signals.lines import UNLABELLED
 from rotorred.writers import write_csv, write_mat, write_npz, write_text
 
 __all__ = ["data_arrays", "write_data", "write_outputs", "submit_figures", "LINEFIT_HEADER", "POINCARE_HEADER"]
@@ -89,9 +90,13 @@ def _spectra_csv(result: SceneResult, path: Path) -> Path:
 
 
 def _lines_csv(result: SceneResult, path: Path) -> Path:
-    rows = [[d[0], d[1], ln.frequency_hz, 1e6 * ln.amplitude, "" if ln.m is None else ln.m,
-             "" if ln.n is None else str(ln.n), ln.label_ascii]
-            for d in result.scene.output.dofs for ln in result.lines[d]]
+    """The lines at every DOF's spectral peaks, then the peaks at no line (label ``unlabelled``)."""
+    rows = []
+    for d in result.scene.output.dofs:
+        fit = result.lines[d]
+        rows += [[d[0], d[1], ln.frequency_hz, 1e6 * ln.amplitude, str(ln.m), str(ln.n), ln.label]
+                 for ln in fit.lines]
+        rows += [[d[0], d[1], p.frequency_hz, 1e6 * p.amplitude, "", "", UNLABELLED] for p in fit.unlabelled]
     header = ["node", "direction", "frequency (Hz)", "amplitude (um or urad)", "m (multiple of f_H)",
               "n (multiple of f_L)", "label"]
     return write_csv(path, header, list(zip(*rows)) if rows else [[]] * len(header))
@@ -101,9 +106,9 @@ def _linefit_csv(result: SceneResult, path: Path) -> Path:
     """Fitted lines of the table DOF, then its residual's strongest peaks (label ``unlabelled``)."""
     a = result.analysis
     fit, k, j = a.fit, a.fit.torus.k, a.fit.torus.j
-    rows = [[ln.frequency_hz, ln.label_ascii, ";".join(ln.labels), str(ln.m), str(ln.n), k, j, 1e6 * ln.amplitude,
+    rows = [[ln.frequency_hz, ln.label, ";".join(ln.labels), str(ln.m), str(ln.n), k, j, 1e6 * ln.amplitude,
              ln.phase, 1e6 * ln.standard_error, ln.share] for ln in fit.lines]
-    rows += [[p.frequency_hz, "unlabelled", "", "", "", "", "", 1e6 * p.amplitude, "", "", ""] for p in fit.unlabelled]
+    rows += [[p.frequency_hz, UNLABELLED, "", "", "", "", "", 1e6 * p.amplitude, "", "", ""] for p in fit.unlabelled]
     cols = list(zip(*rows)) if rows else [[]] * len(LINEFIT_HEADER)
     return write_csv(path, LINEFIT_HEADER, cols, digits=17)
 

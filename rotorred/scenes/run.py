@@ -18,9 +18,9 @@ Spectra (:func:`rotorred.signals.spectra.settled_spectrum`, pyFFTW with reused p
 amplitude in metres, rectangular window over the last whole number of common periods of the
 two spools (70/90 Hz: 0.1 s), where every combination ``m f_H + n f_L`` is on a bin and is
 read without amplitude error; when the speeds are not commensurate the flat-top window is
-used (amplitude error below 0.0045 dB) and the spectrum's ``note`` says so. Lines are the
-peaks above ``output.line_threshold`` of the largest, labelled by
-:func:`rotorred.signals.lines.label_lines` within half a bin.
+used (amplitude error below 0.0045 dB) and the spectrum's ``note`` says so. The lines of each DOF
+are those at the spectrum's peaks above ``output.line_threshold`` of the largest, labelled and
+fitted by least squares on the spectrum's samples (:func:`rotorred.signals.linefit.fit_peaks`).
 
 Line fit, settling and class of the table DOF (:func:`table_dof`): the lines
 ``(m/k) f_H + (n/j) f_L`` are fitted by least squares (:func:`rotorred.signals.linefit.fit_lines`,
@@ -46,11 +46,10 @@ import numpy as np
 from rotorred.model.assembly import assemble
 from rotorred.progress import stage
 from rotorred.linear.harmonic import SteadyState, steady_state
-from rotorred.signals.lines import label_lines
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
 from rotorred.signals.classify import Classification, classify
-from rotorred.signals.linefit import LineFit, fit_lines
+from rotorred.signals.linefit import LineFit, fit_lines, fit_peaks
 from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
@@ -122,8 +121,8 @@ class SceneResult:
         One per rub plate (empty without plates).
     spectra : dict of (int, str) to Spectrum
         Amplitude spectrum of each recorded DOF (m).
-    lines : dict of (int, str) to list of SpectralLine
-        Labelled peaks of each spectrum.
+    lines : dict of (int, str) to LineFit
+        The lines at each spectrum's peaks (:func:`rotorred.signals.linefit.fit_peaks`).
     f_L, f_H : float
         Lower and higher spool frequency (Hz).
     method : {"harmonic", "transient", "harmonic-balance"}
@@ -189,10 +188,10 @@ class SceneResult:
         """Number of contact onsets (open -> slip/stick) of plate ``plate`` in the window."""
         return self.contacts[plate].n_impacts() if self.contacts else 0
 
-    def line_amplitude(self, dof, m: int, n) -> float:
-        """Amplitude (m) of the labelled line m f_H + n f_L of ``dof``, 0 if it is not a peak."""
-        for ln in self.lines[tuple(dof)]:
-            if ln.known and ln.m == m and ln.n == n:
+    def line_amplitude(self, dof, m, n) -> float:
+        """Amplitude (m) of the line m f_H + n f_L of ``dof`` (its first label), 0 if it is not at a peak."""
+        for ln in self.lines[tuple(dof)].lines:
+            if ln.m == m and ln.n == n:
                 return ln.amplitude
         return 0.0
 
@@ -369,7 +368,7 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     f_L, f_H = spool_frequencies(scene)
     t0 = time.perf_counter()
     response = respond(scene, model, initial, progress)
-    spectra, lines = _spectra_and_lines(scene, response.outputs, f_L, f_H)
+    spectra, lines = _spectra_and_lines(scene, response.t, response.outputs, f_L, f_H)
     solve_time = time.perf_counter() - t0
     if compare_normal is None:
         compare_normal = scene.output.compare_normal
@@ -569,7 +568,7 @@ def explain_divergence(scene: Scene, exc) -> str:
     """
     import re
 
-    from rotorred.transient import kernel
+    from rotorred.transient.status import LIMIT, NEWTON_FAILED, NONFINITE
 
     status, t_done = exc.result.status, exc.result.final.t
     where, why = exc.dof, exc.cause
@@ -577,12 +576,12 @@ def explain_divergence(scene: Scene, exc) -> str:
     if m:
         k = int(m.group(1))
         where = f"rub[{k}] (node {m.group(2)}{', ' + m.group(3) if m.group(3) else ''})"
-    if status == kernel.LIMIT:
+    if status == LIMIT:
         why = ("the disk's displacement exceeded 1 m, the transient's divergence limit: the response left the "
                "model (lower unbalance[].m_e, or move speeds away from a critical speed)")
-    elif status == kernel.NEWTON_FAILED:
+    elif status == NEWTON_FAILED:
         why = "the contact iteration did not converge (rub[].K_nr, rub[].c, solver.dt)"
-    elif status == kernel.NONFINITE:
+    elif status == NONFINITE:
         why = "a displacement became infinite or NaN (solver.dt, rub[].K_nr)"
     return (f"the transient diverged at t = {exc.time:.6g} s at {where}: {why}; halving solver.dt = "
             f"{scene.solver.dt:g} s did not cure it; the record up to t = {t_done:.6g} s is kept")
@@ -619,10 +618,10 @@ class SceneDiverged(RuntimeError):
         return cls(message, partial, exc.time, exc.dof, exc.cause)
 
 
-def _spectra_and_lines(scene: Scene, outputs: dict, f_L: float, f_H: float) -> tuple[dict, dict]:
-    """Amplitude spectrum and labelled lines of every recorded DOF."""
+def _spectra_and_lines(scene: Scene, t: np.ndarray, outputs: dict, f_L: float, f_H: float) -> tuple[dict, dict]:
+    """Amplitude spectrum and the lines at its peaks (a :class:`LineFit`) of every recorded DOF."""
     spectra, lines = {}, {}
     for d in scene.output.dofs:
         spectra[d] = settled_spectrum(outputs[d], scene.solver.dt, f_L, f_H)
-        lines[d] = label_lines(spectra[d], f_L, f_H, threshold=scene.output.line_threshold)
+        lines[d] = fit_peaks(t, outputs[d], f_L, f_H, spectrum=spectra[d], threshold=scene.output.line_threshold)
     return spectra, lines

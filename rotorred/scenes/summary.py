@@ -141,21 +141,23 @@ def _contacts(result: SceneResult) -> str:
 def _lines(result: SceneResult) -> str:
     sc = result.scene
     d = table_dof(result)
-    spec, found = result.spectra[d], result.lines[d]
+    spec, fit = result.spectra[d], result.lines[d]
     exact = spec.window == "rectangular" and "on bins" in spec.note
     error = "0 on-bin" if exact else f"<= {WINDOWS[spec.window].max_scalloping_db:.3g} dB"
-    known = [ln for ln in found if ln.known]
-    combos = [ln for ln in known if ln.m not in (0, 1) or ln.n not in (0, 1) or (ln.m == 1 and ln.n == 1)]
+    combos = [ln for ln in fit.lines if ln.m not in (0, 1) or ln.n not in (0, 1) or (ln.m == 1 and ln.n == 1)]
     lines = [f"Spectral lines of node {d[0]} {direction_name(d[1])} above {100 * sc.output.line_threshold:g} % of "
-             f"the largest (f_L = {result.f_L:.6g} Hz, f_H = {result.f_H:.6g} Hz; bin {spec.df:.4g} Hz, labels "
-             f"m f_H + n f_L matched within half a bin; {spec.window} window, amplitude error {error}):",
-             format_table(found, ascii=True, amplitude_scale=1e6, amplitude_unit="um"),
-             f"{len(found)} lines, {len(known)} labelled, {len(combos)} besides f_L and f_H; spectrum: {spec.note}"]
+             f"the largest (f_L = {result.f_L:.6g} Hz, f_H = {result.f_H:.6g} Hz; bin {spec.df:.4g} Hz, peaks "
+             f"labelled m f_H + n f_L within half a bin and fitted by least squares; {spec.window} window, "
+             f"spectrum amplitude error {error}):",
+             format_table(fit, amplitude_scale=1e6, amplitude_unit="um"),
+             f"{len(fit.lines) + len(fit.unlabelled)} lines, {len(fit.lines)} labelled, {len(combos)} besides f_L "
+             f"and f_H; spectrum: {spec.note}"]
     others = [x for x in sc.output.dofs if x != d]
     if others:
         lines.append("other DOFs: " + "; ".join(
-            f"node {x[0]} {direction_name(x[1])}: {len(result.lines[x])} lines "
-            f"({', '.join(ln.label_ascii for ln in result.lines[x][:6])}{', ...' if len(result.lines[x]) > 6 else ''})"
+            f"node {x[0]} {direction_name(x[1])}: {len(result.lines[x].lines)} lines "
+            f"({', '.join(ln.label for ln in result.lines[x].lines[:6])}"
+            f"{', ...' if len(result.lines[x].lines) > 6 else ''})"
             for x in others))
     return "\n".join(lines)
 

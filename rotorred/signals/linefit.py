@@ -8,6 +8,8 @@ with sub-harmonic orders k, j > 1 when rub impacts lock to a fraction of a spool
 the time record itself, not on FFT bins: the frequencies are exact by construction (they come
 from the labels) and a line between bins loses nothing to scalloping. It finds the torus (k, j)
 by itself, keeps only significant lines, and reports what the lines do not explain.
+:func:`fit_peaks` fits the same lines, chosen by the peaks of an FFT amplitude spectrum instead of
+by their significance (the scenes' lines above ``output.line_threshold``).
 
 Model
     ``x(t_i) = mu + sum_l [C_l cos(2 pi f_l t_i) + S_l sin(2 pi f_l t_i)] + r_i`` on a uniform
@@ -27,11 +29,17 @@ Resolution: the merge rule
     Candidates below c/T are not fitted (they cannot be told from an offset or a drift), and
     ``f_max`` defaults to the Nyquist frequency minus c/T.
 
-Priority
-    ``(|m| + |n|, lcm of the denominators of m and n, |n|, -m)``: lowest order first, whole
-    orders before fractional ones, then the rule of :mod:`rotorred.signals.lines` (fewest
-    multiples of f_L, positive m). On whole orders this is the labelling rule of
-    :func:`rotorred.signals.lines.label_lines`, so the two modules give the same labels.
+Priority: the labelling rule
+    ``(|m| + |n|, lcm of the denominators of m and n, |n|, -m)``. Every label of rotorred comes from this
+    rule (:func:`fit_lines`, :func:`fit_peaks`), written by :func:`rotorred.signals.lines.line_label`. With
+    f_L = 70 and f_H = 90 Hz every combination lies on a 10 Hz grid, so many ``(m, n)`` give one frequency
+    (140 Hz = 2 f_L = 7 f_H - 7 f_L ...); the line carries them all, first the one of (1) the lowest order
+    ``|m| + |n|``; (2) on a tie, whole orders before fractional ones; (3) then the fewest multiples of f_L:
+    the rubbing disk (node 18) is on the high-pressure spool, so harmonics of f_H are the carrier and f_L
+    the modulation (the paper's "fundamental modulated by the other rotor"); (4) then positive m. Rule (1)
+    alone reproduces all 24 lines of the paper's Table 1 (each has a unique lowest-order combination within
+    ``|m|, |n| <= 8``); rule (3) decides lines the paper does not list, e.g. 80 Hz = 4f_H-4f_L (not
+    5f_L-3f_H) and 560 Hz = 7f_H-f_L (not 8f_L).
 
 No packing
     Candidates have bounded orders (``|m| <= max_m``, ``|n| <= max_n`` as multiples of f_H and
@@ -132,14 +140,14 @@ import scipy.linalg
 import scipy.special
 
 from rotorred import checks
-from rotorred.signals.lines import MINUS, combination_label
-from rotorred.signals.spectra import Spectrum, amplitude_spectrum
+from rotorred.signals.lines import find_peaks, line_label
+from rotorred.signals.spectra import Spectrum, amplitude_spectrum, settled_spectrum
 
 __all__ = [
     "RESOLUTION", "Z_SIGNIFICANCE", "RELATIVE_FLOOR", "FILL", "MAX_LINES", "MAX_SUBHARMONIC",
     "PEAK_FACTOR", "N_TORI",
     "Torus", "FittedLine", "UnlabelledPeak", "TorusTrial", "LineFit", "FrequencyFit",
-    "fit_lines", "fit_frequencies", "fraction_label", "commensurate_ratio", "residual_peaks",
+    "fit_lines", "fit_peaks", "fit_frequencies", "commensurate_ratio", "residual_peaks",
 ]
 
 RESOLUTION = 2.0  #: c: candidates closer than c/T are one line (cond of the fit <= (c+1)/(c-1))
@@ -159,34 +167,7 @@ LOCAL_BINS = 64  #: the residual's local level is the median of +-64 Hann bins a
 _CHUNK = 512  #: samples per chunk of the phasor products
 
 
-# --------------------------------------------------------------------------- labels
-def fraction_label(m, n, minus: str = MINUS) -> str:
-    """Label of ``m f_H + n f_L`` for fractional orders, in the paper's Table 1 style.
-
-    Parameters
-    ----------
-    m, n : int or Fraction
-        Multiples of f_H and f_L (``Fraction(1, 3)`` is f_H/3).
-    minus : str
-        Minus sign: ``MINUS`` (U+2212, default) or ``"-"``.
-
-    Returns
-    -------
-    str
-        :func:`rotorred.signals.lines.combination_label` of the exact orders: ``"f_H/3"``,
-        ``"2f_H/3+f_L"``.
-
-    Examples
-    --------
-    >>> fraction_label(Fraction(2, 3), -1, minus="-")
-    '2f_H/3-f_L'
-    """
-    for name, value in (("m", m), ("n", n)):
-        if not isinstance(value, (int, Fraction)) or isinstance(value, bool):
-            checks.fail(name, value, "must be an int or a fractions.Fraction")
-    return combination_label(Fraction(m), Fraction(n), minus=minus)
-
-
+# --------------------------------------------------------------------------- speeds
 def commensurate_ratio(f_L: float, f_H: float) -> Fraction | None:
     """``f_H / f_L = p / q`` in lowest terms, or None when the speeds are not commensurate.
 
@@ -237,13 +218,13 @@ class Torus:
     @property
     def label(self) -> str:
         """``"f_H/3, f_L"``-style text of the bases, with ``" (common base 10 Hz)"`` if commensurate."""
-        text = f"{fraction_label(Fraction(1, self.k), 0)}, {fraction_label(0, Fraction(1, self.j))}"
+        text = f"{line_label(Fraction(1, self.k), 0)}, {line_label(0, Fraction(1, self.j))}"
         return text + (f" (common base {self.bases[0]:.6g} Hz)" if self.ratio is not None else "")
 
 
 @dataclass(frozen=True)
 class FittedLine:
-    """One significant line of a :class:`LineFit`: ``amplitude cos(2 pi frequency_hz t + phase)``.
+    """One line of a :class:`LineFit`: ``amplitude cos(2 pi frequency_hz t + phase)``, and its labels.
 
     Attributes
     ----------
@@ -283,18 +264,13 @@ class FittedLine:
 
     @property
     def label(self) -> str:
-        """First label, Unicode minus (``"2f_H/3−f_L"``)."""
-        return fraction_label(self.m, self.n)
-
-    @property
-    def label_ascii(self) -> str:
-        """First label, ASCII hyphen."""
-        return fraction_label(self.m, self.n, minus="-")
+        """First label (:func:`rotorred.signals.lines.line_label`: ``"2f_H/3-f_L"``)."""
+        return line_label(self.m, self.n)
 
     @property
     def labels(self) -> tuple[str, ...]:
-        """Every label the line carries, first by priority (ASCII hyphen)."""
-        return tuple(fraction_label(m, n, minus="-") for m, n in self.orders)
+        """Every label the line carries, first by priority."""
+        return tuple(line_label(m, n) for m, n in self.orders)
 
     @property
     def significance(self) -> float:
@@ -331,20 +307,22 @@ class TorusTrial:
 
 @dataclass(frozen=True)
 class LineFit:
-    """Result of :func:`fit_lines`.
+    """Result of :func:`fit_lines` and :func:`fit_peaks`: the labelled lines of a record of N samples.
 
     Attributes
     ----------
     lines : tuple of FittedLine
-        Significant lines, by increasing frequency.
+        The lines (significant ones for :func:`fit_lines`, those at the spectrum's peaks for
+        :func:`fit_peaks`), by increasing frequency.
     torus : Torus
         Torus of the lines (found, or as given).
     explained_share : float
-        ``1 - RSS / sum (x - mean)^2`` on the time record.
+        ``1 - RSS / sum (x - mean)^2`` on the time record (dimensionless; NaN for a constant record).
     mean : float
         Fitted offset (units of the signal).
     unlabelled : tuple of UnlabelledPeak
-        Strongest peaks of the residual, strongest first.
+        What the lines do not explain: the strongest peaks of the residual, strongest first
+        (:func:`fit_lines`), or the spectrum's peaks near no line, by frequency (:func:`fit_peaks`).
     residual : ndarray, shape (N,)
         ``x`` minus the fitted mean and lines.
     residual_spectrum : Spectrum
@@ -363,7 +341,7 @@ class LineFit:
         Candidate lines fitted before the significance test (after merging).
     n_significant : int
         Lines that passed the significance test before the ``max_kept`` cap (= ``len(lines)``
-        without a cap).
+        without a cap; ``len(lines)`` for :func:`fit_peaks`).
     """
 
     lines: tuple[FittedLine, ...]
@@ -720,6 +698,12 @@ def _fit_torus(grid: _Grid, x: np.ndarray, opts: _Options, k: int, j: int) -> _T
     mp, nq, f, _ = _candidates(opts, k, j)
     line_of, line_freqs = _merge(f, opts.resolution_hz, opts.cap)
     keep, sol, errors, n_significant = _significant(grid, x, line_freqs, opts)
+    return _torus_fit(k, j, mp, nq, line_of, line_freqs, keep, sol, errors, n_significant)
+
+
+def _torus_fit(k: int, j: int, mp: np.ndarray, nq: np.ndarray, line_of: np.ndarray, line_freqs: np.ndarray,
+               keep: np.ndarray, sol: _Solution, errors: tuple, n_significant: int) -> _TorusFit:
+    """The :class:`_TorusFit` of the merged lines ``keep`` (increasing line indices), each with its labels."""
     by_line = np.argsort(line_of, kind="stable")  # candidates grouped by line, priority order kept
     starts = np.searchsorted(line_of[by_line], keep)
     ends = np.searchsorted(line_of[by_line], keep, side="right")
@@ -820,7 +804,7 @@ def _search(grid: _Grid, x: np.ndarray, opts: _Options, max_sub: int, energy: fl
 
 # --------------------------------------------------------------------------- the fit
 def _options(grid: _Grid, x: np.ndarray, f_L, f_H, f_max, max_m, max_n, resolution, z, relative_floor,
-             max_lines, max_kept=None) -> _Options:
+             max_lines, max_kept=None, constant_ok: bool = False) -> _Options:
     f_L = checks.positive("f_L", f_L, "Hz")
     f_H = checks.positive("f_H", f_H, "Hz")
     resolution = checks.number("resolution", resolution, ge=1.0)
@@ -832,7 +816,7 @@ def _options(grid: _Grid, x: np.ndarray, f_L, f_H, f_max, max_m, max_n, resoluti
     f_hi = top if f_max is None else checks.number("f_max", f_max, "Hz", gt=f_lo, le=top)
     cap = min(checks.integer("max_lines", max_lines, ge=1), int(FILL * (f_hi - f_lo) / f_lo))
     a_ref = math.sqrt(2.0 * np.mean((x - x.mean()) ** 2))
-    if a_ref == 0.0:
+    if a_ref == 0.0 and not constant_ok:
         checks.fail("x", x, "must not be constant: there is no line to fit")
     return _Options(f_L, f_H, f_lo, f_hi, f_lo, max(cap, 1), checks.integer("max_m", max_m, ge=0),
                     checks.integer("max_n", max_n, ge=0), checks.positive("z", z),
@@ -893,24 +877,102 @@ def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, f_max: float | None =
     return _line_fit(grid, x, opts, best, fits, energy, checks.integer("n_unlabelled", n_unlabelled, ge=0))
 
 
+def fit_peaks(t, x, f_L: float, f_H: float, *, spectrum: Spectrum | None = None, threshold: float = 0.005,
+              torus=(1, 1), max_m: int = 8, max_n: int = 8, resolution: float = RESOLUTION) -> LineFit:
+    """The lines at the peaks of an amplitude spectrum, labelled and fitted by least squares as :func:`fit_lines` does.
+
+    The spectrum's peaks (:func:`rotorred.signals.lines.find_peaks`) only propose candidates: the lines are
+    those of :func:`fit_lines` (the torus's candidates, merged within c/T, labelled by the priority of the module
+    docstring) within half a bin of a peak, fitted together at their exact frequencies on the spectrum's samples.
+    A peak no line is near is kept in ``unlabelled`` at its bin. Where :func:`fit_lines` keeps the same lines,
+    both give the same labels, frequencies and amplitudes (to round-off on a commensurate record).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Uniform sample times (s).
+    x : array_like, shape (N,)
+        Samples (any units, e.g. m).
+    f_L, f_H : float
+        Spool frequencies (Hz), > 0.
+    spectrum : Spectrum, optional
+        Amplitude spectrum of the last ``spectrum.n_samples`` samples of ``x`` (the samples fitted), with
+        ``spectrum.dt`` the sample interval; default :func:`rotorred.signals.spectra.settled_spectrum` (the last
+        whole common periods on a rectangular window, else flat-top).
+    threshold : float
+        Peaks below ``threshold`` times the spectrum's largest non-DC amplitude are ignored, in (0, 1]
+        (default 0.005, 0.5 %).
+    torus : (int, int)
+        Sub-harmonic orders (k, j) of the candidates ``(m/k) f_H + (n/j) f_L``; (1, 2) admits the half-integer
+        multiples of f_L of the paper's experiment (f_H + 3f_L/2).
+    max_m, max_n : int
+        ``|m| <= max_m``, ``|n| <= max_n``.
+    resolution : float
+        c >= 1: candidates closer than c/T are one line (T the fitted duration).
+
+    Returns
+    -------
+    LineFit
+        The lines at the peaks, by increasing frequency (``n_significant``: how many); ``unlabelled`` the peaks at
+        no line, by increasing frequency; ``explained_share`` that of these lines.
+    """
+    grid, x = _record(t, x)
+    f_L = checks.positive("f_L", f_L, "Hz")
+    f_H = checks.positive("f_H", f_H, "Hz")
+    if spectrum is None:
+        spectrum = settled_spectrum(x, grid.dt, f_L, f_H)
+    elif not isinstance(spectrum, Spectrum) or spectrum.n_samples > grid.n \
+            or abs(spectrum.dt - grid.dt) > 1e-9 * grid.dt:
+        checks.fail("spectrum", spectrum, f"must be a Spectrum of the last samples of x (at most {grid.n}, "
+                    f"dt = {grid.dt:.6g} s)")
+    n = spectrum.n_samples
+    grid, x = _Grid(grid.t0 + (grid.n - n) * grid.dt, grid.dt, n), x[grid.n - n:]
+    k, j = checks.sequence("torus", torus, lambda f, v: checks.integer(f, v, ge=1, le=12), min_len=2, max_len=2)
+    opts = _options(grid, x, f_L, f_H, None, max_m, max_n, resolution, Z_SIGNIFICANCE, 0.0, MAX_LINES,
+                    constant_ok=True)
+    mp, nq, f, _ = _candidates(opts, k, j)
+    line_of, line_freqs = _merge(f, opts.resolution_hz, opts.cap)
+    tol = 0.5 * spectrum.df * (1.0 + 1e-9)  # a tone peaks within half a bin (windows of monotonic kernels)
+    chosen, unlabelled = set(), []
+    for b in find_peaks(spectrum, threshold):
+        near = np.flatnonzero((np.abs(f - spectrum.frequencies[b]) <= tol) & (line_of >= 0))  # by priority
+        if near.size:
+            chosen.add(int(line_of[near[0]]))
+        else:
+            unlabelled.append(UnlabelledPeak(float(spectrum.frequencies[b]), float(spectrum.amplitudes[b])))
+    keep = np.array(sorted(chosen), dtype=int)
+    sol = _solve(grid, x, line_freqs[keep])
+    scale = _local_noise_scale(grid, sol, line_freqs[keep])
+    fit = _torus_fit(k, j, mp, nq, line_of, line_freqs, keep, sol, tuple(e * scale for e in sol.amplitude_errors),
+                     int(keep.size))
+    return _line_fit(grid, x, opts, fit, (fit,), float(np.sum((x - x.mean()) ** 2)), 0, tuple(unlabelled))
+
+
 def _line_fit(grid: _Grid, x: np.ndarray, opts: _Options, best: _TorusFit, fits: tuple, energy: float,
-              n_unlabelled: int) -> LineFit:
-    """Assemble the :class:`LineFit` of the chosen torus fit."""
+              n_unlabelled: int, unlabelled: tuple[UnlabelledPeak, ...] | None = None) -> LineFit:
+    """Assemble the :class:`LineFit` of the chosen torus fit; ``unlabelled`` default: the residual's strongest
+    ``n_unlabelled`` peaks."""
     sol = best.solution
     se_a, se_p = best.errors
     a = np.abs(sol.z)
     lines = [FittedLine(float(f), float(ai), float(np.angle(zi)), float(sa), float(sp),
-                        float(grid.n * ai * ai / 2.0 / energy), orders)
+                        float(grid.n * ai * ai / 2.0 / energy) if energy > 0 else math.nan, orders)
              for f, ai, zi, sa, sp, orders in zip(best.freqs, a, sol.z, se_a, se_p, best.orders)]
     lines.sort(key=lambda ln: ln.frequency_hz)
     spec = amplitude_spectrum(sol.residual, grid.dt, window="hann")
-    peaks = residual_peaks(spec, f_min=opts.f_lo, f_max=opts.f_hi, floor=opts.floor, n_peaks=n_unlabelled)
-    trials = tuple(TorusTrial(ft.k, ft.j, int(ft.freqs.size), 1.0 - ft.solution.rss / energy, ft.bic(energy))
+    if unlabelled is None:
+        unlabelled = residual_peaks(spec, f_min=opts.f_lo, f_max=opts.f_hi, floor=opts.floor, n_peaks=n_unlabelled)
+    trials = tuple(TorusTrial(ft.k, ft.j, int(ft.freqs.size), _explained(ft.solution.rss, energy), ft.bic(energy))
                    for ft in fits)
     p = 2 * best.freqs.size + 1
     return LineFit(
         lines=tuple(lines), torus=Torus(opts.f_L, opts.f_H, best.k, best.j),
-        explained_share=1.0 - sol.rss / energy, mean=sol.mean, unlabelled=peaks, residual=sol.residual,
+        explained_share=_explained(sol.rss, energy), mean=sol.mean, unlabelled=unlabelled, residual=sol.residual,
         residual_spectrum=spec, trials=trials, t0=grid.t0, dt=grid.dt, n_samples=grid.n,
         resolution_hz=opts.resolution_hz, noise_rms=math.sqrt(sol.rss / max(grid.n - p, 1)),
         n_candidates=best.n_candidates, n_significant=best.n_significant)
+
+
+def _explained(rss: float, energy: float) -> float:
+    """``1 - rss / energy``; NaN for a constant record (no energy to explain)."""
+    return 1.0 - rss / energy if energy > 0 else math.nan

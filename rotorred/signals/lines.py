@@ -1,45 +1,28 @@
-"""Spectral lines of a dual-rotor response, labelled as combinations m f_H + n f_L.
+"""Labels of the combination lines ``m f_H + n f_L`` of a dual-rotor response, FFT peaks, and the paper's Table 1.
 
 A rub on one spool of a twin-spool rotor makes the response contain combinations
 ``m f_H + n f_L`` of the two spool frequencies (Xu et al. 2016, Sec. 3, Table 1; the
-experiment, Table 2, adds half-integer ``n`` such as ``f_H + 3 f_L / 2``).
-
-Peaks
-    A peak is a local maximum of the amplitude spectrum (``A[k] > A[k-1]`` and
-    ``A[k] >= A[k+1]``), other than the DC bin, whose amplitude is at least ``threshold``
-    times the largest non-DC amplitude (default 0.5 %).
-
-Matching tolerance
-    A peak at bin frequency ``f`` matches every combination with
-    ``|m f_H + n f_L - f| <= tol_hz``. The default ``tol_hz = df / 2`` (half a bin, plus
-    1e-9 df for rounding) is the largest distance between a tone and the bin where it
-    peaks, for any window whose kernel falls off monotonically from its centre (all of
-    :data:`rotorred.signals.spectra.WINDOWS`). With the exact spool frequencies and a commensurate
-    record (:func:`rotorred.signals.spectra.settled_spectrum`) every combination is exactly on a
-    bin. Pass a larger ``tol_hz`` when ``f_L`` and ``f_H`` are only estimates: an error
-    ``e`` in each moves ``m f_H + n f_L`` by up to ``(|m| + |n|) e``.
-
-Choice among several matches
-    With f_L = 70 and f_H = 90 Hz every combination lies on a 10 Hz grid, so many
-    ``(m, n)`` give the same frequency (140 Hz = 2 f_L = 9 f_H - 9 f_L ...). The label is
-    the combination with the smallest key
-
-        (|m| + |n|,  |n|,  -m)
-
-    i.e. (1) the smallest order ``|m| + |n|``; (2) on a tie, the fewest multiples of f_L:
-    the rubbing disk (node 18) is on the high-pressure spool, so harmonics of f_H are the
-    carrier and f_L the modulation (the paper's "fundamental modulated by the other rotor");
-    (3) then positive ``m``. Rule (1) alone reproduces all 24 lines of the paper's Table 1
-    (each has a unique lowest-order combination within ``|m|, |n| <= 8``); rule (2) decides
-    lines the paper does not list, e.g. 80 Hz = 4f_H-4f_L (not 5f_L-3f_H) and
-    560 Hz = 7f_H-f_L (not 8f_L).
+experiment, Table 2, adds half-integer ``n`` such as ``f_H + 3 f_L / 2``), and sub-harmonic
+orders ``(m/k) f_H + (n/j) f_L`` where impacts lock to a fraction of a spool frequency.
+The lines themselves, their amplitudes and the choice of label among the combinations at one
+frequency come from the least-squares line fit (:mod:`rotorred.signals.linefit`, the one source
+of labels); this module holds what the fit's lines are written and read with:
 
 Labels
-    Written as in the paper's Table 1: positive terms first, f_H before f_L, coefficient 1
-    omitted, half-integer ``n`` as ``3f_L/2``. :attr:`SpectralLine.label` uses the Unicode
-    minus sign U+2212 ("f_H−f_L"), :attr:`SpectralLine.label_ascii` the ASCII hyphen
-    ("f_H-f_L"), :attr:`SpectralLine.label_math` matplotlib mathtext ("$f_H-f_L$").
-    A peak that matches no combination has ``m = n = None`` and label ``"unknown"``.
+    :func:`line_label` is the one place that writes a label: ASCII, as in the paper's Table 1,
+    positive terms first, f_H before f_L, coefficient 1 omitted, fractional orders as
+    ``3f_L/2`` or ``2f_H/3``: ``"f_H-f_L"``, ``"2f_L-f_H"``, ``"f_H+3f_L/2"``.
+    :func:`parse_label` reads it back. Figures render the same text with subscripts and a
+    minus sign (:func:`rotorred.plots.scene.plot_label`).
+
+Peaks
+    :func:`find_peaks` gives the local maxima of an amplitude spectrum (``A[k] > A[k-1]`` and
+    ``A[k] >= A[k+1]``), other than the DC bin, at least ``threshold`` times the largest non-DC
+    amplitude (default 0.5 %). They are only candidates: :func:`rotorred.signals.linefit.fit_peaks`
+    labels each by the fit's rule and fits the lines at their exact frequencies.
+
+Table 1
+    :data:`XU2016_TABLE1` and :func:`compare_with_expected` pair the paper's lines with a fit's.
 
 References
 ----------
@@ -49,7 +32,6 @@ References
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -58,29 +40,22 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from rotorred import checks
-from rotorred.writers import render_table
 from rotorred.signals.spectra import Spectrum
+from rotorred.writers import render_table
 
 __all__ = [
-    "MINUS",
-    "UNKNOWN",
+    "UNLABELLED",
     "XU2016_TABLE1",
-    "SpectralLine",
     "LineMatch",
-    "combination_label",
+    "line_label",
     "parse_label",
-    "combinations_near",
-    "label_frequency",
     "find_peaks",
-    "label_lines",
     "format_table",
-    "print_table",
     "compare_with_expected",
     "format_comparison",
 ]
 
-MINUS = "\u2212"  #: the Unicode minus sign used in labels
-UNKNOWN = "unknown"  #: label of a peak that matches no combination
+UNLABELLED = "unlabelled"  #: the label column of a peak that no line explains (tables, CSV files)
 
 #: Table 1 of Xu et al. 2016 (simulated outer-rotor Y spectrum): (frequency as printed (Hz),
 #: component). The 520 Hz row is printed "5f_H+2f_L", which is 590 Hz; 5*90 + 70 = 520, so it
@@ -114,22 +89,11 @@ XU2016_TABLE1: tuple[tuple[float, str], ...] = (
 
 
 # --------------------------------------------------------------------------- labels
-def _as_m(m) -> Fraction:
-    """m as a Fraction: any ``fractions.Fraction`` (an exact sub-harmonic order, f_H/3), else an integer."""
-    if isinstance(m, Fraction):
-        return m
-    return Fraction(checks.integer("m", m))
-
-
-def _as_n(n) -> Fraction:
-    if isinstance(n, Fraction):  # an exact order: any denominator (f_L/3)
-        return n
-    if not isinstance(n, Fraction):
-        checks.number("n", n)  # a finite real number (not a bool) ...
-    f = Fraction(n) if not isinstance(n, np.generic) else Fraction(n.item())
-    if f.denominator not in (1, 2):  # ... that is a multiple of 1/2
-        checks.fail("n", n, "must be an integer or half-integer")
-    return f
+def _order(name: str, value) -> Fraction:
+    """An order as a Fraction: an int or a ``fractions.Fraction`` (not a float: f_L/3 has no exact float)."""
+    if isinstance(value, Fraction):
+        return value
+    return Fraction(checks.integer(name, value))
 
 
 def _term(coefficient: Fraction, symbol: str) -> str:
@@ -140,213 +104,72 @@ def _term(coefficient: Fraction, symbol: str) -> str:
     return f"{num}{symbol}{den}"
 
 
-def combination_label(m, n, minus: str = MINUS, math_text: bool = False) -> str:
-    """Label of ``m f_H + n f_L`` in the paper's Table 1 style.
+def line_label(m, n) -> str:
+    """The label of the line ``m f_H + n f_L``: the one text form of every line's label.
 
     Parameters
     ----------
-    m : int or Fraction
-        Multiple of f_H: an integer, or a ``fractions.Fraction`` of any denominator
-        (``Fraction(2, 3)``: ``2f_H/3``, a sub-harmonic order, :mod:`rotorred.signals.linefit`).
-    n : int or Fraction or float
-        Multiple of f_L: a ``Fraction`` of any denominator, or an integer or half-integer number.
-    minus : str
-        Minus sign: ``MINUS`` (U+2212, default) or ``"-"``.
-    math_text : bool
-        Return matplotlib mathtext (``"$2f_H-f_L$"``), which renders subscripts and a minus.
+    m, n : int or Fraction
+        Multiples of f_H and f_L (dimensionless; ``Fraction(1, 3)`` is f_H/3, a sub-harmonic order).
 
     Returns
     -------
     str
-        Positive terms first, f_H before f_L: ``"f_H−f_L"``, ``"2f_L−f_H"``,
-        ``"f_H+3f_L/2"``; ``"0"`` for m = n = 0.
+        ASCII, positive terms first, f_H before f_L, coefficient 1 omitted: ``"f_H-f_L"``,
+        ``"2f_L-f_H"``, ``"f_H+3f_L/2"``; ``"0"`` for m = n = 0.
 
     Examples
     --------
-    >>> combination_label(3, -2, minus="-")
+    >>> line_label(3, -2)
     '3f_H-2f_L'
-    >>> combination_label(1, 1.5, minus="-")
-    'f_H+3f_L/2'
-    >>> combination_label(Fraction(2, 3), Fraction(-1, 3), minus="-")
-    '2f_H/3-f_L/3'
+    >>> line_label(Fraction(2, 3), -1)
+    '2f_H/3-f_L'
     """
-    mf = _as_m(m)
-    nf = _as_n(n)
-    terms = [(c, s) for c, s in ((mf, "f_H"), (nf, "f_L")) if c != 0]
+    terms = [(c, s) for c, s in ((_order("m", m), "f_H"), (_order("n", n), "f_L")) if c != 0]
     if not terms:
-        return "$0$" if math_text else "0"
+        return "0"
     terms.sort(key=lambda cs: cs[0] < 0)  # stable: positive first, f_H before f_L
-    if math_text:
-        minus = "-"
     text = ""
     for i, (c, s) in enumerate(terms):
-        sign = (minus if c < 0 else "") if i == 0 else (minus if c < 0 else "+")
-        text += sign + _term(c, s)
-    return f"${text}$" if math_text else text
+        text += ("-" if c < 0 else "" if i == 0 else "+") + _term(c, s)
+    return text
 
 
-_TERM_RE = re.compile(r"([+-]?)(\d*)f_?([HL])(?:/(\d+))?")
+_TERM_RE = re.compile(r"([+-]?)(\d*)f_([HL])(?:/(\d+))?")
 
 
-def parse_label(label: str) -> tuple[int, Fraction]:
-    """Inverse of :func:`combination_label`: ``"3f_H−2f_L"`` -> ``(3, Fraction(-2))``.
-
-    Accepts the Unicode or ASCII minus, spaces, ``f_H``/``fH``, and ``3f_L/2``.
+def parse_label(label: str) -> tuple[Fraction, Fraction]:
+    """Inverse of :func:`line_label`: ``"3f_H-2f_L"`` -> ``(Fraction(3), Fraction(-2))``.
 
     Returns
     -------
-    m : int
-    n : Fraction
+    m, n : Fraction
+        Multiples of f_H and f_L.
     """
     checks.string("label", label)
-    text = label.replace(MINUS, "-").replace(" ", "").strip("$")
     m, n = Fraction(0), Fraction(0)
     pos = 0
     seen = set()
-    for match in _TERM_RE.finditer(text):
-        if match.start() != pos or (pos > 0 and not match.group(1)):
+    for match in _TERM_RE.finditer(label):
+        if match.start() != pos or (pos > 0 and not match.group(1)) or match.group(3) in seen \
+                or match.group(4) == "0":
             break
-        sign = -1 if match.group(1) == "-" else 1
-        coef = Fraction(int(match.group(2) or 1), int(match.group(4) or 1))
-        which = match.group(3)
-        if which in seen:
-            break
-        seen.add(which)
-        if which == "H":
-            m = sign * coef
+        seen.add(match.group(3))
+        coefficient = Fraction(int(match.group(2) or 1), int(match.group(4) or 1))
+        if match.group(1) == "-":
+            coefficient = -coefficient
+        if match.group(3) == "H":
+            m = coefficient
         else:
-            n = sign * coef
+            n = coefficient
         pos = match.end()
-    if pos != len(text) or pos == 0 or m.denominator != 1 or n.denominator not in (1, 2):
-        checks.fail("label", label, "must look like 'f_H-f_L', '2f_H+f_L', 'f_H+3f_L/2' (integer m, integer or "
-                    "half-integer n)")
-    return int(m), n
-
-
-# --------------------------------------------------------------------------- matching
-def _rule_key(mn: tuple[int, Fraction]) -> tuple:
-    m, n = mn
-    return (abs(m) + abs(n), abs(n), -m)
-
-
-def combinations_near(
-    frequency_hz: float,
-    f_L: float,
-    f_H: float,
-    tol_hz: float,
-    *,
-    max_m: int = 8,
-    max_n: int = 8,
-    half_integer: bool = False,
-) -> list[tuple[int, Fraction]]:
-    """All ``(m, n)`` with ``|m f_H + n f_L - frequency_hz| <= tol_hz``, best first.
-
-    Parameters
-    ----------
-    frequency_hz : float
-        Frequency to explain (Hz), > 0.
-    f_L, f_H : float
-        Spool frequencies (Hz), > 0.
-    tol_hz : float
-        Matching tolerance (Hz), > 0.
-    max_m, max_n : int
-        Bounds ``|m| <= max_m``, ``|n| <= max_n``.
-    half_integer : bool
-        Also allow half-integer ``n`` (f_L/2, 3f_L/2, ...).
-
-    Returns
-    -------
-    list of (int, Fraction)
-        Sorted by the labelling rule (``(|m| + |n|, |n|, -m)``, see the module docstring);
-        only combinations with positive frequency.
-    """
-    f = checks.positive("frequency_hz", frequency_hz, "Hz")
-    f_L = checks.positive("f_L", f_L, "Hz")
-    f_H = checks.positive("f_H", f_H, "Hz")
-    tol = checks.positive("tol_hz", tol_hz, "Hz")
-    max_m = checks.integer("max_m", max_m, ge=0)
-    max_n = checks.integer("max_n", max_n, ge=0)
-    step = 2 if half_integer else 1
-    out = []
-    for k in range(-max_n * step, max_n * step + 1):
-        n = Fraction(k, step)
-        # m f_H within [f - n f_L - tol, f - n f_L + tol]
-        lo = math.ceil((f - float(n) * f_L - tol) / f_H - 1e-12)
-        hi = math.floor((f - float(n) * f_L + tol) / f_H + 1e-12)
-        for m in range(max(lo, -max_m), min(hi, max_m) + 1):
-            c = m * f_H + float(n) * f_L
-            if c > 0 and abs(c - f) <= tol:
-                out.append((m, n))
-    out.sort(key=_rule_key)
-    return out
-
-
-def label_frequency(
-    frequency_hz: float,
-    f_L: float,
-    f_H: float,
-    tol_hz: float,
-    *,
-    max_m: int = 8,
-    max_n: int = 8,
-    half_integer: bool = False,
-) -> tuple[int, Fraction] | None:
-    """The combination chosen by the labelling rule, or None if nothing matches.
-
-    See :func:`combinations_near` for the parameters.
-    """
-    found = combinations_near(
-        frequency_hz, f_L, f_H, tol_hz, max_m=max_m, max_n=max_n, half_integer=half_integer
-    )
-    return found[0] if found else None
+    if pos != len(label) or pos == 0:
+        checks.fail("label", label, "must look like 'f_H-f_L', '2f_H+f_L', 'f_H+3f_L/2' or '2f_H/3' (as line_label "
+                    "writes it)")
+    return m, n
 
 
 # --------------------------------------------------------------------------- peaks
-@dataclass(frozen=True)
-class SpectralLine:
-    """One peak of a spectrum and its combination label.
-
-    Attributes
-    ----------
-    frequency_hz : float
-        Bin frequency of the peak (Hz).
-    amplitude : float
-        Amplitude at the peak, in the spectrum's units.
-    m : int or None
-        Multiple of f_H (None if unknown).
-    n : Fraction or None
-        Multiple of f_L, integer or half-integer (None if unknown).
-    label : str
-        Table 1 style with the Unicode minus ("f_H−f_L"), or ``"unknown"``.
-    """
-
-    frequency_hz: float
-    amplitude: float
-    m: int | None
-    n: Fraction | None
-    label: str
-
-    @property
-    def known(self) -> bool:
-        """True when the peak matched a combination."""
-        return self.m is not None
-
-    @property
-    def order(self) -> Fraction | None:
-        """``|m| + |n|`` (None if unknown)."""
-        return None if self.m is None else abs(self.m) + abs(self.n)
-
-    @property
-    def label_ascii(self) -> str:
-        """Label with the ASCII hyphen as minus ("f_H-f_L")."""
-        return UNKNOWN if self.m is None else combination_label(self.m, self.n, minus="-")
-
-    @property
-    def label_math(self) -> str:
-        """Label as matplotlib mathtext ("$f_H-f_L$"), or "?" if unknown."""
-        return "?" if self.m is None else combination_label(self.m, self.n, math_text=True)
-
-
 def find_peaks(spectrum: Spectrum, threshold: float = 0.005) -> np.ndarray:
     """Bins of the local maxima above ``threshold`` times the largest non-DC amplitude.
 
@@ -382,75 +205,17 @@ def find_peaks(spectrum: Spectrum, threshold: float = 0.005) -> np.ndarray:
     return k
 
 
-def label_lines(
-    spectrum: Spectrum,
-    f_L: float,
-    f_H: float,
-    *,
-    threshold: float = 0.005,
-    tol_hz: float | None = None,
-    max_m: int = 8,
-    max_n: int = 8,
-    half_integer: bool = False,
-) -> list[SpectralLine]:
-    """Find the peaks of a spectrum and label each as a combination ``m f_H + n f_L``.
-
-    Parameters
-    ----------
-    spectrum : Spectrum
-    f_L, f_H : float
-        Spool frequencies (Hz).
-    threshold : float
-        Peaks below ``threshold`` times the largest line are ignored (default 0.5 %).
-    tol_hz : float, optional
-        Matching tolerance (Hz); default half a bin (``spectrum.df / 2``), see the module
-        docstring.
-    max_m, max_n : int
-        Bounds on ``|m|`` and ``|n|``.
-    half_integer : bool
-        Allow half-integer ``n`` (f_H + 3f_L/2, as in the paper's experiment, Table 2).
-
-    Returns
-    -------
-    list of SpectralLine
-        By increasing frequency.
-    """
-    if tol_hz is None:
-        tol_hz = 0.5 * spectrum.df * (1.0 + 1e-9)
-    lines = []
-    for k in find_peaks(spectrum, threshold):
-        f = float(spectrum.frequencies[k])
-        mn = label_frequency(
-            f, f_L, f_H, tol_hz, max_m=max_m, max_n=max_n, half_integer=half_integer
-        )
-        if mn is None:
-            lines.append(SpectralLine(f, float(spectrum.amplitudes[k]), None, None, UNKNOWN))
-        else:
-            m, n = mn
-            lines.append(
-                SpectralLine(f, float(spectrum.amplitudes[k]), m, n, combination_label(m, n))
-            )
-    return lines
-
-
 # --------------------------------------------------------------------------- tables
-def format_table(
-    lines: Iterable[SpectralLine],
-    *,
-    ascii: bool = False,
-    amplitude_scale: float | None = None,
-    amplitude_unit: str = "µm",
-) -> str:
-    """Table in the form of the paper's Table 1: ``Frequency (Hz) | Component``.
+def format_table(fit, *, amplitude_scale: float | None = None, amplitude_unit: str = "µm") -> str:
+    """Table in the form of the paper's Table 1: ``Frequency (Hz) | Component``, the fit's lines then the peaks
+    it left unlabelled (:data:`UNLABELLED`), by increasing frequency.
 
     Parameters
     ----------
-    lines : iterable of SpectralLine
-    ascii : bool
-        ASCII hyphen instead of the Unicode minus.
+    fit : rotorred.signals.linefit.LineFit
     amplitude_scale : float, optional
         If given, add an amplitude column, amplitudes multiplied by this factor
-        (1e6 for a spectrum in metres shown in µm).
+        (1e6 for a signal in metres shown in µm).
     amplitude_unit : str
         Unit shown in the amplitude column header.
 
@@ -459,21 +224,17 @@ def format_table(
     str
     """
     header = ["Frequency (Hz)", "Component"]
+    items = sorted([(ln.frequency_hz, ln.label, ln.amplitude) for ln in fit.lines]
+                   + [(p.frequency_hz, UNLABELLED, p.amplitude) for p in fit.unlabelled])
     rows = []
-    for line in lines:
-        label = line.label_ascii if ascii else line.label
-        row = [f"{line.frequency_hz:.2f}", label]
+    for f, label, amplitude in items:
+        row = [f"{f:.2f}", label]
         if amplitude_scale is not None:
-            row.append(f"{line.amplitude * amplitude_scale:.4g}")
+            row.append(f"{amplitude * amplitude_scale:.4g}")
         rows.append(row)
     if amplitude_scale is not None:
         header.append(f"Amplitude ({amplitude_unit})")
     return render_table(header, rows)
-
-
-def print_table(lines: Iterable[SpectralLine], **kwargs) -> None:
-    """Print :func:`format_table` (same keyword arguments)."""
-    print(format_table(lines, **kwargs))
 
 
 @dataclass(frozen=True)
@@ -485,14 +246,14 @@ class LineMatch:
     expected_hz : float
         Expected frequency (Hz).
     expected_label : str or None
-        Expected component (ASCII form), if given.
-    found : SpectralLine or None
+        Expected component (:func:`line_label` form), if given.
+    found : rotorred.signals.linefit.FittedLine or None
         Nearest found line within the tolerance, None if there is none.
     """
 
     expected_hz: float
     expected_label: str | None
-    found: SpectralLine | None
+    found: object | None
 
     @property
     def found_hz(self) -> float | None:
@@ -505,13 +266,13 @@ class LineMatch:
         was expected; False if nothing was found)."""
         if self.expected_label is None:
             return None
-        if self.found is None or not self.found.known:
+        if self.found is None:
             return False
         return parse_label(self.expected_label) == (self.found.m, self.found.n)
 
 
 def compare_with_expected(
-    lines: Sequence[SpectralLine],
+    lines: Sequence,
     expected: Iterable[float | tuple[float, str]],
     tol_hz: float = 1.0,
 ) -> list[LineMatch]:
@@ -519,8 +280,8 @@ def compare_with_expected(
 
     Parameters
     ----------
-    lines : sequence of SpectralLine
-        Found lines (from :func:`label_lines`).
+    lines : sequence of rotorred.signals.linefit.FittedLine
+        Found lines (``LineFit.lines``).
     expected : iterable of float or (float, str)
         Expected frequencies (Hz), optionally with their component label
         (e.g. :data:`XU2016_TABLE1`).
@@ -545,7 +306,6 @@ def compare_with_expected(
                 checks.fail(f"expected[{i}]", item, "must be a frequency (Hz) or a (frequency, label) pair")
             f, label = item
             parse_label(label)  # validates the label
-            label = label.replace(MINUS, "-").replace(" ", "")
         else:
             f, label = item, None
         f = checks.positive(f"expected[{i}]", f, "Hz")
@@ -558,22 +318,18 @@ def compare_with_expected(
     return out
 
 
-def format_comparison(matches: Iterable[LineMatch], *, ascii: bool = False) -> str:
-    """Table ``Paper (Hz) | Paper component | Ours (Hz) | Ours - paper (Hz) | Our component |
-    Agrees``."""
+def format_comparison(matches: Iterable[LineMatch]) -> str:
+    """Table ``Paper (Hz) | Paper component | Ours (Hz) | Ours - paper (Hz) | Our component | Agrees``."""
     header = ["Paper (Hz)", "Paper component", "Ours (Hz)", "Ours - paper (Hz)",
               "Our component", "Agrees"]
     rows = []
     for mt in matches:
-        exp_label = mt.expected_label or ""
-        if not ascii:
-            exp_label = exp_label.replace("-", MINUS)
         if mt.found is None:
             ours, diff, our_label = "-", "-", "not found"
         else:
             ours = f"{mt.found.frequency_hz:.2f}"
             diff = f"{mt.found.frequency_hz - mt.expected_hz:+.2f}"
-            our_label = mt.found.label_ascii if ascii else mt.found.label
+            our_label = mt.found.label
         agrees = {None: "", True: "yes", False: "NO"}[mt.label_agrees]
-        rows.append([f"{mt.expected_hz:.2f}", exp_label, ours, diff, our_label, agrees])
+        rows.append([f"{mt.expected_hz:.2f}", mt.expected_label or "", ours, diff, our_label, agrees])
     return render_table(header, rows)

@@ -33,11 +33,11 @@ import numpy as np
 from numba import njit
 
 from rotorred.transient import numba_cache
-from rotorred.transient.kernel import (C_STEPS, E_DOF, LIMIT, LOOP, NEED_DENSE, RUNNING,
-                                       Condensed, State, _add_columns, _beyond_limit, _condense_rlin,
-                                       _cos_sin, _disk_forces, _failed_plate, _forcing_at_step_end, _matvec, _record,
-                                       _solve_contact_forces, _start_forcing, _stick_reset, _stop_at_limit,
-                                       _update_contact_dofs, _write_state)
+from rotorred.transient.kernel import (C_STEPS, E_DOF, LOOP, Condensed, State, _add_columns, _beyond_limit,
+                                       _condense_rlin, _cos_sin, _disk_forces, _failed_plate, _forcing_at_step_end,
+                                       _matvec, _record, _solve_contact_forces, _start_forcing, _stick_reset,
+                                       _stop_at_limit, _update_contact_dofs, _write_state)
+from rotorred.transient.status import LIMIT, NEED_DENSE, RUNNING
 
 numba_cache.register()
 

@@ -60,6 +60,7 @@ from rotorred.transient.contact_solve import (  # noqa: F401 - also read as kern
     C_CONTACT, C_MAXNEWTON, C_NEWTON, C_STEPS, C_SUBSTEPS, N_COUNTERS, N_PLATE_PAR, P_CLEAR, P_COS, P_MP, P_SIN, P_V,
     P_W0, Condensed, _kinematics, _normal_law, _open_plates, _solve_small, contact_residual, solve_contact)
 from rotorred.transient.contact_solve import compiled_disk_force as _disk_force
+from rotorred.transient.status import LIMIT, NEED_LEVELS, NEWTON_FAILED, NONFINITE, RUNNING
 
 numba_cache.register()
 
@@ -79,15 +80,6 @@ LOOP = {"cache": True, "_nrt": False}
 COLD = {"cache": True, "no_cpython_wrapper": True}
 
 
-# status codes
-RUNNING, DONE, NONFINITE, NEWTON_FAILED, LIMIT = 0, 1, 2, 3, 4
-#: the loop stopped at the start of main step ``diag.counters[C_STEPS]`` (its state in ``state``) because the step
-#: needs halving and ``levels`` holds level 0 only: the caller builds every level and calls again from there (the
-#: halving levels, dense n x 2n matrices each, are built on first need)
-NEED_LEVELS = 5
-#: the eigenbasis loop stopped at the start of main step ``diag.counters[C_STEPS]`` (its state in ``state``) whose
-#: contact solve failed there: the caller redoes that step with :func:`run_steps` and goes on
-NEED_DENSE = 6
 # steps between exact re-evaluations of the forcing's cos/sin in the rotation recurrence
 RESYNC = 1024
 

@@ -64,6 +64,7 @@ from rotorred.transient.matrices import (contact_rows, force_columns, kernel_pla
                                          plate_parameters, step_levels, step_matrices)
 from rotorred.transient.ramp import run_profile
 from rotorred.transient.results import ContactHistory, FinalState, SimulationDiverged, TransientResult
+from rotorred.transient.status import NEED_DENSE, NEED_LEVELS, RUNNING
 from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces, also read as newmark.<name>
     COMPILING_NOTE, METHODS, Loads, RecordPlan, RunOptions, Scheme, check_loads, check_run_options, check_scheme,
     check_start, initial_state, initial_vector, load_kernel, package_result, record_buffers, record_plan,
@@ -79,14 +80,14 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     on its state y; ``dense_record`` is the same record with the rows on x), else the dense one.
 
     ``levels`` may hold level 0 only, with ``every_level()`` building every level: a loop then stops at the
-    first step that needs halving (``kernel.NEED_LEVELS``), and goes on from that step with all of them. A
-    step the eigenbasis loop cannot take (``kernel.NEED_DENSE``) is taken by the dense loop (compiled or loaded
+    first step that needs halving (``NEED_LEVELS``), and goes on from that step with all of them. A
+    step the eigenbasis loop cannot take (``NEED_DENSE``) is taken by the dense loop (compiled or loaded
     when first needed), and the eigenbasis loop goes on from the next step.
 
     Returns
     -------
     status : int
-        The kernel's status (``kernel.RUNNING`` when every step completed).
+        The kernel's status (``RUNNING`` when every step completed).
     run_time, run_cpu_time : float
         Wall and CPU time of the loop (s).
     load_time : float
@@ -96,12 +97,12 @@ def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Pl
     """
     loops = _Loops(levels, forcing, plates, state, record, dense_record or record, settings, diag, eig, every_level)
     t_run, cpu_run = time.perf_counter(), time.process_time()
-    status, i = kernel.RUNNING, 0
+    status, i = RUNNING, 0
     with step_bar(n_steps, settings.dt, progress) as shown:
         while i < n_steps:
             i_next = min(n_steps, i + chunk)
             status = loops.run(i, i_next)
-            if status != kernel.RUNNING:
+            if status != RUNNING:
                 break
             shown.update((i_next - i) * settings.dt)
             i = i_next
@@ -141,16 +142,16 @@ class _Loops:
     def run(self, i: int, i_next: int) -> int:
         while i < i_next:
             status = self._loop()(i, i_next, *self._args())
-            if status == kernel.NEED_LEVELS and self.every_level is not None:
+            if status == NEED_LEVELS and self.every_level is not None:
                 self._build_levels()
-            elif status == kernel.NEED_DENSE:
+            elif status == NEED_DENSE:
                 status = self._dense_step(self._steps_done())
-                if status != kernel.RUNNING:
+                if status != RUNNING:
                     return status
             else:
                 return status
             i = self._steps_done()
-        return kernel.RUNNING
+        return RUNNING
 
     def _build_levels(self) -> None:
         self.levels, self.every_level = self.every_level(), None
@@ -164,7 +165,7 @@ class _Loops:
             self.dense_loaded = True
         while True:
             status = kernel.run_steps(i, i + 1, *self._args(dense=True))
-            if status != kernel.NEED_LEVELS or self.every_level is None:
+            if status != NEED_LEVELS or self.every_level is None:
                 return status
             self._build_levels()
 

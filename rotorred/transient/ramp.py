@@ -23,6 +23,7 @@ from rotorred.model.speeds import SpeedProfile
 from rotorred.transient import kernel, ramp_kernel, stepping
 from rotorred.transient.matrices import (ForceColumns, contact_rows, disk_radii, force_columns, kernel_plates,
                                          newmark_coefficients, plate_parameters, step_levels)
+from rotorred.transient.status import RUNNING
 
 #: default bound of the fixed-point contraction per step (sets the speed intervals' width)
 RHO_TARGET = 1e-3
@@ -245,7 +246,7 @@ def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, re
     work = kernel.work_arrays(n, len(plates), len(forces.kind))
     rwork = ramp_kernel.ramp_work(n, n_s, len(forces.kind))
     chunk = chunk_steps or max(2000, min(n_steps, 100_000))
-    status, build, load, compiled = kernel.RUNNING, 0.0, 0.0, False
+    status, build, load, compiled = RUNNING, 0.0, 0.0, False
     wall = cpu = 0.0
     with stepping.step_bar(n_steps, settings.dt, progress) as shown:
         for interval in intervals:
@@ -262,12 +263,12 @@ def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, re
                 i_next = min(interval.end, i + chunk)
                 status = ramp_kernel.run_ramp_steps(i, i_next, levels, var, contact, state, spare, work, rwork,
                                                     record, settings, diag)
-                if status != kernel.RUNNING:
+                if status != RUNNING:
                     break
                 shown.update((i_next - i) * settings.dt)
                 i = i_next
             wall += time.perf_counter() - t_run
             cpu += time.process_time() - cpu_run
-            if status != kernel.RUNNING:
+            if status != RUNNING:
                 break
     return status, (build, wall, cpu, load, compiled)

@@ -43,16 +43,14 @@ from numba import njit
 from rotorred.transient import numba_cache
 from rotorred.transient.contact_solve import C_MAXPASSES, C_PASSES
 from rotorred.transient.kernel import (C_STEPS, C_SUBSTEPS, E_STATUS, E_TIME, LOOP,
-                                       P_V, RUNNING, Condensed, _beyond_limit,
+                                       P_V, Condensed, _beyond_limit,
                                        _condense_contact, _disk_forces, _add_columns, _failed_plate, _matvec,
                                        _newmark_update, _record, _record_step, _solve_contact_forces,
                                        _stick_reset, _stop_at_limit, _update_contact, _write_state,
                                        solve_contact)
+from rotorred.transient.status import PASSES_FAILED, RUNNING
 
 numba_cache.register()
-
-#: status: the fixed-point passes of a step did not converge (the step is halved)
-PASSES_FAILED = 5
 
 
 class ProfileTable(NamedTuple):

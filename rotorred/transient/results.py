@@ -7,15 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred.transient import kernel
-from rotorred.transient.ramp_kernel import PASSES_FAILED
 from rotorred.transient.contact import STATE_NAMES, RubPlate, disk_force
-
-_CAUSES = {
-    kernel.NONFINITE: "a non-finite value",
-    kernel.NEWTON_FAILED: "the contact Newton iteration failed",
-    kernel.LIMIT: "a contact-node displacement beyond `displacement_limit`",
-    PASSES_FAILED: "the step at varying speed did not converge",
-}
+from rotorred.transient.status import LIMIT, NONFINITE, Status
 
 
 class SimulationDiverged(RuntimeError):
@@ -133,8 +126,8 @@ class TransientResult:
         One per plate, in the order given.
     success : bool
     status : int
-        0 finished; 2 non-finite value; 3 Newton failure; 4 displacement limit; 5 the passes of a step at
-        varying speed did not converge.
+        A code of :mod:`rotorred.transient.status`: ``RUNNING`` (0) when finished, else the failure
+        (``Status(status).message`` says which).
     message : str
     final : FinalState
     method : str
@@ -218,15 +211,15 @@ def contact_histories(plates, record: kernel.Record) -> tuple[ContactHistory, ..
 
 def failure(model, plates, status: int, err: np.ndarray, max_halvings: int, t_done: float) -> tuple[str, str, str]:
     """(message, dof, cause) of a run that stopped with ``status`` (the kernel's ``Diagnostics.err``)."""
-    if status == kernel.NONFINITE:
+    if status == NONFINITE:
         dof = _dof_label(model, int(err[kernel.E_DOF]))
-    elif status == kernel.LIMIT:
+    elif status == LIMIT:
         j = -int(err[kernel.E_DOF]) - 1
         dof = f"plate {j // 2} node {plates[j // 2].node} {'xy'[j % 2]}"
     else:
         k = int(err[kernel.E_PLATE])
         dof = f"plate {k} at node {plates[k].node}" if plates else "contact"
-    cause = _CAUSES.get(status, f"status {status}")
+    cause = Status(status).message
     message = (f"diverged at t = {float(err[kernel.E_TIME]):.9g} s ({dof}): {cause}, not cured by halving the step "
                f"{max_halvings} times; results kept up to t = {t_done:.9g} s")
     return message, dof, cause
