@@ -11,7 +11,7 @@ from scipy.signal import butter, lfilter
 
 from rotorred.checks import InputError
 from rotorred.signals import linefit
-from rotorred.signals.linefit import fit_frequencies, fit_lines, fit_peaks
+from rotorred.signals.linefit import FitOptions, fit_frequencies, fit_lines, fit_peaks
 from rotorred.signals.lines import line_label
 from rotorred.signals.spectra import settled_spectrum
 
@@ -203,7 +203,7 @@ def test_candidates_closer_than_the_resolution_merge_into_one_line_with_both_lab
     for T, expected in ((1.0, 1), (4.0, 2)):  # 2/T = 2 Hz merges them; 0.5 Hz resolves them
         t = np.arange(int(T / DT)) * DT
         x = np.cos(2 * np.pi * f_L * t + 0.3) + 0.7 * np.cos(2 * np.pi * f_H * t - 1.0) + 1e-3 * rng.normal(size=t.size)
-        fit = fit_lines(t, x, f_L, f_H, max_subharmonic=1)
+        fit = fit_lines(t, x, f_L, f_H, options=FitOptions(max_subharmonic=1))
         near = [ln for ln in fit.lines if abs(ln.frequency_hz - 70.4) < 1.0]
         assert len(near) == expected
         if expected == 1:
@@ -239,7 +239,7 @@ def test_fft_peaks_feed_the_fit_two_paths_one_answer(f_H):
     t = np.arange(6000) * dt  # 0.6 s: 6 common periods of 70/90 Hz
     orders = [(1, 0), (0, 1), (1, -1), (2, -1), (3, -2), (2, 0), (1, 1), (0, 2), (2, 1)]
     x, truth = _known_lines(t, f_L, f_H, orders, 3)
-    peaks, full = fit_peaks(t, x, f_L, f_H), fit_lines(t, x, f_L, f_H, max_subharmonic=1)
+    peaks, full = fit_peaks(t, x, f_L, f_H), fit_lines(t, x, f_L, f_H, options=FitOptions(max_subharmonic=1))
     assert peaks.unlabelled == () and len(peaks.lines) == len(full.lines) == len(orders)
     for a, b in zip(peaks.lines, full.lines):
         m, n = a.orders[0]

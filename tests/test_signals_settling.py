@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from rotorred.checks import InputError
+from rotorred.signals.linefit import FitOptions
 from rotorred.signals.settling import settling_time
 
 F_L = 70.0
@@ -86,7 +87,7 @@ def test_a_settled_signal_settles_at_its_first_window():
 
 def test_a_record_shorter_than_two_windows_is_not_settled():
     t = np.arange(2_000) * DT  # 0.2 s; the window is 10 / 70 Hz = 0.14 s
-    s = settling_time(t, np.cos(2 * np.pi * F_L * t), F_L, F_H, max_subharmonic=1)
+    s = settling_time(t, np.cos(2 * np.pi * F_L * t), F_L, F_H, options=FitOptions(max_subharmonic=1))
     assert not s.settled and s.reason.startswith("record too short")
 
 

@@ -82,7 +82,7 @@ import numpy as np
 import scipy.fft
 
 from rotorred import checks
-from rotorred.signals.linefit import LineFit, Torus, commensurate_ratio, fit_lines
+from rotorred.signals.linefit import FitOptions, LineFit, Torus, commensurate_ratio, fit_lines
 from rotorred.signals.settling import Settling, settling_time
 
 __all__ = ["EXPLAINED_MIN", "CHAOS_K", "BROADBAND_MAX", "STRUCTURE_SHARE", "ZERO_ONE_MIN_SAMPLES",
@@ -337,10 +337,10 @@ class Classification:
         return f"period-{self.subharmonic}" if self.kind == "period-k" else self.kind
 
 
-def _evidence(t: np.ndarray, x: np.ndarray, y, f_L: float, f_H: float, start: float, fit_options: dict):
+def _evidence(t: np.ndarray, x: np.ndarray, y, f_L: float, f_H: float, start: float, options):
     """Line fit, Poincare samples, 0-1 test K and residual peak share of the record from ``start``."""
     part = t >= start
-    fit = fit_lines(t[part], x[part], f_L, f_H, **fit_options)
+    fit = fit_lines(t[part], x[part], f_L, f_H, options=options)
     samples = poincare_samples(t[part], x[part], _section_frequency(fit.torus), y=None if y is None else y[part])
     K = zero_one_test(samples.x) if samples.x.size >= ZERO_ONE_MIN_SAMPLES else math.nan
     return fit, samples, K, _peak_share(fit)
@@ -367,7 +367,7 @@ def _regular_kind(fit: LineFit, samples: PoincareSamples, explained_min: float, 
 
 def classify(t, x, f_L: float, f_H: float, *, y=None, settling: Settling | None = None,
              explained_min: float = EXPLAINED_MIN, chaos_K: float = CHAOS_K, broadband_max: float = BROADBAND_MAX,
-             **fit_options) -> Classification:
+             options: FitOptions | None = None) -> Classification:
     """Classify a response as periodic, period-k, quasi-periodic, chaotic, unexplained or unsettled.
 
     Parameters
@@ -384,8 +384,8 @@ def classify(t, x, f_L: float, f_H: float, *, y=None, settling: Settling | None 
         Of this record; default :func:`rotorred.signals.settling.settling_time` with its defaults.
     explained_min, chaos_K, broadband_max : float
         Thresholds of the rules (module docstring).
-    **fit_options
-        Passed to :func:`rotorred.signals.linefit.fit_lines`.
+    options : FitOptions, optional
+        Of :func:`rotorred.signals.linefit.fit_lines`.
 
     Returns
     -------
@@ -398,11 +398,11 @@ def classify(t, x, f_L: float, f_H: float, *, y=None, settling: Settling | None 
     chaos_K = checks.number("chaos_K", chaos_K, gt=0.0, le=1.0)
     broadband_max = checks.number("broadband_max", broadband_max, gt=0.0, le=1.0)
     if settling is None:
-        settling = settling_time(t, x, f_L, f_H, **fit_options)
+        settling = settling_time(t, x, f_L, f_H, options=options)
     elif not isinstance(settling, Settling):
         checks.fail("settling", settling, "must be a Settling (from settling_time)")
     start = settling.time if settling.settled else 0.5 * (t[0] + t[-1])
-    fit, samples, K, peak_share = _evidence(t, x, y, f_L, f_H, start, fit_options)
+    fit, samples, K, peak_share = _evidence(t, x, y, f_L, f_H, start, options)
     eta = fit.explained_share
     rules = [f"rule 1: {settling.reason}"]
     chaotic = eta < explained_min and peak_share < broadband_max and K >= chaos_K

@@ -824,10 +824,54 @@ def _options(grid: _Grid, x: np.ndarray, f_L, f_H, f_max, max_m, max_n, resoluti
                     None if max_kept is None else checks.integer("max_kept", max_kept, ge=1))
 
 
-def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, f_max: float | None = None, max_m: int = 8,
-              max_n: int = 8, max_subharmonic: int = MAX_SUBHARMONIC, resolution: float = RESOLUTION,
-              z: float = Z_SIGNIFICANCE, relative_floor: float = RELATIVE_FLOOR, max_lines: int = MAX_LINES,
-              n_unlabelled: int = 10, max_kept: int | None = None) -> LineFit:
+@dataclass(frozen=True)
+class FitOptions:
+    """How :func:`fit_lines` chooses, fits and keeps lines (the defaults are the module docstring's).
+
+    Parameters
+    ----------
+    f_max : float, optional
+        Highest candidate frequency (Hz); default the Nyquist frequency minus c/T.
+    max_m, max_n : int
+        ``|m| <= max_m``, ``|n| <= max_n`` (multiples of f_H and f_L, fractions allowed).
+    max_subharmonic : int
+        Largest sub-harmonic order k, j searched (1 searches nothing).
+    resolution : float
+        c >= 1: candidates closer than c/T are one line (-).
+    z : float
+        Significance: a line needs ``amplitude > z * standard_error`` (-).
+    relative_floor : float
+        ... and ``amplitude >= relative_floor * sqrt(2) rms(x - mean)`` (-).
+    max_lines : int
+        Most candidate lines fitted.
+    n_unlabelled : int
+        Residual peaks reported.
+    max_kept : int, optional
+        Keep at most this many lines, the largest amplitudes among the significant ones, refitted
+        alone (module docstring, "Parsimony"); default: every significant line.
+    """
+
+    f_max: float | None = None
+    max_m: int = 8
+    max_n: int = 8
+    max_subharmonic: int = MAX_SUBHARMONIC
+    resolution: float = RESOLUTION
+    z: float = Z_SIGNIFICANCE
+    relative_floor: float = RELATIVE_FLOOR
+    max_lines: int = MAX_LINES
+    n_unlabelled: int = 10
+    max_kept: int | None = None
+
+
+def _checked_fit_options(options) -> FitOptions:
+    if options is None:
+        return FitOptions()
+    if not isinstance(options, FitOptions):
+        checks.fail("options", type(options).__name__, "must be a FitOptions")
+    return options
+
+
+def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, options: FitOptions | None = None) -> LineFit:
     """Fit the combination lines ``(m/k) f_H + (n/j) f_L`` of a record by least squares.
 
     Parameters
@@ -840,33 +884,18 @@ def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, f_max: float | None =
         Spool frequencies (Hz), > 0.
     torus : (int, int), optional
         Sub-harmonic orders (k, j) to use; default: found (module docstring).
-    f_max : float, optional
-        Highest candidate frequency (Hz); default the Nyquist frequency minus c/T.
-    max_m, max_n : int
-        ``|m| <= max_m``, ``|n| <= max_n`` (multiples of f_H and f_L, fractions allowed).
-    max_subharmonic : int
-        Largest k, j searched (1 searches nothing).
-    resolution : float
-        c >= 1: candidates closer than c/T are one line.
-    z : float
-        Significance: a line needs ``amplitude > z * standard_error``.
-    relative_floor : float
-        ... and ``amplitude >= relative_floor * sqrt(2) rms(x - mean)``.
-    max_lines : int
-        Most candidate lines fitted.
-    n_unlabelled : int
-        Residual peaks reported.
-    max_kept : int, optional
-        Keep at most this many lines, the largest amplitudes among the significant ones, refitted
-        alone (module docstring, "Parsimony"); default: every significant line.
+    options : FitOptions, optional
+        The candidates, significance and parsimony of the fit (default ``FitOptions()``).
 
     Returns
     -------
     LineFit
     """
     grid, x = _record(t, x)
-    opts = _options(grid, x, f_L, f_H, f_max, max_m, max_n, resolution, z, relative_floor, max_lines, max_kept)
-    max_sub = checks.integer("max_subharmonic", max_subharmonic, ge=1, le=12)
+    o = _checked_fit_options(options)
+    opts = _options(grid, x, f_L, f_H, o.f_max, o.max_m, o.max_n, o.resolution, o.z, o.relative_floor, o.max_lines,
+                    o.max_kept)
+    max_sub = checks.integer("options.max_subharmonic", o.max_subharmonic, ge=1, le=12)
     energy = float(np.sum((x - x.mean()) ** 2))
     if torus is None:
         best, fits = _search(grid, x, opts, max_sub, energy)
@@ -874,7 +903,7 @@ def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, f_max: float | None =
         k, j = checks.sequence("torus", torus, lambda f, v: checks.integer(f, v, ge=1, le=12), min_len=2, max_len=2)
         best = _fit_torus(grid, x, opts, k, j)
         fits = (best,)
-    return _line_fit(grid, x, opts, best, fits, energy, checks.integer("n_unlabelled", n_unlabelled, ge=0))
+    return _line_fit(grid, x, opts, best, fits, energy, checks.integer("options.n_unlabelled", o.n_unlabelled, ge=0))
 
 
 def fit_peaks(t, x, f_L: float, f_H: float, *, spectrum: Spectrum | None = None, threshold: float = 0.005,

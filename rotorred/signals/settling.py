@@ -66,7 +66,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred import checks
-from rotorred.signals.linefit import RESOLUTION, LineFit, fit_frequencies, fit_lines
+from rotorred.signals.linefit import FitOptions, LineFit, fit_frequencies, fit_lines
 
 __all__ = ["TOLERANCE", "N_CYCLES", "STEP_FRACTION", "Z_CHANGE", "Settling", "settling_time"]
 
@@ -129,11 +129,11 @@ def _tracked(reference: LineFit) -> np.ndarray:
 
 
 def _reference(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, torus, reference: LineFit | None,
-               fit_options: dict) -> LineFit:
+               options) -> LineFit:
     """The given reference fit, checked against the record, or the fit of the record's last quarter."""
     if reference is None:
         quarter = t.size // 4
-        return fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, torus=torus, **fit_options)
+        return fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, torus=torus, options=options)
     if not isinstance(reference, LineFit):
         checks.fail("reference", reference, "must be a LineFit (from fit_lines)")
     if not np.allclose((reference.torus.f_L, reference.torus.f_H), (f_L, f_H), rtol=1e-12, atol=0.0):
@@ -185,7 +185,7 @@ def _not_settled(reason: str, tol: float, reference: LineFit | None, freqs: np.n
 
 def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, window: float | None = None,
                   torus=None, n_cycles: float = N_CYCLES, reference: LineFit | None = None,
-                  **fit_options) -> Settling:
+                  options: FitOptions | None = None) -> Settling:
     """When the line amplitudes (and the offset and residual level) of a response stop changing.
 
     Parameters
@@ -206,9 +206,9 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
         Periods of the slowest labelled line in a default window (speeds not commensurate).
     reference : LineFit, optional
         A fit of the end of this record (same f_L, f_H) that chooses the tracked lines, in place
-        of the fit of the last quarter (``torus`` and ``fit_options`` are then not used for it).
-    **fit_options
-        Passed to :func:`rotorred.signals.linefit.fit_lines` (``resolution``, ``z``, ...).
+        of the fit of the last quarter (``torus`` and ``options`` are then not used for it).
+    options : FitOptions, optional
+        Of :func:`rotorred.signals.linefit.fit_lines` (``resolution``, ``z``, ...).
 
     Returns
     -------
@@ -218,12 +218,12 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
     x = checks.vector("x", x, min_len=32)
     tol = checks.number("tol", tol, gt=0.0, lt=1.0)
     n_cycles = checks.positive("n_cycles", n_cycles)
-    reference = _reference(t, x, f_L, f_H, torus, reference, fit_options)
+    reference = _reference(t, x, f_L, f_H, torus, reference, options)
     freqs = _tracked(reference)
     if freqs.size == 0:
         return _not_settled("no significant line on the last quarter of the record to track", tol, reference, freqs)
     dt = (t[-1] - t[0]) / (t.size - 1)
-    resolution = fit_options.get("resolution", RESOLUTION)
+    resolution = (options or FitOptions()).resolution
     w = (_default_window(reference, freqs, n_cycles, resolution) if window is None
          else checks.positive("window", window, "s"))
     n_window = int(math.ceil(w / dt - 1e-9))
