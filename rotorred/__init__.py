@@ -23,6 +23,10 @@ import importlib
 
 from rotorred._version import __version__
 
+#: the service modules of the bottom layer, public as modules: the one validation module (its InputError messages),
+#: the one writer of each file format and the locked output folder, the feedback of long work, the provenance record
+_MODULES = ("checks", "writers", "progress", "provenance")
+
 #: public name -> module that defines it
 _EXPORTS = {
     # errors
@@ -33,10 +37,14 @@ _EXPORTS = {
     "Disk": "rotorred.model.elements",
     "Bearing": "rotorred.model.elements",
     "IntershaftBearing": "rotorred.model.elements",
+    "BearingTable": "rotorred.model.elements",
+    "Pedestal": "rotorred.model.elements",
+    "Support": "rotorred.model.elements",
     "Spool": "rotorred.model.rotor",
     "Rotor": "rotorred.model.rotor",
     "load_rotor": "rotorred.model.rotor_file",
     "presets": "rotorred.model.rotor_file",
+    "convert_ross": "rotorred.model.rotor_file",
     "assemble": "rotorred.model.assembly",
     "SystemMatrices": "rotorred.model.assembly",
     "Unbalance": "rotorred.model.loads",
@@ -68,6 +76,13 @@ _EXPORTS = {
     "settled_spectrum": "rotorred.signals.spectra",
     "Spectrum": "rotorred.signals.spectra",
     "fit_lines": "rotorred.signals.linefit",
+    "FitOptions": "rotorred.signals.linefit",
+    "settling_time": "rotorred.signals.settling",
+    "Settling": "rotorred.signals.settling",
+    "classify": "rotorred.signals.classify",
+    "Classification": "rotorred.signals.classify",
+    "poincare_samples": "rotorred.signals.classify",
+    "PoincareSamples": "rotorred.signals.classify",
     "fit_peaks": "rotorred.signals.linefit",
     "LineFit": "rotorred.signals.linefit",
     "FittedLine": "rotorred.signals.linefit",
@@ -85,10 +100,12 @@ _EXPORTS = {
     "RunupResult": "rotorred.scenes.runup",
 }
 
-__all__ = sorted(_EXPORTS)
+__all__ = sorted([*_EXPORTS, *_MODULES])
 
 
 def __getattr__(name: str):
+    if name in _MODULES:
+        return importlib.import_module(f"rotorred.{name}")
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'rotorred' has no attribute {name!r}")

@@ -282,7 +282,7 @@ def test_inputs_are_refused_with_the_one_message_form():
     with pytest.raises(InputError, match="must not be constant"):
         fit_lines(t, np.ones(100), 10.0, 20.0)
     with pytest.raises(InputError, match="torus"):
-        fit_lines(t, np.sin(50 * t), 10.0, 20.0, torus=(0, 1))
+        fit_lines(t, np.sin(50 * t), 10.0, 20.0, options=FitOptions(torus=(0, 1)))
 
 
 @pytest.mark.parametrize("n", [10_000, 100_000])

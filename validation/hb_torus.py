@@ -43,7 +43,7 @@ from rotorred.scenes.harmonic_balance import unknown_records
 from rotorred.scenes.run import build_model, run_scene
 from rotorred.scenes.schema import load_scene
 from rotorred.scenes.torus_balance import torus_rub_problem
-from rotorred.signals.linefit import fit_lines
+from rotorred.signals.linefit import FitOptions, fit_lines
 
 OUTER_HZ = 91.37  #: outer spool (Hz); inner 70 Hz as paper-rub
 DURATION, RECORD_START = 22.0, 2.0  #: s: 20 s recorded (the response has settled by 2.3 s: settling_time)
@@ -118,7 +118,7 @@ def evidence(result, largest, amplitudes, rp, z) -> None:
     print("evidence: the transient's 10 lines fitted on 5 s windows, relative to the whole record's:")
     for lo in np.arange(RECORD_START, DURATION - 1e-9, 5.0):
         part = (result.t >= lo) & (result.t < lo + 5.0)
-        fit = fit_lines(result.t[part], x[part], result.f_L, result.f_H, torus=(3, 1))
+        fit = fit_lines(result.t[part], x[part], result.f_L, result.f_H, options=FitOptions(torus=(3, 1)))
         found = {round(ln.frequency_hz, 6): ln.amplitude for ln in fit.lines}
         d = np.array([found.get(f, np.nan) for f in frequencies]) / reference - 1
         print(f"  {lo:4.1f}-{lo + 5:4.1f} s: worst {np.nanmax(np.abs(d)):.2%}: "

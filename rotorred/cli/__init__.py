@@ -126,13 +126,13 @@ class _Formatter(argparse.RawDescriptionHelpFormatter):
 
 def build_parser() -> argparse.ArgumentParser:
     from rotorred.cli import feedback
-    from rotorred.provenance import package_version
+    from rotorred import provenance
 
     parser = argparse.ArgumentParser(
         prog="rotorred", description="Rotordynamics of dual-rotor machines with rub-impact faults. "
                                      "`rotorred COMMAND --help` describes a command, with examples.",
         epilog=_epilog(), formatter_class=_Formatter)
-    parser.add_argument("--version", action="version", version=f"rotorred {package_version()}")
+    parser.add_argument("--version", action="version", version=f"rotorred {provenance.package_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         module = importlib.import_module(f"rotorred.cli.{name}")
@@ -211,8 +211,7 @@ def _error(args, text: str) -> None:
 
 def _report(args, exc: BaseException) -> int:
     """One message for ``exc`` on stderr; returns the exit status."""
-    from rotorred.checks import InputError
-    from rotorred.writers import FolderBusy
+    from rotorred import InputError, writers
 
     if isinstance(exc, KeyboardInterrupt):
         _error(args, "interrupted (SIGINT); the output folder keeps its earlier result")
@@ -232,7 +231,7 @@ def _report(args, exc: BaseException) -> int:
     if _is_diverged(exc):
         _error(args, str(exc))
         return EXIT_DIVERGED
-    if isinstance(exc, FolderBusy):
+    if isinstance(exc, writers.FolderBusy):
         _error(args, str(exc))
         return EXIT_ENVIRONMENT
     if isinstance(exc, OSError):
@@ -244,7 +243,7 @@ def _report(args, exc: BaseException) -> int:
 
 def _is_internal(exc: BaseException) -> bool:
     """A ValueError from a library deep in a computation, not from an input check (e.g. numpy's)."""
-    from rotorred.checks import InputError
+    from rotorred import InputError
 
     if isinstance(exc, (InputError, FileNotFoundError)):
         return False
@@ -281,7 +280,7 @@ def _internal(args, exc: BaseException) -> int:
 
 
 def _usable_out(args) -> Path | None:
-    from rotorred.checks import InputError
+    from rotorred import InputError
     from rotorred.cli.options import out_dir
 
     try:

@@ -22,25 +22,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from rotorred.model.elements import BearingTable
-    from rotorred.model.rotor_file import (RotorFileError, read_rotor_toml, read_text_file, rotor_document,
-                                           rotor_from_dict)
-    from rotorred.model.ross_file import is_ross_document
+    from rotorred import BearingTable, convert_ross
 
     source, target = Path(args.source), _target(args.target, args.source)
     if not source.is_file():
         checks.fail("ROSS_FILE", args.source, "must be an existing file (a rotor saved by ROSS 3)")
-    data = read_rotor_toml(read_text_file(source, RotorFileError), str(source))
-    if not is_ross_document(data):
-        checks.fail("ROSS_FILE", args.source, "must be a rotor saved by ROSS (it has no ross_version line); it reads "
-                    "as a rotorred rotor file already")
     try:
-        rotor = rotor_from_dict(rotor_document(data, str(source), name=source.stem))
-    except RotorFileError as exc:
-        raise exc.from_source(str(source)) from None
-    rotor.to_toml(target, header=f"rotorred rotor file converted from {source.name} (saved by ROSS "
-                                 f"{data.get('ross_version')}) by `rotorred convert`\n(axial and torsional "
-                                 "coefficients of ROSS's 6-DOF model are not read: docs/model.md §14)")
+        rotor = convert_ross(source, target)
+    except checks.InputError as exc:
+        if exc.field != "source":
+            raise
+        checks.fail("ROSS_FILE", args.source, exc.requirement)
     spool = rotor.spools[0]
     tables = sum(1 for b in rotor.bearings if isinstance(b, BearingTable))
     report(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"

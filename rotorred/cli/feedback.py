@@ -17,7 +17,9 @@ from __future__ import annotations
 import logging
 import sys
 
-from rotorred.progress import LOG
+from rotorred import progress
+
+LOG = progress.LOG
 
 __all__ = ["REPORT", "report", "error", "configure", "add_options", "level"]
 

@@ -137,6 +137,45 @@ def read_rotor(spec: str | Path) -> tuple[Rotor, dict[str, Any]]:
         raise exc.from_source(source) from None
 
 
+def convert_ross(source: str | Path, target: str | Path) -> Rotor:
+    """Read a rotor saved by ROSS 3 (``ross.Rotor.save``, TOML) and write it as a rotorred rotor file.
+
+    The rotor is checked as :func:`load_rotor` reads it, then written by :meth:`Rotor.to_toml` with a header naming
+    the source and its ROSS version (axial and torsional coefficients of ROSS's 6-DOF model are not read:
+    docs/model.md §14).
+
+    Parameters
+    ----------
+    source : str or Path
+        The ROSS file.
+    target : str or Path
+        The rotorred rotor file to write (.toml).
+
+    Returns
+    -------
+    Rotor
+        The rotor written.
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For a source that is not a rotor saved by ROSS, or that rotorred cannot read (naming the entry).
+    """
+    source = Path(source)
+    data = read_rotor_toml(read_text_file(source, RotorFileError), str(source))
+    if not is_ross_document(data):
+        raise InputError("source", str(source), "must be a rotor saved by ROSS (it has no ross_version line); it "
+                         "reads as a rotorred rotor file already")
+    try:
+        rotor = rotor_from_dict(rotor_document(data, str(source), name=source.stem))
+    except RotorFileError as exc:
+        raise exc.from_source(str(source)) from None
+    rotor.to_toml(target, header=f"rotorred rotor file converted from {source.name} (saved by ROSS "
+                                 f"{data.get('ross_version')}) by `rotorred convert`\n(axial and torsional "
+                                 "coefficients of ROSS's 6-DOF model are not read: docs/model.md §14)")
+    return rotor
+
+
 def read_rotor_toml(text: str, source: str = "<string>") -> dict[str, Any]:
     """The parsed TOML of a rotor file (rotorred's or ROSS's); a syntax error is a :class:`RotorFileError` naming
     ``source``."""

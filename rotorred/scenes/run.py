@@ -49,7 +49,7 @@ from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
 from rotorred.signals.classify import Classification, classify
-from rotorred.signals.linefit import LineFit, fit_lines, fit_peaks
+from rotorred.signals.linefit import FitOptions, LineFit, fit_lines, fit_peaks
 from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
@@ -414,7 +414,7 @@ def analyse_lines(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, n_fit: i
     """
     t0 = time.perf_counter()
     fit, settling = settled or fit_and_settling(t, x, f_L, f_H, n_fit)
-    cls = classify(t, x, f_L, f_H, settling=settling, torus=(fit.torus.k, fit.torus.j))
+    cls = classify(t, x, f_L, f_H, settling=settling, options=FitOptions(torus=(fit.torus.k, fit.torus.j)))
     return LineAnalysis(tuple(dof), fit, settling, cls, time.perf_counter() - t0)
 
 

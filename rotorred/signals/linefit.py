@@ -830,6 +830,8 @@ class FitOptions:
 
     Parameters
     ----------
+    torus : (int, int), optional
+        Sub-harmonic orders (k, j) to use; default: found (module docstring).
     f_max : float, optional
         Highest candidate frequency (Hz); default the Nyquist frequency minus c/T.
     max_m, max_n : int
@@ -851,6 +853,7 @@ class FitOptions:
         alone (module docstring, "Parsimony"); default: every significant line.
     """
 
+    torus: tuple[int, int] | None = None
     f_max: float | None = None
     max_m: int = 8
     max_n: int = 8
@@ -871,7 +874,7 @@ def _checked_fit_options(options) -> FitOptions:
     return options
 
 
-def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, options: FitOptions | None = None) -> LineFit:
+def fit_lines(t, x, f_L: float, f_H: float, *, options: FitOptions | None = None) -> LineFit:
     """Fit the combination lines ``(m/k) f_H + (n/j) f_L`` of a record by least squares.
 
     Parameters
@@ -882,10 +885,8 @@ def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, options: FitOptions |
         Samples (any units, e.g. m).
     f_L, f_H : float
         Spool frequencies (Hz), > 0.
-    torus : (int, int), optional
-        Sub-harmonic orders (k, j) to use; default: found (module docstring).
     options : FitOptions, optional
-        The candidates, significance and parsimony of the fit (default ``FitOptions()``).
+        The sub-harmonic orders, candidates, significance and parsimony of the fit (default ``FitOptions()``).
 
     Returns
     -------
@@ -897,10 +898,11 @@ def fit_lines(t, x, f_L: float, f_H: float, *, torus=None, options: FitOptions |
                     o.max_kept)
     max_sub = checks.integer("options.max_subharmonic", o.max_subharmonic, ge=1, le=12)
     energy = float(np.sum((x - x.mean()) ** 2))
-    if torus is None:
+    if o.torus is None:
         best, fits = _search(grid, x, opts, max_sub, energy)
     else:
-        k, j = checks.sequence("torus", torus, lambda f, v: checks.integer(f, v, ge=1, le=12), min_len=2, max_len=2)
+        k, j = checks.sequence("options.torus", o.torus, lambda f, v: checks.integer(f, v, ge=1, le=12),
+                               min_len=2, max_len=2)
         best = _fit_torus(grid, x, opts, k, j)
         fits = (best,)
     return _line_fit(grid, x, opts, best, fits, energy, checks.integer("options.n_unlabelled", o.n_unlabelled, ge=0))

@@ -128,12 +128,12 @@ def _tracked(reference: LineFit) -> np.ndarray:
     return np.sort(np.array(freqs))
 
 
-def _reference(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, torus, reference: LineFit | None,
+def _reference(t: np.ndarray, x: np.ndarray, f_L: float, f_H: float, reference: LineFit | None,
                options) -> LineFit:
     """The given reference fit, checked against the record, or the fit of the record's last quarter."""
     if reference is None:
         quarter = t.size // 4
-        return fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, torus=torus, options=options)
+        return fit_lines(t[-quarter:], x[-quarter:], f_L, f_H, options=options)
     if not isinstance(reference, LineFit):
         checks.fail("reference", reference, "must be a LineFit (from fit_lines)")
     if not np.allclose((reference.torus.f_L, reference.torus.f_H), (f_L, f_H), rtol=1e-12, atol=0.0):
@@ -184,7 +184,7 @@ def _not_settled(reason: str, tol: float, reference: LineFit | None, freqs: np.n
 
 
 def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, window: float | None = None,
-                  torus=None, n_cycles: float = N_CYCLES, reference: LineFit | None = None,
+                  n_cycles: float = N_CYCLES, reference: LineFit | None = None,
                   options: FitOptions | None = None) -> Settling:
     """When the line amplitudes (and the offset and residual level) of a response stop changing.
 
@@ -200,15 +200,14 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
         Relative tolerance of the window states, in (0, 1); default 0.02 (module docstring).
     window : float, optional
         Window length (s); default: module docstring, step 2.
-    torus : (int, int), optional
-        Sub-harmonic orders; default: found on the last quarter of the record.
     n_cycles : float
         Periods of the slowest labelled line in a default window (speeds not commensurate).
     reference : LineFit, optional
         A fit of the end of this record (same f_L, f_H) that chooses the tracked lines, in place
-        of the fit of the last quarter (``torus`` and ``options`` are then not used for it).
+        of the fit of the last quarter (``options`` are then not used for it).
     options : FitOptions, optional
-        Of :func:`rotorred.signals.linefit.fit_lines` (``resolution``, ``z``, ...).
+        Of :func:`rotorred.signals.linefit.fit_lines` (``torus``: the sub-harmonic orders, default found on the last
+        quarter of the record; ``resolution``, ``z``, ...).
 
     Returns
     -------
@@ -218,7 +217,7 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
     x = checks.vector("x", x, min_len=32)
     tol = checks.number("tol", tol, gt=0.0, lt=1.0)
     n_cycles = checks.positive("n_cycles", n_cycles)
-    reference = _reference(t, x, f_L, f_H, torus, reference, options)
+    reference = _reference(t, x, f_L, f_H, reference, options)
     freqs = _tracked(reference)
     if freqs.size == 0:
         return _not_settled("no significant line on the last quarter of the record to track", tol, reference, freqs)
