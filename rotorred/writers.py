@@ -132,7 +132,7 @@ def write_npz(path: str | Path, arrays: Mapping[str, np.ndarray], attributes: Ma
     """
     path = Path(path)
     entries = {**arrays, **{k: np.array(v) for k, v in _attributes(arrays, attributes, "write_npz").items()}}
-    with atomic_path(path, ".npz") as tmp, _signals_blocked():
+    with atomic_path(path, ".npz") as tmp, signals_held():
         np.savez(tmp, **entries)
     return path
 
@@ -471,7 +471,7 @@ def _release_lock(path: Path, handle) -> None:
 
 
 @contextmanager
-def _signals_blocked():
+def signals_held():
     """SIGINT and SIGTERM held back, then delivered on exit, so that a commit or an archive is not cut in half.
 
     Held back in Python: while inside, their handlers only note the signal, and the first one noted is raised again
@@ -555,7 +555,7 @@ class OutputFolder:
         list of Path
             The files of the result in the folder.
         """
-        with _signals_blocked():
+        with signals_held():
             marker = self.folder / INCOMPLETE
             write_text(marker, (incomplete or "a rotorred run was writing this folder and did not finish") + "\n")
             new = sorted(p.name for p in self.staging.iterdir() if not p.name.startswith("."))

@@ -307,8 +307,8 @@ def test_available_memory_is_psutils(monkeypatch):
     assert budget.available_memory() == 3 << 30
     estimate = budget.Estimate(10, 10, 2 << 30, 8, 0, {"memory": ("solver.record_start", 0.0)})
     with pytest.raises(InputError, match=r"more than 0.5 x the 3 GiB available"):
-        budget.check(estimate)
-    assert budget.check(estimate, memory=5 << 30) is estimate
+        estimate.check()
+    assert estimate.check(memory=5 << 30) is estimate
 
 
 def _umask() -> int:

@@ -19,10 +19,9 @@ from __future__ import annotations
 
 import contextlib
 
-from rotorred import checks
+from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import out_dir, provenance
-from rotorred.progress import bar, stage
 
 
 def add_parser(subparsers):
@@ -66,11 +65,7 @@ def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
     from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
     from rotorred.cli.run import _settings
-    from rotorred.scenes.branch import check_key, continue_scene
-    from rotorred.scenes.branch_outputs import format_branch
-    from rotorred.scenes.resolved import scene_toml
-    from rotorred.scenes.run import build_model
-    from rotorred.scenes.schema import load_scene
+    from rotorred import build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
     key, start, stop = _param(args.param)
@@ -85,10 +80,10 @@ def run(args) -> int:
     model = build_model(scene).model
     report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
-    stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
-    with _Progress(key) as progress:
+    progress.stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
+    with _Progress(key) as tracing:
         branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
-                                progress=progress, interrupts=interrupts)
+                                progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
     for f in _write(branch, out, scene.name, tuple(interrupts), record):
         report(f"wrote {f}")
@@ -100,14 +95,13 @@ def run(args) -> int:
 
 def _write(branch, out, scene_name: str, interrupts: tuple, record=None) -> list:
     """Stage and commit the branch's files into ``out``: those of an interrupted branch with SIGINT and SIGTERM held
-    back (``writers._signals_blocked``, as a commit is), so that a second signal does not cut the points the first
+    back (``writers.signals_held``, as a commit is), so that a second signal does not cut the points the first
     one kept; it is dropped once they are committed (the exit status is the first's). The files written."""
-    from rotorred.scenes.branch_outputs import write_branch
-    from rotorred.writers import OutputFolder, _signals_blocked
+    from rotorred import write_branch, writers
 
-    folder, files = OutputFolder(out), []
+    folder, files = writers.OutputFolder(out), []
     try:
-        with _signals_blocked() if branch.interrupted else contextlib.nullcontext(), folder:
+        with writers.signals_held() if branch.interrupted else contextlib.nullcontext(), folder:
             write_branch(branch, folder, scene_name, record)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except interrupts:
@@ -121,7 +115,7 @@ class _Progress:
     points traced with the key's value, then a stage line and a bar of the points whose stability is computed."""
 
     def __init__(self, key: str):
-        self.key, self.points, self.bar, self.stability = key, 0, bar(None, "tracing", "point"), False
+        self.key, self.points, self.bar, self.stability = key, 0, progress.bar(None, "tracing", "point"), False
 
     def __call__(self, points: int, value) -> None:
         if value is not None:
@@ -132,8 +126,8 @@ class _Progress:
         if not self.stability:
             self.stability = True
             self.bar.close()
-            stage("stability of %d points: Floquet multipliers", self.points)
-            self.bar = bar(self.points, "stability", "point")
+            progress.stage("stability of %d points: Floquet multipliers", self.points)
+            self.bar = progress.bar(self.points, "stability", "point")
         self.bar.update(points - self.bar.n)
 
     def __enter__(self):

@@ -168,8 +168,7 @@ def check_model_size(rotor, force: bool) -> None:
 
     n_dof, model_bytes = budget.model_estimate(rotor)
     name = rotor.name or "the rotor"
-    budget.check(budget.Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}),
-                 force=force)
+    budget.Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}).check(force)
 
 
 def format_whirl_table(result, i: int = 0) -> str:

@@ -47,8 +47,7 @@ def add_parser(subparsers):
 
 def spec_of(args):
     """The :class:`rotorred.maps.spec.MapSpec` of the options, every point's scene validated."""
-    from rotorred.maps.spec import Axis, MapSpec
-    from rotorred.scenes.schema import parse_setting
+    from rotorred import Axis, MapSpec, parse_setting
 
     fixed = []
     for item in args.set:
@@ -70,9 +69,7 @@ def base_scene_toml(spec) -> str:
     """The resolved base scene of a map: its scene with the fixed settings (``--set``), the varied keys as the scene
     has them (the command line in the provenance names their values). A base scene that is not valid on its own
     (a varied key makes it so) gives the scene of the map's first grid point."""
-    from rotorred.checks import InputError
-    from rotorred.scenes.resolved import scene_toml
-    from rotorred.scenes.schema import load_scene
+    from rotorred import InputError, load_scene, scene_toml
 
     try:
         scene = load_scene(spec.scene, dict(spec.settings))
@@ -91,7 +88,7 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
 def run(args) -> int:
     """Check everything, then run the map into ``--out`` (exit 3 when points failed, 130 when interrupted)."""
     from rotorred.cli import EXIT_DIVERGED, EXIT_SIGINT
-    from rotorred.maps.run import format_map, run_map
+    from rotorred import format_map, run_map
 
     out = out_dir("--out", args.out)
     spec = spec_of(args)

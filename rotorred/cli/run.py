@@ -21,17 +21,15 @@ from __future__ import annotations
 
 import time
 
-from rotorred import checks
+from rotorred import checks, progress, writers
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import out_dir, provenance
-from rotorred.progress import stage
-from rotorred.writers import INCOMPLETE, OutputFolder
 
 DEFAULT_SCENE = "paper-rub"
 
 
 def add_parser(subparsers):
-    from rotorred.scenes.builtin import builtin_scenes  # light: the scene schema is imported when a scene is read
+    from rotorred import builtin_scenes  # light: the scene schema is imported when a scene is read
     p = subparsers.add_parser(
         "run", help="run a scene (default paper-rub): figures, data (NPZ, CSV, .mat) and a summary",
         description="Run a scene file or built-in scene and write the paper's figures (time waveforms, spectra, "
@@ -53,9 +51,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Check everything, then compute into a locked, staged ``--out`` (exit statuses: :mod:`rotorred.cli`)."""
-    from rotorred.scenes import budget
-    from rotorred.scenes.resolved import scene_toml
-    from rotorred.scenes.schema import load_scene
+    from rotorred import load_scene, scene_estimate, scene_toml
 
     t0 = time.perf_counter()
     out = out_dir("--out", args.out) if args.out is not None else None  # refused before the scene is read
@@ -65,10 +61,10 @@ def run(args) -> int:
     scene = load_scene(args.scene, settings)
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
-    budget.check(budget.scene_estimate(scene), force=args.force)
+    scene_estimate(scene).check(force=args.force)
     record = provenance(args, "scene", scene_toml(scene))
-    with OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
-        stage("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
+    with writers.OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
+        progress.stage("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
         status = _compute_and_write(scene, args, folder, out, pool, record)
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
@@ -78,10 +74,10 @@ def _figure_pool(scene):
     """The :class:`rotorred.plots.pool.FigurePool` of ``scene``: its workers draw the figures while the data files are
     written, their fork server importing matplotlib and preparing the figures' frames while the scene is solved; for
     a scene without figures or a run-up (drawn here), an empty pool."""
-    from rotorred.plots.pool import FigurePool  # here, not at the top: every command imports this module (its parser)
+    from rotorred import FigurePool  # here, not at the top: every command imports this module (its parser)
 
     if scene.output.plots and scene.runup is None:
-        from rotorred.plots.scene import scene_frames  # light: matplotlib is imported when a figure is drawn
+        from rotorred import scene_frames  # light: matplotlib is imported when a figure is drawn
 
         return FigurePool(frames=scene_frames(scene))
     return FigurePool(workers=0)
@@ -89,7 +85,7 @@ def _figure_pool(scene):
 
 def _settings(items: list[str]) -> dict:
     """The ``--set KEY=VALUE`` overrides (one value each)."""
-    from rotorred.scenes.schema import parse_setting
+    from rotorred import parse_setting
 
     settings = {}
     for item in items:
@@ -107,10 +103,7 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
 
     if scene.runup is not None:
         return _runup_and_write(scene, folder, out, record)
-    from rotorred.scenes.outputs import submit_figures, write_outputs
-    from rotorred.scenes.run import SceneDiverged
-    from rotorred.scenes.summary import format_summary
-    from rotorred.scenes.tolerance import run_to_tolerance
+    from rotorred import SceneDiverged, format_summary, run_to_tolerance, submit_figures, write_outputs
 
     drawing = []  # the record's figures: drawn while the line fit, settling and class are computed
 
@@ -122,7 +115,7 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
         write_outputs(exc.partial, folder.staging, shown=out, pool=pool, provenance=record)
         files = folder.commit(incomplete=str(exc))
         report(format_summary(exc.partial, files))
-        error(f"{exc}; partial results written to {out} (marked {INCOMPLETE})")
+        error(f"{exc}; partial results written to {out} (marked {writers.INCOMPLETE})")
         return EXIT_DIVERGED
     files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing, provenance=record)
     folder.commit()
@@ -134,14 +127,13 @@ def _runup_and_write(scene, folder, out, record) -> int:
     """A run-up scene: the transient through its speed profile, its figures, data and summary; a diverged run
     writes what it computed up to then, analysed, marked INCOMPLETE (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
-    from rotorred.scenes.runup import run_runup
-    from rotorred.scenes.runup_outputs import format_runup_summary, write_runup_outputs
+    from rotorred import format_runup_summary, run_runup, write_runup_outputs
 
     result = run_runup(scene, progress=None)
     write_runup_outputs(result, folder.staging, shown=out, provenance=record)
     committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:
-        error(f"{result.incomplete}; partial results written to {out} (marked {INCOMPLETE})")
+        error(f"{result.incomplete}; partial results written to {out} (marked {writers.INCOMPLETE})")
         return EXIT_DIVERGED
     return 0

@@ -169,7 +169,7 @@ class MapSpec:
                 checks.fail("solver.tolerance", scene.solver.tolerance, "is not available in maps yet (each point would "
                             "choose its own model and step): choose the settings with `rotorred run --set "
                             "solver.tolerance=...` at a representative point and give them to the map")
-            budget.check(budget.scene_estimate(scene), force=force)
+            budget.scene_estimate(scene).check(force=force)
             total += max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
         if total > budget.MAX_STEPS and not force:
             checks.fail("--vary", " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes),

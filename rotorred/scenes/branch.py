@@ -45,7 +45,7 @@ from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interru
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
-from rotorred.writers import _signals_blocked
+from rotorred.writers import signals_held
 
 __all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "scene_at"]
 
@@ -355,7 +355,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     if progress is not None and len(values):
         progress(len(values), values[-1])  # the points traced, the last one included
     try:
-        with _signals_blocked():  # a few ms a point, and the branch's files need every point's outputs
+        with signals_held():  # a few ms a point, and the branch's files need every point's outputs
             outputs = _outputs(rub_at, values, branch.z, dofs)
         t3 = time.perf_counter()
         if stability and not interrupt:

@@ -82,6 +82,45 @@ class Estimate:
                  f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
         return "estimate: " + ", ".join(p for p in parts if p)
 
+    def check(self, force: bool = False, memory: int | None = None) -> Estimate:
+        """Refuse a run beyond :data:`MAX_STEPS`, :data:`MAX_DOFS` or the available memory (unless ``force``).
+
+        Parameters
+        ----------
+        force : bool
+            Go on beyond the limits.
+        memory : int, optional
+            Memory available (bytes); default :func:`available_memory`.
+
+        Returns
+        -------
+        Estimate
+            This estimate, within the limits (or forced).
+
+        Raises
+        ------
+        rotorred.checks.InputError
+            Naming the key or option behind the limit passed (:attr:`fields`) and ``--force``.
+        """
+        if force:
+            return self
+        memory = available_memory() if memory is None else memory
+        need = self.record_bytes + self.model_bytes
+        reasons = {}
+        if need > MEMORY_FRACTION * memory:
+            reasons["memory"] = (f"{format_bytes(need)} of memory, more than {MEMORY_FRACTION:g} x the "
+                                 f"{format_bytes(memory)} available")
+        if self.n_dof > MAX_DOFS:
+            reasons["dofs"] = f"more than {MAX_DOFS} DOFs"
+        if self.steps > MAX_STEPS:
+            reasons["steps"] = f"more than {MAX_STEPS:.3g} steps"
+        if reasons:
+            field, value = self.fields[list(reasons)[-1]]
+            checks.fail(field, value,
+                        f"gives a run beyond the limits ({self.describe()}: {'; '.join(reasons.values())}); "
+                        f"use --force to go on")
+        return self
+
 
 def model_estimate(rotor) -> tuple[int, int]:
     """(DOFs, bytes of the dense matrices) of ``rotor``'s finite-element model (4 DOFs per node)."""
@@ -110,25 +149,3 @@ def scene_estimate(scene) -> Estimate:
     fields = {"steps": ("solver.duration", s.duration), "dofs": model,
               "memory": ("solver.record_start", s.record_start) if record >= model_bytes else model}
     return Estimate(steps, samples, record, n_dof, model_bytes, fields)
-
-
-def check(estimate: Estimate, force: bool = False, memory: int | None = None) -> Estimate:
-    """Refuse an estimate beyond :data:`MAX_STEPS`, :data:`MAX_DOFS` or the available memory (unless ``force``)."""
-    if force:
-        return estimate
-    memory = available_memory() if memory is None else memory
-    need = estimate.record_bytes + estimate.model_bytes
-    reasons = {}
-    if need > MEMORY_FRACTION * memory:
-        reasons["memory"] = (f"{format_bytes(need)} of memory, more than {MEMORY_FRACTION:g} x the "
-                             f"{format_bytes(memory)} available")
-    if estimate.n_dof > MAX_DOFS:
-        reasons["dofs"] = f"more than {MAX_DOFS} DOFs"
-    if estimate.steps > MAX_STEPS:
-        reasons["steps"] = f"more than {MAX_STEPS:.3g} steps"
-    if reasons:
-        field, value = estimate.fields[list(reasons)[-1]]
-        checks.fail(field, value,
-                    f"gives a run beyond the limits ({estimate.describe()}: {'; '.join(reasons.values())}); "
-                    f"use --force to go on")
-    return estimate
