@@ -614,6 +614,25 @@ def test_ratio_option_reads_repeated_and_comma_separated_items():
     assert parse_ratio(["1.2857"]) == 1.2857 and parse_ratio([]) is None
 
 
+def test_the_commands_speed_line_is_operatings_rule_and_names_the_options():
+    """campbell and harmonic build their Operating with cli.options.speed_line: the spools not given by --ratio follow
+    the nominal ratio (Operating.lines); a spool the rotor gives no ratio for, an unknown spool or reference, is
+    refused naming the option."""
+    from rotorred.cli.options import speed_line
+
+    rig = load_rotor("seed-rig")
+    line = speed_line(rig, [0.0, 6000.0], None, None, "rpm")
+    assert line.speeds(rig)["outer"] == pytest.approx([0.0, 6000.0 * math.pi / 30 * 90 / 70], rel=1e-15)
+    assert speed_line(rig, [100.0], "outer", {"inner": 0.5}, "rad/s").at(rig) == {"inner": 50.0, "outer": 100.0}
+    with pytest.raises(InputError, match=r"^--ratio = None: must state the speed of spool\(s\) \['outer'\] .*the "
+                                         r"nominal speed of the reference spool 'inner' is 0"):
+        speed_line(rig.with_speeds({"inner": 0.0}), [0.0, 100.0], None, None, "rpm")
+    with pytest.raises(InputError, match=r"^--reference-spool = 'mid': must be one of 'inner', 'outer'$"):
+        speed_line(rig, [0.0], "mid", None, "rpm", ("--reference-spool", "--ratio"))
+    with pytest.raises(InputError, match=r"^--ratio = 'inner': must be one of 'outer'$"):
+        speed_line(rig, [0.0], None, {"inner": 2.0}, "rpm")
+
+
 def test_mass_proportional_damping_leaves_no_overdamped_pair_as_a_mode():
     """With the paper scenes' Rayleigh damping (alpha = 40 1/s) the inner shaft's lowest modes are
     overdamped; their real eigenvalue pairs split by round-off into complex pairs of tiny imaginary

@@ -18,7 +18,6 @@ every rotorred value rounds to the printed one).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
