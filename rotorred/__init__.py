@@ -5,7 +5,7 @@ The user-level functions and result types, importable from ``rotorred`` directly
     import rotorred as rr
 
     rotor = rr.load_rotor("seed-rig")
-    cd = rr.campbell(rotor, np.linspace(0, 1200, 61))       # rad/s of the reference spool
+    cd = rr.campbell(rotor, rr.Operating.line(np.linspace(0, 1200, 61)))   # rad/s of the reference spool
     model = rr.reduce_rotor(rotor, extra_nodes=[18], n_modes=24)
     res = rr.simulate(model, None, 0.5, 2e-5, rotor=rotor, unbalances=[rr.Unbalance(18, 2e-3)],
                       plates=[rr.RubPlate.for_rotor(rotor, 18)], outputs=[(18, "y")])
@@ -49,6 +49,7 @@ _EXPORTS = {
     "SystemMatrices": "rotorred.model.assembly",
     "Unbalance": "rotorred.model.loads",
     "SpeedProfile": "rotorred.model.speeds",
+    "Operating": "rotorred.model.operating",
     # linear analyses
     "campbell": "rotorred.linear.campbell",
     "CampbellResult": "rotorred.linear.campbell",

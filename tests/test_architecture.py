@@ -27,7 +27,9 @@ LAYERS = {
     "rotorred.scenes": 6,
     "rotorred.maps": 7,
     "rotorred.cli": 8,
-    "rotorred": 9,
+    # the public API (rotorred/__init__.py: the names of rotorred.__all__, loaded on first use), which the CLI, its
+    # first client, imports: above every layer it exports from, below the CLI
+    "rotorred": 7.5,
 }
 #: where matplotlib may be imported
 MATPLOTLIB_ALLOWED = ("rotorred.plots", "rotorred.cli")

@@ -19,6 +19,7 @@ from rotorred.model.assembly import assemble
 from rotorred.linear.campbell import CampbellResult, campbell, whirl_direction
 from rotorred.plots.axes import save
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
+from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.model.rotor_file import load_rotor
@@ -76,7 +77,7 @@ SPEEDS_RIGID = np.linspace(0.0, 500.0, 51)  # rad/s; grid step 10 rad/s, no grid
 
 
 def _rigid_errors(E: float) -> tuple[float, CampbellResult]:
-    result = campbell(rigid_rotor(E), SPEEDS_RIGID, n_modes=4)
+    result = campbell(rigid_rotor(E), Operating.line(SPEEDS_RIGID), n_modes=4)
     m, _, _ = rigid_body_properties()
     w_cyl = math.sqrt(2 * K_BRG / m)
     expected = np.array([[*conical_roots(W), w_cyl, w_cyl] for W in SPEEDS_RIGID])
@@ -126,7 +127,7 @@ def test_log_decrement_of_damped_rigid_rotor():
     # bearing damping c: cylindrical m x'' + 2c x' + 2k x = 0 (unaffected by spin);
     # conical at rest I_d th'' + 2 c a^2 th' + k_theta th = 0; log dec = 2 pi zeta / sqrt(1 - zeta^2)
     c = 150.0
-    result = campbell(rigid_rotor(2.1e14, c=c), np.array([0.0, 200.0, 400.0]), n_modes=4)
+    result = campbell(rigid_rotor(2.1e14, c=c), Operating.line([0.0, 200.0, 400.0]), n_modes=4)
     m, I_d, _ = rigid_body_properties()
     k_theta = 2 * K_BRG * A_HALF**2
     zeta_cyl = 2 * c / (2 * math.sqrt(2 * K_BRG * m))
@@ -158,7 +159,7 @@ def test_whirl_direction_convention():
 def test_orthotropic_modes_at_rest_are_planar_and_elliptic_when_spinning():
     # cross-coupled (symmetric) bearings: at rest the modes are straight lines in the bearings'
     # principal directions; spinning makes them elliptic
-    result = campbell(nelson.rotor("orthotropic"), np.array([0.0, 10000.0]) * math.pi / 30, n_modes=4)
+    result = campbell(nelson.rotor("orthotropic"), Operating.line([0.0, 10000.0], unit="rpm"), n_modes=4)
     assert list(result.whirl[0]) == ["planar"] * 4
     assert set(result.whirl[1]) <= {"forward", "backward", "mixed"}
     assert "forward" in result.whirl[1] and "backward" in result.whirl[1]
@@ -199,7 +200,7 @@ def _check_critical_speeds(result, rotor, spool, harmonic):
 
 def test_critical_speeds_match_hermitian_formulation():
     rotor = nelson.rotor("isotropic")
-    result = campbell(rotor, np.linspace(0, 40000, 41) * math.pi / 30, n_modes=6, harmonics=(1, 2))
+    result = campbell(rotor, Operating.line(np.linspace(0, 40000, 41), unit="rpm"), n_modes=6, harmonics=(1, 2))
     for h in (1.0, 2.0):
         _check_critical_speeds(result, rotor, "shaft", h)
 
@@ -231,12 +232,12 @@ def test_uncoupled_spools_each_equal_the_spool_alone(ratio):
     # without the inter-shaft bearing every tracked curve is a curve of the inner spool alone at Omega
     # or of the outer spool alone at ratio x Omega (ratio 0: outer at rest, its curves flat)
     rotor = two_spool_rotor(intershaft=False)
-    full = campbell(rotor, SPEEDS_2, ratio=ratio, n_modes=8)
-    inner = campbell(rotor.only_spool("inner"), SPEEDS_2, n_modes=8).frequencies
+    full = campbell(rotor, Operating.line(SPEEDS_2, ratios={"outer": ratio}), n_modes=8)
+    inner = campbell(rotor.only_spool("inner"), Operating.line(SPEEDS_2), n_modes=8).frequencies
     if ratio > 0:
-        outer = campbell(rotor.only_spool("outer"), ratio * SPEEDS_2, n_modes=8).frequencies
+        outer = campbell(rotor.only_spool("outer"), Operating.line(ratio * SPEEDS_2), n_modes=8).frequencies
     else:
-        outer = np.tile(campbell(rotor.only_spool("outer"), SPEEDS_2[:2], n_modes=8).frequencies[0],
+        outer = np.tile(campbell(rotor.only_spool("outer"), Operating.line(SPEEDS_2[:2]), n_modes=8).frequencies[0],
                         (len(SPEEDS_2), 1))
     # the same matrices solved as one block-diagonal problem: roundoff only (1e-9)
     assert _same_curves(full.frequencies, np.hstack([inner, outer]), rtol=1e-9)
@@ -245,7 +246,7 @@ def test_uncoupled_spools_each_equal_the_spool_alone(ratio):
     assert 2 <= len(of_outer) <= 6
     # ... and the outer spool's curves depend on the ratio: they are not those at the inner speed
     if ratio > 0:
-        at_inner_speed = campbell(rotor.only_spool("outer"), SPEEDS_2, n_modes=8).frequencies
+        at_inner_speed = campbell(rotor.only_spool("outer"), Operating.line(SPEEDS_2), n_modes=8).frequencies
         assert not _same_curves(full.frequencies[:, of_outer], at_inner_speed, 1e-6)
 
 
@@ -253,8 +254,8 @@ def test_ratio_one_uses_the_sum_of_the_gyroscopic_matrices():
     # every tracked curve is an eigenfrequency of M q'' + (C + Omega sum_s r_s G_s) q' + K q = 0
     rotor = two_spool_rotor()
     sm = assemble(rotor)
-    same = campbell(rotor, SPEEDS_2, ratio=1.0, n_modes=8)
-    other = campbell(rotor, SPEEDS_2, ratio=1.3, n_modes=8)
+    same = campbell(rotor, Operating.line(SPEEDS_2, ratios={"outer": 1.0}), n_modes=8)
+    other = campbell(rotor, Operating.line(SPEEDS_2, ratios={"outer": 1.3}), n_modes=8)
     for i, W in enumerate(SPEEDS_2):
         shared = eigen(sm.M, sm.C + W * (sm.G["inner"] + sm.G["outer"]), sm.K).frequencies
         own = eigen(sm.M, sm.C + W * sm.G["inner"] + 1.3 * W * sm.G["outer"], sm.K).frequencies
@@ -269,8 +270,8 @@ def test_ratio_one_uses_the_sum_of_the_gyroscopic_matrices():
 
 def test_reference_spool_choice_is_only_the_x_axis():
     rotor = two_spool_rotor()
-    by_inner = campbell(rotor, SPEEDS_2, ratio=1.3, n_modes=6)
-    by_outer = campbell(rotor, 1.3 * SPEEDS_2, ratio=1.3, reference="outer", n_modes=6)
+    by_inner = campbell(rotor, Operating.line(SPEEDS_2, ratios={"outer": 1.3}), n_modes=6)
+    by_outer = campbell(rotor, Operating.line(1.3 * SPEEDS_2, "outer", ratios={"inner": 1 / 1.3}), n_modes=6)
     assert by_outer.speed_ratios == pytest.approx({"inner": 1 / 1.3, "outer": 1.0})
     assert np.allclose(by_outer.frequencies, by_inner.frequencies, rtol=1e-10)
     # the same physical critical speeds, on the other spool's axis
@@ -278,13 +279,13 @@ def test_reference_spool_choice_is_only_the_x_axis():
     b = np.array([c.speed for c in by_outer.critical_speeds])
     assert len(a) == len(b) > 0 and np.allclose(1.3 * a, b, rtol=1e-8)
     # default ratio = nominal speeds 400/300
-    assert campbell(rotor, SPEEDS_2[:2], n_modes=2).speed_ratios["outer"] == pytest.approx(400 / 300)
+    assert campbell(rotor, Operating.line(SPEEDS_2[:2]), n_modes=2).speed_ratios["outer"] == pytest.approx(400 / 300)
 
 
 def test_two_spool_critical_speeds_match_hermitian_formulation():
     rotor = dataclasses.replace(two_spool_rotor(), intershaft_bearings=(
         IntershaftBearing(k_xx=1e7, k_yy=1e7, node_a=13, node_b=5),))  # undamped for the exact check
-    result = campbell(rotor, np.linspace(0.0, 3000.0, 31), ratio=1.3, n_modes=6)
+    result = campbell(rotor, Operating.line(np.linspace(0.0, 3000.0, 31), ratios={"outer": 1.3}), n_modes=6)
     for spool in ("inner", "outer"):
         _check_critical_speeds(result, rotor, spool, 1.0)
 
@@ -308,7 +309,7 @@ def test_seed_rig_operating_point_is_10_percent_from_every_critical_speed():
 
 # --- output ----------------------------------------------------------------------------------------
 def test_csv_and_png(tmp_path):
-    result = campbell(rigid_rotor(2.1e13), SPEEDS_RIGID[:6], n_modes=4)
+    result = campbell(rigid_rotor(2.1e13), Operating.line(SPEEDS_RIGID[:6]), n_modes=4)
     assert isinstance(result, CampbellResult)
     rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
     assert rows[0] == ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"]
@@ -347,39 +348,88 @@ def test_cli_bad_speeds(tmp_path, capsys, speeds, message):
 
 
 # --- bad input -------------------------------------------------------------------------------------
-@pytest.mark.parametrize("kwargs, message", [
-    (dict(speeds=[]), "speeds = []: must be a 1-D array of at least 1 value (rad/s)"),
-    (dict(speeds=[[0.0, 1.0]]), "speeds = [[0.0, 1.0]]: must be a 1-D array of at least 1 value (rad/s)"),
-    (dict(speeds=[0.0, 2.0, 1.0]),
-     "speeds = [0.0, 2.0, 1.0]: must be strictly increasing; entry 1 = 2 is followed by 1 (rad/s)"),
-    (dict(speeds=[-1.0, 2.0]), "speeds = [-1.0, 2.0]: must hold values >= 0 only (rad/s)"),
-    (dict(speeds=[0.0, math.nan]), "speeds = [0.0, nan]: must hold finite numbers only (rad/s)"),
-    (dict(speeds="fast"), "speeds = 'fast': must be an array of numbers (rad/s)"),
-    (dict(n_modes=0), "n_modes = 0: must be an integer >= 1"),
-    (dict(n_modes=2.5), "n_modes = 2.5: must be an integer >= 1"),
-    (dict(n_modes=10_000), "n_modes = 10000: must be <= 44, the number of DOFs"),
-    (dict(harmonics=()), "harmonics = (): must be a 1-D array of at least 1 value"),
-    (dict(harmonics=(1, -2)), "harmonics = (1, -2): must hold values > 0 only"),
-    (dict(reference="fan"), "reference = 'fan': must be one of 'inner', 'outer'"),
-    (dict(ratio=-1.0), "ratio = -1.0: must be >= 0"),
-    (dict(ratio=math.inf), "ratio = inf: must be a finite number >= 0"),
+LINE = Operating.line([0.0, 100.0])
+
+
+@pytest.mark.parametrize("operating, kwargs, message", [
+    (Operating.line([0.0, 2.0, 1.0]), {},
+     "operating.Omega = [0.0, 2.0, 1.0]: must be strictly increasing; entry 1 = 2 is followed by 1 (rad/s)"),
+    ([0.0, 100.0], {}, "operating = [0.0, 100.0]: must be an Operating (Operating.point, Operating.line, "
+                       "Operating.profile; rotorred.model.operating)"),
+    (Operating.ramp({"inner": 0.0}, {"inner": 100.0}, 1.0), {},
+     "operating = 'profile of 2 breakpoint(s) over 1 s, spools inner 0-100 rad/s': must be a point or a speed line "
+     "for speeds(); a profile gives speeds in time (profile_for)"),
+    (LINE, dict(n_modes=0), "n_modes = 0: must be an integer >= 1"),
+    (LINE, dict(n_modes=2.5), "n_modes = 2.5: must be an integer >= 1"),
+    (LINE, dict(n_modes=10_000), "n_modes = 10000: must be <= 44, the number of DOFs"),
+    (LINE, dict(harmonics=()), "harmonics = (): must be a 1-D array of at least 1 value"),
+    (LINE, dict(harmonics=(1, -2)), "harmonics = (1, -2): must hold values > 0 only"),
+    (Operating.line([0.0, 100.0], "fan"), {}, "reference = 'fan': must be one of 'inner', 'outer'"),
+    (Operating.line([0.0, 100.0], ratios={"fan": 1.0}), {}, "ratios spool = 'fan': must be one of 'outer'"),
 ])
-def test_bad_input(kwargs, message):
-    args = dict(speeds=[0.0, 100.0])
-    args.update(kwargs)
-    speeds = args.pop("speeds")
+def test_bad_input(operating, kwargs, message):
     with pytest.raises(InputError, match="^" + re.escape(message) + "$"):
-        campbell(two_spool_rotor(), speeds, **args)
+        campbell(two_spool_rotor(), operating, **kwargs)
 
 
-def test_bad_ratio_for_one_spool_and_zero_reference_speed():
-    with pytest.raises(InputError, match=r"^ratio = 1\.2: must be left unset: it applies to two-spool rotors only"):
-        campbell(rigid_rotor(2.1e13), [0.0, 1.0], ratio=1.2)
+def test_zero_reference_speed_needs_the_other_spools_stated():
+    """A reference spool of nominal speed 0 gives no ratio: the rule of Operating.lines names the spool to state;
+    stated, the diagram runs, from a reference at rest too."""
     still = two_spool_rotor().with_speeds({"inner": 0.0})
-    with pytest.raises(InputError, match=r"^reference = 'inner': must be a spool with a nominal speed > 0, or ratio "
-                                         r"must be given: spool 'inner' has nominal speed 0"):
-        campbell(still, [0.0, 1.0])
-    assert campbell(still, [0.0, 1.0], ratio=1.5, n_modes=2).speed_ratios["outer"] == 1.5
+    with pytest.raises(InputError, match=r"^operating = 'line of 2 speeds: first spool 0-1 rad/s': must state the "
+                                         r"speed of spool\(s\) \['outer'\] \(ratios= or fixed=\): the nominal speed "
+                                         r"of the reference spool 'inner' is 0"):
+        campbell(still, Operating.line([0.0, 1.0]))
+    assert campbell(still, Operating.line([0.0, 1.0], ratios={"outer": 1.5}), n_modes=2).speed_ratios["outer"] == 1.5
+
+
+# --- a spool held at a fixed speed: horizontal excitation lines --------------------------------------------------
+K_A = 0.5 * K_BRG  # spool a's bearings: its modes apart from spool b's
+
+
+def two_rigid_spools() -> Rotor:
+    """Two uncoupled copies of the rigid rotor: spool ``a`` on bearings K_A (nodes 0-4), ``b`` on K_BRG (10-14)."""
+    steel = Material("stiff steel", E=2.1e14, rho=7850.0, nu=0.3)
+    L = 2 * A_HALF / 4
+    spools = tuple(Spool(name, tuple(ShaftElement(first + i, first + i + 1, L, D_SHAFT, 0.0, steel) for i in range(4)),
+                         speed=100.0) for name, first in (("a", 0), ("b", 10)))
+    bearings = tuple(Bearing(k_xx=k, k_yy=k, node=n)
+                     for k, first in ((K_A, 0), (K_BRG, 10)) for n in (first, first + 4))
+    return Rotor(spools, disks=(Disk(2, M_DISK, ID_DISK, IP_DISK), Disk(12, M_DISK, ID_DISK, IP_DISK)),
+                 bearings=bearings, name="two rigid spools")
+
+
+def test_a_spool_at_a_fixed_speed_gives_critical_speeds_where_the_whirl_equals_h_times_its_speed():
+    """Spool b swept (0-500 rad/s), spool a held at W_a = 200 rad/s. Closed forms of the rigid rotor (conical
+    I_d w^2 -+ I_p Omega w - k_theta = 0, cylindrical m w^2 = 2 k):
+    - the horizontal line 1x a (w = W_a) meets b's backward conical curve where I_d W_a^2 + I_p Omega W_a = k_theta;
+    - the line 1x b (w = Omega) meets a's flat curves (its modes at W_a: conical roots with k_theta,a = 2 K_A a^2,
+      cylindrical sqrt(2 K_A / m)) at Omega = their frequency, and b's own curves as for one spool.
+    Eight critical speeds, each off by the residual shaft flexibility (measured 2.8e-6 on 1x b; 9.8e-6 on 1x a,
+    where the backward curve is shallow, so a frequency error moves the crossing more; 1e-4 and 3e-5 allowed, where
+    a line at the wrong offset is off by O(1)); on the horizontal line the whirl frequency is W_a (measured 1e-11,
+    1e-7 allowed), and a's curves are its modes at W_a at every speed (measured 2.4e-6)."""
+    m, I_d, I_p = rigid_body_properties()
+    W_a = 200.0
+    k_theta, k_theta_a = 2 * K_BRG * A_HALF ** 2, 2 * K_A * A_HALF ** 2
+    result = campbell(two_rigid_spools(), Operating.line(SPEEDS_RIGID, "b", fixed={"a": W_a}), n_modes=8)
+    assert result.reference == "b" and result.speed_ratios == {"a": 0.0, "b": 1.0} and result.fixed_speeds == {"a": W_a}
+    assert result.excitation_lines == (("a", 1.0, 0.0, W_a), ("b", 1.0, 1.0, 0.0))
+    on_a = [c for c in result.critical_speeds if c.spool == "a"]
+    assert len(on_a) == 1
+    assert on_a[0].speed == pytest.approx((k_theta - I_d * W_a ** 2) / (I_p * W_a), rel=1e-4)
+    assert on_a[0].whirl == "backward" and abs(on_a[0].frequency / W_a - 1) < 1e-7
+    assert on_a[0].spool_speed == pytest.approx(W_a, rel=1e-7)
+    a_backward, a_forward = (brentq(lambda w, s=s: I_d * w * w + s * I_p * W_a * w - k_theta_a, 0.0, 1e4)
+                             for s in (1, -1))
+    expected = sorted([a_backward, a_forward, math.sqrt(2 * K_A / m), math.sqrt(2 * K_A / m),
+                       math.sqrt(k_theta / (I_d + I_p)), math.sqrt(2 * K_BRG / m), math.sqrt(2 * K_BRG / m)])
+    on_b = [c.speed for c in result.critical_speeds if c.spool == "b"]
+    assert len(on_b) == len(expected)
+    np.testing.assert_allclose(on_b, expected, rtol=3e-5)
+    # a's curves are flat, its modes at W_a at every speed of the line
+    for w in (a_backward, a_forward, math.sqrt(2 * K_A / m)):
+        assert np.all(np.min(np.abs(result.frequencies / w - 1), axis=1) < 2e-5)
 
 
 def test_one_speed_is_a_row_of_the_diagram_and_its_damping_ratio_is_the_eigenvalues():
@@ -393,8 +443,8 @@ def test_one_speed_is_a_row_of_the_diagram_and_its_damping_ratio_is_the_eigenval
 
     rig = load_rotor("seed-rig")
     Omega = 3000 * math.pi / 30
-    one = campbell(rig, [Omega], n_modes=6)
-    grid = campbell(rig, np.linspace(0.0, Omega, 4), n_modes=6)
+    one = campbell(rig, Operating.point({"inner": Omega}), n_modes=6)
+    grid = campbell(rig, Operating.line(np.linspace(0.0, Omega, 4)), n_modes=6)
     assert one.critical_speeds == () and one.tracking_mac.shape == (0, 6)
     order = np.argsort(grid.frequencies[-1])  # tracked from rest: the columns may be ordered otherwise
     np.testing.assert_allclose(one.frequencies[0], grid.frequencies[-1][order], rtol=1e-13)
@@ -426,11 +476,11 @@ def test_critical_speeds_csv_and_a_shared_line_listed_once(tmp_path):
 
     rig = load_rotor("seed-rig")
     speeds = np.linspace(0.0, 12000.0, 61) * math.pi / 30
-    one = campbell(rig, speeds, ratio=1.0, n_modes=6)
+    one = campbell(rig, Operating.line(speeds, ratios={"outer": 1.0}), n_modes=6)
     g = one.frequencies - speeds[:, None]
     assert len(one.critical_speeds) == int(np.sum(g[:-1] * g[1:] < 0)) == 6
     assert all(c.line == "1× inner = 1× outer" for c in one.critical_speeds)
-    result = campbell(rig, speeds, n_modes=6)
+    result = campbell(rig, Operating.line(speeds), n_modes=6)
     op = rig.speeds["inner"]
     rows = list(csv.reader(result.critical_speeds_to_csv(tmp_path / "c.csv", op).open()))
     assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][-1] == "margin to operating point (%)"
@@ -451,13 +501,13 @@ def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():
     n, L, D = 20, 1.0, 0.05
     free = Rotor((Spool("shaft", tuple(ShaftElement(i, i + 1, L / n, D, 0.0, steel) for i in range(n)),
                         speed=100.0),), name="free-free")
-    result = campbell(free, np.linspace(0.0, 2000.0 * math.pi, 41), n_modes=8)  # to 60 000 rpm
+    result = campbell(free, Operating.line(np.linspace(0.0, 2000.0 * math.pi, 41)), n_modes=8)  # to 60 000 rpm
     assert result.rigid_modes and all(result.frequencies_hz[0, j] < 1e-2 for j in result.rigid_modes)
     assert result.critical_speeds and all(c.frequency_hz > 100.0 for c in result.critical_speeds)
     from rotorred.cli.campbell import format_critical_speeds
     assert "rigid-body modes (a free or singly supported spool; not critical speeds): modes 0, 1" in \
         format_critical_speeds(result)
-    assert campbell(rigid_rotor(2.1e11), SPEEDS_RIGID, n_modes=4).rigid_modes == ()  # held by bearings
+    assert campbell(rigid_rotor(2.1e11), Operating.line(SPEEDS_RIGID), n_modes=4).rigid_modes == ()  # held by bearings
     bl = brentq(lambda x: math.cos(x) * math.cosh(x) - 1.0, 4.0, 5.0)
     A, I = math.pi * D ** 2 / 4, math.pi * D ** 4 / 64
     f_eb = bl ** 2 / (2 * math.pi * L ** 2) * math.sqrt(steel.E * I / (steel.rho * A))
@@ -478,7 +528,7 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     c, kxy = 300.0, 3e5
     rotor = dataclasses.replace(rigid_rotor(2.1e13), bearings=tuple(
         Bearing(k_xx=K_BRG, k_yy=K_BRG, k_xy=kxy, k_yx=-kxy, c_xx=c, c_yy=c, node=n) for n in (0, 4)))
-    result = campbell(rotor, np.linspace(0.0, 1500.0, 31), n_modes=4)
+    result = campbell(rotor, Operating.line(np.linspace(0.0, 1500.0, 31)), n_modes=4)
     _, I_d, I_p = rigid_body_properties()
     kt, ct, kxt = (2 * A_HALF ** 2 * v for v in (K_BRG, c, kxy))
 
@@ -495,7 +545,7 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
     assert rows[1][:2] == ["0", "0"] and rows[1][-1] == "no"  # mode 0 at rest
     assert save(result.plot(), tmp_path / "c.png").stat().st_size > 10_000
-    stable = campbell(rigid_rotor(2.1e13), np.linspace(0.0, 1500.0, 31), n_modes=4)
+    stable = campbell(rigid_rotor(2.1e13), Operating.line(np.linspace(0.0, 1500.0, 31)), n_modes=4)
     assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off
 
 
@@ -512,19 +562,21 @@ def test_three_spools_take_ratios_by_name():
     """Ratios to the reference spool by name, for any number of spools: the same diagram as a rotor whose
     nominal speeds have those ratios (two paths, equal to the last bit); a spool without a ratio keeps its
     nominal one; where the rotor gives none, the message names every missing spool."""
+    from rotorred.cli.campbell import ratios_to_reference
+
     speeds = np.linspace(0.0, 800.0, 9)
-    by_name = campbell(_three_spools(), speeds, ratio={"b": 1.5, "c": 0.5}, n_modes=6)
-    by_nominal = campbell(_three_spools((100.0, 150.0, 50.0)), speeds, n_modes=6)
+    by_name = campbell(_three_spools(), Operating.line(speeds, ratios={"b": 1.5, "c": 0.5}), n_modes=6)
+    by_nominal = campbell(_three_spools((100.0, 150.0, 50.0)), Operating.line(speeds), n_modes=6)
     assert by_name.speed_ratios == {"a": 1.0, "b": 1.5, "c": 0.5}
     np.testing.assert_array_equal(by_name.frequencies, by_nominal.frequencies)
     assert [c.line for c in by_name.critical_speeds] == [c.line for c in by_nominal.critical_speeds]
-    assert campbell(_three_spools((100.0, 150.0, 50.0)), speeds, ratio={"c": 2.0}).speed_ratios == \
+    assert campbell(_three_spools((100.0, 150.0, 50.0)), Operating.line(speeds, ratios={"c": 2.0})).speed_ratios == \
         {"a": 1.0, "b": 1.5, "c": 2.0}
-    with pytest.raises(InputError, match=r"^ratio = \{'b': 1\.5\}: must give the ratio to 'a' of every other spool; "
-                                         r"missing \['c'\] \(--ratio c=R\): the nominal speed of 'a' is 0"):
-        campbell(_three_spools((0.0, 0.0, 0.0)), speeds, ratio={"b": 1.5})
-    with pytest.raises(InputError, match=r"^ratio = 1\.5: must name its spools"):
-        campbell(_three_spools(), speeds, ratio=1.5)
+    with pytest.raises(InputError, match=r"^operating = .*: must state the speed of spool\(s\) \['c'\] \(ratios= or "
+                                         r"fixed=\): the nominal speed of the reference spool 'a' is 0"):
+        campbell(_three_spools((0.0, 0.0, 0.0)), Operating.line(speeds, ratios={"b": 1.5}))
+    with pytest.raises(InputError, match=r"^--ratio = 1\.5: must be SPOOL=R for rotor 'three' with 3 spool\(s\)"):
+        ratios_to_reference(1.5, _three_spools(), None)
 
 
 def test_campbell_of_the_craig_bampton_model_converges_to_the_full_one(tmp_path, capsys):
@@ -538,16 +590,17 @@ def test_campbell_of_the_craig_bampton_model_converges_to_the_full_one(tmp_path,
 
     rig = load_rotor("seed-rig")
     speeds = np.linspace(0.0, 12000.0, 61) * math.pi / 30
-    full = campbell(rig, speeds, n_modes=8)
+    full = campbell(rig, Operating.line(speeds), n_modes=8)
     errors = []
     for n in (4, 8, 16):
-        reduced = campbell(rig, speeds, n_modes=8, model=reduce_rotor(rig, n_modes=n))
+        reduced = campbell(reduce_rotor(rig, n_modes=n), Operating.line(speeds), n_modes=8)
         errors.append(float(np.max(np.abs(reduced.frequencies / full.frequencies - 1))))
     assert errors[0] > errors[1] > errors[2] and errors[2] < 4.6e-3
     assert (reduced.whirl == full.whirl).all() and len(reduced.critical_speeds) == len(full.critical_speeds)
     assert max(abs(a.speed / b.speed - 1) for a, b in zip(reduced.critical_speeds, full.critical_speeds)) < 1.2e-3
-    with pytest.raises(InputError, match=r"^model = 'a ReducedSystem': must be reduced from rotor 'rigid'"):
-        campbell(rigid_rotor(2.1e11), SPEEDS_RIGID, model=reduce_rotor(rig, n_modes=8))
+    # the rotor and its assembled model are one model (system_of): the same diagram, to the last bit
+    np.testing.assert_array_equal(campbell(assemble(rig), Operating.line(speeds), n_modes=8).frequencies,
+                                  full.frequencies)
     assert main(["campbell", "seed-rig", "--speeds", "0:12000:61", "--reduce", "16", "--out", str(tmp_path)]) == 0
     assert "reduced model against the full one: whirl frequencies within" in capsys.readouterr().out
 
@@ -559,6 +612,25 @@ def test_ratio_option_reads_repeated_and_comma_separated_items():
 
     assert parse_ratio(["b=1.5", "c=0.5"]) == parse_ratio(["b=1.5,c=0.5"]) == {"b": 1.5, "c": 0.5}
     assert parse_ratio(["1.2857"]) == 1.2857 and parse_ratio([]) is None
+
+
+def test_the_commands_speed_line_is_operatings_rule_and_names_the_options():
+    """campbell and harmonic build their Operating with cli.options.speed_line: the spools not given by --ratio follow
+    the nominal ratio (Operating.lines); a spool the rotor gives no ratio for, an unknown spool or reference, is
+    refused naming the option."""
+    from rotorred.cli.options import speed_line
+
+    rig = load_rotor("seed-rig")
+    line = speed_line(rig, [0.0, 6000.0], None, None, "rpm")
+    assert line.speeds(rig)["outer"] == pytest.approx([0.0, 6000.0 * math.pi / 30 * 90 / 70], rel=1e-15)
+    assert speed_line(rig, [100.0], "outer", {"inner": 0.5}, "rad/s").at(rig) == {"inner": 50.0, "outer": 100.0}
+    with pytest.raises(InputError, match=r"^--ratio = None: must state the speed of spool\(s\) \['outer'\] .*the "
+                                         r"nominal speed of the reference spool 'inner' is 0"):
+        speed_line(rig.with_speeds({"inner": 0.0}), [0.0, 100.0], None, None, "rpm")
+    with pytest.raises(InputError, match=r"^--reference-spool = 'mid': must be one of 'inner', 'outer'$"):
+        speed_line(rig, [0.0], "mid", None, "rpm", ("--reference-spool", "--ratio"))
+    with pytest.raises(InputError, match=r"^--ratio = 'inner': must be one of 'outer'$"):
+        speed_line(rig, [0.0], None, {"inner": 2.0}, "rpm")
 
 
 def test_mass_proportional_damping_leaves_no_overdamped_pair_as_a_mode():
@@ -575,7 +647,8 @@ def test_mass_proportional_damping_leaves_no_overdamped_pair_as_a_mode():
     rig = load_rotor("seed-rig")
     damped = dataclasses.replace(rig, rayleigh=(40.0, 2e-5))
     speeds = np.linspace(0.0, 2 * np.pi * 84.0, 41)
-    found = [campbell(r, speeds, ratio={"outer": 90 / 70}, reference="inner").critical_speeds for r in (rig, damped)]
+    line = Operating.line(speeds, "inner", ratios={"outer": 90 / 70})
+    found = [campbell(r, line).critical_speeds for r in (rig, damped)]
     assert len(found[0]) == len(found[1]) == 8
     for a, b in zip(sorted(found[0], key=lambda c: c.speed), sorted(found[1], key=lambda c: c.speed)):
         assert (a.spool, a.whirl) == (b.spool, b.whirl)
@@ -626,7 +699,7 @@ def test_speed_dependent_bearings_critical_speeds_against_an_independent_root_fi
     The tables matter: with the coefficients at rest the lowest crossing is at half the speed."""
     rotor, rt = tabulated
     speeds = np.linspace(0.0, 25000 * math.pi / 30, 101)
-    res = campbell(rt, speeds, n_modes=6)
+    res = campbell(rt, Operating.line(speeds), n_modes=6)
     assert len(res.critical_speeds) == 2
     for c in res.critical_speeds:
         def g(Omega):
@@ -636,7 +709,7 @@ def test_speed_dependent_bearings_critical_speeds_against_an_independent_root_fi
             return f[np.argmin(abs(f - c.frequency))] - Omega
         ref = brentq(g, 0.9 * c.speed, 1.1 * c.speed, xtol=1e-12, rtol=1e-14)
         assert c.speed == pytest.approx(ref, rel=2e-9)
-    at_rest = campbell(_with_bearings_at(rotor, rt, 0.0), speeds, n_modes=6).critical_speeds
+    at_rest = campbell(_with_bearings_at(rotor, rt, 0.0), Operating.line(speeds), n_modes=6).critical_speeds
     assert min(c.speed for c in res.critical_speeds) > 1.4 * min(c.speed for c in at_rest)  # 9331 against 4646 rpm
 
 
@@ -648,9 +721,9 @@ def test_speed_dependent_bearings_in_a_reduced_model(tabulated):
 
     _, rt = tabulated
     speeds = np.linspace(0.0, 25000 * math.pi / 30, 101)
-    full = campbell(rt, speeds, n_modes=6).critical_speeds
+    full = campbell(rt, Operating.line(speeds), n_modes=6).critical_speeds
     for n_modes, tol in ((4, 5e-3), (8, 5e-5)):
-        red = campbell(rt, speeds, n_modes=6, model=reduce_rotor(rt, n_modes=n_modes)).critical_speeds
+        red = campbell(reduce_rotor(rt, n_modes=n_modes), Operating.line(speeds), n_modes=6).critical_speeds
         assert len(red) == len(full)
         assert max(abs(a.speed / b.speed - 1) for a, b in zip(red, full)) < tol
 
@@ -677,7 +750,7 @@ def test_cli_campbell_of_a_rotor_file_with_bearing_tables(tmp_path, capsys):
                 "range, where the end values are held") in out
     rows = [line.split() for line in out.splitlines() if re.match(r"\s+\d+\.\d\s+1× shaft", line)]
     assert [float(r[0]) for r in rows] == pytest.approx([9330.8, 10992.8], abs=0.06)  # printed to 0.1 rpm
-    within = campbell(load_rotor(path), np.linspace(0.0, 20000 * math.pi / 30, 41), n_modes=6)
+    within = campbell(load_rotor(path), Operating.line(np.linspace(0.0, 20000, 41), unit="rpm"), n_modes=6)
     assert within.beyond_tables == ()
 
 
@@ -717,49 +790,53 @@ def test_default_lists_the_critical_speeds_of_thirty_modes(tmp_path, capsys, arg
 
 def _coverage_cases():
     rig = load_rotor("seed-rig")
-    rpm = math.pi / 30
-    return [(rig, np.linspace(0.0, 12000 * rpm, 61), {}),
-            (rig, np.linspace(0.0, 12000 * rpm, 61), dict(ratio=1.0)),
-            (rig, np.linspace(3000 * rpm, 9000 * rpm, 25), dict(harmonics=(1, 2), reference="outer")),
-            (load_rotor("nelson-mcvaugh"), np.linspace(0.0, 40000 * rpm, 41), dict(harmonics=(0.5, 1)))]
+    rpm = np.linspace(0.0, 12000.0, 61)
+    return [(rig, Operating.line(rpm, unit="rpm"), (1,)),
+            (rig, Operating.line(rpm, ratios={"outer": 1.0}, unit="rpm"), (1,)),
+            (rig, Operating.line(np.linspace(3000.0, 9000.0, 25), "outer", unit="rpm"), (1, 2)),
+            (load_rotor("nelson-mcvaugh"), Operating.line(np.linspace(0.0, 40000.0, 41), unit="rpm"), (0.5, 1)),
+            # a spool held fixed above the swept one's top speed gives the highest excitation frequency
+            (rig, Operating.line(np.linspace(0.0, 3000.0, 16), "outer", fixed={"inner": 9000.0}, unit="rpm"), (1,))]
 
 
-@pytest.mark.parametrize("case", range(4))
+@pytest.mark.parametrize("case", range(5))
 def test_default_tracks_every_mode_below_the_highest_excitation_frequency(case):
     """The rule, against an independent full eigen-solve (modal.eigen, every mode) at each grid speed: every whirl
-    frequency below the highest excitation frequency h_max x max_s(r_s) x top speed is one of the tracked
+    frequency below the highest excitation frequency h_max x max_s(Omega_s) at the top speed is one of the tracked
     frequencies there (to 1e-9); the count is the most modes below 1.25 x that frequency at the first and last
     speed (at least 6), or more where that count left one out (the rig at ratio 1: its 254 Hz backward mode drops
     below the 206 Hz forward one, so 8 counted modes miss the critical speed at 9588 rpm that the default finds)."""
-    from rotorred.linear.campbell import DEFAULT_MARGIN, MIN_DEFAULT_MODES, default_mode_count, speed_ratios
+    from rotorred.linear.campbell import DEFAULT_MARGIN, MIN_DEFAULT_MODES, default_mode_count
     from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO
 
-    rotor, speeds, kw = _coverage_cases()[case]
-    result = campbell(rotor, speeds, **kw)
-    ratios = speed_ratios(rotor, kw.get("ratio"), kw.get("reference"))
-    limit = max(kw.get("harmonics", (1,))) * max(ratios.values()) * speeds[-1]
+    rotor, operating, harmonics = _coverage_cases()[case]
+    result = campbell(rotor, operating, harmonics=harmonics)
+    spool_speeds = operating.speeds(rotor)
+    limit = max(harmonics) * max(w[-1] for w in spool_speeds.values())
     mc = result.mode_count
     assert mc.limit == pytest.approx(limit, rel=1e-14) and mc.margin == DEFAULT_MARGIN
     sm = assemble(rotor)
     below_ends = []
-    for i, W in enumerate(speeds):
-        D = sm.damping({s: r * W for s, r in ratios.items()})
-        K = sm.stiffness({s: r * W for s, r in ratios.items()})
-        f = eigen(sm.M, D, K, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
+    for i in range(operating.n_points):
+        at = {s: w[i] for s, w in spool_speeds.items()}
+        f = eigen(sm.M, sm.damping(at), sm.stiffness(at), max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
         for w in f[f < limit]:
             assert np.min(np.abs(result.frequencies[i] / w - 1)) < 1e-9, (i, w)
-        if i in (0, len(speeds) - 1):
+        if i in (0, operating.n_points - 1):
             below_ends.append(int(np.sum(f < DEFAULT_MARGIN * limit)))
     counted = max(MIN_DEFAULT_MODES, *below_ends)
     assert mc.below == tuple(below_ends)
-    assert default_mode_count(rotor, speeds, **kw) == dataclasses.replace(mc, n_modes=counted, grown_at=None)
+    assert default_mode_count(rotor, operating, harmonics=harmonics) == \
+        dataclasses.replace(mc, n_modes=counted, grown_at=None)
     if mc.grown_at is None:
         assert result.n_modes == counted
     else:
         assert result.n_modes > counted
-        fewer = campbell(rotor, speeds, n_modes=counted, **kw)
+        fewer = campbell(rotor, operating, n_modes=counted, harmonics=harmonics)
         assert {c.speed for c in fewer.critical_speeds} < {c.speed for c in result.critical_speeds}
-    assert (mc.grown_at is not None) == (kw == dict(ratio=1.0))
+    assert (mc.grown_at is not None) == (case == 1)
+    if case == 4:  # the fixed inner spool's line, horizontal at 9000 rpm, is above the outer's up to 3000 rpm
+        assert mc.spool == "inner" and mc.limit == pytest.approx(9000 * math.pi / 30, rel=1e-14)
 
 
 def test_modes_option_overrides_the_default(tmp_path, capsys):
@@ -768,9 +845,9 @@ def test_modes_option_overrides_the_default(tmp_path, capsys):
 
     rig = load_rotor("seed-rig")
     speeds = np.linspace(0.0, 12000 * math.pi / 30, 13)
-    default = campbell(rig, speeds)
+    default = campbell(rig, Operating.line(speeds))
     for n in (3, default.n_modes + 2):
-        given = campbell(rig, speeds, n_modes=n)
+        given = campbell(rig, Operating.line(speeds), n_modes=n)
         assert given.n_modes == n and given.mode_count is None
     assert main(["campbell", "seed-rig", "--speeds", "0:12000:13", "--modes", "3", "--out", str(tmp_path)]) == 0
     assert "tracked 3 modes (--modes)" in capsys.readouterr().out
@@ -785,10 +862,10 @@ def test_default_mode_count_at_rest_and_bad_margin():
     from rotorred.linear.campbell import default_mode_count
 
     rig = load_rotor("seed-rig")
-    rest = campbell(rig, [0.0])
+    rest = campbell(rig, Operating.point({"inner": 0.0}))
     assert rest.n_modes == 6 and rest.mode_count.limit == 0.0 and rest.mode_count.below == (0,)
     assert format_mode_count(rest).startswith("tracked 6 modes: the default's minimum (6), as no spool turns at 0 rpm")
     with pytest.raises(InputError, match=r"^margin = 0\.5: must be >= 1$"):
-        default_mode_count(rig, [0.0, 100.0], margin=0.5)
-    wide = default_mode_count(rig, [0.0, 600.0], margin=2.0)
-    assert wide.n_modes > default_mode_count(rig, [0.0, 600.0]).n_modes
+        default_mode_count(rig, Operating.line([0.0, 100.0]), margin=0.5)
+    wide = default_mode_count(rig, Operating.line([0.0, 600.0]), margin=2.0)
+    assert wide.n_modes > default_mode_count(rig, Operating.line([0.0, 600.0])).n_modes

@@ -18,13 +18,13 @@ every rotorred value rounds to the printed one).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rotorred.linear.campbell import campbell
+from rotorred.model.operating import Operating
 from rotorred.model.rotor_file import rotor_from_toml
 
 FRISWELL = Path(__file__).resolve().parents[1] / "validation" / "reference" / "friswell"
@@ -42,7 +42,7 @@ def example(name: str, bearings: str | None = None):
 
 def whirl(rotor, rpm: float, n: int = 6):
     """The ``n`` lowest whirl frequencies (rad/s) and undamped natural frequencies |lambda| (rad/s) at ``rpm``."""
-    result = campbell(rotor, [rpm * math.pi / 30.0], n_modes=n)
+    result = campbell(rotor, Operating.line([rpm], unit="rpm"), n_modes=n)
     wd = result.frequencies[0]
     return wd, wd / np.sqrt(1.0 - result.damping_ratio[0] ** 2)
 

@@ -19,10 +19,13 @@ from rotorred.model.dofs import parse_dof
 from rotorred.plots.axes import save
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
+from rotorred.model.operating import Operating
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.linear.reduction import default_boundary_nodes, reduce, reduce_rotor
 
 STEEL = Material("steel", 2.1e11, 7850.0, 0.3)
+#: the two-spool rotors of this file at rest
+AT_REST = Operating.point({"inner": 0.0, "outer": 0.0})
 
 
 def jeffcott_closed_form(rho, zeta):
@@ -41,7 +44,7 @@ def test_jeffcott_point_mass_matches_closed_form():
                             G={"shaft": np.zeros((4, 4))}, dofs=DofMap((7,)))
     w_n = math.sqrt(k / m)
     speeds = w_n * np.linspace(0.05, 3.0, 60)
-    res = unbalance_response(system, [Unbalance(7, m * e, 0.4)], speeds, outputs=[(7, "x"), (7, "y")])
+    res = unbalance_response(system, Operating.line(speeds), [Unbalance(7, m * e, 0.4)], [(7, "x"), (7, "y")])
     amp, lag = jeffcott_closed_form(speeds / w_n, zeta)
     Qx, Qy = res.phasors["shaft"][(7, "x")], res.phasors["shaft"][(7, "y")]
     # one 4x4 complex solve per speed: round-off only
@@ -69,7 +72,7 @@ def test_jeffcott_finite_element_rotor_matches_closed_form():
     w_n = math.sqrt(k / m)
     speeds = w_n * np.linspace(0.1, 2.5, 49)
     e = 1e-5
-    res = unbalance_response(system, [Unbalance(2, m * e)], speeds, outputs=[(2, "x")])
+    res = unbalance_response(system, Operating.line(speeds), [Unbalance(2, m * e)], [(2, "x")])
     amp, _ = jeffcott_closed_form(speeds / w_n, zeta)
     # By symmetry the midspan disk does not tilt, so its gyroscopic and rotary terms do not couple in;
     # Hermite elements are exact for the static condensation of a massless EB shaft. What is left is
@@ -103,8 +106,7 @@ def test_two_spool_response_is_the_settled_state_of_a_long_transient():
     unbalances = [Unbalance(2, 1e-4, 0.3), Unbalance(11, 2e-4, 1.1)]
     outputs = [(2, "x"), (2, "y"), (11, "x"), (3, "y")]
     ratio = speeds["outer"] / speeds["inner"]
-    res = unbalance_response(system, unbalances, [speeds["inner"]], {"inner": 1.0, "outer": ratio}, outputs,
-                             rotor.spool_of)
+    res = unbalance_response(system, Operating.line([speeds["inner"]], ratios={"outer": ratio}), unbalances, outputs)
     # first-order form with the force written straight from the loads.py convention, in time
     M_inv = np.linalg.inv(system.M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-M_inv @ system.K, -M_inv @ system.damping(speeds)]])
@@ -150,7 +152,7 @@ def test_steady_state_satisfies_the_equation_of_motion():
     for model, rotor_, unbalances in ((system, rotor, [Unbalance(2, 1e-4, 0.3), Unbalance(11, 2e-4, 1.1)]),
                                       (red, rig, [Unbalance(11, 1e-5), Unbalance(16, 1e-5, 2.0)])):
         speeds = rotor_.speeds
-        st = steady_state(model, unbalances, speeds, rotor_.spool_of)
+        st = steady_state(model, Operating.point(speeds), unbalances)
         D = model.damping(speeds)
         for t in (0.0, 0.0123, 0.5):
             acc = sum(np.real(-(speeds[s] ** 2) * Q * np.exp(1j * speeds[s] * t)) for s, Q in st.phasors.items())
@@ -167,8 +169,8 @@ def test_steady_state_satisfies_the_equation_of_motion():
         # and it agrees with the sweep function at the same point
         out = (13, "x") if model is red else (2, "y")
         ref_speed = speeds["inner"]
-        res = unbalance_response(model, unbalances, [ref_speed], {"outer": speeds["outer"] / ref_speed}, [out],
-                                 rotor_.spool_of)
+        res = unbalance_response(model, Operating.line([ref_speed], ratios={"outer": speeds["outer"] / ref_speed}),
+                                 unbalances, [out])
         for s in st.phasors:
             assert (model.output_rows([out]) @ st.phasors[s])[0] == pytest.approx(res.phasors[s][out][0], rel=1e-12)
 
@@ -177,7 +179,7 @@ def test_spools_at_the_same_speed_add_as_phasors():
     rotor = transient_two_spool()
     system = assemble(rotor)
     unbalances = [Unbalance(2, 1e-4, 0.0), Unbalance(11, 1e-4, math.pi)]
-    res = unbalance_response(system, unbalances, [300.0, 500.0], {"outer": 1.0}, [(2, "x")], rotor.spool_of)
+    res = unbalance_response(system, Operating.line([300.0, 500.0], ratios={"outer": 1.0}), unbalances, [(2, "x")])
     total = res.phasors["inner"][(2, "x")] + res.phasors["outer"][(2, "x")]
     np.testing.assert_allclose(res.peak((2, "x")), np.abs(total), rtol=1e-14)
     assert np.all(res.peak((2, "x")) < res.amplitude((2, "x"), "inner") + res.amplitude((2, "x"), "outer"))
@@ -190,15 +192,15 @@ def test_frf_reciprocity_and_consistency_with_unbalance_response():
     system = assemble(rotor)
     w = np.linspace(10.0, 3000.0, 25)
     a, b = (2, "x"), (11, "y")
-    frf = frequency_response(system, [a, b], [a, b], w)
+    frf = frequency_response(system, AT_REST, [a, b], [a, b], w)
     # not spinning: M, K, C symmetric, so H is symmetric (Maxwell-Betti reciprocity)
     np.testing.assert_allclose(frf.h(a, b), frf.h(b, a), rtol=1e-10)
     # spinning: the unbalance response is the FRF times the unbalance force phasors
     W = 400.0
     speeds = {"inner": W, "outer": W * 1.3}
-    frf = frequency_response(system, [(2, "x"), (2, "y")], [(3, "y")], [W], speeds=speeds)
+    frf = frequency_response(system, Operating.point(speeds), [(2, "x"), (2, "y")], [(3, "y")], [W])
     u = Unbalance(2, 3e-5, 0.7)
-    res = unbalance_response(system, [u], [W], {"outer": 1.3}, [(3, "y")], rotor.spool_of)
+    res = unbalance_response(system, Operating.line([W], ratios={"outer": 1.3}), [u], [(3, "y")])
     F = u.m_e * W**2 * np.exp(1j * u.phase) * np.array([1.0, -1j])
     expected = frf.H[0, 0] @ F
     assert res.phasors["inner"][(3, "y")][0] == pytest.approx(expected, rel=1e-10)
@@ -213,8 +215,8 @@ def test_reduced_model_with_every_mode_gives_the_full_response():
     boundary = default_boundary_nodes(rig, (18,))
     red = reduce(system, boundary, n_modes=system.n_dof - 4 * len(boundary))
     sweep = np.linspace(0.0, 600.0, 31)
-    args = ([Unbalance(11, 1e-5), Unbalance(16, 1e-5, 1.0)], sweep, {"outer": 9 / 7},
-            [(13, "x"), (14, "y"), (11, "x"), (3, "y")], rig.spool_of)  # 11 and 3 are interior nodes
+    args = (Operating.line(sweep, ratios={"outer": 9 / 7}), [Unbalance(11, 1e-5), Unbalance(16, 1e-5, 1.0)],
+            [(13, "x"), (14, "y"), (11, "x"), (3, "y")])  # 11 and 3 are interior nodes
     full, got = unbalance_response(system, *args), unbalance_response(red, *args)
     # same linear system in other coordinates: round-off of an 80-DOF complex solve (measured 4.8e-11)
     assert response_error(full, got) < 1e-9
@@ -226,8 +228,8 @@ def test_csv_and_plots(tmp_path):
     rotor = transient_two_spool()
     system = assemble(rotor)
     sweep = np.linspace(0.0, 500.0, 21)
-    res = unbalance_response(system, [Unbalance(2, 1e-4), Unbalance(11, 1e-4)], sweep, {"outer": 1.2},
-                             [(2, "x"), (11, "y")], rotor.spool_of)
+    res = unbalance_response(system, Operating.line(sweep, ratios={"outer": 1.2}),
+                             [Unbalance(2, 1e-4), Unbalance(11, 1e-4)], [(2, "x"), (11, "y")])
     path = res.write_csv(tmp_path / "r.csv")
     with path.open() as fh:
         rows = list(csv.reader(fh))
@@ -240,7 +242,7 @@ def test_csv_and_plots(tmp_path):
     np.testing.assert_allclose(data[:, col], 1e6 * res.amplitude((11, "y"), "outer"), rtol=1e-9)
     col = header.index("node 2 x peak bound (um)")
     np.testing.assert_allclose(data[:, col], 1e6 * res.peak((2, "x")), rtol=1e-9)
-    frf = frequency_response(system, [(2, "x")], [(2, "x"), (11, "x")], np.linspace(0, 2000, 50))
+    frf = frequency_response(system, AT_REST, [(2, "x")], [(2, "x"), (11, "x")], np.linspace(0, 2000, 50))
     for p in (save(res.plot(kind="bode"), tmp_path / "b.png"), save(res.plot(kind="polar"), tmp_path / "p.png"),
               save(frf.plot(), tmp_path / "f.png"), frf.write_csv(tmp_path / "f.csv")):
         assert p.stat().st_size > 1000
@@ -290,7 +292,7 @@ def test_cli_harmonic_takes_a_scene(tmp_path, capsys):
                                "numbers (rpm)"),
     (["--reduced", "--modes", "-2"], "--modes = -2: must be an integer >= 0"),
     (["--reduced", "--cutoff", "50"], "below the frequency band"),
-    (["--ratio", "fan=2"], "unknown spool"),
+    (["--ratio", "fan=2"], "--ratio = 'fan': must be one of 'outer'"),
 ])
 def test_cli_bad_input(tmp_path, capsys, argv, message):
     assert main(["harmonic", "seed-rig", "--speeds", "0:6300:11", "--out", str(tmp_path)] + argv) == 2
@@ -298,37 +300,44 @@ def test_cli_bad_input(tmp_path, capsys, argv, message):
 
 
 def test_bad_input_is_named():
+    import dataclasses
+
     rotor = transient_two_spool()
     system = assemble(rotor)
     ub = [Unbalance(2, 1e-5)]
-    ok = dict(ratios={"outer": 1.2}, outputs=[(2, "x")], spool_of=rotor.spool_of)
+    line = Operating.line([100.0], ratios={"outer": 1.2})
     nodes = r"\(1-3, 10-11\)"
     with pytest.raises(InputError, match=rf"^unbalances\[0\]\.node = 99: must be a node of the model {nodes}$"):
-        unbalance_response(system, [Unbalance(99, 1e-5)], [100.0], **ok)
+        unbalance_response(system, line, [Unbalance(99, 1e-5)], [(2, "x")])
     with pytest.raises(InputError, match=rf"^outputs\[0\] = \(42, 'x'\): must name a node of the model {nodes}; "
                                          r"node 42 is not one$"):
-        unbalance_response(system, ub, [100.0], **{**ok, "outputs": [(42, "x")]})
-    with pytest.raises(InputError, match=r"^speeds = \[-1\.0, 100\.0\]: must hold values >= 0 only \(rad/s\)$"):
-        unbalance_response(system, ub, [-1.0, 100.0], **ok)
-    with pytest.raises(InputError, match=r"^ratios = None: must give the speed ratio \(to 'inner'\) of spool\(s\) "
-                                         r"\['outer'\]$"):
-        unbalance_response(system, ub, [100.0], **{**ok, "ratios": None})
-    with pytest.raises(InputError, match=r"^spool_of = None: must be given \(node -> spool, e\.g\. Rotor\.spool_of\) "
-                                         r"for a model with 2 spools$"):
-        unbalance_response(system, ub, [100.0], **{**ok, "spool_of": None})
-    with pytest.raises(InputError, match=r"^ratios = \{'outer': 1\.2, 'fan': 2\.0\}: must name only spools of the "
-                                         r"model \(inner, outer\); unknown spool\(s\) \['fan'\]$"):
-        unbalance_response(system, ub, [100.0], **{**ok, "ratios": {"outer": 1.2, "fan": 2.0}})
-    with pytest.raises(InputError, match=r"^ratios\['inner'\] = 2\.0: must be 1 \(it is the reference spool\)$"):
-        unbalance_response(system, ub, [100.0], **{**ok, "ratios": {"inner": 2.0, "outer": 1.2}})
+        unbalance_response(system, line, ub, [(42, "x")])
+    with pytest.raises(InputError, match=r"^operating = \[100\.0\]: must be an Operating \(Operating\.point, "):
+        unbalance_response(system, [100.0], ub, [(2, "x")])
+    # the ratio rule is Operating's: a reference at nominal speed 0 gives no ratio; every spool must be the model's
+    with pytest.raises(InputError, match=r"^operating = 'point: first spool at 100 rad/s': must state the "
+                                         r"speed of spool\(s\) \['outer'\]"):
+        unbalance_response(assemble(rotor.with_speeds({"inner": 0.0})), Operating.line([100.0]), ub, [(2, "x")])
+    with pytest.raises(InputError, match=r"^ratios spool = 'fan': must be one of 'outer'$"):
+        unbalance_response(system, Operating.line([100.0], ratios={"outer": 1.2, "fan": 2.0}), ub, [(2, "x")])
+    with pytest.raises(InputError, match=r"^ratios spool = 'inner': must be one of 'outer'$"):
+        unbalance_response(system, Operating.line([100.0], ratios={"inner": 2.0}), ub, [(2, "x")])
+    # the spool of each node comes from the model: one built by hand with two spools has none
+    with pytest.raises(InputError, match=r"^model = 'SystemMatrices': must know the spool of each node \(built from "
+                                         r"a Rotor: assemble, reduce_rotor\) to place unbalances on a model of 2 "
+                                         r"spools$"):
+        unbalance_response(dataclasses.replace(system, rotor=None), AT_REST, ub, [(2, "x")])
     with pytest.raises(InputError, match=r"^unbalances = \[\]: must hold at least one Unbalance$"):
-        unbalance_response(system, [], [100.0], **ok)
+        unbalance_response(system, line, [], [(2, "x")])
     with pytest.raises(InputError, match=r"^inputs\[0\] = \(2, 'z'\): direction must be one of 'x', 'y', "):
-        frequency_response(system, [(2, "z")], [(2, "x")], [10.0])
+        frequency_response(system, AT_REST, [(2, "z")], [(2, "x")], [10.0])
     with pytest.raises(InputError, match=r"^--outputs = '13x': must be NODE:DIRECTION \(e\.g\. '13:x'\)"):
         parse_dof("--outputs", "13x")
     red = reduce_rotor(rotor, n_modes=0)  # every node of this small rotor is a boundary node
     with pytest.raises(InputError, match=rf"^unbalances\[0\]\.node = 99: must be a node of the model {nodes}$"):
-        unbalance_response(red, [Unbalance(99, 1e-5)], [100.0], **ok)
-    with pytest.raises(InputError, match=r"^speeds\.inner: missing; required$"):
-        steady_state(system, ub, {"outer": 1.0}, rotor.spool_of)
+        unbalance_response(red, line, [Unbalance(99, 1e-5)], [(2, "x")])
+    # steady state and FRF run at one point, not along a line
+    for analysis, args in ((steady_state, (ub,)), (frequency_response, ([(2, "x")], [(2, "x")], [10.0]))):
+        with pytest.raises(InputError, match=r"^operating = 'line of 2 speeds: first spool 0-100 rad/s': must be one "
+                                             r"operating point \(Operating\.point\), not a line$"):
+            analysis(system, Operating.line([0.0, 100.0]), *args)

@@ -302,6 +302,7 @@ def test_nelson_mcvaugh_from_its_station_table():
     from pathlib import Path
 
     from rotorred.linear.campbell import campbell
+    from rotorred.model.operating import Operating
 
     ref = json.loads((Path(__file__).resolve().parents[1] / "validation/reference/nelson_mcvaugh_rotor.json").read_text())
     preset = load_rotor("nelson-mcvaugh")
@@ -316,8 +317,8 @@ def test_nelson_mcvaugh_from_its_station_table():
         f"\n  {{ z = {z[-1]!r} }},\n]\n" + tail
     from_stations = rotor_from_toml(stations)
     speeds = np.linspace(0.0, 5000.0, 6)
-    a = campbell(from_stations, speeds, n_modes=6).frequencies
-    b = campbell(preset, speeds, n_modes=6).frequencies
+    a = campbell(from_stations, Operating.line(speeds), n_modes=6).frequencies
+    b = campbell(preset, Operating.line(speeds), n_modes=6).frequencies
     assert np.max(np.abs(a / b - 1)) < 2.5e-10
 
 

@@ -155,6 +155,7 @@ def test_settles_onto_harmonic_response():
     """No contact: the transient from rest settles onto the steady unbalance response of
     rotorred.linear.harmonic (both spools, each at its own speed and phase) to 1e-4 relative."""
     from rotorred.linear.harmonic import unbalance_response
+    from rotorred.model.operating import Operating
     from rotorred.model.rotor_file import load_rotor
 
     rig = load_rotor("seed-rig")
@@ -167,8 +168,7 @@ def test_settles_onto_harmonic_response():
     outputs = [(18, "x"), (18, "y"), (13, "x"), (14, "y")]
     res = simulate(system, speeds, 0.9, 1e-5, unbalances=unb, rotor=rig, outputs=outputs, record_start=0.8)
     ratio = speeds["outer"] / speeds["inner"]
-    harm = unbalance_response(system, unb, [speeds["inner"]], ratios={"outer": ratio}, outputs=outputs,
-                              spool_of=rig.spool_of, reference_spool="inner")
+    harm = unbalance_response(system, Operating.line([speeds["inner"]], "inner", ratios={"outer": ratio}), unb, outputs)
     for o in outputs:
         ref = harm.time_history(o, res.t)[0]
         err = np.max(np.abs(res.outputs[o] - ref)) / np.max(np.abs(ref))

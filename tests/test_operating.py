@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -9,8 +10,9 @@ import pytest
 
 import rotorred as rr
 from rotorred.checks import InputError
-from rotorred.model.assembly import system_of
+from rotorred.model.assembly import SystemMatrices, system_of
 from rotorred.model.elements import Bearing, Disk, Material, ShaftElement
+from rotorred.model.loads import Unbalance
 from rotorred.model.operating import Operating, from_rad_s, to_rad_s
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.model.speeds import SpeedProfile
@@ -91,3 +93,68 @@ def test_point_line_profile_and_their_errors():
 def test_repr_is_one_short_line():
     text = repr(Operating.line(np.linspace(0, 12000, 61), "inner", ratios={"outer": 1.3}, unit="rpm"))
     assert text == "Operating(line of 61 speeds: inner 0-12000 rpm; outer at ratio 1.3)"
+
+
+# --- every analysis reads its spool speeds from the Operating by the one rule ----------------------------------------
+@dataclasses.dataclass(frozen=True)
+class _Recording(SystemMatrices):
+    """An assembled model that records the spool speeds (rad/s) its speed-dependent matrices are asked for."""
+
+    calls: list = dataclasses.field(default_factory=list, compare=False, repr=False)
+
+    @classmethod
+    def of(cls, rotor: Rotor) -> _Recording:
+        sm = system_of(rotor)
+        return cls(**{f.name: getattr(sm, f.name) for f in dataclasses.fields(SystemMatrices)})
+
+    def damping(self, speeds):
+        self.calls.append(dict(speeds))
+        return super().damping(speeds)
+
+    def stiffness(self, speeds):
+        self.calls.append(dict(speeds))
+        return super().stiffness(speeds)
+
+    def taken(self) -> list[dict]:
+        """The speeds of the calls since the last ``taken``, each rounded to 1e-9 rad/s (a float key)."""
+        out, self.calls[:] = [{s: round(w, 9) for s, w in c.items()} for c in self.calls], []
+        return out
+
+
+def _linear_analyses(model, operating):
+    """Each analysis of rotorred.linear run on ``model`` at ``operating`` (a point runs at every point analysis)."""
+    unbalances = [Unbalance(2, 1e-4), Unbalance(12, 1e-4, 1.0), Unbalance(22, 1e-4, 2.0)]
+    out = {"campbell": lambda: rr.campbell(model, operating, n_modes=4),
+           "unbalance_response": lambda: rr.unbalance_response(model, operating, unbalances, [(2, "x"), (12, "y")])}
+    if operating.kind == "point":
+        out["steady_state"] = lambda: rr.steady_state(model, operating, unbalances)
+        out["frequency_response"] = lambda: rr.frequency_response(model, operating, [(2, "x")], [(22, "y")],
+                                                                  [10.0, 200.0])
+    return out
+
+
+@pytest.mark.parametrize("operating, reference, line, grid", [
+    # points with the reference at rest: a spool held at a fixed speed turns, one at the nominal ratio stands
+    (Operating.line([0.0], "a", fixed={"b": 300.0}), "a", lambda W: {"a": W, "b": 300.0, "c": 0.5 * W}, [0.0]),
+    (Operating.point({"c": 0.0, "a": 40.0}), "c", lambda W: {"a": 40.0, "b": 3.0 * W, "c": W}, [0.0]),
+    # a line from a reference at rest: a stated ratio, a fixed speed
+    (Operating.line([0.0, 40.0, 80.0], "b", ratios={"a": 2.0}, fixed={"c": 30.0}), "b",
+     lambda W: {"a": 2.0 * W, "b": W, "c": 30.0}, [0.0, 40.0, 80.0]),
+])
+def test_every_linear_analysis_computes_at_the_operatings_spool_speeds(operating, reference, line, grid):
+    """Campbell, unbalance response, steady state and FRF, given the same Operating, ask the three-spool model (nominal
+    speeds 100, 150, 50 rad/s) for its matrices at the spool speeds written out here by hand (Eq. O1, docs/model.md
+    §17: ``line``, at the reference speeds ``grid``): each at every point of the operating condition and at no other
+    speed; the Campbell diagram's root refinement between grid speeds stays on the line."""
+    model = _Recording.of(three_spools())
+    expected = {tuple(line(W).items()) for W in grid}
+    for name, run in _linear_analyses(model, operating).items():
+        result = run()
+        calls = {tuple(c.items()) for c in model.taken()}
+        assert result.operating is operating, name
+        if name == "campbell":
+            assert expected <= calls, name
+            for c in map(dict, calls):
+                assert c == pytest.approx(line(c[reference]), rel=1e-12, abs=1e-9), (name, c)
+        else:
+            assert calls == expected, name

@@ -12,6 +12,7 @@ import scipy.linalg as sla
 
 from rotorred.checks import InputError
 from rotorred.linear.campbell import campbell
+from rotorred.model.operating import Operating
 from rotorred.linear.reduction import reduce_rotor
 from rotorred.model.assembly import assemble
 from rotorred.model.elements import Bearing, Disk, Pedestal
@@ -75,13 +76,13 @@ def test_pedestal_dofs_campbell_and_craig_bampton(nelson):
     with pytest.raises(InputError, match=r"^node = 100: must be a shaft node to have theta_x; node 100 is a pedestal"):
         sm.dofs.index(100, "tx")
     speeds = np.linspace(0.0, 5000.0, 26)
-    full = campbell(rotor, speeds, n_modes=6)
+    full = campbell(rotor, Operating.line(speeds), n_modes=6)
     assert full.rigid_modes == () and len(full.critical_speeds) == 6
     errors = []
     for n_modes in (4, 8, 12):
         red = reduce_rotor(rotor, n_modes=n_modes)
         assert red.boundary_nodes == (10, 14, 100, 101)
-        crit = campbell(rotor, speeds, n_modes=6, model=red).critical_speeds
+        crit = campbell(red, Operating.line(speeds), n_modes=6).critical_speeds
         errors.append(max(abs(a.speed / b.speed - 1) for a, b in zip(crit, full.critical_speeds)))
     assert errors[0] > errors[1] > errors[2] and errors[2] < 3.1e-4
 

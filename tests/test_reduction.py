@@ -16,6 +16,7 @@ from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, 
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
+from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.linear.reduction import (ResponseCheck, default_boundary_nodes, reduce, reduce_rotor, whirl_error,
@@ -147,14 +148,14 @@ def test_rig_auto_basis_meets_whirl_target_with_at_most_12_modes(rig, rig_system
 
 
 def test_rig_unbalance_response_at_13_and_14_within_half_percent(rig, rig_system):
-    ratios = {"inner": 1.0, "outer": rig.speeds["outer"] / rig.speeds["inner"]}
-    sweep = np.linspace(0.0, 1.5 * rig.speeds["inner"], 151)
+    sweep = Operating.line(np.linspace(0.0, 1.5 * rig.speeds["inner"], 151), "inner",
+                           ratios={"outer": rig.speeds["outer"] / rig.speeds["inner"]})
     unbalances = (Unbalance(11, 1e-5), Unbalance(16, 1e-5, 0.5))
     outputs = ((13, "x"), (13, "y"), (14, "x"), (14, "y"))
-    check = ResponseCheck(unbalances, sweep, outputs, ratios, rig.spool_of, target=5e-3)
+    check = ResponseCheck(unbalances, sweep, outputs, target=5e-3)
     red = reduce_rotor(rig, RIG_EXTRA, response=check, system=rig_system)
-    full = unbalance_response(rig_system, unbalances, sweep, ratios, outputs, rig.spool_of)
-    got = unbalance_response(red, unbalances, sweep, ratios, outputs, rig.spool_of)
+    full = unbalance_response(rig_system, sweep, unbalances, outputs)
+    got = unbalance_response(red, sweep, unbalances, outputs)
     err = response_error(full, got)
     assert err <= 5e-3  # the 0.5 % target, recomputed outside the selection loop
     assert red.selection.response_error == pytest.approx(err, rel=1e-9)
@@ -165,7 +166,7 @@ def test_rig_unbalance_response_at_13_and_14_within_half_percent(rig, rig_system
     # With the unbalanced disks 11 and 16 on the boundary too, the loads act on physical DOFs and 10
     # modes meet both targets (measured: whirl 0.004 %, response 0.14 %; 42 DOFs against 38 above)
     loaded = reduce_rotor(rig, RIG_EXTRA + (11, 16), n_modes=10, system=rig_system)
-    assert response_error(full, unbalance_response(loaded, unbalances, sweep, ratios, outputs, rig.spool_of)) < 5e-3
+    assert response_error(full, unbalance_response(loaded, sweep, unbalances, outputs)) < 5e-3
     speeds = [_scaled(rig.speeds, f) for f in np.linspace(0.0, 1.5, 7)]
     assert whirl_error([whirl_frequencies(rig_system, s) for s in speeds], loaded, speeds, n_check=8) < 1e-3
 

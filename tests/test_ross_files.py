@@ -20,6 +20,7 @@ from scipy.optimize import linear_sum_assignment
 
 from rotorred.cli import main
 from rotorred.linear.campbell import campbell
+from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.assembly import assemble
 from rotorred.model.rotor_file import RotorFileError, load_rotor, rotor_from_toml
@@ -74,7 +75,7 @@ def test_campbell_at_one_speed_lists_the_compressors_heavily_damped_modes_as_ros
     frequency (measured 1.2e-11)."""
     block = REFERENCE["compressor_example"]["modal"][1]
     assert block["speed_rpm"] == pytest.approx(6000.0)
-    result = campbell(load_rotor(ROSS3 / "compressor_example.toml"), [block["speed_rad_s"]], n_modes=16)
+    result = campbell(load_rotor(ROSS3 / "compressor_example.toml"), Operating.line([block["speed_rad_s"]]), n_modes=16)
     reference = np.sort(np.array(block["lateral_wd"]))[:16]
     assert np.max(np.abs(result.frequencies[0] / reference - 1)) < 1.2e-10
     assert result.damping_ratio[0, :2] == pytest.approx([0.857, 0.846], abs=1e-3)
@@ -105,7 +106,7 @@ def test_critical_speeds_of_rotor_example_equal_rosss():
     (measured 7.3e-7 on the highest, ROSS's convergence; the issue asks for 0.5 %)."""
     reference = REFERENCE["rotor_example"]["critical_speeds"]
     lateral = [(w, d.lower()) for w, d in zip(reference["wn"], reference["whirl_direction"]) if w < 1000 and d != "None"]
-    found = campbell(load_rotor(ROSS3 / "rotor_example.toml"), np.linspace(0.0, 1000.0, 101), n_modes=8)
+    found = campbell(load_rotor(ROSS3 / "rotor_example.toml"), Operating.line(np.linspace(0.0, 1000.0, 101)), n_modes=8)
     assert [c.whirl for c in found.critical_speeds] == [d for _, d in lateral]
     for c, (w, _) in zip(found.critical_speeds, lateral):
         assert c.speed == pytest.approx(w, rel=7e-6)
@@ -122,7 +123,7 @@ def test_critical_speeds_and_damping_of_a_lightly_damped_ross_rotor_equal_rosss(
     lateral = [(s, d.lower(), ld) for s, d, ld, kind in zip(reference["wd"], reference["whirl_direction"],
                                                            reference["log_dec"], reference["energy_type"])
                if s < 1000 and kind == "Lateral"]
-    found = campbell(load_rotor(EXTRA / "damped_rotor.toml"), np.linspace(0.0, 1000.0, 101), n_modes=8)
+    found = campbell(load_rotor(EXTRA / "damped_rotor.toml"), Operating.line(np.linspace(0.0, 1000.0, 101)), n_modes=8)
     assert [c.whirl for c in found.critical_speeds] == [d for _, d, _ in lateral]
     for c, (s, _, log_dec) in zip(found.critical_speeds, lateral):
         assert c.speed == pytest.approx(s, rel=2.4e-5)
@@ -167,7 +168,7 @@ k = 1e6
     solid = rotor_from_toml(text.replace("WIDE", "0.08").replace("SLEEVES", ""))
     assert len(layered.spools[0].sleeves) == 2 and layered.mass == pytest.approx(solid.mass, rel=1e-14)
     for a, b, tol in ((layered, solid, 8e-12), (layered.refined(3), solid.refined(3), 5e-10)):
-        fa, fb = (campbell(r, [0.0, 800.0], n_modes=8).frequencies for r in (a, b))
+        fa, fb = (campbell(r, Operating.line([0.0, 800.0]), n_modes=8).frequencies for r in (a, b))
         assert np.max(np.abs(fa / fb - 1)) < tol
 
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from rotorred.linear.harmonic import unbalance_response
+from rotorred.model.operating import Operating
 from rotorred.scenes.outputs import write_outputs
 from rotorred.scenes.run import build_model, harmonic_outputs, run_scene, settled_state
 from rotorred.scenes.schema import scene_from_dict
@@ -62,8 +63,8 @@ def test_spectrum_reads_the_phasor_amplitudes_exactly(linear):
     """
     sc, res = linear
     model = build_model(sc).model
-    ref = unbalance_response(model, sc.unbalances, [sc.speeds["inner"]], ratios={"outer": 90.0 / 70.0},
-                             outputs=sc.output.dofs, spool_of=sc.rotor.spool_of, reference_spool="inner")
+    ref = unbalance_response(model, Operating.line([sc.speeds["inner"]], "inner", ratios={"outer": 90.0 / 70.0}),
+                             sc.unbalances, sc.output.dofs)
     for d in sc.output.dofs:
         spec = res.spectra[d]
         for spool, f in (("inner", 70.0), ("outer", 90.0)):

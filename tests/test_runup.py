@@ -14,6 +14,7 @@ from scipy.special import fresnel
 
 from rotorred.checks import InputError
 from rotorred.linear.harmonic import unbalance_response
+from rotorred.model.operating import Operating
 from rotorred.model.assembly import DofMap, SystemMatrices
 from rotorred.model.elements import Disk
 from rotorred.model.loads import Unbalance
@@ -267,7 +268,7 @@ def test_slow_ramp_is_the_steady_unbalance_response():
     blocks = angle_blocks(res.t, [res.outputs[(1, "x")], res.outputs[(1, "y")]], profile.at(res.t)["shaft"][2],
                           revs_per_block=16)
     track = order_tracks(blocks, "shaft", [1.0])[0][0]
-    steady = unbalance_response(model, speeds=blocks.speed, outputs=[(1, "x")], **loads)
+    steady = unbalance_response(model, Operating.line(blocks.speed), loads["unbalances"], [(1, "x")])
     W, a, Q = blocks.speed, track.amplitude, np.abs(steady.phasors["shaft"][(1, "x")])
     keep = W > 220.0  # the start from rest has rung out
     W, a, Q = W[keep], a[keep], Q[keep]

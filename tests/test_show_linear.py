@@ -13,6 +13,7 @@ from rotorred.linear.campbell import WHIRL_LABELS, campbell
 from rotorred.linear.harmonic import frequency_response, steady_state, unbalance_response
 from rotorred.model.assembly import assemble
 from rotorred.model.loads import Unbalance
+from rotorred.model.operating import Operating
 from rotorred.model.rotor_file import load_rotor
 from rotorred.transient.energy import energy_balance
 from rotorred.transient.newmark import simulate
@@ -31,27 +32,28 @@ def rig():
 
 @pytest.fixture(scope="module")
 def diagram(rig):
-    return campbell(rig[0], np.linspace(0.0, 1200.0, 9))
+    return campbell(rig[0], Operating.line(np.linspace(0.0, 1200.0, 9)))
 
 
 @pytest.fixture(scope="module")
 def response(rig):
     rotor, model, unbalances = rig
     ratio = rotor.speeds["outer"] / rotor.speeds["inner"]
-    return unbalance_response(model, unbalances, np.linspace(0.0, 900.0, 31), {"outer": ratio}, OUTPUTS,
-                              rotor.spool_of)
+    return unbalance_response(model, Operating.line(np.linspace(0.0, 900.0, 31), ratios={"outer": ratio}),
+                              unbalances, OUTPUTS)
 
 
 @pytest.fixture(scope="module")
 def frf(rig):
     rotor, model, _ = rig
-    return frequency_response(model, [(18, "x")], OUTPUTS, 2 * np.pi * np.linspace(0.0, 300.0, 41), rotor.speeds)
+    return frequency_response(model, Operating.point(rotor.speeds), [(18, "x")], OUTPUTS,
+                              2 * np.pi * np.linspace(0.0, 300.0, 41))
 
 
 @pytest.fixture(scope="module")
 def state(rig):
     rotor, model, unbalances = rig
-    return steady_state(model, unbalances, rotor.speeds, rotor.spool_of)
+    return steady_state(model, Operating.point(rotor.speeds), unbalances)
 
 
 @pytest.fixture(scope="module")
@@ -74,10 +76,10 @@ def test_campbell_result_shows_itself(diagram, tmp_path):
 def test_a_whirl_table_and_a_diagram_without_critical_speeds_show_themselves(rig, tmp_path):
     """One speed (the whirl table of `rotorred campbell --speeds 3000`): its points, the lines from rest; a sweep
     below every crossing: no critical speed, an empty `critical` dimension in the dataset."""
-    table = campbell(rig[0], [300.0])
+    table = campbell(rig[0], Operating.line([300.0]))
     assert_shows_itself(table, tmp_path)
     assert "at 2864.79 rpm of the inner spool" in repr(table)
-    below = campbell(rig[0], [0.0, 20.0, 40.0])
+    below = campbell(rig[0], Operating.line([0.0, 20.0, 40.0]))
     assert below.critical_speeds == ()
     assert_shows_itself(below, tmp_path)
     assert below.to_xarray().sizes["critical"] == 0
@@ -135,7 +137,7 @@ def test_reprs_are_short_for_many_outputs(rig):
     """A sweep of 16 outputs still has a short repr (the outputs beyond the first few counted)."""
     rotor, model, unbalances = rig
     outputs = [(n, d) for n in (2, 5, 8, 11, 13, 14, 16, 18) for d in "xy"]
-    many = unbalance_response(model, unbalances, [0.0, 400.0], {"outer": 1.2}, outputs, rotor.spool_of)
+    many = unbalance_response(model, Operating.line([0.0, 400.0], ratios={"outer": 1.2}), unbalances, outputs)
     assert "... 8 more outputs" in assert_short_repr(many)
 
 

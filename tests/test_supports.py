@@ -14,6 +14,7 @@ from scipy.optimize import brentq
 from rotorred.checks import InputError
 from rotorred.linear.campbell import campbell
 from rotorred.linear.harmonic import steady_state
+from rotorred.model.operating import Operating
 from rotorred.linear.reduction import reduce_rotor
 from rotorred.model.assembly import assemble
 from rotorred.model.elements import Bearing, Disk, Material, ShaftElement, Support
@@ -90,7 +91,7 @@ def test_campbell_of_a_spinning_shaft_between_pinned_ends():
     modes: below 1e-10 of the bearings' w^2, campbell.rigid_body_motions' threshold.)"""
     n = 8
     disk = (Disk(node=4, m=5.0, I_d=0.02, I_p=0.04),)
-    speeds = np.linspace(0.0, 1500.0, 31)
+    speeds = Operating.line(np.linspace(0.0, 1500.0, 31))
     pinned = campbell(beam(n, (Support(0, "pinned"), Support(n, "pinned")), rotary=True, disks=disk), speeds, n_modes=4)
     assert pinned.rigid_modes == () and len(pinned.critical_speeds) == 2
     gaps = []
@@ -125,7 +126,7 @@ def test_supports_in_craig_bampton_harmonic_and_transient():
               for k in (6, 10, 14)]
     assert errors[0] > errors[1] > errors[2] and errors[2] < 6e-5
     unb = [Unbalance(4, 1e-4, 0.0)]
-    X = steady_state(full, unb, Omega, rotor.spool_of).phasors["s"]
+    X = steady_state(full, Operating.point(Omega), unb).phasors["s"]
     res = simulate(full, Omega, 0.5, 2e-5, rotor=rotor, unbalances=unb, outputs=[(4, "x")], q0=X.real, v0=-300.0 * X.imag)
     row = full.output_rows([(4, "x")])[0]
     reference = (row @ X * np.exp(1j * 300.0 * res.t)).real

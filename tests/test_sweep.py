@@ -8,6 +8,7 @@ import pytest
 
 import rotorred.maps.execute as execute
 from rotorred.linear.harmonic import unbalance_response
+from rotorred.model.operating import Operating
 from rotorred.maps.run import run_map
 from rotorred.maps.spec import Axis, MapSpec
 from rotorred.scenes.reach import free_reach
@@ -29,8 +30,8 @@ def test_free_reach_against_the_harmonic_module():
     sc = load_scene("paper-rub", SHORT)
     model = build_model(sc)
     reach = free_reach(sc, model)
-    ref = unbalance_response(model.model, sc.unbalances, [sc.speeds["inner"]], ratios={"outer": 90.0 / 70.0},
-                             outputs=[(18, "y")], spool_of=sc.rotor.spool_of, reference_spool="inner")
+    ref = unbalance_response(model.model, Operating.line([sc.speeds["inner"]], "inner", ratios={"outer": 90.0 / 70.0}),
+                             sc.unbalances, [(18, "y")])
     t = np.arange(0.0, 0.1, sc.solver.dt / 10)
     y = sum(np.real(ref.phasors[s][(18, "y")][0] * np.exp(1j * sc.speeds[s] * t)) for s in ref.phasors)
     bound = sum(abs(ref.phasors[s][(18, "y")][0]) * sc.speeds[s] ** 2 for s in ref.phasors) * sc.solver.dt ** 2 / 8

@@ -54,6 +54,7 @@ import numpy as np  # noqa: E402
 
 from rotorred.model.assembly import assemble  # noqa: E402
 from rotorred.linear.campbell import campbell  # noqa: E402
+from rotorred.model.operating import Operating  # noqa: E402
 from rotorred.model.rotor_file import load_rotor  # noqa: E402
 from rotorred.model.loads import Unbalance  # noqa: E402
 from rotorred.transient.newmark import simulate  # noqa: E402
@@ -133,10 +134,10 @@ class CampbellComparison:
 def compare_campbell(rs, rotor, rpm=CAMPBELL_RPM, repeats: int = 3) -> CampbellComparison:
     """First six whirl speeds of ``rotor`` at ``rpm`` in rotorred and ROSS."""
     Omega = np.asarray(rpm, float) * math.pi / 30
-    campbell(rotor, Omega[:2], n_modes=N_MODES + 2)                     # warm-up
+    campbell(rotor, Operating.line(Omega[:2]), n_modes=N_MODES + 2)     # warm-up
     with contextlib.redirect_stdout(io.StringIO()):
         ross_rotor(rs, rotor).run_campbell(Omega[:2], frequencies=N_MODES + 2)  # warm-up (ROSS's numba code)
-    t_ours, s_ours, res = _median_time(lambda: campbell(rotor, Omega, n_modes=N_MODES + 2), repeats)
+    t_ours, s_ours, res = _median_time(lambda: campbell(rotor, Operating.line(Omega), n_modes=N_MODES + 2), repeats)
     # ROSS caches run_modal per rotor and speed (lru_cache): a new rotor object for every repeat
     t_ross, s_ross, camp = _median_time(lambda rr: rr.run_campbell(Omega, frequencies=N_MODES + 2), repeats,
                                         setup=lambda: ross_rotor(rs, rotor))

@@ -35,6 +35,7 @@ import scipy.linalg as sla
 
 from rotorred.model.assembly import assemble
 from rotorred.linear.campbell import CampbellResult, campbell
+from rotorred.model.operating import Operating
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.rotor import Rotor
 
@@ -47,8 +48,12 @@ N_MODES = 10  # enough to hold every curve that meets a 1x line below 12000 rpm 
 
 def rig_campbell(n_modes: int = N_MODES) -> CampbellResult:
     """Campbell diagram of the seed rig at Omega_H/Omega_L = 90/70 over inner 0-12000 rpm (61 speeds)."""
-    return campbell(load_rotor("seed-rig"), SPEEDS_RPM * math.pi / 30, ratio=RATIO, reference="inner",
-                    n_modes=n_modes, harmonics=(1,))
+    return campbell(load_rotor("seed-rig"), operating(), n_modes=n_modes, harmonics=(1,))
+
+
+def operating() -> Operating:
+    """The speed line of the rig's diagram: inner 0-12000 rpm (61 speeds), outer at RATIO."""
+    return Operating.line(SPEEDS_RPM, "inner", ratios={"outer": RATIO}, unit="rpm")
 
 
 def margins(result: CampbellResult, operating_rpm: float = OPERATING_RPM) -> list[tuple[object, float]]:
@@ -102,8 +107,7 @@ def completeness(result: CampbellResult) -> tuple[int, float]:
         Largest |Omega_c,damped - Omega_c,undamped| / Omega_c,undamped (-).
     """
     bare_rotor = undamped(load_rotor("seed-rig"))
-    bare = campbell(bare_rotor, result.speeds, ratio=RATIO, reference=result.reference, n_modes=result.n_modes,
-                    harmonics=(1,))
+    bare = campbell(bare_rotor, result.operating, n_modes=result.n_modes, harmonics=(1,))
     missing = 0
     for spool in bare.speed_ratios:
         found = np.array([c.speed for c in bare.critical_speeds if c.spool == spool])
@@ -121,13 +125,13 @@ def completeness(result: CampbellResult) -> tuple[int, float]:
 def timing(repeats: int = 3) -> tuple[float, float, int]:
     """(first call (s), best of ``repeats`` (s), number of speeds) of the 61-speed rig Campbell after import."""
     rotor = load_rotor("seed-rig")
-    speeds = SPEEDS_RPM * math.pi / 30
+    line = operating()
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        campbell(rotor, speeds, ratio=RATIO, n_modes=N_MODES)
+        campbell(rotor, line, n_modes=N_MODES)
         times.append(time.perf_counter() - t0)
-    return times[0], min(times), len(speeds)
+    return times[0], min(times), line.n_points
 
 
 def eigen_time(repeats: int = 10) -> float:

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred.linear.campbell import campbell
+from rotorred.model.operating import Operating
 from rotorred.model.elements import Bearing
 from rotorred.model.rotor_file import load_rotor
 
@@ -60,7 +61,7 @@ def reference(case: str = "isotropic") -> tuple[np.ndarray, np.ndarray]:
 def whirl_speeds(case: str = "isotropic") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(speeds (rpm), ours (rpm), reference (rpm)); whirl speeds shape (n_speeds, 6), sorted per speed."""
     rpm, ref = reference(case)
-    result = campbell(rotor(case), rpm * math.pi / 30, n_modes=N_MODES + 2)
+    result = campbell(rotor(case), Operating.line(rpm, unit="rpm"), n_modes=N_MODES + 2)
     ours = np.sort(result.frequencies, axis=1)[:, :N_MODES] * 30 / math.pi
     return rpm, ours, ref
 
@@ -92,8 +93,8 @@ def main(argv=None) -> int:
         print(_table(case))
         print()
     if args.plot:
-        result = campbell(rotor("isotropic"), np.linspace(0, 40000, 81) * math.pi / 30, n_modes=N_MODES,
-                          harmonics=(1, 2))
+        result = campbell(rotor("isotropic"), Operating.line(np.linspace(0, 40000, 81), unit="rpm"),
+                          n_modes=N_MODES, harmonics=(1, 2))
         from rotorred.plots.axes import save
 
         print(f"wrote {save(result.plot(), args.plot)}")

@@ -38,6 +38,7 @@ from rotorred.model.assembly import assemble
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
+from rotorred.model.operating import Operating
 from rotorred.linear.reduction import ResponseCheck, default_boundary_nodes, reduce, whirl_error, whirl_frequencies
 
 MODE_COUNTS = (0, 2, 4, 6, 8, 10, 12, 16, 20, 24)
@@ -91,11 +92,11 @@ def nelson_case() -> Case:
                 ((13, "x"), (13, "y"), (14, "x"), (14, "y")))
 
 
-def _sweep(case: Case):
-    spools = [s.name for s in case.rotor.spools]
-    ref = spools[0]
-    ratios = {s: case.operating[s] / case.operating[ref] for s in spools}
-    return ref, ratios, np.linspace(0.0, 1.5 * case.operating[ref], N_SWEEP)
+def _sweep(case: Case) -> Operating:
+    """The response sweep: the first spool 0 to 1.5x its speed at ``case.operating``, the others at its ratios."""
+    ref = case.rotor.spools[0].name
+    ratios = {s: w / case.operating[ref] for s, w in case.operating.items() if s != ref}
+    return Operating.line(np.linspace(0.0, 1.5 * case.operating[ref], N_SWEEP), ref, ratios=ratios)
 
 
 def run_case(case: Case, mode_counts=MODE_COUNTS) -> list[Row]:
@@ -107,8 +108,8 @@ def run_case(case: Case, mode_counts=MODE_COUNTS) -> list[Row]:
     t0 = time.perf_counter()
     reference = [whirl_frequencies(system, s) for s in speeds]
     t_eig_full = time.perf_counter() - t0
-    ref, ratios, sweep = _sweep(case)
-    args = (case.unbalances, sweep, ratios, case.outputs, case.rotor.spool_of)
+    sweep = _sweep(case)
+    args = (sweep, case.unbalances, case.outputs)
     t0 = time.perf_counter()
     full = unbalance_response(system, *args)
     t_resp_full = time.perf_counter() - t0
@@ -134,7 +135,7 @@ def run_case(case: Case, mode_counts=MODE_COUNTS) -> list[Row]:
             rows.append(row(str(n), n_modes=n))
     sel_speeds = [{s: f * w for s, w in case.operating.items()} for f in (0.0, 0.5, 1.0, 1.5)]
     rows.append(row("auto", check_speeds=sel_speeds, target=WHIRL_TARGET))
-    check = ResponseCheck(case.unbalances, sweep, case.outputs, ratios, case.rotor.spool_of, target=RESPONSE_TARGET)
+    check = ResponseCheck(case.unbalances, sweep, case.outputs, target=RESPONSE_TARGET)
     r = row("auto", check_speeds=sel_speeds, target=WHIRL_TARGET, response=check)
     rows.append(Row(r.label, r.modes + " (+resp)", r.size, r.whirl_error, r.response_error, r.t_reduce,
                     r.t_eigen, r.t_response))

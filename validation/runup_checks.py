@@ -33,6 +33,7 @@ from scipy.signal import find_peaks
 
 from rotorred.linear.campbell import campbell
 from rotorred.linear.harmonic import unbalance_response
+from rotorred.model.operating import Operating
 from rotorred.model.speeds import SpeedProfile
 from rotorred.scenes.run import build_model
 from rotorred.scenes.runup import block_revolutions, run_runup
@@ -58,7 +59,7 @@ def slow_ramp(T: float) -> None:
     print(f"1. slow ramp: inner 30 -> 84 Hz in {T:g} s (lambda = Omega'/omega^2 = {0.9 * 2 * math.pi * 54 / T / (2 * math.pi * 55.7) ** 2:.1e} "
           f"at the inner 55.7 Hz critical), {res.n_steps} steps of {dt:g} s in {time.perf_counter() - t0:.1f} s "
           f"({res.us_per_step:.2f} us/step)")
-    cd = campbell(scene.rotor, np.linspace(0, 2 * math.pi * 84, 61), ratio={"outer": ratio}, reference="inner")
+    cd = campbell(scene.rotor, Operating.line(np.linspace(0, 2 * math.pi * 84, 61), "inner", ratios={"outer": ratio}))
     at = profile.at(res.t)
     X = np.array([res.outputs[o] for o in outputs])
     ratios = {"inner": 1.0, "outer": ratio}
@@ -70,8 +71,8 @@ def slow_ramp(T: float) -> None:
         tracks = order_tracks(blocks, s, [1.0])
         keep = blocks.t.mean(axis=1) > 0.1 * T
         W = blocks.speed[keep]
-        steady = unbalance_response(model, scene.unbalances, W / ratios[s], ratios=ratios, outputs=outputs,
-                                    spool_of=scene.rotor.spool_of, reference_spool="inner")
+        steady = unbalance_response(model, Operating.line(W / ratios[s], "inner", ratios={"outer": ratio}),
+                                    scene.unbalances, outputs)
         crit = [c.speed * ratios[s] for c in cd.critical_speeds]  # every resonance of the machine, in this spool's speed
         for j, o in enumerate(outputs):
             a, Q = tracks[j][0].amplitude[keep], np.abs(steady.phasors[s][o])

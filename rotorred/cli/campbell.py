@@ -13,14 +13,15 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import grid, number_list, out_dir, provenance, ratio_number, spool_ratios, stage_summary
+from rotorred.cli.options import (grid, number_list, out_dir, provenance, ratio_number, speed_line, spool_ratios,
+                                  stage_summary)
 from rotorred.writers import OutputFolder
 
 
 def parse_speeds(text: str) -> np.ndarray:
-    """``"0:12000:61"``, ``"0,1000,2500"`` or ``"3000"`` (rpm, >= 0, increasing) -> speeds (rad/s)."""
+    """``"0:12000:61"``, ``"0,1000,2500"`` or ``"3000"`` (rpm, >= 0, increasing) -> speeds (rpm)."""
     single = ":" not in text and "," not in text  # one speed; a range or a list holds at least two
-    return grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True) * math.pi / 30.0
+    return grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True)
 
 
 def parse_ratio(items: list[str]):
@@ -30,6 +31,24 @@ def parse_ratio(items: list[str]):
     if len(items) == 1 and "=" not in items[0]:
         return checks.number("--ratio", ratio_number("--ratio", items[0]), ge=0.0)
     return {spool: checks.number(f"--ratio {spool}", r, ge=0.0) for spool, r in spool_ratios("--ratio", items).items()}
+
+
+def ratios_to_reference(ratio, rotor, reference: str | None) -> dict[str, float] | None:
+    """``--ratio`` as {spool: speed ratio to the reference spool}: a bare number R (two spools) is the speed of
+    the second spool over that of the first (``rotor.spools`` order), whichever is the reference."""
+    if ratio is None or isinstance(ratio, dict):
+        return ratio
+    names = [s.name for s in rotor.spools]
+    if len(names) != 2:
+        checks.fail("--ratio", ratio, f"must be SPOOL=R for rotor {rotor.name!r} with {len(names)} spool(s) {names}: a "
+                    "bare number is the speed of the second spool over that of the first, for two spools")
+    first, second = names
+    if reference in (None, first):
+        return {second: ratio}
+    if ratio <= 0:
+        checks.fail("--ratio", ratio, f"must be > 0 with --reference {second}: {first} then turns at 1/R times "
+                    f"{second}")
+    return {first: 1.0 / ratio}
 
 
 def parse_harmonics(text: str) -> tuple[float, ...]:
@@ -87,20 +106,19 @@ def run(args) -> int:
     rotor, document = read_rotor(args.rotor)
     record = provenance(args, "rotor", toml_text(document))
     check_model_size(rotor, args.force)
-    if args.reference is not None and args.reference not in rotor.speeds:
-        checks.fail("--reference", args.reference, f"must be a spool of the rotor ({', '.join(rotor.speeds)})")
+    operating = speed_line(rotor, speeds, args.reference, ratios_to_reference(ratio, rotor, args.reference), "rpm")
     with OutputFolder(out) as folder:
-        kw = dict(ratio=ratio, reference=args.reference, n_modes=args.modes, harmonics=harmonics)
-        result = campbell(rotor, speeds, **kw, model=_reduced(rotor, args.reduce))
+        model = rotor if args.reduce is None else _reduced(rotor, args.reduce)
+        result = campbell(model, operating, n_modes=args.modes, harmonics=harmonics)
         # the full model tracks as many modes as the reduced one, whose frequencies it is compared with
         comparison = None if args.reduce is None else format_reduction_error(
-            result, campbell(rotor, speeds, **{**kw, "n_modes": result.n_modes}))
+            result, campbell(rotor, operating, n_modes=result.n_modes, harmonics=harmonics))
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
-            operating = ref_nominal if ref_nominal > 0 else None
-            files.append(save(result.plot(operating_speed=operating), folder.staged("campbell.png")))
-            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating))
+            operating_speed = ref_nominal if ref_nominal > 0 else None
+            files.append(save(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
+            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed))
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
                           format_mode_count(result)] + ([comparison] if comparison else []))
         files += stage_summary(folder, "campbell.txt", text, record)
@@ -122,9 +140,9 @@ def format_mode_count(result) -> str:
     if mc.limit <= 0:
         return (f"tracked {result.n_modes} modes: the default's minimum ({MIN_DEFAULT_MODES}), as no spool turns at "
                 f"{mc.top_speed * rpm:.6g} rpm (no excitation line). --modes N sets the number")
-    ratio = result.speed_ratios[mc.spool]
+    spool_speed = result.speed_ratios[mc.spool] * mc.top_speed + result.fixed_speeds.get(mc.spool, 0.0)
     line = (f"{mc.harmonic:g}× {mc.spool} at {mc.top_speed * rpm:.6g} rpm of {result.reference}"
-            + (f", {mc.spool} at {ratio * mc.top_speed * rpm:.6g} rpm" if mc.spool != result.reference else ""))
+            + (f", {mc.spool} at {spool_speed * rpm:.6g} rpm" if mc.spool != result.reference else ""))
     at = " and ".join(f"{w * rpm:.6g} rpm ({n})" for n, w in zip(mc.below, mc.speeds))
     text = (f"tracked {result.n_modes} modes: every mode below {mc.margin:g} × {mc.limit_hz:.4g} Hz, the highest "
             f"excitation frequency ({line}); modes below that at {at}")
@@ -138,10 +156,8 @@ def format_mode_count(result) -> str:
     return text + ". --modes N sets the number"
 
 
-def _reduced(rotor, modes: int | None):
-    """The Craig-Bampton model of ``rotor`` with ``modes`` fixed-interface modes (0: the default choice), or None."""
-    if modes is None:
-        return None
+def _reduced(rotor, modes: int):
+    """The Craig-Bampton model of ``rotor`` with ``modes`` fixed-interface modes (0: the default choice)."""
     from rotorred.linear.reduction import reduce_rotor
 
     return reduce_rotor(rotor, n_modes=modes or None)
@@ -173,7 +189,8 @@ def check_model_size(rotor, force: bool) -> None:
 
 def format_whirl_table(result, i: int = 0) -> str:
     """The whirl frequencies, directions, damping ratios and log decrements at speed ``i``, as a text table."""
-    others = ", ".join(f"{s} at {r:.4g}x" for s, r in result.speed_ratios.items() if s != result.reference)
+    others = ", ".join(f"{s} at {result.fixed_speeds[s] * 30 / math.pi:.6g} rpm" if s in result.fixed_speeds
+                       else f"{s} at {r:.4g}x" for s, r in result.speed_ratios.items() if s != result.reference)
     lines = [f"whirl frequencies of {result.rotor_name or 'rotor'} at {result.speeds_rpm[i]:.6g} rpm of "
              f"{result.reference}" + (f" ({others})" if others else ""),
              f"{'mode':>5} {'freq Hz':>12} {'whirl':>9} {'damping ratio':>14} {'log dec':>10}"]
@@ -185,9 +202,10 @@ def format_whirl_table(result, i: int = 0) -> str:
 
 def format_critical_speeds(result) -> str:
     """The critical speeds as a text table."""
-    ratios = ", ".join(f"{s}: {r:.4g}" for s, r in result.speed_ratios.items())
+    ratios = ", ".join(f"{s}: {r:.4g}" for s, r in result.speed_ratios.items() if s not in result.fixed_speeds)
+    fixed = "".join(f"; {s} fixed at {w * 30 / math.pi:.6g} rpm" for s, w in result.fixed_speeds.items())
     w = max([12] + [len(c.line) for c in result.critical_speeds])
-    lines = [f"critical speeds of {result.rotor_name or 'rotor'} (speed ratios to {result.reference}: {ratios})",
+    lines = [f"critical speeds of {result.rotor_name or 'rotor'} (speed ratios to {result.reference}: {ratios}{fixed})",
              f"{result.reference + ' rpm':>14} {'line':>{w}} {'mode':>5} {'freq Hz':>10} {'whirl':>9} {'log dec':>9}"]
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")

@@ -30,8 +30,8 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, spool_ratios,
-                                  stage_summary)
+from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, speed_line,
+                                  spool_ratios, stage_summary)
 from rotorred.progress import stage
 from rotorred.writers import OutputFolder
 
@@ -99,25 +99,18 @@ def _unbalance(text: str, nodes):
     return Unbalance(node, m_e, math.radians(checks.number("--unbalance", phase, "deg")))
 
 
-def _ratios(text: str | None, rotor, reference: str) -> dict[str, float]:
+def _ratios(text: str | None, rotor, reference: str) -> dict[str, float] | None:
+    """--ratio as {spool: speed ratio to the reference spool} (None: not given; :func:`speed_line` completes it): a
+    bare number is the other spool's ratio, for a two-spool rotor."""
     names = [s.name for s in rotor.spools]
     if text is None:
-        nominal = rotor.speeds
-        if nominal[reference] <= 0:
-            return {s: 1.0 for s in names}
-        return {s: nominal[s] / nominal[reference] for s in names}
-    out = {reference: 1.0}
+        return None
     if "=" not in text:
         others = [s for s in names if s != reference]
         if len(others) != 1:
             checks.fail("--ratio", text, f"a bare number needs a two-spool rotor; spools are {names}: write SPOOL=R,...")
-        out[others[0]] = checks.number("--ratio", ratio_number("--ratio", text), gt=0.0)
-        return out
-    for spool, r in spool_ratios("--ratio", [text]).items():
-        if spool not in names:
-            checks.fail("--ratio", text, f"names unknown spool {spool!r}; spools are {names}")
-        out[spool] = checks.number("--ratio", r, ge=0.0)
-    return out
+        return {others[0]: checks.number("--ratio", ratio_number("--ratio", text), gt=0.0)}
+    return {spool: checks.number("--ratio", r, ge=0.0) for spool, r in spool_ratios("--ratio", [text]).items()}
 
 
 def _load(spec: str):
@@ -189,7 +182,7 @@ def _outputs(args, rotor, scene, unbalances) -> list[tuple[int, str]]:
     return [(u.node, d) for u in unbalances for d in ("x", "y")]
 
 
-def _model(args, rotor, scene, speeds, ratios):
+def _model(args, rotor, scene, operating):
     """The full model, or the Craig-Bampton model with its description."""
     from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
     from rotorred.model.assembly import assemble
@@ -210,7 +203,7 @@ def _model(args, rotor, scene, speeds, ratios):
     extra = list(dict.fromkeys(extra))
     cutoff = None if cutoff_hz is None else 2 * math.pi * checks.positive("--cutoff", cutoff_hz, "Hz")
     # the band a cutoff must cover: every excitation frequency of the sweep
-    band = None if cutoff is None else (0.0, max(float(np.max(speeds)) * r for r in ratios.values()))
+    band = None if cutoff is None else (0.0, max(float(np.max(w)) for w in operating.speeds(rotor).values()))
     model = reduce_rotor(rotor, extra, n_modes=modes, cutoff=cutoff, band=band, system=system)
     label = (f"Craig-Bampton model, {model.n_dof} DOFs ({model.n_boundary_dofs} boundary DOFs at nodes "
              f"{list(default_boundary_nodes(rotor, extra))} + {model.n_modes} modes); {model.selection.describe()}")
@@ -236,27 +229,26 @@ def run(args) -> int:
     rotor, scene, resolved = _load(str(args.rotor))
     record = provenance(args, *resolved)
     check_model_size(rotor, args.force)
-    reference = args.reference_spool or rotor.spools[0].name
-    if reference not in rotor.speeds:
-        checks.fail("--reference-spool", reference, f"must be one of {[s.name for s in rotor.spools]}")
+    reference = checks.choice("--reference-spool", args.reference_spool or rotor.spools[0].name,
+                              [s.name for s in rotor.spools])
     speeds = _speeds(args, rotor, reference)
     unbalances = _unbalances(args, rotor, scene)
     outputs = _outputs(args, rotor, scene, unbalances)
-    ratios = _ratios(args.ratio, rotor, reference)
+    operating = speed_line(rotor, speeds, reference, _ratios(args.ratio, rotor, reference), "rad/s",
+                           ("--reference-spool", "--ratio"))
     frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
     frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
     _check_model_options(args)
 
     with OutputFolder(out) as folder:
         t0 = time.perf_counter()
-        model, label, kind = _model(args, rotor, scene, speeds, ratios)  # checks the model's options against the rotor
+        model, label, kind = _model(args, rotor, scene, operating)  # checks the model's options against the rotor
         stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds ({kind} model)")
-        result = unbalance_response(model, unbalances, speeds, ratios=ratios, outputs=outputs,
-                                    spool_of=rotor.spool_of, reference_spool=reference)
+        result = unbalance_response(model, operating, unbalances, outputs)
         elapsed = time.perf_counter() - t0
         title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
         names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
-        text = _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result)
+        text = _report(args, rotor, scene, label, unbalances, elapsed, result)
         names += [f.name for f in stage_summary(folder, "harmonic.txt", text, record)]
         folder.commit()
     report(text)
@@ -276,6 +268,7 @@ def _check_model_options(args) -> None:
 def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[str]:
     """Stage response.csv, bode.png, polar.png (and frf.csv, frf.png); returns their names."""
     from rotorred.linear.harmonic import frequency_response
+    from rotorred.model.operating import Operating
     from rotorred.plots.axes import save
 
     result.write_csv(folder.staged("response.csv"))
@@ -284,20 +277,22 @@ def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[st
     names = ["response.csv", "bode.png", "polar.png"]
     if frf_pairs:
         inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
-        frf = frequency_response(model, inputs, list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs,
-                                 speeds=rotor.speeds)
+        frf = frequency_response(model, Operating.point(rotor.speeds), inputs,
+                                 list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs)
         frf.write_csv(folder.staged("frf.csv"))
         save(frf.plot(), folder.staged("frf.png"))
         names += ["frf.csv", "frf.png"]
     return names
 
 
-def _report(args, rotor, scene, label, unbalances, speeds, reference, ratios, elapsed, result) -> str:
+def _report(args, rotor, scene, label, unbalances, elapsed, result) -> str:
     """What the sweep solved and the peak of each output (printed, and ``harmonic.txt``)."""
     lines = [f"scene {scene.name} ({scene.source})"] if scene is not None else []
     lines.append(f"rotor {rotor.name or args.rotor}: {label}")
     lines.append("unbalances: " + ", ".join(f"node {u.node} ({rotor.spool_of[u.node]}) {u.m_e:g} kg m at "
                                             f"{math.degrees(u.phase):g} deg" for u in unbalances))
+    speeds, reference = result.speeds, result.reference_spool
+    ratios = {s: line.slope for s, line in result.operating.lines(rotor).items()}
     lines.append(f"sweep: {len(speeds)} speeds, {reference} {speeds[0] * _RPM:.0f}-{speeds[-1] * _RPM:.0f} rpm, "
                  f"ratios {ratios}; solved in {elapsed:.2f} s")
     for o in result.outputs:

@@ -5,16 +5,17 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from rotorred import checks
 from rotorred.model.dofs import parse_dof
+from rotorred.model.operating import Operating
 
-__all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "out_dir", "provenance",
-           "stage_summary", "MAX_COUNT"]
+__all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
+           "provenance", "stage_summary", "MAX_COUNT"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -106,6 +107,42 @@ def spool_ratios(option: str, items: Sequence[str], *, bound: str = ">= 0",
             checks.fail(option, item, f"must give spool {spool.strip()!r} once")
         out[spool.strip()] = value
     return out
+
+
+def speed_line(rotor, speeds, reference: str | None, ratios: Mapping[str, float] | None, unit: str,
+               options: tuple[str, str] = ("--reference", "--ratio")) -> Operating:
+    """The speed line of a command's options: the ``reference`` spool (default the rotor's first) at ``speeds``,
+    the spools named in ``ratios`` at those ratios to it, and every other spool by the one rule of
+    :meth:`rotorred.model.operating.Operating.lines` (the ratio of the nominal speeds).
+
+    Parameters
+    ----------
+    rotor : Rotor
+    speeds : array_like, shape (n,)
+        The reference spool's speeds, in ``unit``.
+    reference : str or None
+        The reference spool's name as typed.
+    ratios : dict of str to float or None
+        ``Omega_s / Omega_reference`` (-) of the spools named by the ratio option.
+    unit : {"rad/s", "rpm", "Hz"}
+    options : (str, str)
+        The names of the reference and the ratio options, which every error names.
+
+    Returns
+    -------
+    Operating
+    """
+    reference_option, ratio_option = options
+    names = [s.name for s in rotor.spools]
+    reference = checks.choice(reference_option, names[0] if reference is None else reference, names)
+    for spool in ratios or {}:
+        checks.choice(ratio_option, spool, [n for n in names if n != reference])
+    operating = Operating.line(speeds, reference, ratios=dict(ratios or {}), unit=unit)
+    try:
+        operating.lines(rotor)
+    except checks.InputError as exc:  # a spool whose ratio the rotor does not give
+        raise checks.InputError(ratio_option, dict(ratios) if ratios else None, exc.requirement) from None
+    return operating
 
 
 def dof_list(option: str, text: str, nodes=None) -> list[tuple[int, str]]:

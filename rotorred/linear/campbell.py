@@ -1,23 +1,26 @@
 """Campbell diagram: whirl frequencies against speed, whirl direction, critical speeds.
 
-The spools turn at fixed ratios: the x-axis is the speed Omega of a *reference* spool, and
-spool ``s`` turns at ``r_s Omega`` (``r_ref = 1``). At each speed the damped eigenproblem
+The x-axis is the speed Omega of a *reference* spool along a speed line
+(:class:`rotorred.model.operating.Operating`); every spool ``s`` turns at ``Omega_s = a_s Omega + b_s`` by the
+one ratio rule :meth:`Operating.lines`: at a ratio (``a_s``, ``b_s = 0``; the reference has ``a = 1``) or at a
+fixed speed (``a_s = 0``, ``b_s``). At each speed the damped eigenproblem
 
-    M q'' + (C + Omega sum_s r_s G_s) q' + K q = 0
+    M q'' + (C + sum_s Omega_s G_s) q' + K q = 0
 
 (Xu et al. 2016, Eq. 13 with one gyroscopic matrix per spool) is solved with
 :func:`rotorred.linear.modal.eigen`. Modes are followed from speed to speed by the modal assurance
 criterion (MAC, :func:`rotorred.linear.modal.mac`) with an optimal one-to-one assignment
 (:func:`scipy.optimize.linear_sum_assignment`), so a curve keeps its identity where two curves
 cross. A critical speed is a speed where a tracked curve omega_j(Omega) meets an excitation line
-``h r_s Omega`` (harmonic ``h`` of spool ``s``); it is bracketed on the speed grid and refined with
+``h Omega_s = h (a_s Omega + b_s)`` (harmonic ``h`` of spool ``s``; horizontal for a spool at a fixed speed); it is
+bracketed on the speed grid and refined with
 :func:`scipy.optimize.brentq`, solving the eigenproblem at the intermediate speeds. A speed where a
 tracked mode's log decrement changes sign (it becomes unstable, or stable again) is refined the same
 way, on Re(lambda) = 0 (:class:`StabilityChange`). Rigid-body modes of a free or singly supported
 spool (:func:`rigid_body_share`) give neither.
 
 By default (``n_modes=None``) the tracked modes are every mode below ``DEFAULT_MARGIN`` times the highest
-excitation frequency of the sweep (the largest ``h r_s Omega`` at the top speed), counted from the eigenvalues at
+excitation frequency of the sweep (the largest ``h Omega_s`` at the top speed), counted from the eigenvalues at
 the first and the last speed, at least ``MIN_DEFAULT_MODES`` (:func:`default_mode_count`); the tracked curves are
 then checked at every grid speed to leave no untracked mode below that frequency, and more are tracked if one does.
 
@@ -42,7 +45,7 @@ Allemang, "The modal assurance criterion - twenty years of use and abuse", Sound
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -52,8 +55,9 @@ from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
-from rotorred.model.assembly import SystemMatrices, assemble
-from rotorred.model.rotor import Rotor
+from rotorred.model.assembly import SystemMatrices, system_of
+from rotorred.model.operating import Operating, SpoolLine
+from rotorred.model.operating import checked as checked_operating
 from rotorred.progress import stage
 from rotorred.results import Result
 
@@ -102,7 +106,7 @@ class _PointOnTheDiagram:
 
 @dataclass(frozen=True, repr=False)
 class CriticalSpeed(_PointOnTheDiagram, Result):
-    """A crossing of a whirl curve with an excitation line h x Omega_s.
+    """A crossing of a whirl curve with an excitation line h x Omega_s (Omega_s = a_s Omega + b_s).
 
     Attributes
     ----------
@@ -121,7 +125,7 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
     log_dec : float
         Logarithmic decrement of the mode at the crossing (-).
     same_line : tuple of str
-        Other excitations on the same line (equal slope), e.g. ``("1× outer",)`` for ``1× inner``
+        Other excitations on the same line (equal slope and offset), e.g. ``("1× outer",)`` for ``1× inner``
         at speed ratio 1: the crossing is listed once.
     """
 
@@ -276,7 +280,8 @@ class CampbellResult(Result):
     reference : str
         Name of the reference spool.
     speed_ratios : dict of str to float
-        Omega_s / Omega_reference of each spool.
+        ``dOmega_s / dOmega`` of each spool (-): its ratio to the reference spool (1 for the reference), 0 for a
+        spool held at a fixed speed.
     harmonics : tuple of float
         Multiples of each spool's speed used as excitation lines.
     rotor_name : str
@@ -292,6 +297,11 @@ class CampbellResult(Result):
         (node, the table's lowest and highest speed (rad/s), its ``extrapolate``: "hold" or "linear").
     mode_count : ModeCount or None
         Why ``n_modes`` modes were tracked, when chosen by default (``n_modes=None``); None when given.
+    fixed_speeds : dict of str to float
+        Speed of each spool held at a fixed speed along the sweep (rad/s); its excitation lines are horizontal,
+        h x that speed. Spool ``s`` turns at ``speed_ratios[s] * speeds + fixed_speeds.get(s, 0)``.
+    operating : Operating or None
+        The speed line the diagram was computed on (:class:`rotorred.model.operating.Operating`).
     """
 
     speeds: np.ndarray
@@ -308,6 +318,8 @@ class CampbellResult(Result):
     stability_changes: tuple[StabilityChange, ...] = ()
     beyond_tables: tuple[tuple[int, float, float, str], ...] = ()
     mode_count: ModeCount | None = None
+    fixed_speeds: Mapping[str, float] = field(default_factory=dict)
+    operating: Operating | None = None
 
     def __post_init__(self):
         for f in ("speeds", "frequencies", "log_dec", "whirl", "tracking_mac"):
@@ -315,6 +327,7 @@ class CampbellResult(Result):
             a.setflags(write=False)
             object.__setattr__(self, f, a)
         object.__setattr__(self, "speed_ratios", dict(self.speed_ratios))
+        object.__setattr__(self, "fixed_speeds", dict(self.fixed_speeds))
 
     @property
     def n_modes(self) -> int:
@@ -331,9 +344,11 @@ class CampbellResult(Result):
         return self.frequencies / (2.0 * np.pi)
 
     @property
-    def excitation_lines(self) -> tuple[tuple[str, float, float], ...]:
-        """(spool, harmonic, slope) of each excitation line; frequency (rad/s) = slope x reference speed."""
-        return tuple((s, h, h * r) for s, r in self.speed_ratios.items() if r > 0 for h in self.harmonics)
+    def excitation_lines(self) -> tuple[tuple[str, float, float, float], ...]:
+        """(spool, harmonic, slope, offset) of each excitation line of a turning spool: frequency (rad/s) =
+        slope x reference speed + offset; the offset is h x the speed of a spool held at a fixed speed, else 0."""
+        return tuple((s, h, h * r, h * self.fixed_speeds.get(s, 0.0)) for s, r in self.speed_ratios.items()
+                     if r > 0 or self.fixed_speeds.get(s, 0.0) > 0 for h in self.harmonics)
 
     def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None) -> Path:
         """Write the critical speeds, one row each: the reference spool's speed (rpm), the excitation line,
@@ -365,12 +380,14 @@ class CampbellResult(Result):
     def summary(self) -> list[str]:
         """The sweep, the modes tracked, the frequency range, the first critical speeds and the stability."""
         rpm = self.speeds_rpm
-        others = [f"{s}/{self.reference} = {r:.4g}" for s, r in self.speed_ratios.items() if s != self.reference]
+        others = [f"{s}/{self.reference} = {r:.4g}" for s, r in self.speed_ratios.items()
+                  if s != self.reference and s not in self.fixed_speeds]
+        others += [f"{s} fixed at {w * 30 / np.pi:.6g} rpm" for s, w in self.fixed_speeds.items()]
         sweep = f"{len(rpm)} speeds of the {self.reference} spool, {rpm[0]:.6g}-{rpm[-1]:.6g} rpm" if len(rpm) > 1 \
             else f"{rpm[0]:.6g} rpm of the {self.reference} spool"
         lines = [f"{self.rotor_name or 'rotor'}: {self.n_modes} modes tracked at {sweep}",
                  (f"speed ratios {', '.join(others)}; " if others else "") + "excitation lines "
-                 + ", ".join(excitation_label(h, s) for s, h, _ in self.excitation_lines)]
+                 + ", ".join(excitation_label(h, s) for s, h, _, _ in self.excitation_lines)]
         if self.mode_count is not None:
             mc = self.mode_count
             lines.append(f"modes: every mode below {mc.margin:g} x {mc.limit_hz:.4g} Hz "
@@ -593,70 +610,12 @@ def _canonical_basis(lam: np.ndarray, modes: np.ndarray, x_rows, y_rows) -> np.n
 
 # --- the analysis ------------------------------------------------------------------------------
 
-def speed_ratios(rotor: Rotor, ratio=None, reference: str | None = None) -> dict[str, float]:
-    """Omega_s / Omega_reference of each spool.
-
-    Parameters
-    ----------
-    rotor : Rotor
-    ratio : float or mapping of str to float, optional
-        A mapping ``{spool: Omega_s / Omega_reference}`` (any number of spools, each >= 0); a spool
-        not in it keeps the ratio of the nominal speeds. A float, for a two-spool rotor only:
-        Omega of the second spool / Omega of the first, in ``rotor.spools`` order (for the seed rig
-        (inner, outer): Omega_H / Omega_L). Default: the ratios of the spools' nominal speeds.
-    reference : str, optional
-        The spool on the x-axis (default the first).
-
-    Returns
-    -------
-    dict of str to float
-    """
-    names = [s.name for s in rotor.spools]
-    reference = checks.choice("reference", names[0] if reference is None else reference, names)
-    if isinstance(ratio, Mapping):
-        return _given_ratios(rotor, dict(ratio), reference)
-    if ratio is not None:
-        if len(names) == 1:
-            checks.fail("ratio", ratio, f"must be left unset: it applies to two-spool rotors only, and rotor "
-                        f"{rotor.name!r} has one spool {names}")
-        if len(names) != 2:
-            checks.fail("ratio", ratio, f"must name its spools ({{spool: ratio to {reference!r}}}, --ratio SPOOL=R) "
-                        f"for rotor {rotor.name!r} with {len(names)} spool(s) {names}; a single number is the "
-                        "second spool's ratio to the first, for two spools")
-        absolute = {names[0]: 1.0, names[1]: checks.non_negative("ratio", ratio)}
-    else:
-        absolute = dict(rotor.speeds)
-        if len(names) == 1:
-            absolute = {names[0]: 1.0}
-    if absolute[reference] <= 0:
-        missing = [n for n in names if n != reference]
-        checks.fail("reference", reference, "must be a spool with a nominal speed > 0, or ratio must be given: "
-                    f"spool {reference!r} has nominal speed 0, so the speed ratios are undefined (give "
-                    + ", ".join(f"--ratio {n}=R" for n in missing) + ")")
-    return {n: absolute[n] / absolute[reference] for n in names}
-
-
-def _given_ratios(rotor: Rotor, given: dict, reference: str) -> dict[str, float]:
-    """The ratios of ``given`` (checked), the others from the nominal speeds, or a message naming what is missing."""
-    names = [s.name for s in rotor.spools]
-    for name, r in given.items():
-        checks.choice("ratio", name, [n for n in names if n != reference])
-        given[name] = checks.non_negative(f"ratio[{name!r}]", r)
-    nominal = rotor.speeds
-    missing = [n for n in names if n != reference and n not in given]
-    if missing and nominal[reference] <= 0:
-        checks.fail("ratio", given, f"must give the ratio to {reference!r} of every other spool; missing "
-                    f"{missing} (" + ", ".join(f"--ratio {n}=R" for n in missing) + f"): the nominal speed of "
-                    f"{reference!r} is 0, so the rotor gives none")
-    return {n: 1.0 if n == reference else given.get(n, nominal[n] / max(nominal[reference], 1e-300)) for n in names}
-
-
 class _Solver:
     """Eigen-solves of one rotor along the speed axis (matrices assembled once; speed-dependent bearings evaluated
     at each speed)."""
 
-    def __init__(self, sm, ratios: Mapping[str, float], n_candidates: int):
-        self.sm, self.ratios = sm, dict(ratios)
+    def __init__(self, sm, lines: Mapping[str, SpoolLine], n_candidates: int):
+        self.sm, self.lines = sm, dict(lines)
         self.M = sm.M
         self.n_candidates = n_candidates
         self.x_rows, self.y_rows = _xy_rows(sm)
@@ -664,7 +623,7 @@ class _Solver:
     def matrices(self, Omega: float) -> tuple[np.ndarray, np.ndarray]:
         """(D, K) at reference speed ``Omega`` (rad/s): damping with the gyroscopic terms, and stiffness, each with
         the speed-dependent bearings at their spools' speeds."""
-        speeds = {s: r * Omega for s, r in self.ratios.items()}
+        speeds = {s: float(line.at(Omega)) for s, line in self.lines.items()}
         return self.sm.damping(speeds), self.sm.stiffness(speeds)
 
     def solve(self, Omega: float):
@@ -717,52 +676,49 @@ def _assign(prev_modes, prev_freq, lam, modes):
     return cols[np.argsort(rows)], m[rows, cols][np.argsort(rows)]
 
 
-def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
-             reference: str | None = None,
-             n_modes: int | None = None, harmonics: Sequence[float] = (1,), model=None) -> CampbellResult:
-    """Campbell diagram of ``rotor`` with critical speeds.
+def campbell(model, operating: Operating, *, n_modes: int | None = None,
+             harmonics: Sequence[float] = (1,)) -> CampbellResult:
+    """Campbell diagram of ``model`` along the speed line ``operating``, with critical speeds.
 
     Parameters
     ----------
-    rotor : Rotor
-    speeds : sequence of float, shape (n_speeds,)
-        Speeds of the reference spool (rad/s), >= 0, strictly increasing. One speed gives the whirl
-        frequencies, directions and damping there (no crossing can be found, so no critical speed).
-    ratio : float or mapping of str to float, optional
-        ``{spool: Omega_s / Omega_reference}`` for any number of spools (the others keep the
-        ratio of their nominal speeds), or, for two spools, Omega of the second spool / Omega of
-        the first (``rotor.spools`` order; Omega_H / Omega_L for the seed rig). Default: the ratios
-        of the nominal spool speeds (:func:`speed_ratios`).
-    reference : str, optional
-        Spool whose speed is the x-axis (default the first spool).
+    model : Rotor, SystemMatrices or ReducedSystem
+        The rotor (assembled here), its assembled model, or a Craig-Bampton model
+        (:func:`rotorred.linear.reduction.reduce_rotor`) solved in place of the full one; whirl directions are
+        then read from the recovered physical shapes (T v). Read through
+        :func:`rotorred.model.assembly.system_of`.
+    operating : Operating
+        The speed line (:meth:`Operating.line`) or point (:meth:`Operating.point`): its ``Omega``, shape
+        (n_speeds,), the reference spool's speeds (rad/s), >= 0 and strictly increasing, is the x-axis; every
+        spool turns at ``a_s Omega + b_s`` by :meth:`Operating.lines` (a stated ratio, a fixed speed, or the
+        ratio of the nominal speeds). One speed gives the whirl frequencies, directions and damping there (no
+        crossing can be found, so no critical speed).
     n_modes : int, optional
-        Number of modes tracked: the lowest ``n_modes`` at ``speeds[0]``. Default: every mode below
+        Number of modes tracked: the lowest ``n_modes`` at ``Omega[0]``. Default: every mode below
         ``DEFAULT_MARGIN`` x the highest excitation frequency at the top speed (:func:`default_mode_count`),
         and more if, at a grid speed, a mode below that frequency (without the margin) is not among them;
         the result's ``mode_count`` says how many and why.
     harmonics : sequence of float
-        Excitation lines h x Omega_s for each h and each spinning spool s (default 1x).
-    model : ReducedSystem, optional
-        A Craig-Bampton model of ``rotor`` (:func:`rotorred.linear.reduction.reduce_rotor`) to solve in
-        place of the full one; whirl directions are read from the recovered physical shapes (T v).
+        Excitation lines h x Omega_s (rad/s) for each h (> 0, -) and each turning spool s (default 1x); a spool
+        at a fixed speed gives horizontal lines.
 
     Returns
     -------
     CampbellResult
     """
-    Omega, h, ratios, reference, sm = _setup(rotor, speeds, ratio, reference, harmonics, model)
+    Omega, h, lines, reference, sm = _setup(model, operating, harmonics)
     n_available = sm.n_dof  # at most one frequency per DOF
     count = None
     if n_modes is None:
-        count = _mode_count(sm, ratios, Omega, h, DEFAULT_MARGIN)
+        count = _mode_count(sm, lines, Omega, h, DEFAULT_MARGIN)
         n_modes = count.n_modes
     else:
         n_modes = checks.integer("n_modes", n_modes, ge=1)
         if n_modes > n_available:
             checks.fail("n_modes", n_modes, f"must be <= {n_available}, the number of DOFs")
-    stage("whirl frequencies of %s at %d speed%s, %d modes tracked (%d DOFs)", rotor.name or "the rotor", len(Omega),
+    stage("whirl frequencies of %s at %d speed%s, %d modes tracked (%d DOFs)", sm.name or "the rotor", len(Omega),
           "s" * (len(Omega) > 1), n_modes, n_available)
-    solver = _Solver(sm, ratios, min(n_available, 2 * n_modes + 4))
+    solver = _Solver(sm, lines, min(n_available, 2 * n_modes + 4))
     solved = {}  # eigen-solves of the grid speeds, kept for a second tracking with more modes
     while True:
         cover = None if count is None else (count.limit, count.margin * count.limit)
@@ -784,8 +740,8 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
     null = rigid_body_motions(sm.M, sm.K)
     is_rigid = np.array([rigid_body_share(sm.M, null, v) > RIGID_SHARE for v in shapes])  # (n_s, n_modes)
     crit = []
-    for spool, hh, slope, same in _distinct_lines(ratios, h):
-        g = freq - slope * Omega[:, None]
+    for spool, hh, slope, offset, same in _distinct_lines(lines, h):
+        g = freq - (slope * Omega + offset)[:, None]
         for j in range(n_modes):
             for i in range(n_s - 1):
                 if is_rigid[i, j] or is_rigid[i + 1, j]:
@@ -795,34 +751,38 @@ def campbell(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[st
                 if g[i, j] * g[i + 1, j] > 0:
                     continue
                 crit.append(replace(
-                    _refine(solver, Omega, lam_all, shapes, whirl, i, j, spool, hh, slope), same_line=same))
+                    _refine(solver, Omega, lam_all, shapes, whirl, (i, j), (spool, hh, slope, offset)),
+                    same_line=same))
     crit.sort(key=lambda c: (c.speed, c.mode))
     changes = _stability_changes(solver, Omega, lam_all, shapes, whirl, log_dec, is_rigid)
     return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
-                          critical_speeds=tuple(crit), reference=reference, speed_ratios=ratios,
-                          harmonics=h, rotor_name=rotor.name,
+                          critical_speeds=tuple(crit), reference=reference,
+                          speed_ratios={s: line.slope for s, line in lines.items()},
+                          harmonics=h, rotor_name=sm.name,
                           rigid_modes=tuple(int(j) for j in np.flatnonzero(is_rigid[0])),
-                          stability_changes=changes, beyond_tables=_beyond_tables(sm, ratios, Omega),
-                          mode_count=count)
+                          stability_changes=changes, beyond_tables=_beyond_tables(sm, lines, Omega),
+                          mode_count=count,
+                          fixed_speeds={s: line.offset for s, line in lines.items() if line.how == "fixed"},
+                          operating=operating)
 
 
-def default_mode_count(rotor: Rotor, speeds: Sequence[float], *, ratio: float | Mapping[str, float] | None = None,
-                       reference: str | None = None, harmonics: Sequence[float] = (1,), model=None,
+def default_mode_count(model, operating: Operating, *, harmonics: Sequence[float] = (1,),
                        margin: float = DEFAULT_MARGIN) -> ModeCount:
     """How many modes :func:`campbell` tracks by default: every mode below ``margin`` x the highest excitation
     frequency of the sweep.
 
-    The highest excitation frequency is the largest h r_s Omega_top over the harmonics h and the turning spools
-    s at the top speed Omega_top. A whirl frequency moves with speed (gyroscopic stiffening of forward whirl and
-    softening of backward whirl, speed-dependent bearings), so the modes below ``margin`` x that frequency are
-    counted from the eigenvalues at the first and at the last speed, and the larger count is kept (at least
-    ``MIN_DEFAULT_MODES``, at most the number of oscillating modes at those speeds). :func:`campbell` then checks
-    at every grid speed that no untracked mode lies below the highest excitation frequency, and tracks more if one
-    does (:attr:`ModeCount.grown_at`); this function solves the two speeds only.
+    The highest excitation frequency is the largest h Omega_s over the harmonics h and the turning spools s at
+    the top speed Omega_top of the reference spool (Omega_s = a_s Omega_top + b_s, :meth:`Operating.lines`). A
+    whirl frequency moves with speed (gyroscopic stiffening of forward whirl and softening of backward whirl,
+    speed-dependent bearings), so the modes below ``margin`` x that frequency are counted from the eigenvalues at
+    the first and at the last speed, and the larger count is kept (at least ``MIN_DEFAULT_MODES``, at most the
+    number of oscillating modes at those speeds). :func:`campbell` then checks at every grid speed that no
+    untracked mode lies below the highest excitation frequency, and tracks more if one does
+    (:attr:`ModeCount.grown_at`); this function solves the two speeds only.
 
     Parameters
     ----------
-    rotor, speeds, ratio, reference, harmonics, model
+    model, operating, harmonics
         As for :func:`campbell` (speeds in rad/s).
     margin : float
         Multiple of the highest excitation frequency below which every mode is counted (>= 1, -);
@@ -832,26 +792,30 @@ def default_mode_count(rotor: Rotor, speeds: Sequence[float], *, ratio: float | 
     -------
     ModeCount
     """
-    Omega, h, ratios, _, sm = _setup(rotor, speeds, ratio, reference, harmonics, model)
-    return _mode_count(sm, ratios, Omega, h, checks.number("margin", margin, ge=1.0))
+    Omega, h, lines, _, sm = _setup(model, operating, harmonics)
+    return _mode_count(sm, lines, Omega, h, checks.number("margin", margin, ge=1.0))
 
 
-def _setup(rotor: Rotor, speeds, ratio, reference, harmonics, model):
-    """The checked speeds (rad/s), harmonics (sorted, distinct), speed ratios, reference spool and model."""
-    Omega = checks.vector("speeds", speeds, "rad/s", min_len=1, ge=0.0, increasing=True)
+def _setup(model, operating, harmonics):
+    """The model (:func:`system_of`), the checked reference speeds (rad/s, strictly increasing), harmonics
+    (sorted, distinct), each spool's speed line (:meth:`Operating.lines`) and the reference spool."""
+    sm = system_of(model)
+    operating = checked_operating(operating)
+    operating.speeds(sm)  # refuses a profile
+    Omega = checks.vector("operating.Omega", operating.Omega.tolist(), "rad/s", min_len=1, ge=0.0, increasing=True)
     h = tuple(sorted(set(float(v) for v in checks.vector("harmonics", harmonics, gt=0.0))))
-    ratios = speed_ratios(rotor, ratio, reference)
-    reference = reference or rotor.spools[0].name
-    sm = assemble(rotor) if model is None else _checked_model(model, rotor)
-    return Omega, h, ratios, reference, sm
+    lines = operating.lines(sm)
+    return Omega, h, lines, operating.reference_of(sm), sm
 
 
-def _mode_count(sm, ratios: Mapping[str, float], Omega: np.ndarray, h: tuple[float, ...], margin: float) -> ModeCount:
+def _mode_count(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray, h: tuple[float, ...],
+                margin: float) -> ModeCount:
     """:func:`default_mode_count` of the model ``sm`` (one full eigen-solve at the first and at the last speed)."""
-    spool, r = max(((s, r) for s, r in ratios.items() if r > 0), key=lambda sr: sr[1], default=("", 0.0))
     top = float(Omega[-1])
-    limit = max(h) * r * top
-    solver = _Solver(sm, ratios, sm.n_dof)
+    at_top = {s: float(line.at(top)) for s, line in lines.items()}
+    spool, w = max(((s, w) for s, w in at_top.items() if w > 0), key=lambda sw: sw[1], default=("", 0.0))
+    limit = max(h) * w
+    solver = _Solver(sm, lines, sm.n_dof)
     ends = tuple(sorted({float(Omega[0]), top}))
     below, available = [], []
     for W in ends:
@@ -899,11 +863,11 @@ def _track(solver: _Solver, Omega: np.ndarray, n_modes: int, cover: tuple[float,
     return lam_all, shapes, tracking, None if first is None else (first, needed)
 
 
-def _beyond_tables(sm, ratios: Mapping[str, float], Omega: np.ndarray) -> tuple[tuple[int, float, float, str], ...]:
+def _beyond_tables(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray) -> tuple[tuple[int, float, float, str], ...]:
     """The speed-dependent bearings of ``sm`` whose spool's speeds along the sweep leave their table."""
     out = []
     for t in sm.tables:
-        spool_speeds = ratios[t.spool] * Omega
+        spool_speeds = lines[t.spool].at(Omega)
         if not (t.table.covers(float(spool_speeds.min())) and t.table.covers(float(spool_speeds.max()))):
             out.append((t.table.node, t.table.speeds[0], t.table.speeds[-1], t.table.extrapolate))
     return tuple(out)
@@ -937,32 +901,22 @@ def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.n
     return np.sum(np.abs(null.T @ Mv) ** 2, axis=0) / energy
 
 
-def _checked_model(model, rotor: Rotor):
-    """``model`` if it is a reduced model of ``rotor``'s spools."""
-    from rotorred.linear.reduction import ReducedSystem
-
-    if not isinstance(model, ReducedSystem):
-        checks.fail("model", type(model).__name__, "must be a ReducedSystem (reduce_rotor) of the rotor, or None")
-    if set(model.G) != {s.name for s in rotor.spools} or tuple(model.full_dofs.nodes) != tuple(rotor.all_nodes):
-        checks.fail("model", "a ReducedSystem", f"must be reduced from rotor {rotor.name!r} (its spools and nodes)")
-    return model
-
-
-def _distinct_lines(ratios: Mapping[str, float], harmonics: tuple[float, ...]):
-    """(spool, h, slope, other labels on the line) of each distinct excitation line h x Omega_s: lines of equal
-    slope (1x inner and 1x outer at speed ratio 1) are one line, crossed once."""
+def _distinct_lines(lines: Mapping[str, SpoolLine], harmonics: tuple[float, ...]):
+    """(spool, h, slope, offset, other labels on the line) of each distinct excitation line h x Omega_s =
+    h a_s Omega + h b_s of a turning spool: lines of equal slope and offset (1x inner and 1x outer at speed ratio 1)
+    are one line, crossed once."""
     out = []
-    for s, r in ratios.items():
+    for s, line in lines.items():
+        if line.slope <= 0 and line.offset <= 0:
+            continue  # a spool at rest along the whole line excites nothing
         for hh in harmonics:
-            if r <= 0:
-                continue
-            slope = hh * r
-            for k, (_, _, other, same) in enumerate(out):
-                if math.isclose(slope, other, rel_tol=1e-12):
-                    out[k] = out[k][:3] + ((*same, excitation_label(hh, s)),)
+            slope, offset = hh * line.slope, hh * line.offset
+            for k, (_, _, other, other_offset, same) in enumerate(out):
+                if math.isclose(slope, other, rel_tol=1e-12) and math.isclose(offset, other_offset, rel_tol=1e-12):
+                    out[k] = out[k][:4] + ((*same, excitation_label(hh, s)),)
                     break
             else:
-                out.append((s, hh, slope, ()))
+                out.append((s, hh, slope, offset, ()))
     return out
 
 
@@ -1024,9 +978,11 @@ def _stability_changes(solver: _Solver, Omega, lam_grid, shapes, whirl, log_dec,
     return tuple(sorted(out, key=lambda c: (c.speed, c.mode)))
 
 
-def _refine(solver: _Solver, Omega, lam_grid, shapes, whirl, i, j, spool, harmonic, slope) -> CriticalSpeed:
-    """The crossing of whirl curve j with the line slope x Omega in [Omega_i, Omega_i+1] (:func:`_root`)."""
-    root, lam, shape = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.imag - slope * W)
+def _refine(solver: _Solver, Omega, lam_grid, shapes, whirl, at: tuple[int, int], line) -> CriticalSpeed:
+    """The crossing of whirl curve j with the excitation line ``line`` = (spool, harmonic, slope, offset), frequency
+    slope x Omega + offset, in [Omega_i, Omega_i+1], ``at`` = (i, j) (:func:`_root`)."""
+    (i, j), (spool, harmonic, slope, offset) = at, line
+    root, lam, shape = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.imag - (slope * W + offset))
     if whirl[i, j] == whirl[i + 1, j]:
         label = str(whirl[i, j])  # also right inside a multiple eigenvalue, where the shape is any basis vector
     else:

@@ -1,12 +1,15 @@
 """Steady-state harmonic response: unbalance response over a speed sweep, FRFs, and the
 steady state at one operating point in model coordinates (a transient's initial condition).
 
-Works on any model with the :class:`~rotorred.model.assembly.SystemMatrices` interface, full or
-reduced (:class:`~rotorred.linear.reduction.ReducedSystem`): it needs ``M, K, damping(speeds),
-spools`` and ``output_rows(outputs)``. A physical force ``f`` at (node, direction) enters
-the model's coordinates as ``rowᵀ f`` with ``row = output_rows([(node, direction)])``
-(virtual work; for a full model this is the unit vector, for a reduced one the row of the
-recovery map T, i.e. ``Tᵀ f``).
+Each analysis takes ``(model, operating, ...)``: a :class:`~rotorred.model.rotor.Rotor`, its
+:class:`~rotorred.model.assembly.SystemMatrices` or a reduced model
+(:class:`~rotorred.linear.reduction.ReducedSystem`), read through
+:func:`~rotorred.model.assembly.system_of` (``M, K, damping(speeds), spools, spool_of`` and
+``output_rows(outputs)``), and the spool speeds as one :class:`~rotorred.model.operating.Operating`.
+
+A physical force ``f`` at (node, direction) enters the model's coordinates as ``rowᵀ f`` with
+``row = output_rows([(node, direction)])`` (virtual work; for a full model this is the unit vector,
+for a reduced one the row of the recovery map T, i.e. ``Tᵀ f``).
 
 Conventions
 -----------
@@ -18,8 +21,9 @@ i.e. ``F = Re(F̂ e^{i Omega_s t})`` with the phasors ``F̂_x = m_e Omega_s² e^
     Q = (K - Omega_s² M + i Omega_s (C + sum_t Omega_t G_t))^-1 F̂,
 
 where every spool ``t`` spins at its own speed ``Omega_t`` (Xu et al. 2016, Eq. 13, steady
-state, F_L = 0). The spool speeds follow one reference speed at fixed ratios,
-``Omega_t = ratio_t * Omega_ref``.
+state, F_L = 0). Along a speed line the spool speeds follow the reference speed by the one rule
+:meth:`Operating.lines <rotorred.model.operating.Operating.lines>`, ``Omega_t = a_t Omega_ref + b_t`` (a stated or
+nominal ratio, or a fixed speed).
 
 Two spools at different speeds excite two different frequencies: their responses add in
 time, ``q(t) = Re(Q_inner e^{i Omega_inner t}) + Re(Q_outer e^{i Omega_outer t})``, not as one
@@ -41,8 +45,11 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks, writers
+from rotorred.model.assembly import system_of
 from rotorred.model.loads import Unbalance
 from rotorred.results import Result
+from rotorred.model.operating import Operating
+from rotorred.model.operating import checked as checked_operating
 
 Output = tuple[int, str]
 #: significant digits of the CSV files
@@ -62,13 +69,15 @@ class UnbalanceResponse(Result):
         Reference spool speed at each sweep point (rad/s).
     reference_spool : str
     spool_speeds : dict of str to ndarray, shape (n,)
-        Speed of every spool (rad/s) = ratio * ``speeds``.
+        Speed of every spool (rad/s) at each sweep point (:meth:`Operating.speeds`).
     outputs : tuple of (int, str)
         Requested physical DOFs (node, direction).
     phasors : dict of str to dict of (int, str) to ndarray, shape (n,), complex
         ``phasors[spool][output]``: complex amplitude Q (m) of the response to the unbalances
         of ``spool``, at that spool's frequency: ``q(t) = Re(Q e^{i Omega_spool t})``.
         Only spools carrying an unbalance appear.
+    operating : Operating or None
+        The speed line of the sweep.
     """
 
     speeds: np.ndarray
@@ -76,6 +85,7 @@ class UnbalanceResponse(Result):
     spool_speeds: Mapping[str, np.ndarray]
     outputs: tuple[Output, ...]
     phasors: Mapping[str, Mapping[Output, np.ndarray]]
+    operating: Operating | None = None
 
     @property
     def excited_spools(self) -> tuple[str, ...]:
@@ -211,6 +221,8 @@ class FrequencyResponse(Result):
     H : ndarray, shape (n, len(outputs), len(inputs)), complex
         Receptance (m/N): ``H[k, o, i]`` = displacement phasor at ``outputs[o]`` per unit
         force phasor at ``inputs[i]`` at ``frequencies[k]``. Use :meth:`h` to read one pair.
+    operating : Operating or None
+        The operating point where the spools turn.
     """
 
     frequencies: np.ndarray
@@ -218,6 +230,7 @@ class FrequencyResponse(Result):
     inputs: tuple[Output, ...]
     outputs: tuple[Output, ...]
     H: np.ndarray
+    operating: Operating | None = None
 
     def h(self, output: Output, input: Output) -> np.ndarray:  # noqa: A002 - FRF vocabulary
         """Receptance (m/N) from ``input`` to ``output``, shape (n,)."""
@@ -306,10 +319,13 @@ class SteadyState(Result):
     phasors : dict of str to ndarray, shape (n,), complex
         Complex amplitude of every model coordinate for the unbalances of each spool, at that
         spool's frequency ``speeds[spool]``.
+    operating : Operating or None
+        The operating point.
     """
 
     speeds: Mapping[str, float]
     phasors: Mapping[str, np.ndarray]
+    operating: Operating | None = None
 
     def displacement(self, t: float) -> np.ndarray:
         """q(t) = sum_s Re(Q_s e^{i Omega_s t}) (model coordinates), shape (n,)."""
@@ -364,27 +380,28 @@ class SteadyState(Result):
         return xr.Dataset(data, coords, attrs={"title": "steady unbalance response"})
 
 
-def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, float],
-                 spool_of: Mapping[int, str] | None = None) -> SteadyState:
-    """Steady-state unbalance response of ``model`` at the spool speeds ``speeds`` (rad/s).
+def steady_state(model, operating: Operating, unbalances: Sequence[Unbalance]) -> SteadyState:
+    """Steady-state unbalance response of ``model`` at the operating point ``operating``.
 
     Parameters
     ----------
-    model : SystemMatrices or ReducedSystem
+    model : Rotor, SystemMatrices or ReducedSystem
+        Read through :func:`rotorred.model.assembly.system_of`; the spool of each node is the model's
+        ``spool_of``.
+    operating : Operating
+        One operating point (:meth:`Operating.point`): the speed of every spool (rad/s) by
+        :meth:`Operating.single`.
     unbalances : sequence of Unbalance
-    speeds : dict of str to float
-        Speed of every spool (rad/s).
-    spool_of : dict of int to str, optional
-        Spool of each node (optional for a single-spool model).
+        Each rotates with the spool its node belongs to.
 
     Returns
     -------
     SteadyState
+        Phasors of shape (n_dof,) in the model's coordinates.
     """
-    spools = tuple(model.spools)
-    checks.keys("speeds", speeds, spools, required=spools)
-    speeds = {s: checks.non_negative(f"speeds.{s}", w, "rad/s") for s, w in speeds.items()}
-    forces = unbalance_forces(model, unbalances, spool_of)
+    model = system_of(model)
+    speeds = checked_operating(operating).single(model)
+    forces = unbalance_forces(model, unbalances)
     D, K = model.damping(speeds), model.stiffness(speeds)
     phasors = {}
     for s, f in forces.items():
@@ -393,19 +410,19 @@ def steady_state(model, unbalances: Sequence[Unbalance], speeds: Mapping[str, fl
             phasors[s] = np.zeros(model.n_dof, dtype=complex)
             continue
         phasors[s] = sla.solve(K - w * w * model.M + 1j * w * D, w * w * f, check_finite=False)
-    return SteadyState(speeds=speeds, phasors=phasors)
+    return SteadyState(speeds=speeds, phasors=phasors, operating=operating)
 
 
-def unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
+def unbalance_forces(model, unbalances: Sequence[Unbalance]) -> dict[str, np.ndarray]:
     """Force phasor per unit Omega² of each spool's unbalances, in model coordinates: ``F(t) = Re(Omega^2 F e^{i Omega t})``
-    with Omega the spool's speed; shape (n,), complex, per spool."""
+    with Omega the spool's speed; shape (n,), complex, per spool. The spool of each unbalance's node is the model's
+    ``spool_of`` (:class:`rotorred.model.assembly.SpoolSpeedMixin`)."""
     spools = tuple(model.spools)
     dofs = model.full_dofs
-    if spool_of is None:
-        if len(spools) != 1:
-            checks.fail("spool_of", spool_of, f"must be given (node -> spool, e.g. Rotor.spool_of) for a model with "
-                        f"{len(spools)} spools")
-        spool_of = {n: spools[0] for n in dofs.nodes}
+    spool_of = model.spool_of
+    if not spool_of:
+        checks.fail("model", type(model).__name__, f"must know the spool of each node (built from a Rotor: assemble, "
+                    f"reduce_rotor) to place unbalances on a model of {len(spools)} spools")
     if len(unbalances) == 0:
         checks.fail("unbalances", unbalances, "must hold at least one Unbalance")
     per_spool: dict[str, np.ndarray] = {}
@@ -415,8 +432,8 @@ def unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
         checks.node(f"unbalances[{k}].node", u.node, dofs.nodes, "a node of the model")
         s = spool_of.get(u.node)
         if s not in spools:
-            checks.fail(f"unbalances[{k}].node", u.node, f"must have a spool of the model ({', '.join(spools)}) in "
-                        f"spool_of, not {s!r}")
+            checks.fail(f"unbalances[{k}].node", u.node, f"must lie on a spool of the model ({', '.join(spools)}), "
+                        f"not {s!r}")
         rows = model.output_rows([(u.node, "x"), (u.node, "y")])
         # per unit Omega²: F_x = m_e e^{i phi}, F_y = -i m_e e^{i phi}
         f = u.m_e * np.exp(1j * u.phase) * (rows[0] - 1j * rows[1])
@@ -424,80 +441,52 @@ def unbalance_forces(model, unbalances, spool_of) -> dict[str, np.ndarray]:
     return per_spool
 
 
-def _check_speeds(speeds, name: str = "speeds") -> np.ndarray:
-    """A non-empty 1-D array of speeds or frequencies >= 0 (rad/s); a single number is one point."""
-    return checks.vector(name, [speeds] if np.ndim(speeds) == 0 else speeds, "rad/s", ge=0.0)
-
-
-def unbalance_response(model, unbalances: Sequence[Unbalance], speeds, ratios: Mapping[str, float] | None = None,
-                       outputs: Sequence[Output] = (), spool_of: Mapping[int, str] | None = None,
-                       reference_spool: str | None = None) -> UnbalanceResponse:
-    """Steady-state response to unbalances on any spool over a speed sweep.
+def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalance],
+                       outputs: Sequence[Output]) -> UnbalanceResponse:
+    """Steady-state response to unbalances on any spool along a speed line.
 
     Parameters
     ----------
-    model : SystemMatrices or ReducedSystem
+    model : Rotor, SystemMatrices or ReducedSystem
+        Read through :func:`rotorred.model.assembly.system_of`; the spool of each node is the model's
+        ``spool_of``.
+    operating : Operating
+        The speed line (:meth:`Operating.line`) or point: ``Omega``, shape (n,), the reference spool's speeds
+        (rad/s, >= 0); every spool's speed at each point by :meth:`Operating.speeds`.
     unbalances : sequence of Unbalance
-        Each rotates with the spool its node belongs to (``spool_of``).
-    speeds : array_like, shape (n,)
-        Reference spool speeds of the sweep (rad/s), >= 0.
-    ratios : dict of str to float, optional
-        Omega_spool / Omega_ref for every spool (the reference spool's is 1). Optional for a
-        single-spool model; required (for every spool other than the reference) otherwise.
+        Each rotates with the spool its node belongs to.
     outputs : sequence of (int, str)
         Physical DOFs (node, direction) to report; any node of the full model.
-    spool_of : dict of int to str, optional
-        Spool of each node (``Rotor.spool_of``); optional for a single-spool model.
-    reference_spool : str, optional
-        Spool whose speed ``speeds`` gives (default the first of ``model.spools``).
 
     Returns
     -------
     UnbalanceResponse
+        Phasors of shape (n,) per excited spool and output (m).
     """
-    spools = tuple(model.spools)
-    speeds = _check_speeds(speeds)
+    model = system_of(model)
+    operating = checked_operating(operating)
+    spool_speeds = operating.speeds(model)
+    speeds = operating.Omega
     outputs = model.full_dofs.checked_outputs(outputs, "outputs")
     if not outputs:
         checks.fail("outputs", outputs, "must name at least one (node, direction) pair")
-    reference_spool = checks.choice("reference_spool", spools[0] if reference_spool is None else reference_spool,
-                                    spools)
-    ratios = _ratios(ratios, spools, reference_spool)
-    per_spool = unbalance_forces(model, unbalances, spool_of)
+    per_spool = unbalance_forces(model, unbalances)
     R = model.output_rows(outputs)
-    spool_speeds = {s: ratios[s] * speeds for s in spools}
     phasors = {s: np.zeros((len(speeds), len(outputs)), dtype=complex) for s in per_spool}
     M = model.M
     for k in range(len(speeds)):
-        at = {s: float(spool_speeds[s][k]) for s in spools}
+        at = {s: float(w[k]) for s, w in spool_speeds.items()}
         D, K = model.damping(at), model.stiffness(at)
         for s, f in per_spool.items():
-            w = float(spool_speeds[s][k])
+            w = at[s]
             if w == 0.0:
                 continue  # no unbalance force at rest
             Z = K - w * w * M + 1j * w * D
             phasors[s][k] = R @ sla.solve(Z, w * w * f, check_finite=False)
     return UnbalanceResponse(
-        speeds=speeds, reference_spool=reference_spool, spool_speeds=spool_speeds, outputs=outputs,
-        phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors})
-
-
-def _ratios(given, spools: tuple[str, ...], reference: str) -> dict[str, float]:
-    """Omega_spool / Omega_reference of every spool: ``given`` checked and completed."""
-    ratios = {} if given is None else dict(checks.table("ratios", given))
-    unknown = sorted(set(ratios) - set(spools))
-    if unknown:
-        checks.fail("ratios", given, f"must name only spools of the model ({', '.join(spools)}); unknown spool(s) "
-                    f"{unknown}")
-    ratios.setdefault(reference, 1.0)
-    if ratios[reference] != 1.0:
-        checks.fail(f"ratios[{reference!r}]", ratios[reference], "must be 1 (it is the reference spool)")
-    if len(spools) == 1:
-        ratios.setdefault(spools[0], 1.0)
-    missing = [s for s in spools if s not in ratios]
-    if missing:
-        checks.fail("ratios", given, f"must give the speed ratio (to {reference!r}) of spool(s) {missing}")
-    return {s: checks.non_negative(f"ratios[{s!r}]", r) for s, r in ratios.items()}
+        speeds=speeds, reference_spool=operating.reference_of(model), spool_speeds=spool_speeds, outputs=outputs,
+        phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors},
+        operating=operating)
 
 
 def response_error(reference: UnbalanceResponse, other: UnbalanceResponse, floor: float = 1e-3) -> float:
@@ -529,37 +518,42 @@ def response_error(reference: UnbalanceResponse, other: UnbalanceResponse, floor
     return worst
 
 
-def frequency_response(model, inputs: Sequence[Output], outputs: Sequence[Output], frequencies,
-                       speeds: Mapping[str, float] | None = None) -> FrequencyResponse:
+def frequency_response(model, operating: Operating, inputs: Sequence[Output], outputs: Sequence[Output],
+                       frequencies) -> FrequencyResponse:
     """Receptance FRFs H(omega) = R (K - omega² M + i omega (C + sum Omega_s G_s))^-1 Bᵀ.
 
     Parameters
     ----------
-    model : SystemMatrices or ReducedSystem
+    model : Rotor, SystemMatrices or ReducedSystem
+        Read through :func:`rotorred.model.assembly.system_of`.
+    operating : Operating
+        The operating point where the spools turn during the sweep (:meth:`Operating.point`; the speed of
+        every spool (rad/s) by :meth:`Operating.single`); ``Operating.point({spool: 0.0})`` for a rotor at rest.
     inputs, outputs : sequence of (int, str)
         Force and response DOFs (node, direction), any node of the full model.
     frequencies : array_like, shape (n,)
         Excitation frequencies (rad/s), >= 0.
-    speeds : dict of str to float, optional
-        Spool speeds (rad/s) held fixed during the sweep (default: not spinning).
 
     Returns
     -------
     FrequencyResponse
+        ``H`` of shape (n, len(outputs), len(inputs)) (m/N).
     """
+    model = system_of(model)
+    speeds = checked_operating(operating).single(model)
     inputs = model.full_dofs.checked_outputs(inputs, "inputs")
     outputs = model.full_dofs.checked_outputs(outputs, "outputs")
     for name, pairs in (("inputs", inputs), ("outputs", outputs)):
         if not pairs:
             checks.fail(name, pairs, "must name at least one (node, direction) pair")
-    w_all = _check_speeds(frequencies, "frequencies")
-    speeds = dict(speeds or {})
-    D, K = model.damping(speeds), model.stiffness(speeds)  # InputError for unknown spools
+    w_all = checks.vector("frequencies", [frequencies] if np.ndim(frequencies) == 0 else frequencies, "rad/s",
+                          ge=0.0)
+    D, K = model.damping(speeds), model.stiffness(speeds)
     B = model.output_rows(inputs).T
     R = model.output_rows(outputs)
     H = np.empty((len(w_all), len(outputs), len(inputs)), dtype=complex)
     for k, w in enumerate(w_all):
         Z = K - w * w * model.M + 1j * w * D
         H[k] = R @ sla.solve(Z, B.astype(complex), check_finite=False)
-    return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H)
-
+    return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H,
+                             operating=operating)

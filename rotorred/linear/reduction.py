@@ -41,6 +41,8 @@ from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
 from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble, model_summary
 from rotorred.model.dofs import DofMap
+from rotorred.model.operating import Operating
+from rotorred.model.operating import checked as checked_operating
 from rotorred.model.rotor import Rotor, node_ranges
 from rotorred.results import Result
 
@@ -120,41 +122,34 @@ class ModeSelection:
 class ResponseCheck:
     """An unbalance-response accuracy requirement for the automatic mode count.
 
-    The reduced model's unbalance response over ``speeds`` must match the full model's
+    The reduced model's unbalance response along ``operating`` must match the full model's
     within ``target`` (see :func:`rotorred.linear.harmonic.response_error`).
 
     Parameters
     ----------
     unbalances : tuple of Unbalance
-    speeds : ndarray, shape (n,)
-        Reference spool speeds of the sweep (rad/s).
+    operating : Operating
+        The speed line of the sweep (:class:`rotorred.model.operating.Operating`; speeds in rad/s).
     outputs : tuple of (int, str)
         Physical DOFs checked.
-    ratios : dict of str to float, optional
-        Spool speed ratios (see :func:`rotorred.linear.harmonic.unbalance_response`).
-    spool_of : dict of int to str, optional
-        Spool of each node.
     target : float
         Relative error target (default 5e-3, i.e. 0.5 %).
     """
 
     unbalances: tuple
-    speeds: np.ndarray
+    operating: Operating
     outputs: tuple
-    ratios: Mapping[str, float] | None = None
-    spool_of: Mapping[int, str] | None = None
     target: float = 5e-3
 
     def __post_init__(self):
         object.__setattr__(self, "unbalances", tuple(self.unbalances))
+        object.__setattr__(self, "operating", checked_operating(self.operating))
         object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
-        object.__setattr__(self, "speeds", np.asarray(self.speeds, dtype=float))
         object.__setattr__(self, "target", checks.positive("target", self.target))
 
     def run(self, model):
         """Unbalance response of ``model`` for this check."""
-        return unbalance_response(model, self.unbalances, self.speeds, ratios=self.ratios,
-                                  outputs=self.outputs, spool_of=self.spool_of)
+        return unbalance_response(model, self.operating, self.unbalances, self.outputs)
 
 
 @dataclass(frozen=True)

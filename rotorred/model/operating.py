@@ -316,3 +316,11 @@ def _spools_and_nominal(model) -> tuple[tuple[str, ...], dict[str, float]]:
         nominal = getattr(model, "speeds", None)
     nominal = dict(nominal) if isinstance(nominal, Mapping) else {}
     return names, nominal
+
+
+def checked(value, field_name: str = "operating") -> Operating:
+    """``value`` if it is an :class:`Operating`; the error names ``field_name`` and the constructors otherwise."""
+    if not isinstance(value, Operating):
+        checks.fail(field_name, value, "must be an Operating (Operating.point, Operating.line, Operating.profile; "
+                    "rotorred.model.operating)")
+    return value

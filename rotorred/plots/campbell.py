@@ -141,27 +141,27 @@ def _excitation_lines(ax, result: CampbellResult, top: float) -> None:
                                                                        np.array([0.0, result.speeds[0]]))
     placed: list[tuple[float, float]] = []
     dashes = [(0, (6, 2)), (0, (1, 1.5)), (0, (6, 2, 1, 2)), (0, (3, 3)), (0, (8, 2, 1, 2, 1, 2))]
-    for k, (spool, h, slope) in enumerate(result.excitation_lines):
+    for k, (spool, h, slope, offset) in enumerate(result.excitation_lines):
         label = excitation_label(h, spool)
-        ax.plot(line_rpm, slope * line_speeds / (2 * np.pi), color="0.2", lw=1.0, linestyle=dashes[k % len(dashes)],
-                label=label)
+        ax.plot(line_rpm, (slope * line_speeds + offset) / (2 * np.pi), color="0.2", lw=1.0,
+                linestyle=dashes[k % len(dashes)], label=label)
         if x_max <= x0:
             continue
         # distances in axes fractions
-        hz_per_rpm = slope * np.pi / 30 / (2 * np.pi)
-        x_end = min(x_max, top / hz_per_rpm) if hz_per_rpm > 0 else x_max
+        hz_per_rpm, hz0 = slope * np.pi / 30 / (2 * np.pi), offset / (2 * np.pi)
+        x_end = min(x_max, (top - hz0) / hz_per_rpm) if hz_per_rpm > 0 else x_max
         best, x = -1.0, 0.5 * (x0 + x_end)
         for t in np.linspace(0.2, 0.9, 15):
             xc = x0 + t * (x_end - x0)
-            yc = hz_per_rpm * xc
+            yc = hz_per_rpm * xc + hz0
             gaps = [abs(np.interp(xc, rpm, f_hz[:, j]) - yc) / top for j in range(result.n_modes)]
             gaps += [np.hypot((xc - xp) / (x_max - x0), (yc - yp) / top) for xp, yp in placed]
             if min(gaps) > best:
                 best, x = min(gaps), xc
-        placed.append((x, hz_per_rpm * x))
-        p0, p1 = ax.transData.transform([(x, hz_per_rpm * x), (x + 1.0, hz_per_rpm * (x + 1.0))])
+        placed.append((x, hz_per_rpm * x + hz0))
+        p0, p1 = ax.transData.transform([(x, hz_per_rpm * x + hz0), (x + 1.0, hz_per_rpm * (x + 1.0) + hz0)])
         angle = float(np.degrees(np.arctan2(p1[1] - p0[1], p1[0] - p0[0])))
-        ax.text(x, hz_per_rpm * x, label, rotation=angle, rotation_mode="anchor", ha="center", va="center",
+        ax.text(x, hz_per_rpm * x + hz0, label, rotation=angle, rotation_mode="anchor", ha="center", va="center",
                 fontsize=8.5, color="0.1", bbox=dict(boxstyle="round,pad=0.12", fc="white", ec="none", alpha=0.85),
                 zorder=4)
 
@@ -170,8 +170,10 @@ def _axes_and_legend(ax, result: CampbellResult, title: str | None) -> None:
     """Axis labels (rpm, Hz), the other spool's speed on top, title with the speed ratios, legend."""
     ax.set_xlabel(f"speed of the {result.reference} spool (rpm)")
     ax.set_ylabel("whirl frequency (Hz)")
-    others = {s: r for s, r in result.speed_ratios.items() if s != result.reference}
-    ratio_text = ", ".join(f"Ω_{s}/Ω_{result.reference} = {r:.4g}" for s, r in others.items())
+    fixed = result.fixed_speeds
+    others = {s: r for s, r in result.speed_ratios.items() if s != result.reference and s not in fixed}
+    ratio_text = ", ".join([f"Ω_{s}/Ω_{result.reference} = {r:.4g}" for s, r in others.items()]
+                           + [f"{s} fixed at {w * 30 / np.pi:.6g} rpm" for s, w in fixed.items()])
     default_title = f"Campbell diagram — {result.rotor_name or 'rotor'}" + (f" ({ratio_text})" if ratio_text else "")
     ax.set_title(title or default_title)
     if len(others) == 1:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from rotorred import checks
 
-__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "check", "MAX_STEPS", "MAX_DOFS",
+__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "MAX_STEPS", "MAX_DOFS",
            "MEMORY_FRACTION", "format_bytes"]
 
 MAX_STEPS = 100_000_000

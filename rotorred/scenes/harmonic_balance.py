@@ -194,7 +194,7 @@ def rub_problem(scene, model, H: int, N: int, f0: float | None = None) -> RubPro
     orders = {s: int(round(fs / f0)) for s, fs in f.items()}
     if any(k > H for k in orders.values()):
         checks.fail("H", H, f"must reach the spools' harmonics of f0 = {f0:g} Hz ({max(orders.values())})")
-    phasors = unbalance_forces(model, scene.unbalances, scene.rotor.spool_of) if scene.unbalances else {}
+    phasors = unbalance_forces(model, scene.unbalances) if scene.unbalances else {}
     forcing = _forcing(h, n + 2 * len(scene.plates), phasors, orders)
     problem = CondensedProblem(M, D, K, h, dofs, forcing, forces)
     return RubProblem(problem, 2 * math.pi * f0, f0, n, model)

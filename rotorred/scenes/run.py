@@ -46,6 +46,7 @@ import numpy as np
 from rotorred.model.assembly import assemble
 from rotorred.progress import stage
 from rotorred.linear.harmonic import SteadyState, steady_state
+from rotorred.model.operating import Operating
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
 from rotorred.signals.classify import Classification, classify
@@ -273,7 +274,7 @@ def scene_steady_state(scene: Scene, model) -> SteadyState | None:
     """Linear steady state of the scene's unbalances, per spool (None without unbalances)."""
     if not scene.unbalances:
         return None
-    return steady_state(model, scene.unbalances, scene.speeds, scene.rotor.spool_of)
+    return steady_state(model, Operating.point(scene.speeds), scene.unbalances)
 
 
 def _static_deflection(scene: Scene, model) -> np.ndarray | None:

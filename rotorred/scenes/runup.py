@@ -251,6 +251,7 @@ def orbit_snapshots(scene: Scene, t: np.ndarray, speeds: dict, outputs: dict) ->
 def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
     """Campbell critical speeds of the reference spool within the swept range, at the profile's final ratios."""
     from rotorred.linear.campbell import campbell
+    from rotorred.model.operating import Operating
 
     ref = scene.runup.reference
     final = {s: float(v[-1]) for s, v in speeds.items()}
@@ -258,7 +259,7 @@ def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
         final = {s: float(np.max(v)) for s, v in speeds.items()}
     ratio = {s: w / final[ref] for s, w in final.items() if s != ref}
     top = float(np.max(speeds[ref]))
-    cd = campbell(scene.rotor, np.linspace(0.0, top, CAMPBELL_SPEEDS), ratio=ratio or None, reference=ref)
+    cd = campbell(scene.rotor, Operating.line(np.linspace(0.0, top, CAMPBELL_SPEEDS), ref, ratios=ratio))
     low = float(np.min(speeds[ref]))
     return tuple(c for c in cd.critical_speeds if low <= c.speed <= top), {ref: 1.0, **ratio}
 

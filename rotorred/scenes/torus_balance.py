@@ -141,7 +141,7 @@ def torus_rub_problem(scene, model, torus, H1: int, H2: int, N1: int, N2: int,
     dofs, forces = plate_rubs(model, scene)
     orders = {s: _spool_order(h, bases, f_s) for s, f_s in scene.frequencies_hz.items()}
     Q = np.zeros((h.n_orders, n + p), complex)
-    phasors = unbalance_forces(model, scene.unbalances, scene.rotor.spool_of) if scene.unbalances else {}
+    phasors = unbalance_forces(model, scene.unbalances) if scene.unbalances else {}
     for s, phasor in phasors.items():  # F = Re(Omega_s^2 F_s e^{i Omega_s t}) at the spool's order
         Q[h.index(*orders[s]), :n] += scene.speeds[s] ** 2 * phasor
     problem = TorusProblem(M, D, K, h, w, dofs, h.from_phasors(Q), forces)
