@@ -348,7 +348,8 @@ class PeriodicSolution(Result):
         return np.arange(self.H + 1) * self.omega / (2.0 * np.pi)
 
     def summary(self) -> list[str]:
-        strongest = np.argsort(-self.amplitudes.max(axis=1))[:3]
+        largest = self.amplitudes.max(axis=1)
+        strongest = [k for k in np.argsort(-largest)[:3] if largest[k] > 1e-9 * largest.max()]  # above round-off
         top = ", ".join(f"{k} ({self.amplitudes[k].max():.4g} m at DOF {self.dofs[int(np.argmax(self.amplitudes[k]))]})"
                         for k in strongest)
         return [f"harmonic balance at omega = {self.omega:.6g} rad/s ({self.omega / (2 * np.pi):.6g} Hz): "

@@ -115,9 +115,10 @@ def _stability_segments(ax, x: np.ndarray, y: np.ndarray, stable: np.ndarray) ->
 MAX_COLUMNS = 6
 
 
-def plot_harmonics(frequencies, amplitudes, labels, ax=None, *, columns=None, scale: float = 1e6, unit: str = "µm",
-                   title: str | None = None):
-    """A solution's amplitude of each harmonic (or line) at its frequency, a stem a column (DOF), on a log scale.
+def plot_harmonics(frequencies, amplitudes, labels, ax=None, *, columns=None, dynamic_range: float = 1e8,
+                   scale: float = 1e6, unit: str = "µm", title: str | None = None):
+    """A solution's amplitude of each harmonic (or line) at its frequency, a stem a column (DOF), on a log scale from
+    the largest over ``dynamic_range`` up.
 
     Parameters
     ----------
@@ -131,6 +132,8 @@ def plot_harmonics(frequencies, amplitudes, labels, ax=None, *, columns=None, sc
         Where to draw (default: a new figure).
     columns : sequence of int, optional
         The columns drawn (default: all, or the :data:`MAX_COLUMNS` of largest amplitude).
+    dynamic_range : float
+        Amplitudes below the largest over this are not drawn (round-off, 1e-17 of a solution, is not shown).
     scale, unit : float, str
         Plotted amplitudes ``scale * amplitudes`` in ``unit`` (default µm from m).
     title : str, optional
@@ -140,19 +143,22 @@ def plot_harmonics(frequencies, amplitudes, labels, ax=None, *, columns=None, sc
     matplotlib.figure.Figure
     """
     f = checks.vector("frequencies", frequencies, min_len=1)
-    A = checks.array("amplitudes", amplitudes, (f.size, len(labels)), "m")
+    A = scale * checks.array("amplitudes", amplitudes, (f.size, len(labels)), "m")
+    dynamic_range = checks.number("dynamic_range", dynamic_range, gt=1.0)
     if columns is None:
         columns = np.sort(np.argsort(-A.max(axis=0))[:MAX_COLUMNS])
     fig, ax, new = laid_out(ax, (8, 5))
+    floor = (float(A[:, columns].max()) or 1.0) / dynamic_range
     width = 0.3 * float(np.min(np.diff(np.unique(f)), initial=1.0) or 1.0) / max(len(columns), 1)
     for i, c in enumerate(columns):
-        x, y = f + (i - (len(columns) - 1) / 2) * width, scale * A[:, c]
-        drawn = y > 0
-        ax.vlines(x[drawn], 0, y[drawn], color=f"C{i}", lw=1.2)
+        x, y = f + (i - (len(columns) - 1) / 2) * width, A[:, c]
+        drawn = y > floor
+        ax.vlines(x[drawn], floor, y[drawn], color=f"C{i}", lw=1.2)
         ax.plot(x[drawn], y[drawn], "o", ms=4, color=f"C{i}", label=labels[c])
     ax.set_yscale("log")
+    ax.set_ylim(bottom=floor)
     ax.set_xlabel("Frequency (Hz)")
     ax.set_ylabel(f"Amplitude ({unit})")
-    ax.grid(True, which="both", alpha=0.3)
+    ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     return titled(fig, ax, title, new)
