@@ -30,17 +30,21 @@ from scipy.optimize import brentq
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import to_phasors
-from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, coefficient_variables, solve
 from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
 from rotorred.results import Result
 
-__all__ = ["Fold", "Branch", "INTERRUPTS", "continue_branch", "interrupt_name", "parameter_of"]
+__all__ = ["Fold", "Branch", "INTERRUPTS", "STABILITY_FLAGS", "continue_branch", "interrupt_name", "parameter_of",
+           "stability_variable"]
 
 #: the exceptions that end a branch where it is, its points kept, and the signal each stands for (a caller may name
 #: others: ``rotorred continue`` adds the command line's SIGTERM)
 INTERRUPTS = MappingProxyType({KeyboardInterrupt: "SIGINT"})
 
+#: a point's stability as a NetCDF flag (CF flag_values, flag_meanings: the variable ``stable``,
+#: :func:`stability_variable`)
+STABILITY_FLAGS = MappingProxyType({1: "stable", 0: "unstable", -1: "unknown"})
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
 MAX_JUMP = 2.0
@@ -133,7 +137,7 @@ class Branch(Result):
     def phasors(self) -> np.ndarray:
         """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of each point, harmonic k and DOF, shape
         (p, H + 1, n) (:func:`rotorred.nonlinear.fourier.to_phasors`)."""
-        return np.array([to_phasors(zi.reshape(-1, self.n)) for zi in self.z]).reshape(len(self.z), self.H + 1, self.n)
+        return np.array([to_phasors(zi.reshape(-1, self.n)) for zi in self.z])
 
     def amplitude(self, dof: int, order: int = 1) -> np.ndarray:
         """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of the unknown ``dof`` at each point,
@@ -176,17 +180,11 @@ class Branch(Result):
         import xarray as xr
 
         name, unit = self.parameter
-        Q, dims = self.phasors, ("point", "harmonic", "dof")
-        flags = np.where(self.known, self.stable.astype(np.int8), np.int8(-1)).astype(np.int8)
         return xr.Dataset(
-            {"cos": (dims, Q.real, {"units": "m", "long_name": "cosine coefficient a_k"}),
-             "sin": (dims, -Q.imag, {"units": "m", "long_name": "sine coefficient b_k"}),
-             "amplitude": (dims, np.abs(Q), {"units": "m", "long_name": "amplitude sqrt(a_k^2 + b_k^2)"}),
+            {**coefficient_variables(self.phasors, ("point", "harmonic", "dof")),
              "max_real": ("point", self.max_real, {"units": "s-1", "long_name": "largest real part of the Floquet "
                                                    "exponents (NaN: not computed)"}),
-             "stable": ("point", flags, {"units": "1", "long_name": "stability (-1: not computed)",
-                                         "flag_values": np.array([1, 0, -1], np.int8),
-                                         "flag_meanings": "stable unstable unknown"}),
+             "stable": stability_variable(self.stable, self.known),
              "iterations": ("point", self.iterations, {"units": "1", "long_name": "corrector iterations"}),
              "slope": ("point", self.slope, {"units": "1", "long_name": "d parameter / ds of the unit tangent"}),
              "fold_parameter": ("fold", np.array([f.value for f in self.folds], float),
@@ -197,6 +195,15 @@ class Branch(Result):
                     "harmonic": ("harmonic", np.arange(self.H + 1), {"units": "1", "long_name": "harmonic k"}),
                     "dof": ("dof", np.arange(self.n), {"units": "1", "long_name": "unknown DOF"})},
             attrs={"stopped": self.stopped, "interrupt": self.interrupt or "no"})
+
+
+def stability_variable(stable: np.ndarray, known: np.ndarray) -> tuple:
+    """The dataset variable ``stable`` of a branch's points (dim point): each point's :data:`STABILITY_FLAGS` value, 1
+    stable, 0 unstable, -1 where ``known`` is False (not computed), int8, with its CF flag attributes."""
+    flags = np.where(known, np.asarray(stable).astype(np.int8), np.int8(-1)).astype(np.int8)
+    return ("point", flags, {"units": "1", "long_name": "stability of the point (-1: not computed)",
+                             "flag_values": np.array(list(STABILITY_FLAGS), np.int8),
+                             "flag_meanings": " ".join(STABILITY_FLAGS.values())})
 
 
 def _cf(unit: str) -> str:

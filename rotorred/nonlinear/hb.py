@@ -28,8 +28,8 @@ from rotorred.nonlinear.fourier import Harmonics, to_phasors
 from rotorred.nonlinear.lowrank import factored
 from rotorred.results import Result
 
-__all__ = ["PeriodicProblem", "PeriodicSolution", "Evaluation", "NotConverged", "solve", "harmonic_dataset",
-           "checked_matrices", "checked_unknowns",
+__all__ = ["PeriodicProblem", "PeriodicSolution", "Evaluation", "NotConverged", "solve", "coefficient_variables",
+           "harmonic_dataset", "checked_matrices", "checked_unknowns",
            "sampled_forces", "force_coefficients", "transformed_forces", "local_forces"]
 
 
@@ -373,18 +373,22 @@ class PeriodicSolution(Result):
                                 {"iterations": self.iterations, "residual": self.residual}, "harmonic")
 
 
+def coefficient_variables(Q: np.ndarray, dims: tuple[str, ...]) -> dict:
+    """The dataset variables of complex amplitudes ``Q = a_k - i b_k`` (m) on ``dims``: ``cos`` a_k, ``sin`` b_k and
+    ``amplitude`` sqrt(a_k^2 + b_k^2)."""
+    return {"cos": (dims, Q.real, {"units": "m", "long_name": "cosine coefficient a_k"}),
+            "sin": (dims, -Q.imag, {"units": "m", "long_name": "sine coefficient b_k"}),
+            "amplitude": (dims, np.abs(Q), {"units": "m", "long_name": "amplitude sqrt(a_k^2 + b_k^2)"})}
+
+
 def harmonic_dataset(Q: np.ndarray, orders, frequencies, dofs, variables: dict, attrs: dict, dim: str):
     """The dataset of a harmonic-balance solution's complex amplitudes ``Q`` (K, n) (m): dims ``dim`` (the harmonics or
-    the orders), dof; ``cos`` a_k, ``sin`` b_k, ``amplitude``; the ``frequency`` of each (Hz); ``variables`` and
-    ``attrs`` added (:meth:`PeriodicSolution.to_xarray`, :meth:`rotorred.nonlinear.torus.TorusSolution.to_xarray`)."""
+    the orders), dof; :func:`coefficient_variables`; the ``frequency`` of each (Hz); ``variables`` and ``attrs`` added
+    (:meth:`PeriodicSolution.to_xarray`, :meth:`rotorred.nonlinear.torus.TorusSolution.to_xarray`)."""
     import xarray as xr
 
-    dims = (dim, "dof")
     return xr.Dataset(
-        {"cos": (dims, Q.real, {"units": "m", "long_name": "cosine coefficient a_k"}),
-         "sin": (dims, -Q.imag, {"units": "m", "long_name": "sine coefficient b_k"}),
-         "amplitude": (dims, np.abs(Q), {"units": "m", "long_name": "amplitude sqrt(a_k^2 + b_k^2)"}),
-         **variables},
+        {**coefficient_variables(Q, (dim, "dof")), **variables},
         coords={dim: (dim, np.asarray(orders), {"units": "1", "long_name": f"{dim} k"}),
                 "frequency": (dim, np.asarray(frequencies), {"units": "Hz", "long_name": f"frequency of the {dim}"}),
                 "dof": ("dof", np.asarray(dofs, int), {"units": "1", "long_name": "DOF of the unknowns"})},

@@ -41,7 +41,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name
+from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name, stability_variable
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.results import Result
@@ -49,8 +49,8 @@ from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_pro
 from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.writers import _signals_blocked
 
-__all__ = ["KEYS", "PLATE_KEYS", "STABILITY_FLAGS", "SceneFamily", "SceneBranch", "check_key", "cold_start",
-           "continue_scene", "dof_name", "scene_at"]
+__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "dof_name",
+           "scene_at"]
 
 #: the plate's numbers a branch follows besides its clearance, and their units: the supports' (Eq. 7), the law's
 #: (Eq. 8) and the rim's; not mu_s (harmonic balance sees sliding only) nor the bending model's (a fitted whole)
@@ -60,8 +60,6 @@ PLATE_KEYS = {"rub.k_n": "N/m", "rub.k_t": "N/m", "rub.c_n": "N s/m", "rub.c_t":
 KEYS = {"rub.clearance": "m", "speeds.<spool>": "Hz", **PLATE_KEYS}
 #: the relative step of the central difference in dR/dvalue
 STEP = 1e-6
-#: the NetCDF variable ``stable``'s values and their meanings (CF flag_values, flag_meanings)
-STABILITY_FLAGS = {1: "stable", 0: "unstable", -1: "unknown"}
 #: intervals of the monodromy product a sample interval of the AFT: the rig's orbit reached by continuation at 13 um
 #: (H = 100, N = 2048) has its largest multiplier 0.780, 1.034, 0.640, 0.698, 0.674, 0.676, 0.679, 0.678 with 256 to
 #: 32768 intervals a period: settled from 4 N (the transient's orbit: 0.773 to 0.662, settled from 1024)
@@ -257,8 +255,9 @@ class SceneBranch(Result):
 
     @property
     def flags(self) -> np.ndarray:
-        """Each point's :data:`STABILITY_FLAGS` value: 1 stable, 0 unstable, -1 not computed; shape (p,), int8."""
-        return np.where(self.known, self.stable.astype(np.int8), np.int8(-1)).astype(np.int8)
+        """Each point's :data:`rotorred.nonlinear.continuation.STABILITY_FLAGS` value: 1 stable, 0 unstable, -1 not
+        computed; shape (p,), int8."""
+        return stability_variable(self.stable, self.known)[1]
 
     @property
     def shown(self) -> tuple[float, str]:
@@ -312,9 +311,7 @@ class SceneBranch(Result):
                  "units": "1", "long_name": "Floquet multiplier of largest modulus, real part"}),
              "critical_multiplier_im": ("point", self.critical.imag, {
                  "units": "1", "long_name": "Floquet multiplier of largest modulus, imaginary part"}),
-             "stable": ("point", self.flags,
-                        {"units": "1", "long_name": "stability of the point (-1: not computed)", "flag_values": np.array(
-                            list(STABILITY_FLAGS), np.int8), "flag_meanings": " ".join(STABILITY_FLAGS.values())}),
+             "stable": stability_variable(self.stable, self.known),
              "f0": ("point", self.f0, {"units": "Hz", "long_name": "base frequency"}),
              "iterations": ("point", self.iterations, {"units": "1", "long_name": "Newton iterations of the point"})},
             coords={netcdf_name(self.key): ("point", self.values, {"units": cf_units(self.key), "long_name": self.key,

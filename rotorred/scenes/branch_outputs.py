@@ -3,7 +3,7 @@ provenance, the base scene (``scene.toml``).
 
 A point whose stability was not computed (``--no-stability``, or an interrupt in the stability phase) is marked
 alike in each: stability "unknown" in the CSV and the summary, the NetCDF flag -1
-(:data:`rotorred.scenes.branch.STABILITY_FLAGS`), its multiplier NaN, and drawn grey in the figure. An interrupted branch's summary starts with "INCOMPLETE: " and why.
+(:data:`rotorred.nonlinear.continuation.STABILITY_FLAGS`), its multiplier NaN, and drawn grey in the figure. An interrupted branch's summary starts with "INCOMPLETE: " and why.
 """
 
 from __future__ import annotations
@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from rotorred.provenance import Provenance
-from rotorred.scenes.branch import STABILITY_FLAGS, dof_name
+from rotorred.nonlinear.continuation import STABILITY_FLAGS
+from rotorred.scenes.branch import dof_name
 from rotorred.writers import render_table, write_csv, write_netcdf, write_text
 
 __all__ = ["format_branch", "write_branch"]
