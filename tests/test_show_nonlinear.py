@@ -27,7 +27,8 @@ SHORT = (("solver.duration", 1.0), ("solver.record_start", 0.6), ("output.plot_w
 @pytest.fixture(scope="module", params=["jeffcott", "duffing"])
 def periodic(request):
     """The Jeffcott rotor in its clearance (2 DOFs, 5 harmonics) at omega = 0.98, in contact on its circular orbit
-    (harmonic 1 alone); the Duffing oscillator (1 DOF, 7 harmonics) at omega = 1.6, on its lower branch (odd harmonics)."""
+    (harmonic 1 alone); the Duffing oscillator (1 DOF, 7 harmonics) at omega = 1.6, on its lower branch (odd
+    harmonics)."""
     problem, omega = (jeffcott(5, 128), 0.98) if request.param == "jeffcott" else (duffing(7), 1.6)
     return problem, solve(problem, problem.linear_response(omega), omega)
 
@@ -126,6 +127,19 @@ def test_a_branchs_dataset_is_its_points_folds_and_stability(duffing_branch):
     assert set(ds["stable"].values) == {0, 1}  # both kinds: the unstable middle part between the folds
     np.testing.assert_array_equal(ds["fold_parameter"].values, [f.omega for f in branch.folds])
     assert len(branch.folds) == 2 and ds["fold_smooth"].values.tolist() == [1, 1]
+
+
+def test_an_interrupted_branch_says_so_in_short_lines(tmp_path):
+    """SIGINT at the 6th point: the repr says where it stopped, in lines of at most 120 characters; 6 points drawn."""
+    problem = jeffcott(5, 128)
+
+    def progress(points, omega):
+        if points == 6:
+            raise KeyboardInterrupt
+    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ds=0.1, progress=progress)
+    text = assert_short_repr(branch)
+    assert "stopped: interrupted (SIGINT) at omega = " in text and "6 points from 0.5 to" in text
+    assert len(assert_plots(branch).axes[0].lines[0].get_xdata()) == 6
 
 
 def test_a_branch_in_a_family_shows_the_familys_parameter(scene_branch, tmp_path):

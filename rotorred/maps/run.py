@@ -15,6 +15,7 @@ Order of work
 
 from __future__ import annotations
 
+import textwrap
 import time
 from collections import Counter
 from dataclasses import dataclass, replace
@@ -74,7 +75,7 @@ class MapRun(Result):
                  f"resumed, {self.n_failed} without results; wall time {self.wall_time:.3g} s",
                  "classes: " + (", ".join(f"{k} {n}" for k, n in counts.most_common()) or "none")]
         if self.incomplete:
-            lines.append(f"INCOMPLETE: {self.incomplete}")
+            lines += textwrap.wrap(f"INCOMPLETE: {self.incomplete}", 110)
         if self.files:
             lines.append(f"{len(self.files)} files in {Path(self.files[0]).parent}")
         return lines

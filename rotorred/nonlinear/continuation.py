@@ -20,6 +20,7 @@ where it is: the points so far are returned, ``stopped`` and ``interrupt`` sayin
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -159,7 +160,7 @@ class Branch(Result):
                 f"{self.values[-1]:.6g}; {self.n} DOFs, {self.H} harmonics",
                 f"turns: {len(folds)}" + (f", at {name} = {shown}" if folds else ""),
                 f"{stability}; largest amplitude of harmonic 1: {np.abs(self.phasors[:, 1]).max():.4g} m",
-                f"stopped: {self.stopped}"]
+                *textwrap.wrap(f"stopped: {self.stopped}", 110)]
 
     def plot(self, ax=None, *, dof: int = 0, order: int = 1, title: str | None = None):
         """The amplitude of harmonic ``order`` of the unknown ``dof`` (µm) against the parameter: stable solid, unstable

@@ -396,7 +396,7 @@ def harmonic_dataset(Q: np.ndarray, orders, frequencies, dofs, variables: dict, 
 
 
 def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
-          max_halvings: int = 30):
+          max_halvings: int = 30) -> PeriodicSolution:
     """The periodic solution near ``z0`` at ``omega`` by Newton's method with a backtracking line search.
 
     Parameters

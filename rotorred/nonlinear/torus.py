@@ -559,8 +559,8 @@ class TorusSolution(Result):
         h, f = self.harmonics, np.array(self.w) / (2.0 * math.pi)
         amplitudes = self.amplitudes
         strongest = np.argsort(-amplitudes.max(axis=1))[:3]
-        top = ", ".join(f"({h.orders[k][0]}, {h.orders[k][1]}) {self.frequencies[k]:.4g} Hz: {amplitudes[k].max():.3g} m"
-                        for k in strongest)
+        top = ", ".join(f"({h.orders[k][0]}, {h.orders[k][1]}) {self.frequencies[k]:.4g} Hz: "
+                        f"{amplitudes[k].max():.3g} m" for k in strongest)
         return [f"quasi-periodic harmonic balance on the torus w = ({self.w[0]:.6g}, {self.w[1]:.6g}) rad/s "
                 f"({f[0]:.6g}, {f[1]:.6g} Hz): {len(self.dofs)} DOFs",
                 f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}"

@@ -151,7 +151,10 @@ def plot_bifurcation(values, samples, ax=None, *, xlabel: str, ylabel: str = "Po
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"{ylabel} ({unit})")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize=8, frameon=False)
+    if new:  # above the axes, under the figure's title
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize=8, frameon=False)
+    else:  # inside: the title is the axes' own
+        ax.legend(loc="best", fontsize=8)
     return titled(fig, ax, title, new)
 
 

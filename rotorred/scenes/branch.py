@@ -32,6 +32,7 @@ start (no point yet) is raised as it came.
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -278,7 +279,7 @@ class SceneBranch(Result):
                 f"turns: {len(turns)}" + (f", at {', '.join(turns[:4])}" if turns else "")
                 + (f" and {len(turns) - 4} more" if len(turns) > 4 else ""),
                 f"{stability}; stability changes: {len(self.bifurcations)}" + (f" ({changes})" if changes else ""),
-                f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}",
+                *textwrap.wrap(f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}", 110),
                 f"times: cold start {self.start_time:.3g} s, continuation {self.solve_time:.3g} s, stability "
                 f"{self.stability_time:.3g} s"]
 

@@ -3,7 +3,8 @@ provenance, the base scene (``scene.toml``).
 
 A point whose stability was not computed (``--no-stability``, or an interrupt in the stability phase) is marked
 alike in each: stability "unknown" in the CSV and the summary, the NetCDF flag -1
-(:data:`rotorred.nonlinear.continuation.STABILITY_FLAGS`), its multiplier NaN, and drawn grey in the figure. An interrupted branch's summary starts with "INCOMPLETE: " and why.
+(:data:`rotorred.nonlinear.continuation.STABILITY_FLAGS`), its multiplier NaN, and drawn grey in the
+figure. An interrupted branch's summary starts with "INCOMPLETE: " and why.
 """
 
 from __future__ import annotations
