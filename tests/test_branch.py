@@ -110,8 +110,9 @@ def test_stability_changes_are_classified_by_the_critical_multiplier():
     no change, no report."""
     values = np.arange(6.0)
     critical = np.array([0.5, -1.2, -0.9, 0.5 + 0.6j, 0.8 + 0.8j, 1.3])
-    branch = SceneBranch("rub.clearance", "m", values, values, ((18, "y"),), np.zeros((6, 1)), np.zeros((6, 4)),
-                         np.zeros((6, 3)), critical, (), "reached the end", np.ones(6, int), 0.0, 0.0, 0.0)
+    branch = SceneBranch("paper-rub", "rub.clearance", "m", values, values, ((18, "y"),), np.zeros((6, 1)),
+                         np.zeros((6, 4)), np.zeros((6, 3)), critical, (), "reached the end", np.ones(6, int), 0.0, 0.0,
+                         0.0)
     assert [kind for _, _, kind in branch.bifurcations] == ["period-doubling", "period-doubling", "Neimark-Sacker"]
     assert [(a, b) for a, b, _ in branch.bifurcations] == [(0.0, 1.0), (1.0, 2.0), (3.0, 4.0)]
     assert list(branch.stable) == [True, False, True, True, False, False]
@@ -308,7 +309,7 @@ def test_the_tolerance_chooses_the_harmonics_by_the_convergence_of_the_response(
     assert (rp.problem.harmonics.H, rp.problem.harmonics.N) == (choice.harmonics, choice.samples)
     assert rp.problem.evaluate(z, rp.omega).relative < 1e-9
     fine = rub_problem(scene, model, 2 * choice.harmonics, samples_for(2 * choice.harmonics))
-    z_fine = solve(fine.problem, padded(z, fine), fine.omega, tol=1e-9)[0]
+    z_fine = solve(fine.problem, padded(z, fine), fine.omega, tol=1e-9).z
     error = response_change(rp, z, fine, z_fine, dofs)
     assert error < choice.estimate
     assert np.log2(choice.steps[-2][1] / choice.estimate) > 1.0

@@ -48,7 +48,7 @@ def test_duffing_with_one_harmonic_is_the_closed_form_folds_included():
     roots of its discriminant (measured 3.2e-14 relative; the issue asks 0.5 %)."""
     problem, branch = duffing_branch(1)
     assert branch.stopped.startswith("reached the end")
-    A, w = branch.amplitude(problem, 0), branch.omega
+    A, w = branch.amplitude(0), branch.omega
     G = ((1 - w**2 + 0.75 * K3 * A**2) ** 2 + (C * w) ** 2) * A**2 - F**2
     assert np.max(np.abs(G)) < 4e-12
     located = sorted(f.omega for f in branch.folds)
@@ -65,7 +65,7 @@ def test_a_curved_prediction_follows_the_same_branch_in_fewer_iterations():
     branches = [continue_branch(problem, np.zeros(problem.size), 0.5, 2.5, ds=0.05, ds_max=0.05, stability=False,
                                 curved=curved) for curved in (False, True)]
     tangent, curved = branches
-    A, w = curved.amplitude(problem, 0), curved.omega
+    A, w = curved.amplitude(0), curved.omega
     assert np.max(np.abs(((1 - w**2 + 0.75 * K3 * A**2) ** 2 + (C * w) ** 2) * A**2 - F**2)) < 2e-11
     for b in branches:
         assert np.allclose(sorted(f.omega for f in b.folds), duffing_folds_closed_form(), rtol=3e-13, atol=0)
@@ -85,7 +85,7 @@ def test_duffing_converges_with_harmonics_to_the_transient(branch7):
         p = duffing(H)
         z0 = np.zeros(p.size)
         z0[:min(p.size, problem7.size)] = upper[:min(p.size, problem7.size)]
-        z, _, _ = solve(p, z0, 1.3)
+        z = solve(p, z0, 1.3).z
         amplitudes[H] = np.hypot(z[1], z[2])
     errors = [abs(amplitudes[H] / amplitudes[9] - 1) for H in (1, 3, 5)]
     assert errors[0] > 300 * errors[1] > 300**2 * errors[2]
@@ -122,7 +122,7 @@ def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
     z0 = np.zeros(problem.size)
     z0[2] = z0[5] = E_UNB * 0.25 / (1 - 0.25)
     branch = continue_branch(problem, z0, 0.5, 12.0, ds=0.1, ds_max=0.5, stability=False)
-    radius = branch.amplitude(problem, 0)
+    radius = branch.amplitude(0)
     samples = np.array([np.hypot(*problem.samples(z, w)[0].T).min() for z, w in zip(branch.z, branch.omega)])
     full = samples > GAP * (1 + 1e-6)
     assert full.sum() > 200
@@ -168,13 +168,13 @@ def test_a_point_that_does_not_converge_says_so():
 # --- independent references ---------------------------------------------------------------------------------
 def _point_near(branch, omega: float, upper: bool | None, problem) -> np.ndarray:
     """The branch's solution at ``omega`` on the upper, lower or (None) middle part, corrected there."""
-    A = branch.amplitude(problem, 0)
+    A = branch.amplitude(0)
     crossings = [i for i in range(len(branch.omega) - 1)
                  if (branch.omega[i] - omega) * (branch.omega[i + 1] - omega) <= 0]
     assert len(crossings) == 3
     by_amplitude = sorted(crossings, key=lambda i: A[i])
     i = by_amplitude[-1] if upper else by_amplitude[0] if upper is False else by_amplitude[1]
-    z, _, _ = solve(problem, branch.z[i], omega)
+    z = solve(problem, branch.z[i], omega).z
     return z
 
 
@@ -314,8 +314,9 @@ def test_condensation_onto_the_contact_dofs_equals_the_full_system(four_dof):
         if np.min(np.abs(radius - GAP)) < 1e-3:  # grazing: differences would straddle the kink
             continue
         checked += 1
-        z_full, _, _ = solve(full, z_full, omega, tol=1e-13)  # both to a tolerance tighter than the branch's
-        z, ev, _ = solve(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=1e-13)
+        z_full = solve(full, z_full, omega, tol=1e-13).z  # both to a tolerance tighter than the branch's
+        solution = solve(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=1e-13)
+        z, ev = solution.z, solution.evaluation
         worst[0] = max(worst[0], np.max(np.abs(z - z_full.reshape(h.size, 4)[:, :2].reshape(-1))))
         worst[1] = max(worst[1], np.max(np.abs(condensed.recover(z, omega) - z_full)))
         eps = 1e-6
@@ -359,7 +360,7 @@ def test_the_monodromy_of_a_condensed_problem_is_the_full_systems(four_dof):
     i = int(np.argmax(radius))
     assert radius[i] > GAP  # in contact all round
     z_full, omega = branch.z[i], branch.omega[i]
-    z, _, _ = solve(condensed, z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega)
+    z = solve(condensed, z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega).z
     a = floquet_by_monodromy(full, z_full, omega, 4)
     b = floquet_by_monodromy(condensed, z, omega, 4)
     assert abs(a.max_real - b.max_real) < 1e-14

@@ -55,7 +55,8 @@ def from_transient(scene, sm, result, largest, records, H: int, N: int):
     window = result.t >= result.t[-1] - 1.0 / rp.f0 + 1e-9
     z0 = rp.start_from_record(result.t[window], {j: x[window] for j, x in records.items()})
     t0 = time.perf_counter()
-    z, _, iterations = solve(rp.problem, z0, rp.omega)
+    solution = solve(rp.problem, z0, rp.omega)
+    z, iterations = solution.z, solution.iterations
     elapsed = time.perf_counter() - t0
     lines = rp.lines(z, OUTPUT)
     diffs = [lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1 for ln in largest]

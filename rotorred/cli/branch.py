@@ -85,7 +85,7 @@ def run(args) -> int:
         branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
-    for f in _write(branch, out, scene.name, tuple(interrupts), record):
+    for f in _write(branch, out, tuple(interrupts), record):
         report(f"wrote {f}")
     if branch.interrupted:
         error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
@@ -93,7 +93,7 @@ def run(args) -> int:
     return 0
 
 
-def _write(branch, out, scene_name: str, interrupts: tuple, record=None) -> list:
+def _write(branch, out, interrupts: tuple, record=None) -> list:
     """Stage and commit the branch's files into ``out``: those of an interrupted branch with SIGINT and SIGTERM held
     back (``writers.signals_held``, as a commit is), so that a second signal does not cut the points the first
     one kept; it is dropped once they are committed (the exit status is the first's). The files written."""
@@ -102,7 +102,7 @@ def _write(branch, out, scene_name: str, interrupts: tuple, record=None) -> list
     folder, files = writers.OutputFolder(out), []
     try:
         with writers.signals_held() if branch.interrupted else contextlib.nullcontext(), folder:
-            write_branch(branch, folder, scene_name, record)
+            write_branch(branch, folder, record)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except interrupts:
         if not (branch.interrupted and folder.committed):

@@ -15,9 +15,10 @@ Order of work
 
 from __future__ import annotations
 
+import textwrap
 import time
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -29,16 +30,34 @@ from rotorred.maps.store import PointStore, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
 from rotorred.progress import stage
 from rotorred.provenance import Provenance
+from rotorred.results import Result
 from rotorred.scenes.run import table_dof
 from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
 
 __all__ = ["MapRun", "run_map", "format_map"]
 
 
-@dataclass(frozen=True)
-class MapRun:
-    """What :func:`run_map` did: the dataset, the files written, the counts, why it stopped early."""
+@dataclass(frozen=True, repr=False)
+class MapRun(Result):
+    """What :func:`run_map` did: the map, its dataset, the files written, the counts, why it stopped early.
 
+    Attributes
+    ----------
+    spec : MapSpec
+        The map: its scene, varied keys and sweeps.
+    dataset : xarray.Dataset
+        Every point on disk, labelled (:func:`rotorred.maps.store.to_dataset`; ``map.nc``).
+    files : tuple of Path
+        The files of the map's folder.
+    n_run, n_resumed, n_failed : int
+        Points run now, read back from an earlier run, and without results (diverged or failed).
+    incomplete : str or None
+        Why the map stopped early (the folder is marked INCOMPLETE), or None.
+    wall_time : float
+        s.
+    """
+
+    spec: MapSpec
     dataset: object
     files: tuple
     n_run: int
@@ -46,6 +65,34 @@ class MapRun:
     n_failed: int
     incomplete: str | None
     wall_time: float
+
+    def summary(self) -> list[str]:
+        spec, done = self.spec, int(np.count_nonzero(self.dataset["status"].values != ""))
+        counts = Counter(str(k) for k in self.dataset["kind"].values.ravel() if k)
+        lines = [f"map of {spec.scene} over " + " x ".join(f"{a.key} ({len(a.values)} values)" for a in spec.axes)
+                 + f", sweeps {'/'.join(spec.directions)} ({'cold starts' if spec.cold else 'continued'})",
+                 f"{done} of {spec.n_points} points: {self.n_run} run, {self.n_resumed} "
+                 f"resumed, {self.n_failed} without results; wall time {self.wall_time:.3g} s",
+                 "classes: " + (", ".join(f"{k} {n}" for k, n in counts.most_common()) or "none")]
+        if self.incomplete:
+            lines += textwrap.wrap(f"INCOMPLETE: {self.incomplete}", 110)
+        if self.files:
+            lines.append(f"{len(self.files)} files in {Path(self.files[0]).parent}")
+        return lines
+
+    def plot(self, ax=None, *, kind: str = "bifurcation", direction: str | None = None, quantity: str = "class"):
+        """One figure of the map (:func:`rotorred.maps.figures.draw`): ``kind`` "bifurcation" (the default: the
+        Poincare samples of every sweep along the first key), "lines" (line amplitudes and contact of one sweep; ``ax``
+        a pair of axes), "waterfall" (the labelled lines of one sweep) or "heatmap" (``quantity`` "class", "contact",
+        "explained" or "amplitude" of one sweep over the first two keys); ``direction``: the sweep (default the
+        first)."""
+        from rotorred.maps.figures import draw
+
+        return draw(self.dataset, self.spec, kind, ax, direction=direction, quantity=quantity)
+
+    def to_xarray(self):
+        """The map's dataset (:attr:`dataset`, module :mod:`rotorred.maps.store`), as ``map.nc`` holds it."""
+        return self.dataset
 
 
 class _Progress:
@@ -116,11 +163,11 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
                 _close(client, scheduler)
         if incomplete is not None:
             points = store.read()
-        ds = _dataset(spec, scenes[0], points)
-        files = _write(ds, spec, folder, figures, provenance)
+        run = MapRun(spec, _dataset(spec, scenes[0], points), (), len(points) - n_resumed, n_resumed,
+                     sum(p.status != "ok" for p in points.values()), incomplete, 0.0)
+        _write(run, folder, figures, provenance)
         files = tuple(folder.commit(incomplete))
-    n_failed = sum(p.status != "ok" for p in points.values())
-    return MapRun(ds, files, len(points) - n_resumed, n_resumed, n_failed, incomplete, time.perf_counter() - t0)
+    return replace(run, files=files, wall_time=time.perf_counter() - t0)
 
 
 def _close(client, scheduler: str | None) -> None:
@@ -139,15 +186,15 @@ def _dataset(spec: MapSpec, scene, points: dict):
     return to_dataset(spec, points, tuple(scene.output.nodes), attrs)
 
 
-def _write(ds, spec: MapSpec, folder: OutputFolder, figures: bool, provenance: Provenance | None) -> list[Path]:
-    staging = folder.staging
+def _write(run: MapRun, folder: OutputFolder, figures: bool, provenance: Provenance | None) -> list[Path]:
+    staging, ds = folder.staging, run.to_xarray()
     attributes = provenance.netcdf_attributes() if provenance is not None else None
     files = [write_netcdf(staging / "map.nc", ds, attributes), *write_tables(ds, staging)]
     if figures:
         from rotorred.maps.figures import map_figures
 
-        files += map_figures(ds, spec, staging)
-    text = format_map(ds, spec)
+        files += map_figures(run, staging)
+    text = format_map(ds, run.spec)
     files.append(write_text(staging / "map.txt", (text if provenance is None else provenance.on_top(text)) + "\n"))
     if provenance is not None:
         files.append(write_text(staging / provenance.file_name, provenance.file_text()))

@@ -20,6 +20,7 @@ where it is: the points so far are returned, ``stopped`` and ``interrupt`` sayin
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -29,16 +30,22 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from rotorred import checks
-from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.fourier import to_phasors
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, coefficient_variables, solve
 from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
+from rotorred.results import Result
 
-__all__ = ["Fold", "Branch", "INTERRUPTS", "continue_branch", "interrupt_name"]
+__all__ = ["Fold", "Branch", "INTERRUPTS", "STABILITY_FLAGS", "continue_branch", "interrupt_name", "parameter_of",
+           "stability_variable"]
 
 #: the exceptions that end a branch where it is, its points kept, and the signal each stands for (a caller may name
 #: others: ``rotorred continue`` adds the command line's SIGTERM)
 INTERRUPTS = MappingProxyType({KeyboardInterrupt: "SIGINT"})
 
+#: a point's stability as a NetCDF flag (CF flag_values, flag_meanings: the variable ``stable``,
+#: :func:`stability_variable`)
+STABILITY_FLAGS = MappingProxyType({1: "stable", 0: "unstable", -1: "unknown"})
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
 MAX_JUMP = 2.0
@@ -60,23 +67,25 @@ CORNER_HALVINGS = 4
 class Fold:
     """Where the branch turns back in omega: a smooth fold (saddle-node, located by Brent on d omega / ds) or, with
     ``smooth`` False, a corner (a kink where a contact starts or ends), at the last point before the turn (the steps
-    shrink onto a corner). The solution there and its frequency (rad/s)."""
+    shrink onto a corner). The solution there, its frequency (rad/s; a family's carried parameter) and ``value``, the
+    parameter in its own unit (``omega`` itself but for a family that carries it scaled: :func:`parameter_of`)."""
 
     omega: float
     z: np.ndarray
+    value: float
     smooth: bool = True
 
 
-@dataclass(frozen=True)
-class Branch:
+@dataclass(frozen=True, repr=False)
+class Branch(Result):
     """A branch of periodic solutions.
 
     Attributes
     ----------
     omega : ndarray, shape (p,)
-        Response frequency of each point (rad/s).
+        Response frequency of each point (rad/s), or the family's carried parameter (``problem.parameter``).
     z : ndarray, shape (p, (2H + 1) n)
-        Fourier coefficients of each point (harmonic-major).
+        Fourier coefficients of each point (harmonic-major; m, rad for a rotation DOF).
     max_real : ndarray, shape (p,)
         Largest real part of the Floquet exponents (1/s), NaN where stability was not asked.
     folds : tuple of Fold
@@ -90,6 +99,12 @@ class Branch:
         changes at the folds).
     interrupt : str
         The signal that ended the tracing ("SIGINT", ... : :data:`INTERRUPTS`), or "" when nothing interrupted it.
+    n : int
+        The unknown DOFs a harmonic.
+    parameter : (str, str)
+        The continuation parameter's name and unit: ("omega", "rad/s"), or the family's (:func:`parameter_of`).
+    values : ndarray, shape (p,)
+        The parameter at each point, in its unit (``omega`` itself but for a family that carries it scaled).
     """
 
     omega: np.ndarray
@@ -99,20 +114,102 @@ class Branch:
     stopped: str
     iterations: np.ndarray
     slope: np.ndarray
-    interrupt: str = ""
+    interrupt: str
+    n: int
+    parameter: tuple[str, str]
+    values: np.ndarray
 
     @property
     def stable(self) -> np.ndarray:
         """Whether each point is stable (False where stability was not computed)."""
         return self.max_real < 0.0
 
-    def amplitude(self, problem: PeriodicProblem, dof: int, order: int = 1) -> np.ndarray:
-        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of ``dof`` at each point."""
-        n = problem.n
+    @property
+    def known(self) -> np.ndarray:
+        """Whether each point's stability was computed."""
+        return ~np.isnan(self.max_real)
+
+    @property
+    def H(self) -> int:
+        """The highest harmonic."""
+        return (self.z.shape[1] // self.n - 1) // 2
+
+    @property
+    def phasors(self) -> np.ndarray:
+        """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of each point, harmonic k and DOF, shape
+        (p, H + 1, n) (:func:`rotorred.nonlinear.fourier.to_phasors`)."""
+        return np.array([to_phasors(zi.reshape(-1, self.n)) for zi in self.z])
+
+    def amplitude(self, dof: int, order: int = 1) -> np.ndarray:
+        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of the unknown ``dof`` at each point,
+        shape (p,)."""
+        n = self.n
         if order == 0:
             return np.abs(self.z[:, dof])
         a, b = self.z[:, (2 * order - 1) * n + dof], self.z[:, 2 * order * n + dof]
         return np.hypot(a, b)
+
+    def summary(self) -> list[str]:
+        name, unit = self.parameter
+        p, k = len(self.values), int(np.count_nonzero(self.known))
+        folds = [f"{f.value:.6g}{'' if f.smooth else ' (corner)'}" for f in self.folds]
+        shown = ", ".join(folds[:4]) + (f" and {len(folds) - 4} more" if len(folds) > 4 else "")
+        stability = (f"{int(np.count_nonzero(self.stable))} of {p} points stable" if k == p else
+                     "stability not computed" if k == 0 else f"stability computed for {k} of {p} points")
+        return [f"harmonic-balance branch in {name} ({unit}): {p} points from {self.values[0]:.6g} to "
+                f"{self.values[-1]:.6g}; {self.n} DOFs, {self.H} harmonics",
+                f"turns: {len(folds)}" + (f", at {name} = {shown}" if folds else ""),
+                f"{stability}; largest amplitude of harmonic 1: {np.abs(self.phasors[:, 1]).max():.4g} m",
+                *textwrap.wrap(f"stopped: {self.stopped}", 110)]
+
+    def plot(self, ax=None, *, dof: int = 0, order: int = 1, title: str | None = None):
+        """The amplitude of harmonic ``order`` of the unknown ``dof`` (µm) against the parameter: stable solid, unstable
+        dashed, stability not computed grey, folds and corners marked (:func:`rotorred.plots.branch.plot_branch`)."""
+        from rotorred.plots.branch import plot_branch
+
+        name, unit = self.parameter
+        stable = None if not self.known.any() else np.where(self.known, self.stable, np.nan)
+        return plot_branch(self.values, self.amplitude(dof, order), stable, [(f.value, f.smooth) for f in self.folds],
+                           ax, xlabel=f"{name} ({unit})", ylabel=f"amplitude of harmonic {order} of DOF {dof} (µm)",
+                           title=title)
+
+    def to_xarray(self):
+        """Dims point, harmonic, dof, fold: the ``parameter`` (its own unit) of each point; ``cos`` a_k, ``sin`` b_k
+        and ``amplitude`` (m) of each point, harmonic and DOF; ``max_real`` (1/s), ``stable`` (1, 0; -1 not computed),
+        ``iterations``, ``slope``; the folds' ``fold_parameter`` and ``fold_smooth``; ``stopped`` and ``interrupt`` as
+        attributes."""
+        import xarray as xr
+
+        name, unit = self.parameter
+        return xr.Dataset(
+            {**coefficient_variables(self.phasors, ("point", "harmonic", "dof")),
+             "max_real": ("point", self.max_real, {"units": "s-1", "long_name": "largest real part of the Floquet "
+                                                   "exponents (NaN: not computed)"}),
+             "stable": stability_variable(self.stable, self.known),
+             "iterations": ("point", self.iterations, {"units": "1", "long_name": "corrector iterations"}),
+             "slope": ("point", self.slope, {"units": "1", "long_name": "d parameter / ds of the unit tangent"}),
+             "fold_parameter": ("fold", np.array([f.value for f in self.folds], float),
+                                {"units": _cf(unit), "long_name": f"{name} at each turn"}),
+             "fold_smooth": ("fold", np.array([f.smooth for f in self.folds], np.int8),
+                             {"units": "1", "long_name": "1: a smooth fold, 0: a corner"})},
+            coords={"parameter": ("point", self.values, {"units": _cf(unit), "long_name": name}),
+                    "harmonic": ("harmonic", np.arange(self.H + 1), {"units": "1", "long_name": "harmonic k"}),
+                    "dof": ("dof", np.arange(self.n), {"units": "1", "long_name": "unknown DOF"})},
+            attrs={"stopped": self.stopped, "interrupt": self.interrupt or "no"})
+
+
+def stability_variable(stable: np.ndarray, known: np.ndarray) -> tuple:
+    """The dataset variable ``stable`` of a branch's points (dim point): each point's :data:`STABILITY_FLAGS` value, 1
+    stable, 0 unstable, -1 where ``known`` is False (not computed), int8, with its CF flag attributes."""
+    flags = np.where(known, np.asarray(stable).astype(np.int8), np.int8(-1)).astype(np.int8)
+    return ("point", flags, {"units": "1", "long_name": "stability of the point (-1: not computed)",
+                             "flag_values": np.array(list(STABILITY_FLAGS), np.int8),
+                             "flag_meanings": " ".join(STABILITY_FLAGS.values())})
+
+
+def _cf(unit: str) -> str:
+    """CF units of a parameter's unit: "1" for a dimensionless one ("-")."""
+    return "1" if unit in ("", "-") else unit
 
 
 @dataclass
@@ -162,8 +259,9 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     checks.positive("omega_start", omega_start, "rad/s")
     checks.positive("omega_end", omega_end, "rad/s")
     direction = 1.0 if omega_end > omega_start else -1.0
-    z, _, it = solve(problem, z0, omega_start, tol=tol)
-    first = _Point(np.append(z, omega_start), _tangent(problem, np.append(z, omega_start), None, direction), it)
+    start = solve(problem, z0, omega_start, tol=tol)
+    y = np.append(start.z, omega_start)
+    first = _Point(y, _tangent(problem, y, None, direction, start.evaluation), start.iterations)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
@@ -235,12 +333,23 @@ def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
     return int(on[0]) if len(on) else None
 
 
+def parameter_of(problem) -> tuple[str, str]:
+    """The name and unit of the parameter a problem is continued in: ("omega", "rad/s"), or a family's own
+    (``problem.parameter``)."""
+    return getattr(problem, "parameter", ("omega", "rad/s"))
+
+
+def _value(problem, s: float) -> float:
+    """The parameter's value in its own unit of the carried ``s``: ``s`` itself, or ``problem.parameter_value(s)``
+    for a family that carries it scaled."""
+    return float(getattr(problem, "parameter_value", lambda v: v)(s))
+
+
 def _at(problem, value: float) -> str:
-    """``omega = 62.8 rad/s``, or the problem's own parameter (``problem.parameter``: its name and unit; a scaled
-    parameter is shown in its own unit by ``problem.parameter_value``)."""
-    name, unit = getattr(problem, "parameter", ("omega", "rad/s"))
-    value = getattr(problem, "parameter_value", lambda v: v)(value)
-    return f"{name} = {value:.9g} {unit}"
+    """``omega = 62.8 rad/s``, or the problem's own parameter (:func:`parameter_of`; a scaled parameter is shown in its
+    own unit, :func:`_value`)."""
+    name, unit = parameter_of(problem)
+    return f"{name} = {_value(problem, value):.9g} {unit}"
 
 
 def _branch(problem, points, folds, stopped, stability, interrupt="") -> Branch:
@@ -249,7 +358,8 @@ def _branch(problem, points, folds, stopped, stability, interrupt="") -> Branch:
     max_real = np.array([floquet(problem, zi, wi).max_real for zi, wi in zip(z, omega)]) if stability \
         else np.full(len(points), np.nan)
     return Branch(omega, z, max_real, tuple(folds), stopped, np.array([p.iterations for p in points]),
-                  np.array([p.t[-1] for p in points]), interrupt)
+                  np.array([p.t[-1] for p in points]), interrupt, problem.n, parameter_of(problem),
+                  np.array([_value(problem, w) for w in omega]))
 
 
 def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarray:
@@ -384,16 +494,16 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
     """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
     just traced."""
     try:
-        z, ev, it = solve(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
+        found = solve(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
     except NotConverged:
         return None
-    y = np.append(z, omega)
+    y = np.append(found.z, omega)
     secant = y - point.y
     traced = secant @ point.t < -0.9 * np.linalg.norm(secant) or (  # back along the tangent, or nearer to
         previous is not None and np.linalg.norm(y - previous.y) < np.linalg.norm(point.y - previous.y))
     if np.linalg.norm(secant) > MAX_JUMP * ds or traced:
         return None
-    return _Point(y, _tangent(problem, y, secant, ev=ev), it)
+    return _Point(y, _tangent(problem, y, secant, ev=found.evaluation), found.iterations)
 
 
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
@@ -411,6 +521,6 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
     try:
         s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
     except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
-        return Fold(float(a.y[-1]), a.y[:-1].copy(), smooth=False)
+        return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
     y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]
-    return Fold(float(y[-1]), y[:-1].copy())
+    return Fold(float(y[-1]), y[:-1].copy(), _value(problem, y[-1]))

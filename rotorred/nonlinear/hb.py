@@ -10,7 +10,8 @@ with ``nabla`` the d/dtheta operator on one DOF's coefficients and ``(x)`` the K
 the AFT of the nonlinear forces (:mod:`rotorred.nonlinear.forces`). The Jacobian is analytic: the chain rule
 through the AFT, ``dF_nl/dz = T(df/dq) + omega T(df/dv) (nabla (x) I)``, with ``T(d)`` the coefficient matrix
 of multiplying by the sampled derivative ``d`` (:meth:`Harmonics.toeplitz`), and ``dR/domega`` likewise.
-:func:`solve` is Newton's method with a backtracking line search; a point that does not converge raises
+:func:`solve` is Newton's method with a backtracking line search; it returns a :class:`PeriodicSolution` (the
+coefficients, their amplitudes per harmonic and DOF, and how Newton got there); a point that does not converge raises
 :class:`NotConverged` with its residual and is never returned as a solution.
 """
 
@@ -23,10 +24,12 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
-from rotorred.nonlinear.fourier import Harmonics
+from rotorred.nonlinear.fourier import Harmonics, to_phasors
 from rotorred.nonlinear.lowrank import factored
+from rotorred.results import Result
 
-__all__ = ["PeriodicProblem", "Evaluation", "NotConverged", "solve", "checked_matrices", "checked_unknowns",
+__all__ = ["PeriodicProblem", "PeriodicSolution", "Evaluation", "NotConverged", "solve", "coefficient_variables",
+           "harmonic_dataset", "checked_matrices", "checked_unknowns",
            "sampled_forces", "force_coefficients", "transformed_forces", "local_forces"]
 
 
@@ -289,16 +292,130 @@ def toeplitz_pair(h: Harmonics, dq: np.ndarray, dv: np.ndarray) -> tuple[np.ndar
     return h.toeplitz(dq), Tv
 
 
+@dataclass(frozen=True, repr=False)
+class PeriodicSolution(Result):
+    """A converged periodic solution of harmonic balance (:func:`solve`): its coefficients and how Newton got there.
+
+    Attributes
+    ----------
+    z : ndarray, shape ((2H + 1) n,)
+        Harmonic-major Fourier coefficients ``[a_0, a_1, b_1, ..., a_H, b_H]`` of the ``n`` unknown DOFs (m; rad for a
+        rotation DOF).
+    omega : float
+        The response frequency (rad/s): the fundamental of the harmonics (a family's parameter where the problem is one,
+        :mod:`rotorred.nonlinear.continuation`).
+    iterations : int
+        Newton iterations.
+    residual : float
+        Relative residual ``||R|| / ||F_ex||`` at ``z``.
+    dofs : tuple of int
+        The DOFs of the unknowns (the problem's ``dofs``: all of them for a :class:`PeriodicProblem`), length n.
+    evaluation : Evaluation
+        The residual at ``z`` and its derivatives (built on first use): a continuation's tangent there.
+    """
+
+    z: np.ndarray
+    omega: float
+    iterations: int
+    residual: float
+    dofs: tuple[int, ...]
+    evaluation: Evaluation = field(compare=False)
+
+    @property
+    def n(self) -> int:
+        """The unknown DOFs."""
+        return len(self.dofs)
+
+    @property
+    def H(self) -> int:
+        """The highest harmonic."""
+        return (self.z.size // self.n - 1) // 2
+
+    @property
+    def phasors(self) -> np.ndarray:
+        """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of each harmonic k and DOF, shape (H + 1, n) (m):
+        harmonic k of a DOF is ``Re(Q_k exp(i k omega t))``."""
+        return to_phasors(self.z.reshape(-1, self.n))
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        """Amplitude ``sqrt(a_k^2 + b_k^2)`` (``|a_0|`` for k = 0) of each harmonic k and DOF, shape (H + 1, n) (m)."""
+        return np.abs(self.phasors)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Frequency ``k omega / (2 pi)`` of each harmonic k, shape (H + 1,) (Hz)."""
+        return np.arange(self.H + 1) * self.omega / (2.0 * np.pi)
+
+    def summary(self) -> list[str]:
+        largest = self.amplitudes.max(axis=1)
+        strongest = [k for k in np.argsort(-largest)[:3] if largest[k] > 1e-9 * largest.max()]  # above round-off
+        top = ", ".join(f"{k} ({self.amplitudes[k].max():.4g} m at DOF {self.dofs[int(np.argmax(self.amplitudes[k]))]})"
+                        for k in strongest)
+        return [f"harmonic balance at omega = {self.omega:.6g} rad/s ({self.omega / (2 * np.pi):.6g} Hz): "
+                f"{self.n} DOFs, {self.H} harmonics",
+                f"converged in {self.iterations} Newton iterations, relative residual {self.residual:.3g}",
+                f"strongest harmonics k: {top}"]
+
+    def plot(self, ax=None, *, dofs=None, title: str | None = None):
+        """The amplitude of each harmonic at its frequency, a stem a DOF (µm, log scale); ``dofs``: positions among
+        :attr:`dofs` (default all, at most the 6 largest)."""
+        from rotorred.plots.branch import plot_harmonics
+
+        return plot_harmonics(self.frequencies, self.amplitudes, [f"DOF {d}" for d in self.dofs], ax, columns=dofs,
+                              title=title)
+
+    def to_xarray(self):
+        """Dims harmonic, dof: ``cos`` a_k, ``sin`` b_k and ``amplitude`` (m); ``frequency`` (Hz) of each harmonic,
+        ``omega`` (rad/s); the iterations and residual as attributes."""
+        return harmonic_dataset(self.phasors, np.arange(self.H + 1), self.frequencies, self.dofs,
+                                {"omega": ((), self.omega, {"units": "rad/s", "long_name": "response frequency"})},
+                                {"iterations": self.iterations, "residual": self.residual}, "harmonic")
+
+
+def coefficient_variables(Q: np.ndarray, dims: tuple[str, ...]) -> dict:
+    """The dataset variables of complex amplitudes ``Q = a_k - i b_k`` (m) on ``dims``: ``cos`` a_k, ``sin`` b_k and
+    ``amplitude`` sqrt(a_k^2 + b_k^2)."""
+    return {"cos": (dims, Q.real, {"units": "m", "long_name": "cosine coefficient a_k"}),
+            "sin": (dims, -Q.imag, {"units": "m", "long_name": "sine coefficient b_k"}),
+            "amplitude": (dims, np.abs(Q), {"units": "m", "long_name": "amplitude sqrt(a_k^2 + b_k^2)"})}
+
+
+def harmonic_dataset(Q: np.ndarray, orders, frequencies, dofs, variables: dict, attrs: dict, dim: str):
+    """The dataset of a harmonic-balance solution's complex amplitudes ``Q`` (K, n) (m): dims ``dim`` (the harmonics or
+    the orders), dof; :func:`coefficient_variables`; the ``frequency`` of each (Hz); ``variables`` and ``attrs`` added
+    (:meth:`PeriodicSolution.to_xarray`, :meth:`rotorred.nonlinear.torus.TorusSolution.to_xarray`)."""
+    import xarray as xr
+
+    return xr.Dataset(
+        {**coefficient_variables(Q, (dim, "dof")), **variables},
+        coords={dim: (dim, np.asarray(orders), {"units": "1", "long_name": f"{dim} k"}),
+                "frequency": (dim, np.asarray(frequencies), {"units": "Hz", "long_name": f"frequency of the {dim}"}),
+                "dof": ("dof", np.asarray(dofs, int), {"units": "1", "long_name": "DOF of the unknowns"})},
+        attrs=attrs)
+
+
 def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
-          max_halvings: int = 30):
+          max_halvings: int = 30) -> PeriodicSolution:
     """The periodic solution near ``z0`` at ``omega`` by Newton's method with a backtracking line search.
 
+    Parameters
+    ----------
+    problem : PeriodicProblem
+        Or a condensed problem or a family of them (anything with ``evaluate(z, omega) -> Evaluation``).
+    z0 : ndarray, shape ((2H + 1) n,)
+        The start (e.g. the linear response).
+    omega : float
+        Response frequency (rad/s), or the family's parameter.
+    tol : float
+        Relative residual ``||R|| / ||F_ex||`` to reach.
+    max_iter : int
     max_halvings : int
         How often the line search may halve a step before giving up.
 
     Returns
     -------
-    (z, Evaluation, iterations)
+    PeriodicSolution
 
     Raises
     ------
@@ -308,9 +425,10 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
     """
     z = np.array(z0, float)
     ev = problem.evaluate(z, omega)
+    dofs = tuple(getattr(problem, "dofs", range(problem.n)))  # a family has none: its unknowns, 0 to n - 1
     for it in range(max_iter):
         if ev.relative <= tol:
-            return z, ev, it
+            return PeriodicSolution(z, float(omega), it, ev.relative, dofs, ev)
         try:
             step = factored(ev.dR_dz).solve(-ev.R)
         except (sla.LinAlgError, ValueError):
@@ -320,7 +438,7 @@ def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float 
             raise NotConverged(omega, problem.evaluate(z, omega).relative, tol, it,
                                "no step reduces the residual")
     if ev.relative <= tol:
-        return z, ev, max_iter
+        return PeriodicSolution(z, float(omega), max_iter, ev.relative, dofs, ev)
     raise NotConverged(omega, ev.relative, tol, max_iter, "iteration limit")
 
 

@@ -48,7 +48,8 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.nonlinear.condensed import dynamic_compliance, real_form
 from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
-from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, sampled_forces
+from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, harmonic_dataset, sampled_forces
+from rotorred.results import Result
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
 
@@ -503,8 +504,8 @@ def _pattern_bases(patterns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return basis(np.hstack(patterns)), basis(np.hstack([A.T for A in patterns]))
 
 
-@dataclass(frozen=True)
-class TorusSolution:
+@dataclass(frozen=True, repr=False)
+class TorusSolution(Result):
     """A converged torus: its coefficients and how Newton got there.
 
     Attributes
@@ -517,17 +518,77 @@ class TorusSolution:
         Relative residual ``||R|| / ||z_lin||`` at ``z``.
     history : tuple of float
         The relative residual before each iteration and at the end.
+    harmonics : TorusHarmonics
+        The orders of ``z``.
+    w : (float, float)
+        The base frequencies (rad/s).
+    dofs : tuple of int
+        The DOFs of the unknowns (the problem's ``dofs``).
     """
 
     z: np.ndarray
     iterations: int
     residual: float
     history: tuple[float, ...]
+    harmonics: TorusHarmonics
+    w: tuple[float, float]
+    dofs: tuple[int, ...]
 
     def __post_init__(self):
-        object.__setattr__(self, "z", checks.array("z", self.z))
+        object.__setattr__(self, "z", checks.array("z", self.z, (self.harmonics.size * len(self.dofs),)))
         checks.integer("iterations", self.iterations, ge=0)
         checks.number("residual", self.residual, ge=0.0)
+
+    @property
+    def phasors(self) -> np.ndarray:
+        """Complex amplitudes ``Q_k`` of each order and DOF, shape (K, len(dofs)) (m): the line of order k is
+        ``Re(Q_k exp(i k . theta))``."""
+        return self.harmonics.phasors(self.z, len(self.dofs))
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        """Amplitude of each order's line and DOF, shape (K, len(dofs)) (m)."""
+        return np.abs(self.phasors)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The line of each order, ``|k . w| / (2 pi)``, shape (K,) (Hz)."""
+        return np.abs(self.harmonics.frequencies(self.w)) / (2.0 * math.pi)
+
+    def summary(self) -> list[str]:
+        h, f = self.harmonics, np.array(self.w) / (2.0 * math.pi)
+        amplitudes = self.amplitudes
+        strongest = np.argsort(-amplitudes.max(axis=1))[:3]
+        top = ", ".join(f"({h.orders[k][0]}, {h.orders[k][1]}) {self.frequencies[k]:.4g} Hz: "
+                        f"{amplitudes[k].max():.3g} m" for k in strongest)
+        return [f"quasi-periodic harmonic balance on the torus w = ({self.w[0]:.6g}, {self.w[1]:.6g}) rad/s "
+                f"({f[0]:.6g}, {f[1]:.6g} Hz): {len(self.dofs)} DOFs",
+                f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}"
+                + (f", |k . w| <= {h.w_max:.6g} rad/s" if h.w_max is not None else "") + f"), grid {h.N1} x {h.N2}",
+                f"converged in {self.iterations} Newton iterations, relative residual {self.residual:.3g}",
+                f"strongest lines (k1, k2): {top}"]
+
+    def plot(self, ax=None, *, dofs=None, title: str | None = None):
+        """The amplitude of each order's line at its frequency ``|k . w| / (2 pi)``, a stem a DOF (µm, log scale);
+        ``dofs``: positions among :attr:`dofs` (default all, at most the 6 largest)."""
+        from rotorred.plots.branch import plot_harmonics
+
+        return plot_harmonics(self.frequencies, self.amplitudes, [f"DOF {d}" for d in self.dofs], ax, columns=dofs,
+                              title=title)
+
+    def to_xarray(self):
+        """Dims order, dof, base, iteration: ``cos`` a_k, ``sin`` b_k, ``amplitude`` (m) of each order and DOF; the
+        orders' ``k1``, ``k2`` and signed ``frequency`` ``k . w / (2 pi)`` (Hz); ``w`` (rad/s); ``history`` of the
+        relative residual; the iterations and residual as attributes."""
+        h = self.harmonics
+        variables = {"k1": ("order", h.orders[:, 0], {"units": "1", "long_name": "order of w_1"}),
+                     "k2": ("order", h.orders[:, 1], {"units": "1", "long_name": "order of w_2"}),
+                     "w": ("base", np.array(self.w), {"units": "rad/s", "long_name": "base frequencies"}),
+                     "history": ("iteration", np.array(self.history),
+                                 {"units": "1", "long_name": "relative residual before each Newton iteration"})}
+        return harmonic_dataset(self.phasors, np.arange(h.n_orders), h.frequencies(self.w) / (2.0 * math.pi),
+                                self.dofs, variables, {"iterations": self.iterations, "residual": self.residual},
+                                "order")
 
 
 def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 40,
@@ -563,7 +624,7 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
         norm = float(np.linalg.norm(R))
         history.append(norm / scale)
         if history[-1] <= tol:
-            return TorusSolution(z, it, history[-1], tuple(history))
+            return TorusSolution(z, it, history[-1], tuple(history), problem.harmonics, problem.w, problem.dofs)
         if it == max_iter:
             break
         try:

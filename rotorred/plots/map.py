@@ -8,22 +8,23 @@ values in SI, the samples and line amplitudes in m (plotted in µm by default, `
 lines) come NaN-padded; a point whose row is all NaN (a failed run) is skipped. The varied values
 are plotted as ``xscale * values``, so a caller shows a speed in Hz or rpm, a clearance in µm.
 
-Like :mod:`rotorred.plots.scene`, every helper checks its arguments with :mod:`rotorred.checks`
-before drawing, builds a :class:`matplotlib.figure.Figure` (no pyplot), writes one file and
-returns its path.
+Every helper checks its arguments with :mod:`rotorred.checks` before drawing, draws into the
+given axes or into a new :class:`matplotlib.figure.Figure` (no pyplot), and returns the Figure;
+writing it is the caller's step (:func:`rotorred.plots.axes.save`). They draw
+:meth:`rotorred.maps.run.MapRun.plot`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
 from rotorred import checks
-from rotorred.plots.scene import _path, _save
+from rotorred.plots.axes import DPI
+from rotorred.plots.branch import laid_out, titled
 
 __all__ = ["plot_bifurcation", "plot_waterfall", "plot_lines", "plot_heatmap", "CLASS_COLOURS"]
 
@@ -107,8 +108,8 @@ def _categories(categories, z: np.ndarray) -> tuple[str, ...]:
 
 
 # --------------------------------------------------------------------------- bifurcation diagram
-def plot_bifurcation(values, samples, path, *, xlabel: str, ylabel: str = "Poincaré samples", scale: float = 1e6,
-                     unit: str = "µm", xscale: float = 1.0, title: str | None = None) -> Path:
+def plot_bifurcation(values, samples, ax=None, *, xlabel: str, ylabel: str = "Poincaré samples", scale: float = 1e6,
+                     unit: str = "µm", xscale: float = 1.0, title: str | None = None):
     """Bifurcation diagram: the Poincaré samples of each point as dots above its value, one colour per sweep.
 
     A periodic response shows as one dot per value, period-k as k dots, a quasi-periodic or chaotic
@@ -122,8 +123,8 @@ def plot_bifurcation(values, samples, path, *, xlabel: str, ylabel: str = "Poinc
     samples : mapping
         ``{sweep label: array shape (n, S)}``, e.g. ``{"up": ..., "down": ...}``: the Poincaré samples
         of one displacement DOF at each value (m), NaN-padded; an all-NaN row (a failed run) is skipped.
-    path : str or Path
-        Output file (the extension picks the format, e.g. .png).
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
     xlabel : str
         Name and unit of the varied key as plotted, e.g. "Outer spool speed (Hz)".
     ylabel : str
@@ -137,14 +138,12 @@ def plot_bifurcation(values, samples, path, *, xlabel: str, ylabel: str = "Poinc
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale, xscale = checks.positive("scale", scale), checks.positive("xscale", xscale)
     values = checks.vector("values", values, min_len=1)
     sweeps = _sweeps(samples, values.size)
-    path = _path(path)
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
-    ax = fig.subplots()
+    fig, ax, new = laid_out(ax, (9, 5.5))
     for i, (label, s) in enumerate(sweeps.items()):
         _sweep_dots(ax, xscale * values, scale * s, label, _sweep_colour(label, i), i)
     if not any(np.isfinite(s).any() for s in sweeps.values()):
@@ -152,8 +151,11 @@ def plot_bifurcation(values, samples, path, *, xlabel: str, ylabel: str = "Poinc
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"{ylabel} ({unit})")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize=8, frameon=False)
-    return _save(fig, path, title)
+    if new:  # above the axes, under the figure's title
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=4, fontsize=8, frameon=False)
+    else:  # inside: the title is the axes' own
+        ax.legend(loc="best", fontsize=8)
+    return titled(fig, ax, title, new)
 
 
 def _sweep_colour(label: str, i: int) -> str:
@@ -176,9 +178,9 @@ def _no_data(ax, text: str) -> None:
 
 
 # --------------------------------------------------------------------------- line amplitudes
-def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscale: float = 1.0,
+def plot_lines(values, amplitudes, contact, impacts, ax=None, *, xlabel: str, xscale: float = 1.0,
                reach: float | None = None, n_lines: int = 4, scale: float = 1e6, unit: str = "µm",
-               ylabel: str = "Line amplitude", title: str | None = None) -> Path:
+               ylabel: str = "Line amplitude", title: str | None = None):
     """Labelled line amplitudes and the rub contact against the varied key (one sweep).
 
     Top: the spools' lines f_L and f_H, the ``n_lines`` other lines strongest over the map, and
@@ -195,8 +197,8 @@ def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscal
         line is not among the point's lines, NaN for a failed point.
     contact, impacts : array_like, shape (n,)
         Contact fraction (0..1) and contact onsets per point (NaN for a failed point).
-    path : str or Path
-        Output file (e.g. .png).
+    ax : pair of matplotlib Axes, optional
+        Where to draw the two panels, (top, bottom) (default: a new figure of two panels sharing x).
     xlabel : str
         Name and unit of the varied key as plotted.
     xscale : float
@@ -211,7 +213,7 @@ def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscal
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale, xscale = checks.positive("scale", scale), checks.positive("xscale", xscale)
     values = checks.vector("values", values, min_len=1)
@@ -222,10 +224,8 @@ def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscal
     contact = _padded("contact", contact, (values.size,))
     impacts = _padded("impacts", impacts, (values.size,))
     n_lines = checks.integer("n_lines", n_lines, ge=0)
-    path = _path(path)
+    fig, (ax1, ax2), new = *_two_panels(ax), ax is None
     x = xscale * values
-    fig = Figure(figsize=(9, 7.5), layout="constrained")
-    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     spools = [k for k in ("f_L", "f_H") if k in amps]
     others = sorted((k for k in amps if k not in spools), key=lambda k: -float(np.nanmax(amps[k], initial=0.0)))
     for k in spools + others[:n_lines]:
@@ -252,13 +252,23 @@ def plot_lines(values, amplitudes, contact, impacts, path, *, xlabel: str, xscal
     ax2.legend(h2 + h3, l2 + l3, loc="upper right", fontsize=8)
     if amps:
         ax1.legend(loc="upper right", fontsize=8)
-    return _save(fig, path, title)
+    return titled(fig, ax1, title, new)
+
+
+def _two_panels(ax):
+    """``(fig, (top, bottom))``: the given pair of axes, or a new figure of two panels sharing x."""
+    if ax is None:
+        fig = Figure(figsize=(9, 7.5), layout="constrained", dpi=DPI)
+        return fig, fig.subplots(2, 1, sharex=True)
+    if not (isinstance(ax, Sequence) or isinstance(ax, np.ndarray)) or len(ax) != 2:
+        checks.fail("ax", ax, "must be a pair of axes (top, bottom): the lines figure has two panels")
+    return ax[0].figure, tuple(ax)
 
 
 # --------------------------------------------------------------------------- waterfall
-def plot_waterfall(values, frequencies, amplitudes, path, *, xlabel: str, f_max: float | None = None,
+def plot_waterfall(values, frequencies, amplitudes, ax=None, *, xlabel: str, f_max: float | None = None,
                    orders: Mapping[str, float] | None = None, dynamic_range: float = 1e4, scale: float = 1e6,
-                   unit: str = "µm", xscale: float = 1.0, title: str | None = None) -> Path:
+                   unit: str = "µm", xscale: float = 1.0, title: str | None = None):
     """Spectral waterfall seen from above: the lines of each point along its value, coloured by amplitude.
 
     Each point is a horizontal "slice" at ``y = xscale * value``: one dot per spectral line at its
@@ -271,8 +281,8 @@ def plot_waterfall(values, frequencies, amplitudes, path, *, xlabel: str, f_max:
     frequencies, amplitudes : array_like, shape (n, L)
         The labelled lines of each point: frequency (Hz, >= 0) and amplitude (m, >= 0), NaN-padded; a
         line is drawn where both are finite and the amplitude is > 0.
-    path : str or Path
-        Output file.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
     xlabel : str
         Name and unit of the varied key as plotted, e.g. "Outer spool speed (Hz)" (on the vertical axis).
     f_max : float, optional
@@ -291,7 +301,7 @@ def plot_waterfall(values, frequencies, amplitudes, path, *, xlabel: str, f_max:
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale, xscale = checks.positive("scale", scale), checks.positive("xscale", xscale)
     values = checks.vector("values", values, min_len=1)
@@ -300,9 +310,7 @@ def plot_waterfall(values, frequencies, amplitudes, path, *, xlabel: str, f_max:
     f_max = None if f_max is None else checks.positive("f_max", f_max, "Hz")
     dynamic_range = checks.number("dynamic_range", dynamic_range, gt=1.0)
     orders = _orders(orders)
-    path = _path(path)
-    fig = Figure(figsize=(9, 6), layout="constrained")
-    ax = fig.subplots()
+    fig, ax, new = laid_out(ax, (9, 6))
     y = np.broadcast_to(xscale * values[:, None], f.shape)
     keep = np.isfinite(f) & np.isfinite(a) & (a > 0) & (f <= (np.inf if f_max is None else f_max))
     top = f_max or _f_top(f[keep], values, orders)
@@ -312,7 +320,7 @@ def plot_waterfall(values, frequencies, amplitudes, path, *, xlabel: str, f_max:
     ax.set_xlabel("Frequency (Hz)")
     ax.set_ylabel(xlabel)
     ax.grid(True, alpha=0.3)
-    return _save(fig, path, title)
+    return titled(fig, ax, title, new)
 
 
 def _line_dots(fig: Figure, ax, f: np.ndarray, y: np.ndarray, amp: np.ndarray, dynamic_range: float,
@@ -349,8 +357,8 @@ def _order_lines(ax, values: np.ndarray, xscale: float, orders: dict[str, float]
 
 
 # --------------------------------------------------------------------------- heat map
-def plot_heatmap(x, y, z, path, *, xlabel: str, ylabel: str, zlabel: str, xscale: float = 1.0, yscale: float = 1.0,
-                 categories: Sequence[str] | None = None, title: str | None = None) -> Path:
+def plot_heatmap(x, y, z, ax=None, *, xlabel: str, ylabel: str, zlabel: str, xscale: float = 1.0,
+                 yscale: float = 1.0, categories: Sequence[str] | None = None, title: str | None = None):
     """A 2-D map over a grid of two varied keys: a continuous quantity, or a class per cell.
 
     Cells are drawn with ``pcolormesh``, their edges midway between the grid values (so a
@@ -365,8 +373,8 @@ def plot_heatmap(x, y, z, path, *, xlabel: str, ylabel: str, zlabel: str, xscale
     z : array_like, shape (ny, nx)
         The quantity at each grid point (NaN: blank); with ``categories``, the index of each
         point's category (integer, -1 for missing: blank).
-    path : str or Path
-        Output file.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
     xlabel, ylabel : str
         Names and units of the keys as plotted.
     zlabel : str
@@ -379,15 +387,13 @@ def plot_heatmap(x, y, z, path, *, xlabel: str, ylabel: str, zlabel: str, xscale
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     xscale, yscale = checks.positive("xscale", xscale), checks.positive("yscale", yscale)
     x, y = _grid("x", x), _grid("y", y)
     z = _padded("z", z, (y.size, x.size))
     names = None if categories is None else _categories(categories, z)
-    path = _path(path)
-    fig = Figure(figsize=(8.5, 5.5), layout="constrained")
-    ax = fig.subplots()
+    fig, ax, new = laid_out(ax, (8.5, 5.5))
     xe, ye = _edges(xscale * x), _edges(yscale * y)
     if names is None:
         _continuous(fig, ax, xe, ye, z, zlabel)
@@ -396,7 +402,7 @@ def plot_heatmap(x, y, z, path, *, xlabel: str, ylabel: str, zlabel: str, xscale
     _grid_ticks(ax, xscale * x, yscale * y)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    return _save(fig, path, title)
+    return titled(fig, ax, title, new)
 
 
 def _edges(v: np.ndarray) -> np.ndarray:

@@ -194,7 +194,7 @@ def cold_solution(scene, model, H: int, N: int, record=None) -> tuple[RubProblem
 def _newton(rp: RubProblem, z0: np.ndarray) -> np.ndarray | None:
     """Newton from ``z0`` (to the cold start's tolerance), or None if it does not converge."""
     try:
-        return solve(rp.problem, z0, rp.omega, tol=TOL)[0]
+        return solve(rp.problem, z0, rp.omega, tol=TOL).z
     except NotConverged:
         return None
 

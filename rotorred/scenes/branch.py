@@ -32,6 +32,7 @@ start (no point yet) is raised as it came.
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -41,13 +42,16 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name
+from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name, stability_variable
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
+from rotorred.results import Result
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
+from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.writers import signals_held
 
-__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "scene_at"]
+__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "dof_name",
+           "scene_at"]
 
 #: the plate's numbers a branch follows besides its clearance, and their units: the supports' (Eq. 7), the law's
 #: (Eq. 8) and the rim's; not mu_s (harmonic balance sees sliding only) nor the bending model's (a fitted whole)
@@ -158,12 +162,14 @@ def _refused():
     raise sla.LinAlgError("no problem at this value: the plate refuses it")
 
 
-@dataclass(frozen=True)
-class SceneBranch:
+@dataclass(frozen=True, repr=False)
+class SceneBranch(Result):
     """A branch of a rub scene's periodic response.
 
     Attributes
     ----------
+    scene : str
+        The scene's name.
     key, unit : str
         The varied scene key and its unit (:data:`KEYS`).
     values : ndarray, shape (p,)
@@ -194,6 +200,7 @@ class SceneBranch:
         The signal that ended the branch ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "".
     """
 
+    scene: str
     key: str
     unit: str
     values: np.ndarray
@@ -247,6 +254,82 @@ class SceneBranch:
         """Whether a signal ended the branch (:attr:`interrupt`)."""
         return bool(self.interrupt)
 
+    @property
+    def flags(self) -> np.ndarray:
+        """Each point's :data:`rotorred.nonlinear.continuation.STABILITY_FLAGS` value: 1 stable, 0 unstable, -1 not
+        computed; shape (p,), int8."""
+        return stability_variable(self.stable, self.known)[1]
+
+    @property
+    def shown(self) -> tuple[float, str]:
+        """The key's shown scale and unit: a clearance in µm, any other key in its own unit (Hz, N/m, ...)."""
+        return (1e6, "µm") if self.key == "rub.clearance" else (1.0, self.unit)
+
+    def summary(self) -> list[str]:
+        xs, xu = self.shown
+        p, known = len(self.values), int(np.count_nonzero(self.known))
+        turns = [f"{xs * v:.6g}{'' if smooth else ' (corner)'}" for v, smooth in self.folds]
+        stability = (f"{int(np.count_nonzero(self.stable))} of {p} points stable" if known == p else
+                     "stability not computed" if known == 0 else f"stability computed for {known} of {p} points")
+        changes = ", ".join(f"{kind} near {xs * (a + b) / 2:.6g}" for a, b, kind in self.bifurcations[:3])
+        return [f"harmonic-balance branch of {self.scene} in {self.key} ({xu}): {p} points from "
+                f"{xs * self.values[0]:.6g} to {xs * self.values[-1]:.6g}",
+                f"peak |{dof_name(self.dofs[0])}| from {1e6 * np.min(self.peaks[:, 0]):.4g} to "
+                f"{1e6 * np.max(self.peaks[:, 0]):.4g} µm; {self.lines.shape[1] - 1} harmonics",
+                f"turns: {len(turns)}" + (f", at {', '.join(turns[:4])}" if turns else "")
+                + (f" and {len(turns) - 4} more" if len(turns) > 4 else ""),
+                f"{stability}; stability changes: {len(self.bifurcations)}" + (f" ({changes})" if changes else ""),
+                *textwrap.wrap(f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}", 110),
+                f"times: cold start {self.start_time:.3g} s, continuation {self.solve_time:.3g} s, stability "
+                f"{self.stability_time:.3g} s"]
+
+    def plot(self, ax=None, *, dof: int = 0, title: str | None = None):
+        """The peak of output DOF ``dofs[dof]`` (µm) against the key: stable solid, unstable dashed, stability not
+        computed grey, folds, corners and stability changes marked (:func:`rotorred.plots.branch.plot_branch`);
+        ``title`` default: the scene's (and INCOMPLETE with the signal of an interrupted branch)."""
+        from rotorred.plots.branch import plot_branch
+
+        xs, xu = self.shown
+        stable = None if not self.known.any() else np.where(self.known, self.stable, np.nan)
+        if title is None:
+            title = f"{self.scene}: harmonic-balance branch" + (
+                f" (INCOMPLETE: interrupted by {self.interrupt})" if self.interrupted else "")
+        return plot_branch(self.values, self.peaks[:, dof], stable, self.folds, ax, xlabel=f"{self.key} ({xu})",
+                           ylabel=f"peak |{dof_name(self.dofs[dof])}| (µm)", changes=self.bifurcations, xscale=xs,
+                           title=title)
+
+    def to_xarray(self):
+        """The branch as ``branch.nc`` holds it: dims point, dof, harmonic; the key's coordinate named
+        :func:`rotorred.scenes.keys.netcdf_name` (``rub_clearance``), the key itself in its ``long_name`` and
+        ``rotorred_key``; CF ``units`` on every variable and coordinate ("1" when dimensionless)."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"peak": (("point", "dof"), self.peaks, {"units": "m", "long_name": "largest |q(t)| over the period"}),
+             "line": (("point", "harmonic"), self.lines,
+                      {"units": "m", "long_name": f"amplitude of harmonic k f0 of {dof_name(self.dofs[0])}"}),
+             "critical_multiplier_re": ("point", self.critical.real, {
+                 "units": "1", "long_name": "Floquet multiplier of largest modulus, real part"}),
+             "critical_multiplier_im": ("point", self.critical.imag, {
+                 "units": "1", "long_name": "Floquet multiplier of largest modulus, imaginary part"}),
+             "stable": stability_variable(self.stable, self.known),
+             "f0": ("point", self.f0, {"units": "Hz", "long_name": "base frequency"}),
+             "iterations": ("point", self.iterations, {"units": "1", "long_name": "Newton iterations of the point"})},
+            coords={netcdf_name(self.key): ("point", self.values, {"units": cf_units(self.key), "long_name": self.key,
+                                                                   "rotorred_key": self.key}),
+                    "dof": ("dof", [dof_name(d) for d in self.dofs], {"units": "1", "long_name": "output DOF"}),
+                    "harmonic": ("harmonic", np.arange(self.lines.shape[1]),
+                                 {"units": "1", "long_name": "harmonic k of f0"})},
+            attrs={"scene": self.scene, "stopped": self.stopped, "interrupted": self.interrupt or "no",
+                   "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds),
+                   "bifurcations": "; ".join(f"{kind} between {a:.9g} and {b:.9g}"
+                                             for a, b, kind in self.bifurcations)})
+
+
+def dof_name(dof) -> str:
+    """An output DOF's name: node and direction, ``14y``."""
+    return f"{dof[0]}{dof[1]}"
+
 
 def check_key(scene, key: str, start: float, end: float | None = None) -> None:
     """Refuse, before anything is computed, a key the branch cannot follow in ``scene`` (:data:`KEYS`), a scene
@@ -290,7 +373,7 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
     """
     z_lin = problem.linear_response(omega)
     try:
-        return solve(problem, z_lin, omega, tol=tol)[0]
+        return solve(problem, z_lin, omega, tol=tol).z
     except NotConverged:
         pass
     family = ClearanceFamily(problem, omega)
@@ -302,7 +385,7 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
                              ds_min=1e-10 * scale, ds_max=0.12 * scale, stability=False, tol=tol,
                              interrupts={})  # no point of the branch yet: an interrupt is raised as it came
     i = int(np.argmin(np.abs(branch.omega - clearance)))
-    return solve(family.at(clearance), branch.z[i], omega, tol=tol)[0]
+    return solve(family.at(clearance), branch.z[i], omega, tol=tol).z
 
 
 def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: int, *, tol: float = 1e-9,
@@ -367,7 +450,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     stability_time = 0.0 if t3 is None else time.perf_counter() - t3
     stopped = branch.stopped if not interrupt else _interrupted(
         interrupt, key, values, critical, stability, None if branch.interrupt else branch.stopped)
-    return SceneBranch(key, KEYS.get(key, "Hz"), values, outputs[0], dofs, outputs[1], branch.z, outputs[2],
+    return SceneBranch(scene.name, key, KEYS.get(key, "Hz"), values, outputs[0], dofs, outputs[1], branch.z, outputs[2],
                        critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), stopped,
                        branch.iterations, t1 - t0, t2 - t1, stability_time, interrupt)
 
