@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from rotorred.checks import InputError
 from rotorred.model.assembly import assemble
 from rotorred.linear.campbell import CampbellResult, campbell, whirl_direction
-from rotorred.plots.axes import save
+from rotorred.plots.axes import save_figure
 from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, ShaftElement
 from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
@@ -315,7 +315,7 @@ def test_csv_and_png(tmp_path):
     assert rows[0] == ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"]
     assert len(rows) == 1 + 6 * 4
     assert float(rows[2][2]) == pytest.approx(result.frequencies[0, 1] / (2 * math.pi), rel=1e-8)
-    png = save(result.plot(), tmp_path / "c.png")
+    png = save_figure(result.plot(), tmp_path / "c.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(ValueError):
         result.frequencies[0, 0] = 1.0  # results are read-only
@@ -544,7 +544,7 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     assert "UNSTABLE: mode 0 (forward" in format_critical_speeds(result)
     rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
     assert rows[1][:2] == ["0", "0"] and rows[1][-1] == "no"  # mode 0 at rest
-    assert save(result.plot(), tmp_path / "c.png").stat().st_size > 10_000
+    assert save_figure(result.plot(), tmp_path / "c.png").stat().st_size > 10_000
     stable = campbell(rigid_rotor(2.1e13), Operating.line(np.linspace(0.0, 1500.0, 31)), n_modes=4)
     assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off
 

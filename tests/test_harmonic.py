@@ -16,7 +16,7 @@ from rotorred.model.elements import Bearing, Disk, IntershaftBearing, Material, 
 from rotorred.checks import InputError
 from rotorred.linear.harmonic import frequency_response, response_error, steady_state, unbalance_response
 from rotorred.model.dofs import parse_dof
-from rotorred.plots.axes import save
+from rotorred.plots.axes import save_figure
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
 from rotorred.model.operating import Operating
@@ -243,8 +243,8 @@ def test_csv_and_plots(tmp_path):
     col = header.index("node 2 x peak bound (um)")
     np.testing.assert_allclose(data[:, col], 1e6 * res.peak((2, "x")), rtol=1e-9)
     frf = frequency_response(system, AT_REST, [(2, "x")], [(2, "x"), (11, "x")], np.linspace(0, 2000, 50))
-    for p in (save(res.plot(kind="bode"), tmp_path / "b.png"), save(res.plot(kind="polar"), tmp_path / "p.png"),
-              save(frf.plot(), tmp_path / "f.png"), frf.write_csv(tmp_path / "f.csv")):
+    for p in (save_figure(res.plot(kind="bode"), tmp_path / "b.png"), save_figure(res.plot(kind="polar"), tmp_path / "p.png"),
+              save_figure(frf.plot(), tmp_path / "f.png"), frf.write_csv(tmp_path / "f.csv")):
         assert p.stat().st_size > 1000
     assert (tmp_path / "b.png").read_bytes()[:4] == b"\x89PNG"
 

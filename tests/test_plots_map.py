@@ -8,7 +8,7 @@ import pytest
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from rotorred.plots.axes import save
+from rotorred.plots.axes import save_figure
 from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_lines, plot_waterfall
 from rotorred.signals.classify import KINDS
 
@@ -31,7 +31,7 @@ def _pixels(path, colour, plot_area=False) -> int:
 def _png(path, fig):
     """``fig`` written to ``path`` (its folder made): the path."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    return save(fig, path)
+    return save_figure(fig, path)
 
 
 def _assert_png(path, colours=(), plot_area=False):

@@ -194,9 +194,9 @@ def main(argv=None) -> int:
           f"{2 * assemble(load_rotor('seed-rig')).n_dof} state matrix with vectors; the Campbell costs about "
           f"{n} of them, so its time scales with the machine's speed for LAPACK)")
     if args.plot:
-        from rotorred.plots.axes import save
+        from rotorred.plots.axes import save_figure
 
-        print(f"wrote {save(result.plot(operating_speed=OPERATING_RPM * math.pi / 30), args.plot)}")
+        print(f"wrote {save_figure(result.plot(operating_speed=OPERATING_RPM * math.pi / 30), args.plot)}")
     return 0
 
 

@@ -95,9 +95,9 @@ def main(argv=None) -> int:
     if args.plot:
         result = campbell(rotor("isotropic"), Operating.line(np.linspace(0, 40000, 81), unit="rpm"),
                           n_modes=N_MODES, harmonics=(1, 2))
-        from rotorred.plots.axes import save
+        from rotorred.plots.axes import save_figure
 
-        print(f"wrote {save(result.plot(), args.plot)}")
+        print(f"wrote {save_figure(result.plot(), args.plot)}")
     return 0
 
 

@@ -11,11 +11,10 @@ import math
 
 import numpy as np
 
-from rotorred import checks
+from rotorred import checks, writers
 from rotorred.cli.feedback import report
 from rotorred.cli.options import (grid, number_list, out_dir, provenance, ratio_number, speed_line, spool_ratios,
                                   stage_summary)
-from rotorred.writers import OutputFolder
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -90,10 +89,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import matplotlib  # noqa: F401 - a missing matplotlib fails before any work
 
-    from rotorred.linear.campbell import campbell
-    from rotorred.model.rotor_file import read_rotor
-    from rotorred.plots.axes import save
-    from rotorred.writers import toml_text
+    from rotorred import campbell, read_rotor, save_figure
 
     out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
@@ -104,10 +100,10 @@ def run(args) -> int:
     if args.reduce is not None:
         checks.integer("--reduce", args.reduce, ge=0)
     rotor, document = read_rotor(args.rotor)
-    record = provenance(args, "rotor", toml_text(document))
+    record = provenance(args, "rotor", writers.toml_text(document))
     check_model_size(rotor, args.force)
     operating = speed_line(rotor, speeds, args.reference, ratios_to_reference(ratio, rotor, args.reference), "rpm")
-    with OutputFolder(out) as folder:
+    with writers.OutputFolder(out) as folder:
         model = rotor if args.reduce is None else _reduced(rotor, args.reduce)
         result = campbell(model, operating, n_modes=args.modes, harmonics=harmonics)
         # the full model tracks as many modes as the reduced one, whose frequencies it is compared with
@@ -117,7 +113,7 @@ def run(args) -> int:
         ref_nominal = rotor.speeds[result.reference]
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
             operating_speed = ref_nominal if ref_nominal > 0 else None
-            files.append(save(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
+            files.append(save_figure(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
             files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed))
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
                           format_mode_count(result)] + ([comparison] if comparison else []))
@@ -131,7 +127,7 @@ def run(args) -> int:
 def format_mode_count(result) -> str:
     """How many modes were tracked and why: ``--modes``, or the default rule
     (:func:`rotorred.linear.campbell.default_mode_count`)."""
-    from rotorred.linear.campbell import MIN_DEFAULT_MODES
+    from rotorred import MIN_DEFAULT_MODES
 
     mc = result.mode_count
     if mc is None:
@@ -158,7 +154,7 @@ def format_mode_count(result) -> str:
 
 def _reduced(rotor, modes: int):
     """The Craig-Bampton model of ``rotor`` with ``modes`` fixed-interface modes (0: the default choice)."""
-    from rotorred.linear.reduction import reduce_rotor
+    from rotorred import reduce_rotor
 
     return reduce_rotor(rotor, n_modes=modes or None)
 
@@ -180,11 +176,11 @@ def format_reduction_error(reduced, full) -> str:
 
 def check_model_size(rotor, force: bool) -> None:
     """Refuse a rotor whose model is beyond the size limits of :mod:`rotorred.scenes.budget` (unless ``force``)."""
-    from rotorred.scenes import budget
+    from rotorred import Estimate, model_estimate
 
-    n_dof, model_bytes = budget.model_estimate(rotor)
+    n_dof, model_bytes = model_estimate(rotor)
     name = rotor.name or "the rotor"
-    budget.Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}).check(force)
+    Estimate(0, 0, 0, n_dof, model_bytes, {"dofs": ("ROTOR", name), "memory": ("ROTOR", name)}).check(force)
 
 
 def format_whirl_table(result, i: int = 0) -> str:

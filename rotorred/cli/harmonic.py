@@ -28,12 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred import checks
+from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
 from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, speed_line,
                                   spool_ratios, stage_summary)
-from rotorred.progress import stage
-from rotorred.writers import OutputFolder
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
 #: file's ``[defaults]`` gives one
@@ -84,7 +82,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _unbalance(text: str, nodes):
-    from rotorred.model.loads import Unbalance
+    from rotorred import Unbalance
 
     parts = text.split(":")
     try:
@@ -115,16 +113,13 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float] | None:
 
 def _load(spec: str):
     """(rotor, scene or None, resolved input: ("scene" or "rotor", its TOML text)) for a rotor or scene argument."""
-    from rotorred.model.rotor_file import read_rotor
-    from rotorred.scenes.resolved import scene_toml
-    from rotorred.scenes.schema import builtin_scenes, load_scene
-    from rotorred.writers import toml_text
+    from rotorred import builtin_scenes, load_scene, read_rotor, scene_toml
 
     if spec in builtin_scenes() or _is_scene_file(spec):
         scene = load_scene(spec)
         return scene.rotor.with_speeds(scene.speeds), scene, ("scene", scene_toml(scene))
     rotor, document = read_rotor(spec)
-    return rotor, None, ("rotor", toml_text(document))
+    return rotor, None, ("rotor", writers.toml_text(document))
 
 
 def _is_scene_file(spec: str) -> bool:
@@ -152,7 +147,7 @@ def _speeds(args, rotor, reference: str) -> np.ndarray:
 
 def _unbalances(args, rotor, scene) -> list:
     """--unbalance, else the scene's, else the rotor file's [defaults], else 1e-5 kg m on each spool's first disk."""
-    from rotorred.model.loads import Unbalance
+    from rotorred import Unbalance
 
     nodes = rotor.spool_of
     if args.unbalance:
@@ -184,8 +179,7 @@ def _outputs(args, rotor, scene, unbalances) -> list[tuple[int, str]]:
 
 def _model(args, rotor, scene, operating):
     """The full model, or the Craig-Bampton model with its description."""
-    from rotorred.linear.reduction import default_boundary_nodes, reduce_rotor
-    from rotorred.model.assembly import assemble
+    from rotorred import assemble, default_boundary_nodes, reduce_rotor
 
     system = assemble(rotor)
     kind = args.model or (scene.solver.model if scene is not None else "full")
@@ -223,7 +217,7 @@ def _frf_pairs(text: str, nodes) -> list[tuple[tuple[int, str], tuple[int, str]]
 def run(args) -> int:
     """Check every option and ``--out``, then solve and write into a locked, staged ``--out``."""
     from rotorred.cli.campbell import check_model_size
-    from rotorred.linear.harmonic import unbalance_response
+    from rotorred import unbalance_response
 
     out = out_dir("--out", args.out)
     rotor, scene, resolved = _load(str(args.rotor))
@@ -240,10 +234,10 @@ def run(args) -> int:
     frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
     _check_model_options(args)
 
-    with OutputFolder(out) as folder:
+    with writers.OutputFolder(out) as folder:
         t0 = time.perf_counter()
         model, label, kind = _model(args, rotor, scene, operating)  # checks the model's options against the rotor
-        stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds ({kind} model)")
+        progress.stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds ({kind} model)")
         result = unbalance_response(model, operating, unbalances, outputs)
         elapsed = time.perf_counter() - t0
         title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
@@ -267,20 +261,18 @@ def _check_model_options(args) -> None:
 
 def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[str]:
     """Stage response.csv, bode.png, polar.png (and frf.csv, frf.png); returns their names."""
-    from rotorred.linear.harmonic import frequency_response
-    from rotorred.model.operating import Operating
-    from rotorred.plots.axes import save
+    from rotorred import Operating, frequency_response, save_figure
 
     result.write_csv(folder.staged("response.csv"))
-    save(result.plot(kind="bode", title=title), folder.staged("bode.png"))
-    save(result.plot(kind="polar", title=title), folder.staged("polar.png"))
+    save_figure(result.plot(kind="bode", title=title), folder.staged("bode.png"))
+    save_figure(result.plot(kind="polar", title=title), folder.staged("polar.png"))
     names = ["response.csv", "bode.png", "polar.png"]
     if frf_pairs:
         inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
         frf = frequency_response(model, Operating.point(rotor.speeds), inputs,
                                  list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs)
         frf.write_csv(folder.staged("frf.csv"))
-        save(frf.plot(), folder.staged("frf.png"))
+        save_figure(frf.plot(), folder.staged("frf.png"))
         names += ["frf.csv", "frf.png"]
     return names
 

@@ -11,8 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from rotorred import checks
-from rotorred.model.dofs import parse_dof
-from rotorred.model.operating import Operating
+from rotorred import Operating, parse_dof
 
 __all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
            "provenance", "stage_summary", "MAX_COUNT"]
@@ -206,16 +205,16 @@ def provenance(args, kind: str, toml: str):
     :func:`rotorred.cli.main`; else ``sys.argv``), now, and the resolved ``kind`` ("scene" or "rotor") as ``toml``."""
     import sys
 
-    from rotorred.provenance import Provenance
+    from rotorred import provenance as records
 
     argv = getattr(args, "argv", None)
-    return Provenance.of_command(sys.argv[1:] if argv is None else argv, kind, toml)
+    return records.Provenance.of_command(sys.argv[1:] if argv is None else argv, kind, toml)
 
 
 def stage_summary(folder, name: str, text: str, record) -> list[Path]:
     """Stage the text summary ``name`` (``record``'s header lines on top of ``text``) and ``record``'s resolved input
     (``rotor.toml`` or ``scene.toml``) in ``folder`` (:class:`rotorred.writers.OutputFolder`); returns their paths."""
-    from rotorred.writers import write_text
+    from rotorred import writers
 
-    return [write_text(folder.staged(name), record.on_top(text) + "\n"),
-            write_text(folder.staged(record.file_name), record.file_text())]
+    return [writers.write_text(folder.staged(name), record.on_top(text) + "\n"),
+            writers.write_text(folder.staged(record.file_name), record.file_text())]

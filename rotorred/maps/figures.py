@@ -20,7 +20,7 @@ import numpy as np
 from rotorred import checks
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit, netcdf_name
-from rotorred.plots.axes import save
+from rotorred.plots.axes import save_figure
 from rotorred.plots.map import CLASS_COLOURS, plot_bifurcation, plot_heatmap, plot_lines, plot_waterfall
 
 __all__ = ["KINDS", "QUANTITIES", "draw", "map_figures"]
@@ -37,12 +37,12 @@ QUANTITIES = {"class": "response class", "contact": "contact fraction", "explain
 def map_figures(run, folder: Path) -> list[Path]:
     """Write the figures of ``run`` (a :class:`rotorred.maps.run.MapRun`) into ``folder`` (module docstring), each
     drawn by ``run.plot``."""
-    files = [save(run.plot(kind=kind), folder / f"{kind}.png") for kind in ("bifurcation", "waterfall", "lines")]
+    files = [save_figure(run.plot(kind=kind), folder / f"{kind}.png") for kind in ("bifurcation", "waterfall", "lines")]
     if len(run.spec.axes) >= 2:
         directions = [str(d) for d in run.dataset["direction"].values]
         for d in directions:
             tag = "" if len(directions) == 1 else f"_{d}"
-            files += [save(run.plot(kind="heatmap", direction=d, quantity=q), folder / f"{q}_map{tag}.png")
+            files += [save_figure(run.plot(kind="heatmap", direction=d, quantity=q), folder / f"{q}_map{tag}.png")
                       for q in QUANTITIES]
     return files
 

@@ -5,7 +5,7 @@ amplitudes per harmonic or line (:class:`rotorred.nonlinear.hb.PeriodicSolution`
 :class:`rotorred.nonlinear.torus.TorusSolution`).
 
 Each draws into the given axes, or into a new figure (:func:`rotorred.plots.axes.axes`), and returns the Figure;
-writing it is the caller's step (:func:`rotorred.plots.axes.save`). A title goes above a new figure, or above the
+writing it is the caller's step (:func:`rotorred.plots.axes.save_figure`). A title goes above a new figure, or above the
 given axes.
 """
 

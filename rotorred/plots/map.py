@@ -10,7 +10,7 @@ are plotted as ``xscale * values``, so a caller shows a speed in Hz or rpm, a cl
 
 Every helper checks its arguments with :mod:`rotorred.checks` before drawing, draws into the
 given axes or into a new :class:`matplotlib.figure.Figure` (no pyplot), and returns the Figure;
-writing it is the caller's step (:func:`rotorred.plots.axes.save`). They draw
+writing it is the caller's step (:func:`rotorred.plots.axes.save_figure`). They draw
 :meth:`rotorred.maps.run.MapRun.plot`.
 """
 

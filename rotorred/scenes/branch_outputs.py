@@ -44,7 +44,7 @@ def write_branch(branch, folder, provenance: Provenance | None = None) -> None:
     (:meth:`SceneBranch.plot <rotorred.scenes.branch.SceneBranch.plot>`) and ``branch.txt``; a ``provenance``
     (:class:`rotorred.provenance.Provenance`, with the base scene) is written as ``scene.toml``, on top of
     ``branch.txt`` and as attributes of ``branch.nc``."""
-    from rotorred.plots.axes import save  # matplotlib only when figures are written
+    from rotorred.plots.axes import save_figure  # matplotlib only when figures are written
 
     dof = dof_name(branch.dofs[0])
     header = [f"{branch.key} ({branch.unit})", "f0 (Hz)"] + [f"peak {dof_name(d)} (um)" for d in branch.dofs] + \
@@ -56,7 +56,7 @@ def write_branch(branch, folder, provenance: Provenance | None = None) -> None:
               [f"{dof} k={k} (um)" for k in range(branch.lines.shape[1])], [branch.values, *(1e6 * branch.lines.T)])
     write_netcdf(folder.staged("branch.nc"), branch.to_xarray(),
                  provenance.netcdf_attributes() if provenance is not None else None)
-    save(branch.plot(), folder.staged("branch.png"))
+    save_figure(branch.plot(), folder.staged("branch.png"))
     text = format_branch(branch)
     write_text(folder.staged("branch.txt"), (text if provenance is None else provenance.on_top(text)) + "\n")
     if provenance is not None:
