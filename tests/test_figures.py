@@ -1,11 +1,15 @@
-"""Plot helpers write legible PNG files from plain arrays; bad inputs are refused."""
+"""The drawings draw legible PNG files from plain arrays, into a new figure or given axes; bad inputs are refused."""
 
 import matplotlib.colors
 import matplotlib.image
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 
-from rotorred.plots.scene import plot_label, plot_orbits, plot_spectra, plot_waveforms
+from functools import partial
+
+from rotorred.plots.axes import save_figure
+from rotorred.plots.scene import draw_orbits, draw_poincare, draw_spectra, draw_waveforms, plot_label, write_figure
 from rotorred.signals.linefit import fit_peaks
 from rotorred.signals.spectra import settled_spectrum
 
@@ -34,27 +38,27 @@ def _assert_png(path, n_series=2):
         assert n_pixels >= 300, (colour, n_pixels)
 
 
-def test_plot_waveforms(tmp_path):
+def test_draw_waveforms(tmp_path):
     rub = _signal()
     normal = 60e-6 * np.cos(2 * np.pi * 90.0 * T)
-    out = plot_waveforms(
-        T,
-        {"node 13 (inner)": {"normal": 0.05 * normal}, "node 14 (outer)": {"normal": normal, "rub": rub}},
-        tmp_path / "sub" / "waveforms.png",
-        title="Y displacement",
-        t_window=(0.1, 0.2),
-    )
+    signals = {"node 13 (inner)": {"normal": 0.05 * normal}, "node 14 (outer)": {"normal": normal, "rub": rub}}
+    out = write_figure(tmp_path / "sub" / "waveforms.png",
+                       partial(draw_waveforms, T, signals, title="Y displacement", t_window=(0.1, 0.2)))
     assert out == tmp_path / "sub" / "waveforms.png"
     _assert_png(out)
+    # into given axes: every panel's series, a label of two panels prefixed with its panel
+    ax = Figure().subplots()
+    assert draw_waveforms(T, signals, ax, t_window=(0.1, 0.2)) is ax.figure
+    assert [line.get_label() for line in ax.lines] == ["node 13 (inner): normal", "node 14 (outer): normal", "rub"]
+    np.testing.assert_array_equal(ax.lines[2].get_ydata(), 1e6 * rub[(T >= 0.1) & (T <= 0.2)])
     with pytest.raises(ValueError, match="must have 30000 samples"):
-        plot_waveforms(T, {"a": rub[:-1]}, tmp_path / "bad.png")
+        draw_waveforms(T, {"a": rub[:-1]})
     with pytest.raises(ValueError, match=r"^t_window = \(0.2, 0.1\): must be \(start, end\) with start < end \(s\)"):
-        plot_waveforms(T, {"a": rub}, tmp_path / "bad.png", t_window=(0.2, 0.1))
+        draw_waveforms(T, {"a": rub}, t_window=(0.2, 0.1))
     with pytest.raises(ValueError, match="^signals = {}: must be a non-empty mapping"):
-        plot_waveforms(T, {}, tmp_path / "bad.png")
+        draw_waveforms(T, {})
     with pytest.raises(ValueError, match="mixes panels"):
-        plot_waveforms(T, {"a": rub, "b": {"c": rub}}, tmp_path / "bad.png")
-    assert not (tmp_path / "bad.png").exists()
+        draw_waveforms(T, {"a": rub, "b": {"c": rub}})
 
 
 def test_plot_spectra_with_labels_linear_and_log(tmp_path):
@@ -62,50 +66,54 @@ def test_plot_spectra_with_labels_linear_and_log(tmp_path):
     s_normal = settled_spectrum(60e-6 * np.cos(2 * np.pi * 90.0 * T), DT, 70.0, 90.0)
     lines = fit_peaks(T, _signal(), 70.0, 90.0, spectrum=s_rub).lines
     assert len(lines) == len(COMBOS)
-    out = plot_spectra(
-        {"normal": s_normal, "rub": s_rub}, tmp_path / "spectra.png",
-        lines={"rub": lines}, title="Outer rotor, Y",
-    )
+    out = save_figure(draw_spectra({"normal": s_normal, "rub": s_rub}, lines={"rub": lines},
+                                   title="Outer rotor, Y"), tmp_path / "spectra.png")
     _assert_png(out)
-    out_log = plot_spectra(
+    out_log = save_figure(draw_spectra(
         {"outer": {"rub": s_rub}, "inner": {"plain arrays": (s_normal.frequencies, s_normal.amplitudes)}},
-        tmp_path / "spectra_log.png", lines={"rub": lines}, log_y=True, f_max=400.0,
-    )
+        lines={"rub": lines}, log_y=True, f_max=400.0,
+    ), tmp_path / "spectra_log.png")
     _assert_png(out_log, n_series=1)  # one series per panel: both drawn in C0
+    ax = Figure().subplots()  # into given axes: both panels' series, the lines marked and labelled
+    assert draw_spectra({"outer": {"rub": s_rub}, "inner": {"normal": s_normal}}, ax, lines={"rub": lines}) is ax.figure
+    assert [line.get_label() for line in ax.lines][::2] == ["rub", "normal"] and len(ax.texts) == len(COMBOS)
     with pytest.raises(ValueError, match=r"^lines\['other'\] = 'other': lines key must be a series of spectra"):
-        plot_spectra({"rub": s_rub}, tmp_path / "bad.png", lines={"other": lines})
+        draw_spectra({"rub": s_rub}, lines={"other": lines})
     with pytest.raises(ValueError, match="must be a Spectrum"):
-        plot_spectra({"rub": np.ones(4)}, tmp_path / "bad.png")
+        draw_spectra({"rub": np.ones(4)})
     with pytest.raises(ValueError, match=r"^f_max = -1.0: must be > 0 \(Hz\)"):
-        plot_spectra({"rub": s_rub}, tmp_path / "bad.png", f_max=-1.0)
+        draw_spectra({"rub": s_rub}, f_max=-1.0)
 
 
-def test_plot_poincare(tmp_path):
-    from rotorred.plots.scene import plot_poincare
+def test_draw_poincare(tmp_path):
     theta = np.linspace(0.0, 2 * np.pi, 150, endpoint=False)
-    _assert_png(plot_poincare(50e-6 * np.cos(theta), 0.03 * np.sin(theta), tmp_path / "poincare.png",
-                              label="quasi-periodic", title="Poincare"), n_series=1)
+    _assert_png(save_figure(draw_poincare(50e-6 * np.cos(theta), 0.03 * np.sin(theta), label="quasi-periodic",
+                                          title="Poincare"), tmp_path / "poincare.png"), n_series=1)
+    ax = Figure().subplots()
+    assert draw_poincare(50e-6 * np.cos(theta), 0.03 * np.sin(theta), ax) is ax.figure and len(ax.lines) == 1
     with pytest.raises(ValueError, match=r"^velocity = array of shape \(149,\): must be a 1-D array of 150 values$"):
-        plot_poincare(np.zeros(150), np.zeros(149), tmp_path / "bad.png")
+        draw_poincare(np.zeros(150), np.zeros(149))
 
 
-def test_plot_orbits(tmp_path):
+def test_draw_orbits(tmp_path):
     rub_x, rub_y = _signal(np.pi / 2), _signal()
     nx, ny = 60e-6 * np.sin(2 * np.pi * 90 * T), 60e-6 * np.cos(2 * np.pi * 90 * T)
-    out = plot_orbits(
-        {"node 14 (outer)": {"normal": (nx, ny), "rub": (rub_x, rub_y)},
-         "node 13 (inner)": {"normal": (0.05 * nx, 0.05 * ny)}},
-        tmp_path / "orbits.png", clearance={"node 14 (outer)": 120e-6}, title="Orbits",
-    )
+    orbits = {"node 14 (outer)": {"normal": (nx, ny), "rub": (rub_x, rub_y)},
+              "node 13 (inner)": {"normal": (0.05 * nx, 0.05 * ny)}}
+    out = save_figure(draw_orbits(orbits, clearance={"node 14 (outer)": 120e-6}, title="Orbits"),
+                      tmp_path / "orbits.png")
     _assert_png(out)
+    ax = Figure().subplots()  # into given axes: every orbit, the clearance circle
+    assert draw_orbits(orbits, ax, clearance={"node 14 (outer)": 120e-6}) is ax.figure
+    assert len(ax.lines) == 3 + 2 and len(ax.patches) == 1  # three orbits and the axes' two zero lines
     with pytest.raises(ValueError, match=r"^clearance = -1.0: must be > 0 \(m\)"):
-        plot_orbits({"a": (nx, ny)}, tmp_path / "bad.png", clearance=-1.0)
+        draw_orbits({"a": (nx, ny)}, clearance=-1.0)
     with pytest.raises(ValueError, match="not panels"):
-        plot_orbits({"a": (nx, ny)}, tmp_path / "bad.png", clearance={"b": 1e-4})
+        draw_orbits({"a": (nx, ny)}, clearance={"b": 1e-4})
     with pytest.raises(ValueError, match="pair"):
-        plot_orbits({"a": nx}, tmp_path / "bad.png")
+        draw_orbits({"a": nx})
     with pytest.raises(ValueError, match="^path = .*no_extension': must have a file extension"):
-        plot_orbits({"a": (nx, ny)}, tmp_path / "no_extension")
+        write_figure(tmp_path / "no_extension", partial(draw_orbits, {"a": (nx, ny)}))
 
 
 def test_line_labels_are_plain_text_with_subscripts():

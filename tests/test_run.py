@@ -264,10 +264,12 @@ def test_figures_drawn_by_worker_processes_are_the_figures_drawn_here(rub, tmp_p
         if a.suffix == ".png":
             np.testing.assert_array_equal(imread(a), imread(b))
     jobs = scene_figures(res, tmp_path / "jobs")
-    assert len(jobs) == 5 and all(pickle.loads(pickle.dumps(job)).func is job.func for job in jobs)
+    assert len(jobs) == 5 and all(pickle.loads(pickle.dumps(job)).args[1].func is job.args[1].func for job in jobs)
     import functools
 
-    bad = functools.partial(jobs[0].func, res.t[:1], *jobs[0].args[1:], **jobs[0].keywords)  # 1 sample: refused
+    path, drawing = jobs[0].args
+    bad = functools.partial(jobs[0].func, path, functools.partial(  # 1 sample: refused
+        drawing.func, res.t[:1], *drawing.args[1:], **drawing.keywords))
     with FigurePool(workers=1) as pool, pytest.raises(Exception, match="at least 2 samples"):
         pool.submit(bad).result()
 

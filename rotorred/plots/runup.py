@@ -1,7 +1,10 @@
 """Figures of a run-up (:class:`rotorred.scenes.runup.RunupResult`): amplitude against speed with the
-critical speeds, order tracks, the waterfall with its order lines, and orbit snapshots.
+critical speeds, order tracks, the waterfall with its order lines, and orbit snapshots; and one order track
+(:class:`rotorred.signals.orders.OrderTrack`).
 
-Speeds are plotted in Hz of the reference spool (rpm on the top axis), displacements in µm.
+Speeds are plotted in Hz of the reference spool (rpm on the top axis), displacements in µm. Each drawing draws into
+the given axes or into a new figure and returns the Figure (:func:`draw_runup` picks one by its kind);
+:func:`plot_runup` writes them all.
 """
 
 from __future__ import annotations
@@ -13,9 +16,12 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter, NullFormatter
 from matplotlib.figure import Figure
 
-from rotorred.plots.scene import _save, _stacked, plot_orbits
+from rotorred import checks
+from rotorred.plots.axes import save_figure
+from rotorred.plots.scene import _figure, _stacked, draw_orbits
 
-__all__ = ["plot_runup_amplitude", "plot_order_tracks", "plot_waterfall", "plot_orbit_snapshots", "plot_runup"]
+__all__ = ["draw_runup_amplitude", "draw_order_tracks", "draw_order_track", "draw_waterfall", "draw_orbit_snapshots",
+           "draw_runup", "plot_runup", "RUNUP_FIGURES"]
 
 HZ = 1.0 / (2 * math.pi)
 _CRITICAL_STYLE = dict(color="0.45", ls=":", lw=1.0)
@@ -47,64 +53,111 @@ def _rubs(ax, result) -> None:
                    label="rub" if k == 0 else None)
 
 
-def plot_runup_amplitude(result, path) -> Path:
+def _one(ax, items: list, option: str, given):
+    """The items drawn: all of them in a new figure; into a given ``ax``, the one named by ``option`` (``given``,
+    default the first)."""
+    if given is not None:
+        return [checks.choice(option, given, items)]
+    return items if ax is None else items[:1]
+
+
+def draw_runup_amplitude(result, ax=None, *, node: int | None = None):
     """Largest orbit radius (over two revolutions) and each spool's 1x track (y) against the reference speed,
-    per node, with the critical speeds (Campbell) and the rub intervals."""
-    nodes = sorted(result.overall)
-    fig, axes = _stacked(10.0, 2.6, max(1, len(nodes)))
-    fig.subplots_adjust(right=0.8)  # the legends beside the panels
+    per node, with the critical speeds (Campbell) and the rub intervals; into a given ``ax``, of ``node`` (default
+    the first). Returns the Figure."""
+    nodes = _one(ax, sorted(result.overall), "node", node)
+    if not nodes:
+        checks.fail("result", "a run-up without x and y records", "has no orbit radius to draw")
+    fig, axes = _figure(ax, lambda: _stacked(10.0, 2.6, max(1, len(nodes))),
+                        None if ax is not None else f"{result.scene.name}: amplitude against speed (critical speeds "
+                                                    "dotted)")
+    if ax is None:
+        fig.subplots_adjust(right=0.8)  # the legends beside the panels
     ref = result.reference
-    for ax, node in zip(axes, nodes):
+    for axis, node in zip(axes, nodes):
         speed, radius = result.overall[node]
-        ax.plot(speed * HZ, 1e6 * radius, color="k", lw=1.0, label="orbit radius (max)")
+        axis.plot(speed * HZ, 1e6 * radius, color="k", lw=1.0, label="orbit radius (max)")
         for track, dof in zip(result.tracks, result.track_dofs):
             if dof == (node, "y") and track.order == 1.0:
                 f = track.speed * HZ
                 if track.spool != ref:  # plot against the reference spool's speed at the block's time
                     f = np.interp(track.t, result.t, result.speeds[ref]) * HZ
-                ax.plot(f, 1e6 * track.amplitude, lw=0.9, ls="--", label=f"1× {track.spool} (y)")
-        _criticals(ax, result)
-        _rubs(ax, result)
-        ax.set_ylabel(f"node {node} (µm)")
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+                axis.plot(f, 1e6 * track.amplitude, lw=0.9, ls="--", label=f"1× {track.spool} (y)")
+        _criticals(axis, result)
+        _rubs(axis, result)
+        axis.set_ylabel(f"node {node} (µm)")
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     axes[-1].set_xlabel(f"{ref} spool speed (Hz)")
     _rpm_axis(axes[0])
-    return _save(fig, Path(path), f"{result.scene.name}: amplitude against speed (critical speeds dotted)")
+    return fig
 
 
-def plot_order_tracks(result, path) -> Path:
-    """Every tracked order of every spool at each recorded DOF in y (or the first direction)."""
+def _track_axes(ax, ylabel: str) -> None:
+    """Log amplitude axis of order tracks, plain tick numbers, grid and legend beside."""
+    ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(_PLAIN)  # plain numbers: no mathtext (slow, and its fonts)
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+
+
+def _track(ax, track, speed_hz: np.ndarray, scale: float) -> None:
+    """One order track's amplitude (``scale`` times) against ``speed_hz`` (Hz)."""
+    ax.plot(speed_hz, scale * track.amplitude, lw=1.0, label=f"{track.order:g}× {track.spool}")
+
+
+def draw_order_tracks(result, ax=None, *, dof: tuple | None = None):
+    """Every tracked order of every spool at each recorded DOF in y (or the first direction) against the reference
+    spool's speed; into a given ``ax``, at ``dof`` (default the first). Returns the Figure."""
     dofs = [d for d in dict.fromkeys(result.track_dofs) if d[1] == "y"] or list(dict.fromkeys(result.track_dofs))
-    fig, axes = _stacked(10.0, 2.4, max(1, len(dofs)))
-    fig.subplots_adjust(right=0.8)
+    dofs = _one(ax, dofs, "dof", None if dof is None else tuple(dof))
+    fig, axes = _figure(ax, lambda: _stacked(10.0, 2.4, max(1, len(dofs))),
+                        None if ax is not None else f"{result.scene.name}: order tracks")
     ref = result.reference
-    for ax, dof in zip(axes, dofs):
-        for track, d in zip(result.tracks, result.track_dofs):
-            if d != dof:
-                continue
-            f = np.interp(track.t, result.t, result.speeds[ref]) * HZ
-            ax.plot(f, 1e6 * track.amplitude, lw=1.0, label=f"{track.order:g}× {track.spool}")
-        _criticals(ax, result)
-        ax.set_yscale("log")
-        ax.yaxis.set_major_formatter(_PLAIN)  # plain numbers: no mathtext (slow, and its fonts)
-        ax.yaxis.set_minor_formatter(NullFormatter())
-        ax.set_ylabel(f"{dof[0]} {dof[1]} (µm)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    for axis, d in zip(axes, dofs):
+        for track, track_dof in zip(result.tracks, result.track_dofs):
+            if track_dof == d:
+                _track(axis, track, np.interp(track.t, result.t, result.speeds[ref]) * HZ, 1e6)
+        _criticals(axis, result)
+        _track_axes(axis, f"{d[0]} {d[1]} (µm)")
     axes[-1].set_xlabel(f"{ref} spool speed (Hz)")
-    method = result.tracks[0].method if result.tracks else ""
     _rpm_axis(axes[0])
-    fig.text(0.01, 0.005, method, fontsize=6, color="0.4")
-    return _save(fig, Path(path), f"{result.scene.name}: order tracks")
+    if ax is None:
+        fig.subplots_adjust(right=0.8)
+        fig.text(0.01, 0.005, result.tracks[0].method if result.tracks else "", fontsize=6, color="0.4")
+    return fig
 
 
-def plot_waterfall(result, path) -> Path:
-    """Spectra of the table DOF against time (colour: dB re 1 µm, 80 dB range) with every spool's order lines."""
+def draw_order_track(track, ax=None, *, scale: float = 1e6, unit: str = "µm", title: str | None = None):
+    """One order track's amplitude against its own spool's speed (Hz, rpm on top), as :func:`draw_order_tracks`
+    draws it; amplitudes ``scale`` times (default µm from m). Returns the Figure."""
+    fig, (axis,) = _figure(ax, lambda: _stacked(10.0, 2.4, 1), title)
+    _track(axis, track, track.speed * HZ, checks.positive("scale", scale))
+    _track_axes(axis, f"amplitude ({unit})")
+    axis.set_xlabel(f"{track.spool} spool speed (Hz)")
+    _rpm_axis(axis)
+    if ax is None:
+        fig.subplots_adjust(right=0.8)
+        fig.text(0.01, 0.005, track.method, fontsize=6, color="0.4")
+    return fig
+
+
+def draw_waterfall(result, ax=None):
+    """Spectra of the table DOF against time (colour: dB re 1 µm, 80 dB range) with every spool's order lines.
+    Returns the Figure."""
     w = result.waterfall
-    fig = Figure(figsize=(8.0, 6.0))
-    fig.subplots_adjust(left=0.1, right=0.88, bottom=0.1, top=0.88)
-    ax = fig.subplots()
+    if w is None:
+        checks.fail("result", "a run-up without a waterfall", "has a record too short for one")
+    if ax is None:
+        fig = Figure(figsize=(8.0, 6.0))
+        fig.subplots_adjust(left=0.1, right=0.88, bottom=0.1, top=0.88)
+        ax = fig.subplots()
+        fig.suptitle(f"{result.scene.name}: waterfall")
+        fig.text(0.01, 0.01, f"Hann segments of {w.segment:g} s, 50 % overlap (pyFFTW); order lines white "
+                 "(solid: " + ", dashed: ".join(result.speeds) + ")", fontsize=7, color="0.35")
+    fig = ax.figure
     db = 20.0 * np.log10(np.maximum(1e6 * w.amplitudes, 1e-12))  # dB re 1 µm
     top = float(db.max())
     mesh = ax.pcolormesh(w.frequencies, w.t, db, shading="nearest", cmap="viridis", vmin=top - 80.0, vmax=top)
@@ -119,34 +172,49 @@ def plot_waterfall(result, path) -> Path:
     ax.set_ylim(result.t[0], result.t[-1])
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("time (s)")
-    fig.text(0.01, 0.01, f"Hann segments of {w.segment:g} s, 50 % overlap (pyFFTW); order lines white "
-             "(solid: " + ", dashed: ".join(result.speeds) + ")", fontsize=7, color="0.35")
-    return _save(fig, Path(path), f"{result.scene.name}: waterfall")
+    return fig
 
 
-def plot_orbit_snapshots(result, path) -> Path:
-    """The orbits at ``runup.orbits_hz``: one panel per speed, every node with x and y."""
+def draw_orbit_snapshots(result, ax=None):
+    """The orbits at ``runup.orbits_hz``: one panel per speed, every node with x and y (into a given ``ax``, all
+    of them). Returns the Figure."""
     panels: dict[str, dict] = {}
     for o in result.orbits:
         panels.setdefault(f"{result.reference} {o.speed_hz:g} Hz (t = {o.t:.2f} s)", {})[f"node {o.node}"] = (o.x, o.y)
+    if not panels:
+        checks.fail("result", "a run-up without orbit snapshots", "passes none of runup.orbits_hz")
     clearance = {}
     if result.scene.plates:
         clearance = {title: result.scene.plates[0].clearance for title in panels}
-    return plot_orbits(panels, path, title=f"{result.scene.name}: orbits during the run-up",
-                       clearance=clearance or None)
+    return draw_orbits(panels, ax, title=f"{result.scene.name}: orbits during the run-up", clearance=clearance or None)
+
+
+#: a run-up's figures by kind: (file name, drawing function, whether the result has it); the first kind is
+#: :func:`draw_runup`'s default
+RUNUP_FIGURES = {
+    "amplitude": ("runup_amplitude.png", draw_runup_amplitude, lambda r: bool(r.overall)),
+    "orders": ("order_tracks.png", draw_order_tracks, lambda r: bool(r.tracks)),
+    "waterfall": ("waterfall.png", draw_waterfall, lambda r: r.waterfall is not None),
+    "orbits": ("runup_orbits.png", draw_orbit_snapshots, lambda r: bool(r.orbits)),
+}
+
+
+def draw_runup(result, kind: str = "amplitude", ax=None, **options):
+    """One figure of a run-up, as ``rotorred run`` writes it (:data:`RUNUP_FIGURES`); returns the Figure.
+
+    Parameters
+    ----------
+    result : rotorred.scenes.runup.RunupResult
+    kind : {"amplitude", "orders", "waterfall", "orbits"}
+        Amplitude against speed (default), the order tracks, the waterfall of the table DOF, the orbit snapshots.
+    ax : matplotlib Axes, optional
+    **options
+        Options of the drawing (``node`` of "amplitude", ``dof`` of "orders").
+    """
+    return RUNUP_FIGURES[checks.choice("kind", kind, RUNUP_FIGURES)][1](result, ax, **options)
 
 
 def plot_runup(result, out) -> list[Path]:
-    """Every figure of a run-up into ``out``; returns their paths."""
+    """Every figure of a run-up the result has, written into ``out``; returns their paths."""
     out = Path(out)
-    files = []
-    if result.overall:
-        files.append(plot_runup_amplitude(result, out / "runup_amplitude.png"))
-    if result.tracks:
-        files.append(plot_order_tracks(result, out / "order_tracks.png"))
-    if result.waterfall is not None:
-        files.append(plot_waterfall(result, out / "waterfall.png"))
-    if result.orbits:
-        files.append(plot_orbit_snapshots(result, out / "runup_orbits.png"))
-    return files
-
+    return [save_figure(draw(result), out / name) for name, draw, has in RUNUP_FIGURES.values() if has(result)]

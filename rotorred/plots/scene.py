@@ -1,9 +1,11 @@
-"""Plot helpers for waveforms, spectra, orbits and Poincare sections (matplotlib, Agg; plain arrays in).
+"""Drawings of waveforms, spectra, orbits and Poincare sections (matplotlib, Agg; plain arrays in), and a scene's
+figures (:class:`rotorred.scenes.run.SceneResult`, :class:`rotorred.transient.results.TransientResult`).
 
-Every helper takes SI arrays (s, m, Hz), plots displacements in µm by default
-(``scale=1e6``, ``unit="µm"``), writes one file and returns its path. Figures are built
-with :class:`matplotlib.figure.Figure` (no pyplot state, no GUI; ``savefig`` renders with
-Agg), so the helpers are safe in scripts, tests and threads.
+Every drawing takes SI arrays (s, m, Hz), plots displacements in µm by default (``scale=1e6``, ``unit="µm"``),
+draws into the given axes (``ax``; every panel's series in it) or into a new figure of its own panels, and returns
+the Figure; :func:`write_figure` draws one and writes it (:func:`rotorred.plots.axes.save_figure`), the figure jobs of
+``rotorred run`` (:func:`scene_figures`). Figures are built with :class:`matplotlib.figure.Figure` (no pyplot
+state, no GUI; ``savefig`` renders with Agg), so the drawings are safe in scripts, tests and threads.
 
 Data may be one panel or several:
 
@@ -24,14 +26,16 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.model.dofs import direction_name
+from rotorred.plots.axes import save_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from rotorred.signals.linefit import FittedLine
 
-__all__ = ["plot_waveforms", "plot_spectra", "plot_orbits", "plot_poincare", "plot_scene", "scene_figures",
-           "record_figures", "analysis_figures", "scene_frames", "prepare_frames"]
+__all__ = ["draw_waveforms", "draw_spectra", "draw_orbits", "draw_poincare", "draw_scene", "draw_transient",
+           "write_figure", "plot_scene", "scene_drawings", "scene_figures", "record_figures", "analysis_figures",
+           "scene_frames", "prepare_frames", "SCENE_KINDS"]
 
 
 # --------------------------------------------------------------------------- helpers
@@ -146,33 +150,53 @@ def prepare_frames(keys: Sequence[tuple]) -> None:
         _PREPARED.setdefault(tuple(key), []).append((fig, axes))
 
 
-#: settings of every figure's drawing: glyphs without FreeType's hinting, the same text to the eye (paper-rub's six
-#: figures, some 360 rotated line labels and the tick labels, drew in 1.27 s, not 1.46 s, with matplotlib 3.11)
-_DRAWING = {"text.hinting": "no_hinting"}
+def write_figure(path, drawing) -> Path:
+    """Draw ``drawing()`` (a callable returning a Figure: a drawing of :func:`scene_drawings`) and write it to ``path``
+    (:func:`rotorred.plots.axes.save_figure`, its folder made); returns the path. A figure job of ``rotorred run``."""
+    return save_figure(drawing(), _path(path))
 
 
-def _save(fig: Figure, path: Path, title: str | None) -> Path:
-    import matplotlib
-
+def _figure(ax, frame, title: str | None):
+    """``(figure, panels)``: a new ``frame`` (:func:`_stacked` or :func:`_side_by_side`, a callable) titled ``title``,
+    or the figure of the given ``ax`` and ``ax`` as its one panel (titled ``title``)."""
+    if ax is not None:
+        if title:
+            ax.set_title(title)
+        return ax.figure, np.array([ax])
+    fig, panels = frame()
     if title:
         fig.suptitle(title)
-    with matplotlib.rc_context(_DRAWING):
-        fig.savefig(path, dpi=120, pil_kwargs={"compress_level": 1})  # zlib level 1: PNG encoding 0.13 -> 0.05 s a figure, files 15 % larger
-    return path
+    return fig, panels
+
+
+def _laid_out(panels: dict[str, dict], merge: bool) -> dict[str, dict[str, tuple[str, object]]]:
+    """``{panel title: {label shown: (its panel, item)}}``: the panels as they are or, with ``merge`` (into a given
+    axes), every series in one panel (title ""), a label found in two panels prefixed with its panel's title."""
+    if not merge:
+        return {panel: {label: (panel, item) for label, item in series.items()} for panel, series in panels.items()}
+    labels = [label for series in panels.values() for label in series]
+    twice = {label for label in labels if labels.count(label) > 1}
+    return {"": {(f"{panel}: {label}" if label in twice and panel else label): (panel, item)
+                 for panel, series in panels.items() for label, item in series.items()}}
+
+
+def _of_panel(value, panel: str):
+    """``value``, or its entry for ``panel`` when it is a mapping ``{panel title: value}``."""
+    return value[panel] if isinstance(value, Mapping) else value
 
 
 # --------------------------------------------------------------------------- waveforms
-def plot_waveforms(
+def draw_waveforms(
     t,
     signals,
-    path,
+    ax=None,
     *,
     title: str | None = None,
     t_window: tuple[float, float] | None = None,
-    scale: float = 1e6,
-    unit: str = "µm",
-    quantity: str = "Displacement",
-) -> Path:
+    scale: float | Mapping[str, float] = 1e6,
+    unit: str | Mapping[str, str] = "µm",
+    quantity: str | Mapping[str, str] = "Displacement",
+):
     """Time histories, one panel per group, sharing the time axis.
 
     Parameters
@@ -181,24 +205,26 @@ def plot_waveforms(
         Time (s).
     signals : mapping
         ``{label: y}`` or ``{panel title: {label: y}}``, each ``y`` shape (n,) in SI (m).
-    path : str or Path
-        Output file (the extension picks the format, e.g. .png).
+    ax : matplotlib Axes, optional
+        Draw every panel's series into it (with the first panel's axis label); default a new figure of stacked
+        panels.
     title : str, optional
-        Figure title.
+        Figure title (the title of ``ax`` when given).
     t_window : (float, float), optional
         Time range shown (s), e.g. the paper's (2.44, 2.58).
-    scale, unit : float, str
-        Plotted values are ``scale * y`` in ``unit`` (default µm from m).
-    quantity : str
+    scale, unit : float, str, or mappings {panel title: value}
+        Plotted values are ``scale * y`` in ``unit`` (default µm from m), for every panel or per panel.
+    quantity : str or mapping {panel title: str}
         Name on the y axis.
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     t = _vector("t", t)
-    scale = checks.positive("scale", scale)
     panels = _panels(signals, "signals")
+    for panel in panels:
+        checks.positive("scale", _of_panel(scale, panel))
     if t_window is not None:
         lo, hi = checks.sequence("t_window", list(t_window), lambda f, v: checks.number(f, v, "s"), min_len=2,
                                  max_len=2)
@@ -209,20 +235,21 @@ def plot_waveforms(
             checks.fail("t_window", t_window, "must hold at least 2 samples of t", "s")
     else:
         keep = np.ones(t.size, dtype=bool)
-    path = _path(path)
-    fig, axes = _stacked(*_WAVEFORM_PANEL, len(panels))
-    for ax, (panel, series) in zip(axes, panels.items()):
-        for label, y in series.items():
+    panels = _laid_out(panels, merge=ax is not None)
+    fig, axes = _figure(ax, lambda: _stacked(*_WAVEFORM_PANEL, len(panels)), title)
+    for axis, (panel, series) in zip(axes, panels.items()):
+        for label, (source, y) in series.items():
             y = _vector(f"signals[{label!r}]", y, t.size)
-            ax.plot(t[keep], scale * y[keep], lw=1.0, label=str(label))
-        ax.set_ylabel(f"{quantity} ({unit})")
+            axis.plot(t[keep], _of_panel(scale, source) * y[keep], lw=1.0, label=str(label))
+        source = next(iter(series.values()))[0]
+        axis.set_ylabel(f"{_of_panel(quantity, source)} ({_of_panel(unit, source)})")
         if panel:
-            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
+            axis.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("Time (s)")
     axes[-1].set_xlim(t[keep][0], t[keep][-1])
-    return _save(fig, path, title)
+    return fig
 
 
 # --------------------------------------------------------------------------- spectra
@@ -236,9 +263,9 @@ def _spectrum_arrays(name: str, item) -> tuple[np.ndarray, np.ndarray]:
     checks.fail(f"spectra[{name!r}]", type(item).__name__, "must be a Spectrum or (frequencies Hz, amplitudes)")
 
 
-def plot_spectra(
+def draw_spectra(
     spectra,
-    path,
+    ax=None,
     *,
     lines: Mapping[str, Sequence[FittedLine]] | None = None,
     title: str | None = None,
@@ -247,7 +274,7 @@ def plot_spectra(
     dynamic_range: float = 1e6,
     scale: float = 1e6,
     unit: str = "µm",
-) -> Path:
+):
     """Single-sided amplitude spectra, optionally with combination labels at the peaks.
 
     Parameters
@@ -255,8 +282,8 @@ def plot_spectra(
     spectra : mapping
         ``{label: spectrum}`` or ``{panel title: {label: spectrum}}``; a spectrum is a
         :class:`rotorred.signals.spectra.Spectrum` or a pair ``(frequencies (Hz), amplitudes (m))``.
-    path : str or Path
-        Output file.
+    ax : matplotlib Axes, optional
+        Draw every panel's series into it; default a new figure of stacked panels.
     lines : mapping, optional
         ``{label: [FittedLine, ...]}`` (``LineFit.lines``, e.g. of :func:`rotorred.signals.linefit.fit_peaks`) for
         the series of the same label; each line is marked and labelled ("2f_H−f_L").
@@ -273,7 +300,7 @@ def plot_spectra(
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale = checks.positive("scale", scale)
     panels = _panels(spectra, "spectra")
@@ -288,34 +315,34 @@ def plot_spectra(
         f_max = 1.1 * max(known) if known else None
     else:
         checks.positive("f_max", f_max, "Hz")
-    path = _path(path)
-    fig, axes = _stacked(*_SPECTRUM_PANEL, len(panels))
-    for ax, (panel, series) in zip(axes, panels.items()):
+    panels = _laid_out(panels, merge=ax is not None)
+    fig, axes = _figure(ax, lambda: _stacked(*_SPECTRUM_PANEL, len(panels)), title)
+    for axis, (panel, series) in zip(axes, panels.items()):
         top = 0.0
         n_series = len(series)
-        for i, (label, item) in enumerate(series.items()):
+        for i, (label, (_, item)) in enumerate(series.items()):
             f, a = _spectrum_arrays(str(label), item)
             show = f <= f_max if f_max is not None else np.ones(f.size, bool)
             # Earlier series are drawn wider, so a line shared by "normal" and "rub" shows
             # both colours instead of the later one hiding the earlier.
             lw = 0.9 + 1.6 * (n_series - 1 - i)
-            (handle,) = ax.plot(f[show], scale * a[show], lw=lw, label=str(label))
+            (handle,) = axis.plot(f[show], scale * a[show], lw=lw, label=str(label))
             top = max(top, float(np.max(scale * a[show][f[show] > 0], initial=0.0)))
             shown = [ln for ln in lines.get(str(label), ()) if f_max is None or ln.frequency_hz <= f_max]
-            _label_lines(ax, shown, scale, handle.get_color())
+            _label_lines(axis, shown, scale, handle.get_color())
         if log_y:
-            ax.set_yscale("log")
-            ax.set_ylim(top / dynamic_range, top * 30)  # headroom for rotated labels
+            axis.set_yscale("log")
+            axis.set_ylim(top / dynamic_range, top * 30)  # headroom for rotated labels
         else:
-            ax.set_ylim(0, top * 1.35 if top > 0 else 1)
-        ax.set_ylabel(f"Amplitude ({unit})")
+            axis.set_ylim(0, top * 1.35 if top > 0 else 1)
+        axis.set_ylabel(f"Amplitude ({unit})")
         if panel:
-            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
-        ax.grid(True, alpha=0.3, which="both" if not log_y else "major")
-        ax.legend(loc="upper right", fontsize=8)
+            axis.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
+        axis.grid(True, alpha=0.3, which="both" if not log_y else "major")
+        axis.legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("Frequency (Hz)")
     axes[-1].set_xlim(0, f_max if f_max is not None else None)
-    return _save(fig, path, title)
+    return fig
 
 
 def _label_lines(ax, lines: Sequence[FittedLine], scale: float, color) -> None:
@@ -344,15 +371,15 @@ def plot_label(label: str) -> str:
 
 
 # --------------------------------------------------------------------------- orbits
-def plot_orbits(
+def draw_orbits(
     orbits,
-    path,
+    ax=None,
     *,
     title: str | None = None,
     clearance: float | Mapping[str, float] | None = None,
     scale: float = 1e6,
     unit: str = "µm",
-) -> Path:
+):
     """Orbits (y against x) with equal axes, e.g. normal and rub overlaid.
 
     Parameters
@@ -360,8 +387,8 @@ def plot_orbits(
     orbits : mapping
         ``{label: (x, y)}`` or ``{panel title: {label: (x, y)}}``; ``x``, ``y`` shape (n,)
         in SI (m). Panels are placed side by side.
-    path : str or Path
-        Output file.
+    ax : matplotlib Axes, optional
+        Draw every panel's orbits into it (the first clearance given); default a new figure of panels side by side.
     title : str, optional
     clearance : float or mapping, optional
         Radial clearance (m), drawn as a dashed circle about the origin: one value for every
@@ -371,7 +398,7 @@ def plot_orbits(
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale = checks.positive("scale", scale)
     panels = _panels(orbits, "orbits")
@@ -386,34 +413,35 @@ def plot_orbits(
         clearances = {panel: clearance for panel in panels}
     for panel, radius in clearances.items():
         checks.positive("clearance", radius, "m")
-    path = _path(path)
-    n = len(panels)
-    fig, axes = _side_by_side(*_ORBIT_PANEL, n)
-    for ax, (panel, series) in zip(axes, panels.items()):
-        for label, xy in series.items():
+    if ax is not None and clearances:
+        clearances = {"": next(iter(clearances.values()))}
+    panels = _laid_out(panels, merge=ax is not None)
+    fig, axes = _figure(ax, lambda: _side_by_side(*_ORBIT_PANEL, len(panels)), title)
+    for axis, (panel, series) in zip(axes, panels.items()):
+        for label, (_, xy) in series.items():
             if not (isinstance(xy, Sequence) and len(xy) == 2):
                 checks.fail(f"orbits[{label!r}]", type(xy).__name__, "must be a pair (x, y)")
             x = _vector(f"orbits[{label!r}] x", xy[0])
             y = _vector(f"orbits[{label!r}] y", xy[1], x.size)
-            ax.plot(scale * x, scale * y, lw=0.9, label=str(label))
+            axis.plot(scale * x, scale * y, lw=0.9, label=str(label))
         radius = clearances.get(panel)
         if radius is not None:
             from matplotlib.patches import Circle
 
-            ax.add_patch(
+            axis.add_patch(
                 Circle((0, 0), scale * radius, fill=False, ls="--", lw=1.0, color="0.4",
                        label=f"clearance {scale * radius:.3g} {unit}")
             )
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"X ({unit})")
-        ax.set_ylabel(f"Y ({unit})")
-        ax.axhline(0, color="0.8", lw=0.6, zorder=0)
-        ax.axvline(0, color="0.8", lw=0.6, zorder=0)
+        axis.set_aspect("equal", adjustable="datalim")
+        axis.set_xlabel(f"X ({unit})")
+        axis.set_ylabel(f"Y ({unit})")
+        axis.axhline(0, color="0.8", lw=0.6, zorder=0)
+        axis.axvline(0, color="0.8", lw=0.6, zorder=0)
         if panel:
-            ax.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
-    return _save(fig, path, title)
+            axis.set_title(panel, y=1.0)  # a fixed position: placing it measured every tick label
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper right", fontsize=8)
+    return fig
 
 
 # --------------------------------------------------------------------------- Poincare section
@@ -437,8 +465,8 @@ def _span_at_least(ax, x: np.ndarray, y: np.ndarray, rel: float) -> None:
 _POINCARE_MARGINS = (1.05, 0.25, 0.6, 0.75)
 
 
-def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "", scale: float = 1e6,
-                  unit: str = "µm") -> Path:
+def draw_poincare(x, velocity, ax=None, *, title: str | None = None, label: str = "", scale: float = 1e6,
+                  unit: str = "µm"):
     """Poincare section: the sampled displacement against the sampled velocity, one dot per sample.
 
     A periodic response shows as k points (period-k), a quasi-periodic one as a closed curve, a
@@ -448,8 +476,8 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
     ----------
     x, velocity : array_like, shape (n,)
         Samples in SI (m and m/s, or rad and rad/s), n >= 1.
-    path : str or Path
-        Output file.
+    ax : matplotlib Axes, optional
+        Draw into it; default a new figure.
     title, label : str
         Figure title; legend text of the samples (e.g. the class and section frequency).
     scale, unit : float, str
@@ -457,13 +485,12 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
 
     Returns
     -------
-    Path
+    matplotlib.figure.Figure
     """
     scale = checks.positive("scale", scale)
     x = checks.vector("x", x, min_len=1)
     velocity = checks.vector("velocity", velocity, min_len=x.size, max_len=x.size)
-    path = _path(path)
-    fig, (ax,) = _side_by_side(*_POINCARE_PANEL, 1, margins=_POINCARE_MARGINS)
+    fig, (ax,) = _figure(ax, lambda: _side_by_side(*_POINCARE_PANEL, 1, margins=_POINCARE_MARGINS), title)
     ax.plot(scale * x, scale * velocity, ".", ms=4 if x.size < 200 else 2, label=f"{label} ({x.size} samples)".strip())
     _span_at_least(ax, scale * x, scale * velocity, SPAN_MIN)
     ax.ticklabel_format(useOffset=False)
@@ -471,7 +498,7 @@ def plot_poincare(x, velocity, path, *, title: str | None = None, label: str = "
     ax.set_ylabel(f"velocity ({unit}/s)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
-    return _save(fig, path, title)
+    return fig
 
 
 # --------------------------------------------------------------------------- a scene's figures
@@ -509,10 +536,10 @@ def _pair(spectrum) -> tuple[np.ndarray, np.ndarray]:
 
 
 def scene_figures(result, out: str | Path) -> list[partial]:
-    """The figures of :func:`plot_scene` as jobs: each a ``functools.partial`` of a plot function and plain
-    arrays, which draws and writes one file when called (in this process or, pickled, in a
-    :class:`rotorred.plots.pool.FigurePool` worker) and returns its path: :func:`record_figures` and
-    :func:`analysis_figures`.
+    """The figures of :func:`plot_scene` as jobs: each a ``functools.partial`` of :func:`write_figure`, its file and
+    its drawing (:func:`scene_drawings`: a drawing function and plain arrays), which draws and writes one file when
+    called (in this process or, pickled, in a :class:`rotorred.plots.pool.FigurePool` worker) and returns its path:
+    :func:`record_figures` and :func:`analysis_figures`.
 
     Parameters
     ----------
@@ -545,25 +572,55 @@ def scene_frames(scene) -> list[tuple]:
     return keys
 
 
+#: the kinds of a scene's figures (``output.plots``), in the order they are drawn; the first is
+#: :func:`draw_scene`'s default
+SCENE_KINDS = ("waveforms", "spectra", "orbits", "poincare")
+#: the kinds drawn from the record, its spectra and lines alone (:func:`record_figures`)
+_RECORD_KINDS = ("waveforms", "spectra", "orbits")
+
+
 def record_figures(result, out: str | Path) -> list[partial]:
     """The figures of :func:`scene_figures` drawn from the record, its spectra and lines alone (waveforms, spectra,
     orbits, as the scene asks): they can be drawn while the line fit, settling and class are computed."""
-    out = Path(out)
+    kinds = [k for k in _RECORD_KINDS if k in result.scene.output.plots]
+    return [partial(write_figure, Path(out) / name, drawing) for name, drawing in scene_drawings(result, kinds)]
+
+
+def analysis_figures(result, out: str | Path) -> list[partial]:
+    """The figures of :func:`scene_figures` drawn from the table DOF's analysis (the Poincare section): none while
+    ``result`` has none."""
+    kinds = [k for k in SCENE_KINDS if k not in _RECORD_KINDS and k in result.scene.output.plots]
+    return [partial(write_figure, Path(out) / name, drawing) for name, drawing in scene_drawings(result, kinds)]
+
+
+def scene_drawings(result, kinds) -> list[tuple[str, partial]]:
+    """``(file name, drawing)`` of each figure of ``kinds`` (of :data:`SCENE_KINDS`) that ``result`` has the data for.
+
+    A drawing is a ``functools.partial`` of a drawing function (:func:`draw_waveforms`, :func:`draw_spectra`,
+    :func:`draw_orbits`, :func:`draw_poincare`) and plain arrays: called, it returns the Figure (``ax=``, and any
+    option of its function, may be given). "spectra" is one figure per node (``spectra_node13.png``), "orbits" needs
+    x and y, "poincare" the table DOF's Poincare samples (:attr:`rotorred.scenes.run.SceneResult.analysis`).
+
+    Parameters
+    ----------
+    result : rotorred.scenes.run.SceneResult
+        With its ``normal`` (no-rub) companion overlaid when present.
+    kinds : sequence of str
+    """
     sc = result.scene
-    plots = sc.output.plots
     case = "rub" if sc.plates else "response"
     pairs = [("normal", result.normal), (case, result)] if result.normal is not None else [(case, result)]
-    jobs = []
+    drawings = []
     speeds, rub_text = _texts(sc)
     translational = [d for d in sc.output.directions if d in ("x", "y")]
-    if "waveforms" in plots:
+    if "waveforms" in kinds:
         window = sc.output.plot_window or (result.t[0], min(result.t[-1], result.t[0] + 0.14))
         signals = {f"node {n} {direction_name(d)}": {label: r.outputs[(n, d)] for label, r in pairs}
                    for n in sc.output.nodes for d in sc.output.directions}
-        jobs.append(partial(plot_waveforms, result.t, signals, out / "waveforms.png", t_window=window,
-                                    title=f"{sc.name}: time waveforms ({speeds}; {rub_text})",
-                                    unit="µm" if translational else "µrad"))
-    if "spectra" in plots:
+        drawings.append(("waveforms.png", partial(draw_waveforms, result.t, signals, t_window=window,
+                                                  title=f"{sc.name}: time waveforms ({speeds}; {rub_text})",
+                                                  unit="µm" if translational else "µrad")))
+    if "spectra" in kinds and result.spectra:
         f_max = sc.output.f_max_hz
         for n in sc.output.nodes:
             spectra, lines = {}, {}
@@ -576,9 +633,10 @@ def record_figures(result, out: str | Path) -> list[partial]:
                 f_max_n = max(1.1 * max(known, default=0.0), 3.0 * result.f_H)
             else:
                 f_max_n = f_max
-            jobs.append(partial(plot_spectra, spectra, out / f"spectra_node{n}.png", lines=lines, f_max=f_max_n,
-                                 title=f"{sc.name}: amplitude spectra at node {n} ({rub_text})"))
-    if "orbits" in plots and {"x", "y"} <= set(sc.output.directions):
+            drawings.append((f"spectra_node{n}.png", partial(
+                draw_spectra, spectra, lines=lines, f_max=f_max_n,
+                title=f"{sc.name}: amplitude spectra at node {n} ({rub_text})")))
+    if "orbits" in kinds and {"x", "y"} <= set(sc.output.directions):
         orbits = {}
         for n in sc.output.nodes:
             title = f"node {n} ({sc.rotor.spool_of[n]})"
@@ -586,19 +644,75 @@ def record_figures(result, out: str | Path) -> list[partial]:
                 if p.node == n:
                     title += f", plate at {math.degrees(p.theta):g} deg"
             orbits[title] = {label: (r.outputs[(n, "x")], r.outputs[(n, "y")]) for label, r in pairs}
-        jobs.append(partial(plot_orbits, orbits, out / "orbits.png",
-                             title=f"{sc.name}: orbits over the recorded window ({rub_text})"))
-    return jobs
+        drawings.append(("orbits.png", partial(draw_orbits, orbits,
+                                               title=f"{sc.name}: orbits over the recorded window ({rub_text})")))
+    if "poincare" in kinds and result.analysis is not None and result.analysis.classification.poincare.x.size:
+        drawings.append(("poincare.png", _scene_poincare(result, speeds, rub_text)))
+    return drawings
 
 
-def analysis_figures(result, out: str | Path) -> list[partial]:
-    """The figures of :func:`scene_figures` drawn from the table DOF's analysis (the Poincare section): none while
-    ``result`` has none."""
-    sc = result.scene
-    if not ("poincare" in sc.output.plots and result.analysis is not None
-            and result.analysis.classification.poincare.x.size):
-        return []
-    return [_scene_poincare(result, Path(out) / "poincare.png", *_texts(sc))]
+def draw_scene(result, kind: str = SCENE_KINDS[0], ax=None, *, node: int | None = None, **options):
+    """One figure of a scene's result, as ``rotorred run`` writes it (:func:`scene_drawings`); returns the Figure.
+
+    Parameters
+    ----------
+    result : rotorred.scenes.run.SceneResult
+    kind : {"waveforms", "spectra", "orbits", "poincare"}
+        Waveforms of every recorded DOF (default), the spectra of one node, the orbits of every node (x and y
+        recorded), the Poincare section of the table DOF (when the analysis has samples).
+    ax : matplotlib Axes, optional
+        Draw every panel's series into it; default a new figure of the file's panels.
+    node : int, optional
+        The node of "spectra" (default the first recorded).
+    **options
+        Options of the drawing function (e.g. ``t_window``, ``f_max``, ``log_y``, ``title``).
+    """
+    kind = checks.choice("kind", kind, SCENE_KINDS)
+    drawings = dict(scene_drawings(result, [kind]))
+    if kind == "spectra":
+        nodes = result.scene.output.nodes
+        node = nodes[0] if node is None else checks.choice("node", node, nodes)
+        drawings = {name: d for name, d in drawings.items() if name == f"spectra_node{node}.png"}
+    elif node is not None:
+        checks.fail("node", node, f"is an option of kind='spectra' only, not of {kind!r}")
+    if not drawings:
+        checks.fail("kind", kind, "has no data in this result (orbits need x and y, spectra a complete record, the "
+                    "Poincare section the table DOF's samples)")
+    return next(iter(drawings.values()))(ax=ax, **options)
+
+
+def draw_transient(result, ax=None, *, t_window: tuple[float, float] | None = None, title: str | None = None):
+    """The recorded outputs of a transient against time (displacements in µm, rotations in µrad) and, when recorded,
+    each plate's normal and friction force (N) (:func:`draw_waveforms`); returns the Figure.
+
+    Parameters
+    ----------
+    result : rotorred.transient.results.TransientResult
+    ax : matplotlib Axes, optional
+        Draw the first panel's series into it (the displacements, else the rotations, else the contact forces);
+        default a new figure with a panel of each.
+    t_window : (float, float), optional
+        Time range shown (s).
+    title : str, optional
+    """
+    panels, scales, units, quantities = {}, {}, {}, {}
+    for (n, d), y in result.outputs.items():
+        panel = "rotations" if d.startswith("t") else "displacements"
+        panels.setdefault(panel, {})[f"node {n} {direction_name(d)}"] = y
+        scales[panel], units[panel] = 1e6, "µrad" if panel == "rotations" else "µm"
+        quantities[panel] = "Rotation" if panel == "rotations" else "Displacement"
+    if result.contacts:
+        panels["contact forces"] = {f"plate {k} (node {ch.plate.node}) {name}": force
+                                    for k, ch in enumerate(result.contacts)
+                                    for name, force in (("normal", ch.normal_force), ("friction", ch.friction_force))}
+        scales["contact forces"], units["contact forces"], quantities["contact forces"] = 1.0, "N", "Force"
+    if not panels:
+        checks.fail("result", "a transient without outputs or contacts", "has nothing recorded to draw")
+    if ax is not None:
+        panels = dict([next(iter(panels.items()))])
+    title = title or f"transient ({result.method}, dt = {result.dt:g} s, {result.n_steps} steps)"
+    return draw_waveforms(result.t, panels, ax, t_window=t_window, scale=scales, unit=units, quantity=quantities,
+                          title=title)
 
 
 def _texts(sc) -> tuple[str, str]:
@@ -608,13 +722,13 @@ def _texts(sc) -> tuple[str, str]:
     return ", ".join(f"{w / (2 * math.pi):.4g} Hz" for w in sc.speeds.values()), rub_text
 
 
-def _scene_poincare(result, path: Path, speeds: str, rub_text: str) -> partial:
-    """The Poincare section of the table DOF, labelled with its class and section frequency (a job)."""
+def _scene_poincare(result, speeds: str, rub_text: str) -> partial:
+    """The Poincare section of the table DOF, labelled with its class and section frequency (a drawing)."""
     a = result.analysis
     c = a.classification
     rot = a.dof[1].startswith("theta")
-    return partial(plot_poincare, c.poincare.x, c.poincare.velocity, path, scale=1e6, unit="µrad" if rot else "µm",
-                         label=f"{c.label}, once per {1.0 / c.poincare.frequency_hz:.4g} s "
-                               f"({c.poincare.frequency_hz:.6g} Hz)",
-                         title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])}\n"
-                               f"({speeds}; {rub_text})")
+    return partial(draw_poincare, c.poincare.x, c.poincare.velocity, scale=1e6, unit="µrad" if rot else "µm",
+                   label=f"{c.label}, once per {1.0 / c.poincare.frequency_hz:.4g} s "
+                         f"({c.poincare.frequency_hz:.6g} Hz)",
+                   title=f"{result.scene.name}: Poincare section of node {a.dof[0]} {direction_name(a.dof[1])}\n"
+                         f"({speeds}; {rub_text})")

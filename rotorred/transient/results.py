@@ -1,11 +1,14 @@
-"""Results of :func:`rotorred.transient.newmark.simulate`, and their packaging from the kernel's buffers."""
+"""Results of :func:`rotorred.transient.newmark.simulate`, their packaging from the kernel's buffers, and the one
+dataset of a record (:func:`record_dataset`: the transient's, a scene's and a run-up's)."""
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
 
+from rotorred.results import Result
 from rotorred.transient import kernel
 from rotorred.transient.contact import STATE_NAMES, RubPlate, disk_force
 from rotorred.transient.status import LIMIT, NONFINITE, Status
@@ -112,8 +115,8 @@ class FinalState:
     sgn: np.ndarray
 
 
-@dataclass(frozen=True)
-class TransientResult:
+@dataclass(frozen=True, repr=False)
+class TransientResult(Result):
     """Result of :func:`simulate`.
 
     Attributes
@@ -197,6 +200,130 @@ class TransientResult:
     def cpu_us_per_step(self) -> float:
         """Step-loop CPU time of this process per main step (µs); robust to other load on the machine."""
         return 1e6 * self.run_cpu_time / max(self.n_steps, 1)
+
+    def summary(self) -> list[str]:
+        """The scheme and steps, how it ended, the peak of each output (a few), the contacts, the cost."""
+        span = f"{len(self.t)} records, t = {self.t[0]:.6g}-{self.t[-1]:.6g} s" if len(self.t) else "no record"
+        lines = [f"{self.method}, {self.n_steps} steps of {self.dt:g} s to t = {self.final.t:.6g} s; {span}",
+                 "finished" if self.success else shorten(f"stopped (status {self.status}): {self.message}")]
+        lines += peak_lines(self.outputs)
+        lines += [contact_line(k, ch) for k, ch in enumerate(self.contacts[:_LISTED])]
+        lines.append(shorten(f"{self.us_per_step:.2f} µs/step; {self.n_newton} Newton iterations, "
+                             f"{self.n_contact_steps} contact steps, {self.n_substeps} half-steps"
+                             + (f"; {self.step_form}" if self.step_form else "")))
+        return lines
+
+    def plot(self, ax=None, **options):
+        """The recorded outputs against time and, when recorded, each plate's contact forces
+        (:func:`rotorred.plots.scene.draw_transient`, whose options it takes: ``t_window`` (s), ``title``); into a
+        given ``ax``, the displacements. Returns the Figure."""
+        from rotorred.plots.scene import draw_transient
+
+        return draw_transient(self, ax, **options)
+
+    def to_xarray(self):
+        """The record as an :class:`xarray.Dataset` (:func:`record_dataset`), with the scheme and how the run ended as
+        attributes (``method``, ``dt`` (s), ``status``, ``message``, ``n_steps``); the states (``record_state``) are
+        left out (model coordinates)."""
+        return record_dataset(self.t, self.outputs, self.contacts, {
+            "title": "transient record", "method": self.method, "dt": self.dt, "gamma": self.gamma, "beta": self.beta,
+            "alpha": self.alpha, "status": int(self.status), "message": self.message, "n_steps": int(self.n_steps)})
+
+
+#: outputs and plates a summary names one by one
+_LISTED = 4
+#: longest line of a summary
+_WIDTH = 116
+
+
+def shorten(text: str) -> str:
+    """``text`` on one line of a summary (at most 116 characters, cut at a word with "...")."""
+    return textwrap.shorten(text, _WIDTH, placeholder=" ...")
+
+
+def peak_lines(outputs: dict) -> list[str]:
+    """Lines of a summary: the largest |value| of each recorded DOF (the first :data:`_LISTED`; µm or µrad)."""
+    lines = []
+    for (node, d), y in list(outputs.items())[:_LISTED]:
+        unit = "µrad" if d.startswith("t") else "µm"
+        lines.append(f"node {node} {d}: peak {1e6 * float(np.max(np.abs(y), initial=0.0)):.4g} {unit}")
+    if len(outputs) > _LISTED:
+        lines.append(f"... {len(outputs) - _LISTED} more outputs")
+    return lines
+
+
+def contact_line(k: int, ch: ContactHistory) -> str:
+    """A line of a summary: how much plate ``k`` touched, its impacts and its largest normal force."""
+    touching = 100.0 * (1.0 - ch.fraction("open"))
+    return (f"plate {k} at node {ch.plate.node}: contact in {touching:.3g} % of the records, {ch.n_impacts()} impacts, "
+            f"largest normal force {float(np.max(ch.normal_force, initial=0.0)):.4g} N")
+
+
+def dof_groups(dofs) -> list[tuple[str, str, list]]:
+    """The recorded DOFs by what they measure, as a dataset names them: ``(prefix, units, dofs)``, ``("", "m",
+    ...)`` for displacements (x, y) and ``("rotation_", "rad", ...)`` for rotations; groups without a DOF left out."""
+    groups = [("", "m", [d for d in dofs if not d[1].startswith("t")]),
+              ("rotation_", "rad", [d for d in dofs if d[1].startswith("t")])]
+    return [g for g in groups if g[2]]
+
+
+def dof_coords(dim: str, dofs, long_name: str) -> dict:
+    """Coordinates of a dimension of (node, direction) pairs: labels ``"13:x"``, ``<dim>_node`` and
+    ``<dim>_direction`` (``node`` and ``direction`` for ``output``)."""
+    from rotorred.linear.harmonic import _output_coords
+
+    return _output_coords(dim, dofs, long_name)
+
+
+def record_dataset(t, outputs: dict, contacts=(), attrs: dict | None = None):
+    """A record as an :class:`xarray.Dataset`: the one builder of the record of a transient
+    (:meth:`TransientResult.to_xarray`), a scene and a run-up.
+
+    Dimensions ``time`` (coordinate, s), ``output`` (the recorded displacements, labels ``"13:x"`` with ``node``
+    and ``direction``), ``rotation_output`` (the recorded rotations, if any) and ``plate``. Variables
+    ``displacement`` (time, output) in m and ``rotation`` (time, rotation_output) in rad; per plate (plate, time)
+    ``normal_force`` and ``friction_force`` (N), ``contact_state`` (0 open, 1 slip, 2 stick), ``u_n``, ``u_t`` and
+    ``gap`` (m), ``sliding_velocity`` (m/s), with the plates' ``plate_node``, ``plate_angle`` (rad) and
+    ``plate_clearance`` (m).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Record times (s).
+    outputs : dict of (int, str) to ndarray, shape (n,)
+    contacts : sequence of ContactHistory
+    attrs : dict, optional
+        The dataset's attributes.
+    """
+    import xarray as xr
+
+    data, coords = {}, {"time": ("time", np.asarray(t, float), {"units": "s", "long_name": "record time"})}
+    for prefix, units, dofs in dof_groups(list(outputs)):
+        name = "rotation" if prefix else "displacement"
+        data[name] = (("time", f"{prefix}output"), np.array([outputs[d] for d in dofs], float).reshape(
+            len(dofs), len(t)).T, {"units": units, "long_name": f"recorded {name}"})
+        coords.update(dof_coords(f"{prefix}output", dofs, f"recorded DOF ({name})"))
+    if contacts:
+        flags = {"flag_values": np.array(sorted(STATE_NAMES), np.int8),
+                 "flag_meanings": " ".join(STATE_NAMES[k] for k in sorted(STATE_NAMES))}
+        for name, units, long_name, extra in (
+                ("normal_force", "N", "normal force P of the plate on the disk (>= 0)", {}),
+                ("friction_force", "N", "friction force T on the disk along the plate tangent", {}),
+                ("contact_state", "1", "contact state", flags),
+                ("u_n", "m", "plate displacement along its normal", {}),
+                ("u_t", "m", "plate displacement along its tangent", {}),
+                ("sliding_velocity", "m/s", "sliding velocity v_rel", {}),
+                ("gap", "m", "gap, negative in contact", {})):
+            values = np.array([getattr(ch, "state" if name == "contact_state" else name) for ch in contacts])
+            data[name] = (("plate", "time"), values, {"units": units, "long_name": long_name, **extra})
+        coords.update({
+            "plate_node": ("plate", np.array([ch.plate.node for ch in contacts], np.int64),
+                           {"units": "1", "long_name": "node of the rubbing disk"}),
+            "plate_angle": ("plate", np.array([ch.plate.theta for ch in contacts], float),
+                            {"units": "rad", "long_name": "angle theta of the plate's normal"}),
+            "plate_clearance": ("plate", np.array([ch.plate.clearance for ch in contacts], float),
+                                {"units": "m", "long_name": "radial clearance"})})
+    return xr.Dataset(data, coords, attrs=dict(attrs or {}))
 
 
 def contact_histories(plates, record: kernel.Record) -> tuple[ContactHistory, ...]:
