@@ -56,9 +56,11 @@ def _rubs(ax, result) -> None:
 def _one(ax, items: list, option: str, given):
     """The items drawn: all of them in a new figure; into a given ``ax``, the one named by ``option`` (``given``,
     default the first)."""
-    if given is not None:
-        return [checks.choice(option, given, items)]
-    return items if ax is None else items[:1]
+    if given is None:
+        return items if ax is None else items[:1]
+    if given not in items:
+        checks.fail(option, given, "must be one of " + ", ".join(map(str, items)))
+    return [given]
 
 
 def draw_runup_amplitude(result, ax=None, *, node: int | None = None):
@@ -215,6 +217,8 @@ def draw_runup(result, kind: str = "amplitude", ax=None, **options):
 
 
 def plot_runup(result, out) -> list[Path]:
-    """Every figure of a run-up the result has, written into ``out``; returns their paths."""
+    """Every figure of a run-up the result has, drawn by its ``plot`` (:meth:`rotorred.scenes.runup.RunupResult.plot`)
+    and written into ``out``; returns their paths."""
     out = Path(out)
-    return [save_figure(draw(result), out / name) for name, draw, has in RUNUP_FIGURES.values() if has(result)]
+    return [save_figure(result.plot(kind=kind), out / name) for kind, (name, _, has) in RUNUP_FIGURES.items()
+            if has(result)]

@@ -671,7 +671,9 @@ def draw_scene(result, kind: str = SCENE_KINDS[0], ax=None, *, node: int | None 
     drawings = dict(scene_drawings(result, [kind]))
     if kind == "spectra":
         nodes = result.scene.output.nodes
-        node = nodes[0] if node is None else checks.choice("node", node, nodes)
+        node = nodes[0] if node is None else node
+        if node not in nodes:
+            checks.fail("node", node, "must be a recorded node: one of " + ", ".join(map(str, nodes)))
         drawings = {name: d for name, d in drawings.items() if name == f"spectra_node{node}.png"}
     elif node is not None:
         checks.fail("node", node, f"is an option of kind='spectra' only, not of {kind!r}")

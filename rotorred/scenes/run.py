@@ -45,6 +45,7 @@ import numpy as np
 
 from rotorred.model.assembly import assemble
 from rotorred.progress import stage
+from rotorred.results import Result
 from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.model.operating import Operating
 from rotorred.model.loads import gravity_force
@@ -107,8 +108,8 @@ class LineAnalysis:
     time: float
 
 
-@dataclass(frozen=True)
-class SceneResult:
+@dataclass(frozen=True, repr=False)
+class SceneResult(Result):
     """Response of a scene in its recorded window.
 
     Attributes
@@ -195,6 +196,125 @@ class SceneResult:
             if ln.m == m and ln.n == n:
                 return ln.amplitude
         return 0.0
+
+    def summary(self) -> list[str]:
+        """The scene, how it was solved, the table DOF's class and strongest lines, the peaks, the contacts."""
+        from rotorred.transient.results import contact_line, peak_lines, shorten
+
+        sc, d = self.scene, table_dof(self.scene)
+        span = f"{len(self.t)} records, t = {self.t[0]:.6g}-{self.t[-1]:.6g} s" if len(self.t) else "no record"
+        lines = [shorten(f"scene {sc.name}: {sc.description}"),
+                 shorten(f"{self.method} response at f_L = {self.f_L:.6g} Hz, f_H = {self.f_H:.6g} Hz; {span}; "
+                         f"{self.n_steps} steps"),
+                 self.model_label.split(" (")[0]]  # its boundary nodes are a list
+        if self.incomplete:
+            lines.append(shorten(f"INCOMPLETE: {self.incomplete}"))
+        if d in self.lines:
+            strongest = sorted(self.lines[d].lines, key=lambda ln: -ln.amplitude)[:4]
+            unit = "µrad" if d[1].startswith("t") else "µm"
+            cls = f"{self.analysis.classification.label}; " if self.analysis is not None else ""
+            lines.append(shorten(f"node {d[0]} {d[1]}: {cls}lines " + ", ".join(
+                f"{ln.label} {1e6 * ln.amplitude:.4g} {unit}" for ln in strongest)))
+        lines += peak_lines(self.outputs)
+        lines += [contact_line(k, ch) for k, ch in enumerate(self.contacts[:2])]
+        if self.normal is not None:
+            lines.append(f"without the rub: node {d[0]} {d[1]} peak {1e6 * self.normal.peak(d):.4g} "
+                         f"{'µrad' if d[1].startswith('t') else 'µm'}")
+        lines.append(f"model built in {self.build_time:.3g} s, solved in {self.solve_time:.3g} s")
+        return lines
+
+    def plot(self, ax=None, kind: str = "waveforms", **options):
+        """Draw one of the scene's figures as ``rotorred run`` writes it (:func:`rotorred.plots.scene.draw_scene`);
+        return the Figure.
+
+        ``kind``: "waveforms" (default, every recorded DOF against time, the normal run overlaid), "spectra" (of one
+        node, ``node=``, default the first, with the labelled lines), "orbits" (x and y recorded) or "poincare" (the
+        table DOF's Poincare section). Other options go to the drawing (``t_window``, ``f_max``, ``log_y``,
+        ``title``, ...). Into a given ``ax``, every panel's series are drawn.
+        """
+        from rotorred.plots.scene import draw_scene
+
+        return draw_scene(self, kind, ax, **options)
+
+    def to_xarray(self):
+        """The result as an :class:`xarray.Dataset`.
+
+        The record (:func:`rotorred.transient.results.record_dataset`: dimensions ``time``, ``output`` (labels
+        ``"13:x"``), ``plate``; ``displacement`` in m, contact forces and states), the normal run's record
+        ``normal_displacement`` (time, output) at the same record times, the spectra ``amplitude`` and
+        ``normal_amplitude`` (frequency, output) in m with ``frequency`` in Hz, the lines at each spectrum's
+        peaks (dimension ``line``: ``line_output``, ``line_frequency`` (Hz), ``line_amplitude`` (m),
+        ``line_label``), and the table DOF's analysis: its fitted lines (dimension ``fit_line``: ``fit_frequency``,
+        ``fit_amplitude``, ``fit_phase``, ``fit_standard_error``, ``fit_label``) and Poincare samples (dimension
+        ``poincare``: ``poincare_time``, ``poincare_x``, ``poincare_velocity``). Rotations (rad) go into the same
+        variables prefixed ``rotation_`` with dimensions ``rotation_output`` and ``rotation_line``. Scalars ``f_L``
+        and ``f_H`` in Hz; the scene, method, model and table DOF as attributes.
+        """
+        from rotorred.transient.results import dof_groups, record_dataset
+
+        d = table_dof(self.scene)
+        ds = record_dataset(self.t, self.outputs, self.contacts, {
+            "title": f"scene {self.scene.name}", "scene": self.scene.name, "method": self.method,
+            "model": self.model_label, "n_steps": int(self.n_steps), "table_dof": f"{d[0]}:{d[1]}",
+            "incomplete": self.incomplete or ""})
+        data = {"f_L": ((), self.f_L, {"units": "Hz", "long_name": "lower spool frequency"}),
+                "f_H": ((), self.f_H, {"units": "Hz", "long_name": "higher spool frequency"})}
+        coords = {}
+        if self.spectra:
+            coords["frequency"] = ("frequency", next(iter(self.spectra.values())).frequencies,
+                                   {"units": "Hz", "long_name": "bin frequency"})
+        for prefix, units, dofs in dof_groups(list(self.outputs)):
+            output = f"{prefix}output"
+            if self.normal is not None:
+                data[f"normal_{'rotation' if prefix else 'displacement'}"] = (
+                    ("time", output), np.array([self.normal.outputs[o] for o in dofs]).T,
+                    {"units": units, "long_name": "the same scene without the rub, at the same record times"})
+            for case, r in (("", self), ("normal_", self.normal)):
+                if r is not None and r.spectra:
+                    data[f"{case}{prefix}amplitude"] = (("frequency", output), np.array(
+                        [r.spectra[o].amplitudes for o in dofs]).T, {"units": units, "long_name": (
+                            f"amplitude spectrum{' without the rub' if case else ''}: peak amplitude of each bin")})
+            lines = [(o, ln) for o in dofs if o in self.lines for ln in self.lines[o].lines]
+            if lines:
+                data.update(self._line_variables(f"{prefix}line", lines, units))
+        a = self.analysis
+        if a is not None:
+            units = "rad" if d[1].startswith("t") else "m"
+            fit = a.fit.lines
+            if fit:
+                data.update({
+                    "fit_frequency": ("fit_line", [ln.frequency_hz for ln in fit], {"units": "Hz", "long_name": (
+                        f"frequency of the line fitted to {d[0]}:{d[1]}")}),
+                    "fit_amplitude": ("fit_line", [ln.amplitude for ln in fit], {"units": units, "long_name": (
+                        "amplitude of the fitted line")}),
+                    "fit_phase": ("fit_line", [ln.phase for ln in fit], {"units": "rad", "long_name": (
+                        "phase of the fitted line")}),
+                    "fit_standard_error": ("fit_line", [ln.standard_error for ln in fit], {"units": units, (
+                        "long_name"): "standard error of the amplitude"}),
+                    "fit_label": ("fit_line", np.array([ln.label for ln in fit], dtype=object), {"units": "1", (
+                        "long_name"): "line m f_H + n f_L"})})
+            p = a.classification.poincare
+            if p.x.size:
+                data.update({
+                    "poincare_time": ("poincare", p.times, {"units": "s", "long_name": "Poincare sample time"}),
+                    "poincare_x": ("poincare", p.x, {"units": units, "long_name": f"{d[0]}:{d[1]} at the samples"}),
+                    "poincare_velocity": ("poincare", p.velocity, {"units": f"{units}/s", "long_name": (
+                        "velocity at the samples")}),
+                    "poincare_frequency": ((), p.frequency_hz, {"units": "Hz", "long_name": "sampling frequency"})})
+            ds.attrs["classification"] = a.classification.label
+        return ds.assign_coords(coords).assign(data)
+
+    @staticmethod
+    def _line_variables(dim: str, lines: list, units: str) -> dict:
+        """The variables of the lines at the spectra's peaks, ``[(dof, FittedLine), ...]``, along ``dim``."""
+        return {f"{dim}_output": (dim, np.array([f"{o[0]}:{o[1]}" for o, _ in lines], dtype=object),
+                                  {"units": "1", "long_name": "recorded DOF of the line"}),
+                f"{dim}_frequency": (dim, [ln.frequency_hz for _, ln in lines], {"units": "Hz", "long_name": (
+                    "frequency of the line")}),
+                f"{dim}_amplitude": (dim, [ln.amplitude for _, ln in lines], {"units": units, "long_name": (
+                    "amplitude of the line, fitted on the spectrum's samples")}),
+                f"{dim}_label": (dim, np.array([ln.label for _, ln in lines], dtype=object), {"units": "1", (
+                    "long_name"): "line m f_H + n f_L"})}
 
 
 # --------------------------------------------------------------------------- model

@@ -27,6 +27,7 @@ from fractions import Fraction
 import numpy as np
 
 from rotorred.progress import stage
+from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
 from rotorred.scenes.schema import Scene
 from rotorred.signals.orders import OrderTrack, angle_blocks, order_tracks, overall_amplitude
@@ -89,8 +90,8 @@ class OrbitSnapshot:
     y: np.ndarray
 
 
-@dataclass(frozen=True)
-class RunupResult:
+@dataclass(frozen=True, repr=False)
+class RunupResult(Result):
     """A run-up scene's record and its analyses (:func:`run_runup`).
 
     Attributes
@@ -152,6 +153,142 @@ class RunupResult:
     @property
     def reference(self) -> str:
         return self.scene.runup.reference
+
+    def summary(self) -> list[str]:
+        """The scene, the speeds swept, the steps, the largest orbit radius per node, the critical speeds, the rubs."""
+        from rotorred.transient.results import shorten
+
+        sc, hz = self.scene, 1.0 / (2 * math.pi)
+        speeds = ", ".join(f"{s} {w[0] * hz:.4g} -> {w[-1] * hz:.4g} Hz" for s, w in self.speeds.items()) if len(
+            self.t) else "no record"
+        lines = [shorten(f"scene {sc.name}: {sc.description}"),
+                 shorten(f"run-up: {speeds} in {self.t[-1] if len(self.t) else 0.0:.4g} s; {self.n_steps} steps of "
+                         f"{sc.solver.dt:g} s, {self.counters.get('us_per_step', 0.0):.2f} µs/step"),
+                 self.model_label.split(" (")[0]]  # its boundary nodes are a list
+        if self.incomplete:
+            lines.append(shorten(f"INCOMPLETE: {self.incomplete}"))
+        for node, (speed, radius) in sorted(self.overall.items())[:4]:
+            if len(radius):
+                k = int(np.argmax(radius))
+                lines.append(f"node {node}: largest orbit radius {1e6 * radius[k]:.4g} µm at {self.reference} "
+                             f"{speed[k] * hz:.4g} Hz ({60 * speed[k] * hz:.5g} rpm)")
+        lines.append(shorten(f"{len(self.tracks)} order tracks; critical speeds in the range: " + (", ".join(
+            f"1x {c.spool} {c.whirl} {c.speed * hz:.4g} Hz" for c in self.critical_speeds) or "none")))
+        if sc.plates:
+            lines.append(shorten("rub intervals: " + (", ".join(
+                f"plate {r.plate} {r.speed_start[self.reference]:.4g}-{r.speed_end[self.reference]:.4g} Hz"
+                for r in self.rubs) if self.rubs else "none")))
+        lines.append(f"model built in {self.build_time:.3g} s, solved in {self.solve_time:.3g} s, analysed in "
+                     f"{self.analysis_time:.3g} s")
+        return lines
+
+    def plot(self, ax=None, kind: str = "amplitude", **options):
+        """Draw one of the run-up's figures as ``rotorred run`` writes it (:func:`rotorred.plots.runup.draw_runup`);
+        return the Figure.
+
+        ``kind``: "amplitude" (default: the largest orbit radius and the 1x tracks against the reference speed, per
+        node, with the critical speeds and rubs; ``node=`` into a given ``ax``), "orders" (every order track;
+        ``dof=``), "waterfall" (of the table DOF) or "orbits" (the snapshots at ``runup.orbits_hz``).
+        """
+        from rotorred.plots.runup import draw_runup
+
+        return draw_runup(self, kind, ax, **options)
+
+    def to_xarray(self):
+        """The run-up as an :class:`xarray.Dataset`.
+
+        The record (:func:`rotorred.transient.results.record_dataset`: dimensions ``time``, ``output``, ``plate``)
+        with ``speed`` (spool, time) in rad/s; the order tracks (dimensions ``track``, ``block``; shorter tracks
+        padded with NaN): ``track_time`` (s), ``track_speed`` (rad/s, of the track's spool), ``track_amplitude``
+        (m) and ``track_phase`` (rad), with ``track_spool``, ``track_order``, ``track_output``; the largest orbit
+        radius ``overall_radius`` (orbit_node, overall_block) in m against ``overall_speed`` (rad/s, reference
+        spool); the waterfall ``waterfall_amplitude`` (segment, waterfall_frequency) in m at ``segment_time`` (s);
+        the critical speeds (dimension ``critical``: ``critical_speed`` and ``critical_frequency`` in rad/s,
+        ``critical_log_dec``, ``critical_spool``, ``critical_whirl``); the rub intervals (dimension ``rub``:
+        ``rub_plate``, ``rub_node``, ``rub_t_start``, ``rub_t_end`` (s), ``rub_impacts``, ``rub_speed_start`` and
+        ``rub_speed_end`` (rub, spool) in Hz). Tracks at rotations go into ``rotation_track_*`` (rad). The orbit
+        snapshots are slices of the record (not repeated).
+        """
+        from rotorred.transient.results import dof_groups, record_dataset
+
+        ds = record_dataset(self.t, self.outputs, self.contacts, {
+            "title": f"run-up {self.scene.name}", "scene": self.scene.name, "reference_spool": self.reference,
+            "model": self.model_label, "n_steps": int(self.n_steps), "incomplete": self.incomplete or "",
+            "campbell_ratio": ", ".join(f"{s} {r:.9g}" for s, r in self.campbell_ratio.items())})
+        spools = list(self.speeds)
+        data = {"speed": (("spool", "time"), np.array([self.speeds[s] for s in spools], float).reshape(
+            len(spools), len(self.t)), {"units": "rad/s", "long_name": "spool speed"})}
+        coords = {"spool": ("spool", np.array(spools, dtype=object), {"units": "1", "long_name": "spool"})}
+        for prefix, units, dofs in dof_groups(list(dict.fromkeys(self.track_dofs))):
+            data.update(self._track_variables(f"{prefix}track", [
+                (tr, d) for tr, d in zip(self.tracks, self.track_dofs) if d in dofs], units))
+        if self.overall:
+            nodes = sorted(self.overall)
+            coords["orbit_node"] = ("orbit_node", np.array(nodes, np.int64), {"units": "1", "long_name": "node"})
+            data["overall_speed"] = ("overall_block", self.overall[nodes[0]][0], {
+                "units": "rad/s", "long_name": f"mean speed of the {self.reference} spool over two revolutions"})
+            data["overall_radius"] = (("orbit_node", "overall_block"), np.array([self.overall[n][1] for n in nodes]),
+                                      {"units": "m", "long_name": "largest orbit radius over two revolutions"})
+        w = self.waterfall
+        if w is not None:
+            units = "rad" if self.waterfall_dof[1].startswith("t") else "m"
+            coords["waterfall_frequency"] = ("waterfall_frequency", w.frequencies, {"units": "Hz",
+                                                                                    "long_name": "bin frequency"})
+            data["segment_time"] = ("segment", w.t, {"units": "s", "long_name": "centre time of the segment"})
+            data["waterfall_amplitude"] = (("segment", "waterfall_frequency"), w.amplitudes, {"units": units, (
+                "long_name"): f"amplitude of {self.waterfall_dof[0]}:{self.waterfall_dof[1]} (Hann segments of "
+                              f"{w.segment:.6g} s)"})
+        cs = self.critical_speeds
+        if cs:
+            data.update({
+                "critical_speed": ("critical", [c.speed for c in cs], {"units": "rad/s", "long_name": (
+                    f"critical speed of the {self.reference} spool")}),
+                "critical_frequency": ("critical", [c.frequency for c in cs], {"units": "rad/s", "long_name": (
+                    "whirl frequency")}),
+                "critical_log_dec": ("critical", [c.log_dec for c in cs], {"units": "1", "long_name": "log dec"}),
+                "critical_spool": ("critical", np.array([c.spool for c in cs], dtype=object), {"units": "1", (
+                    "long_name"): "spool of the 1x line"}),
+                "critical_whirl": ("critical", np.array([c.whirl for c in cs], dtype=object), {"units": "1", (
+                    "long_name"): "whirl"})})
+        if self.rubs:
+            rubs = self.rubs
+            data.update({
+                "rub_plate": ("rub", [r.plate for r in rubs], {"units": "1", "long_name": "plate"}),
+                "rub_node": ("rub", [r.node for r in rubs], {"units": "1", "long_name": "node of the plate"}),
+                "rub_t_start": ("rub", [r.t_start for r in rubs], {"units": "s", "long_name": "first contact"}),
+                "rub_t_end": ("rub", [r.t_end for r in rubs], {"units": "s", "long_name": "last contact"}),
+                "rub_impacts": ("rub", [r.impacts for r in rubs], {"units": "1", "long_name": "contact onsets"}),
+                "rub_speed_start": (("rub", "spool"), [[r.speed_start[s] for s in spools] for r in rubs], {
+                    "units": "Hz", "long_name": "spool speed at the first contact"}),
+                "rub_speed_end": (("rub", "spool"), [[r.speed_end[s] for s in spools] for r in rubs], {
+                    "units": "Hz", "long_name": "spool speed at the last contact"})})
+        return ds.assign_coords(coords).assign(data)
+
+    @staticmethod
+    def _track_variables(dim: str, tracks: list, units: str) -> dict:
+        """The variables of order tracks ``[(OrderTrack, dof), ...]`` along ``dim`` and ``block`` (NaN-padded)."""
+        n = max((len(tr.t) for tr, _ in tracks), default=0)
+
+        def padded(name):
+            out = np.full((len(tracks), n), np.nan)
+            for k, (tr, _) in enumerate(tracks):
+                values = getattr(tr, name)
+                out[k, :len(values)] = values
+            return out
+
+        block = (dim, "block" if dim == "track" else f"{dim}_block")
+        return {f"{dim}_time": (block, padded("t"), {"units": "s", "long_name": "time at the block's centre"}),
+                f"{dim}_speed": (block, padded("speed"), {"units": "rad/s", "long_name": "mean speed of the track's "
+                                                                                       "spool over the block"}),
+                f"{dim}_amplitude": (block, padded("amplitude"), {"units": units, "long_name": "amplitude of the order"}),
+                f"{dim}_phase": (block, padded("phase"), {"units": "rad", "long_name": "phase against the spool's "
+                                                                                     "spin angle"}),
+                f"{dim}_spool": (dim, np.array([tr.spool for tr, _ in tracks], dtype=object), {"units": "1", (
+                    "long_name"): "spool of the order"}),
+                f"{dim}_order": (dim, [tr.order for tr, _ in tracks], {"units": "1", "long_name": (
+                    "order (cycles per revolution of the spool)")}),
+                f"{dim}_output": (dim, np.array([f"{d[0]}:{d[1]}" for _, d in tracks], dtype=object), {"units": "1", (
+                    "long_name"): "recorded DOF"})}
 
 
 # --------------------------------------------------------------------------- analyses

@@ -14,12 +14,14 @@ The overall amplitude against speed is the largest radius of the orbit, ``sqrt(x
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from rotorred import checks
+from rotorred.results import Result
 from rotorred.signals.spectra import window_values
 
 #: the method, as stated with every track
@@ -27,8 +29,8 @@ METHOD = ("angle-domain resampling (computed order tracking): cubic-spline resam
           "revolution, blocks of {rpb} revolutions with 50 % overlap, Hann window, single-bin DFT per order")
 
 
-@dataclass(frozen=True)
-class OrderTrack:
+@dataclass(frozen=True, repr=False)
+class OrderTrack(Result):
     """One order of one spool in one signal, block by block.
 
     Attributes
@@ -54,6 +56,38 @@ class OrderTrack:
     amplitude: np.ndarray
     phase: np.ndarray
     method: str
+
+    def summary(self) -> list[str]:
+        """The order and spool, the blocks and speeds, the largest amplitude and where, the method."""
+        lines = [f"order {self.order:g} of the {self.spool} spool over {len(self.t)} blocks"]
+        if len(self.t):
+            hz = self.speed / (2 * np.pi)
+            k = int(np.argmax(self.amplitude))
+            lines[0] += f", t = {self.t[0]:.4g}-{self.t[-1]:.4g} s, {self.spool} at {hz.min():.4g}-{hz.max():.4g} Hz"
+            lines.append(f"largest amplitude {self.amplitude[k]:.6g} (the signal's units) at {hz[k]:.6g} Hz "
+                         f"({60 * hz[k]:.6g} rpm), t = {self.t[k]:.4g} s")
+        return lines + textwrap.wrap(self.method, 110, max_lines=3, placeholder=" ...")
+
+    def plot(self, ax=None, **options):
+        """The amplitude against the spool's speed (Hz, rpm on top), as a run-up's order tracks are drawn
+        (:func:`rotorred.plots.runup.draw_order_track`, whose options it takes: ``scale`` and ``unit`` (default µm
+        from m), ``title``); return the Figure."""
+        from rotorred.plots.runup import draw_order_track
+
+        return draw_order_track(self, ax, **options)
+
+    def to_xarray(self, units: str = "m"):
+        """The track as an :class:`xarray.Dataset`: dimension ``block``, variables ``time`` (s, the block's centre),
+        ``speed`` (rad/s, the spool's mean), ``amplitude`` in ``units`` (the signal's, which a track does not know:
+        m, as rotorred's displacements, by default) and ``phase`` (rad); spool, order and method as attributes."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"time": ("block", self.t, {"units": "s", "long_name": "time at the block's centre"}),
+             "speed": ("block", self.speed, {"units": "rad/s", "long_name": f"mean speed of the {self.spool} spool"}),
+             "amplitude": ("block", self.amplitude, {"units": units, "long_name": f"amplitude of order {self.order:g}"}),
+             "phase": ("block", self.phase, {"units": "rad", "long_name": "phase against the spool's spin angle"})},
+            attrs={"title": "order track", "spool": self.spool, "order": self.order, "method": self.method})
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+import textwrap
 from dataclasses import dataclass, replace
 from fractions import Fraction
 
@@ -60,6 +61,7 @@ import sys
 import numpy as np
 
 from rotorred import checks
+from rotorred.results import Result
 
 
 def _import_pyfftw():
@@ -292,8 +294,8 @@ def rfft(x: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- spectrum
-@dataclass(frozen=True)
-class Spectrum:
+@dataclass(frozen=True, repr=False)
+class Spectrum(Result):
     """Single-sided amplitude spectrum of a real record.
 
     Attributes
@@ -341,6 +343,39 @@ class Spectrum:
         """Amplitude at the bin nearest to ``frequency_hz`` (signal units)."""
         frequency_hz = checks.number("frequency_hz", frequency_hz, "Hz", ge=0.0, le=float(self.frequencies[-1]))
         return float(self.amplitudes[int(round(frequency_hz / self.df))])
+
+    def summary(self) -> list[str]:
+        """The record, the window and its amplitude error, the largest line, and the note."""
+        k = 1 + int(np.argmax(self.amplitudes[1:])) if len(self.amplitudes) > 1 else 0
+        lines = [f"amplitude spectrum of {self.n_samples} samples of {self.dt:.6g} s ({self.duration:.6g} s): "
+                 f"bins of {self.df:.6g} Hz up to {self.frequencies[-1]:.6g} Hz",
+                 f"{self.window} window: amplitude error up to {self.max_amplitude_error_db:.3g} dB between bins, "
+                 "none on a bin",
+                 f"largest amplitude {self.amplitudes[k]:.6g} (the signal's units) at {self.frequencies[k]:.6g} Hz; "
+                 f"mean {self.amplitudes[0]:.4g}"]
+        return lines + textwrap.wrap(self.note, 110, max_lines=4, placeholder=" ...")
+
+    def plot(self, ax=None, *, label: str = "amplitude", **options):
+        """Draw the spectrum (:func:`rotorred.plots.scene.draw_spectra`, whose options it takes: ``f_max`` (Hz),
+        ``log_y``, ``scale`` and ``unit`` (default µm from m), ``title``), its line labelled ``label``; return the
+        Figure."""
+        from rotorred.plots.scene import draw_spectra
+
+        return draw_spectra({label: self}, ax, **options)
+
+    def to_xarray(self, units: str = "m"):
+        """The spectrum as an :class:`xarray.Dataset`: dimension ``frequency`` (coordinate, Hz), variable
+        ``amplitude`` in ``units`` (the signal's, which a Spectrum does not know: m, as rotorred's displacements, by
+        default), scalars ``df`` (Hz) and ``dt`` (s); window, samples, amplitude error and note as attributes."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"amplitude": ("frequency", self.amplitudes, {"units": units, "long_name": "peak amplitude of the bin"}),
+             "df": ((), self.df, {"units": "Hz", "long_name": "bin width"}),
+             "dt": ((), self.dt, {"units": "s", "long_name": "sample interval"})},
+            {"frequency": ("frequency", self.frequencies, {"units": "Hz", "long_name": "bin frequency"})},
+            attrs={"title": "amplitude spectrum", "window": self.window, "n_samples": int(self.n_samples),
+                   "max_amplitude_error_db": self.max_amplitude_error_db, "note": self.note})
 
 
 def _check_signal(x) -> np.ndarray:
