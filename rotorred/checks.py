@@ -43,12 +43,13 @@ MISSING: Any = _Missing()
 
 
 def fmt_value(value) -> str:
-    """The value as the user wrote it: ``repr`` of Python scalars (numpy scalars unwrapped)."""
+    """The value as the user wrote it: ``repr`` of Python scalars (numpy scalars unwrapped), on one line (a
+    result's repr of several lines joined)."""
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, np.ndarray):
         return f"array of shape {value.shape}"
-    text = repr(value)
+    text = " ".join(line.strip() for line in repr(value).splitlines())
     return text if len(text) <= 80 else text[:77] + "..."
 
 
