@@ -27,6 +27,7 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.dofs import direction_name
 from rotorred.plots.axes import save_figure
+from rotorred.plots.branch import titled
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -160,13 +161,9 @@ def _figure(ax, frame, title: str | None):
     """``(figure, panels)``: a new ``frame`` (:func:`_stacked` or :func:`_side_by_side`, a callable) titled ``title``,
     or the figure of the given ``ax`` and ``ax`` as its one panel (titled ``title``)."""
     if ax is not None:
-        if title:
-            ax.set_title(title)
-        return ax.figure, np.array([ax])
+        return titled(ax.figure, ax, title, new=False), np.array([ax])
     fig, panels = frame()
-    if title:
-        fig.suptitle(title)
-    return fig, panels
+    return titled(fig, None, title, new=True), panels
 
 
 def _laid_out(panels: dict[str, dict], merge: bool) -> dict[str, dict[str, tuple[str, object]]]:
