@@ -658,7 +658,8 @@ def draw_scene(result, kind: str = SCENE_KINDS[0], ax=None, *, node: int | None 
         Waveforms of every recorded DOF (default), the spectra of one node, the orbits of every node (x and y
         recorded), the Poincare section of the table DOF (when the analysis has samples).
     ax : matplotlib Axes, optional
-        Draw every panel's series into it; default a new figure of the file's panels.
+        Draw every panel's series into it (untitled unless ``title`` is given); default a new figure of the file's
+        panels.
     node : int, optional
         The node of "spectra" (default the first recorded).
     **options
@@ -677,6 +678,8 @@ def draw_scene(result, kind: str = SCENE_KINDS[0], ax=None, *, node: int | None 
     if not drawings:
         checks.fail("kind", kind, "has no data in this result (orbits need x and y, spectra a complete record, the "
                     "Poincare section the table DOF's samples)")
+    if ax is not None:
+        options.setdefault("title", None)  # the file's title is the figure's, too long for one axes
     return next(iter(drawings.values()))(ax=ax, **options)
 
 
