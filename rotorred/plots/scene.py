@@ -166,7 +166,7 @@ def _figure(ax, frame, title: str | None):
     return titled(fig, None, title, new=True), panels
 
 
-def _laid_out(panels: dict[str, dict], merge: bool) -> dict[str, dict[str, tuple[str, object]]]:
+def _arranged(panels: dict[str, dict], merge: bool) -> dict[str, dict[str, tuple[str, object]]]:
     """``{panel title: {label shown: (its panel, item)}}``: the panels as they are or, with ``merge`` (into a given
     axes), every series in one panel (title ""), a label found in two panels prefixed with its panel's title."""
     if not merge:
@@ -232,7 +232,7 @@ def draw_waveforms(
             checks.fail("t_window", t_window, "must hold at least 2 samples of t", "s")
     else:
         keep = np.ones(t.size, dtype=bool)
-    panels = _laid_out(panels, merge=ax is not None)
+    panels = _arranged(panels, merge=ax is not None)
     fig, axes = _figure(ax, lambda: _stacked(*_WAVEFORM_PANEL, len(panels)), title)
     for axis, (panel, series) in zip(axes, panels.items()):
         for label, (source, y) in series.items():
@@ -312,7 +312,7 @@ def draw_spectra(
         f_max = 1.1 * max(known) if known else None
     else:
         checks.positive("f_max", f_max, "Hz")
-    panels = _laid_out(panels, merge=ax is not None)
+    panels = _arranged(panels, merge=ax is not None)
     fig, axes = _figure(ax, lambda: _stacked(*_SPECTRUM_PANEL, len(panels)), title)
     for axis, (panel, series) in zip(axes, panels.items()):
         top = 0.0
@@ -412,7 +412,7 @@ def draw_orbits(
         checks.positive("clearance", radius, "m")
     if ax is not None and clearances:
         clearances = {"": next(iter(clearances.values()))}
-    panels = _laid_out(panels, merge=ax is not None)
+    panels = _arranged(panels, merge=ax is not None)
     fig, axes = _figure(ax, lambda: _side_by_side(*_ORBIT_PANEL, len(panels)), title)
     for axis, (panel, series) in zip(axes, panels.items()):
         for label, (_, xy) in series.items():
