@@ -267,14 +267,6 @@ def dof_groups(dofs) -> list[tuple[str, str, list]]:
     return [g for g in groups if g[2]]
 
 
-def dof_coords(dim: str, dofs, long_name: str) -> dict:
-    """Coordinates of a dimension of (node, direction) pairs: labels ``"13:x"``, ``<dim>_node`` and
-    ``<dim>_direction`` (``node`` and ``direction`` for ``output``)."""
-    from rotorred.linear.harmonic import _output_coords
-
-    return _output_coords(dim, dofs, long_name)
-
-
 def record_dataset(t, outputs: dict, contacts=(), attrs: dict | None = None):
     """A record as an :class:`xarray.Dataset`: the one builder of the record of a transient
     (:meth:`TransientResult.to_xarray`), a scene and a run-up.
@@ -297,12 +289,14 @@ def record_dataset(t, outputs: dict, contacts=(), attrs: dict | None = None):
     """
     import xarray as xr
 
+    from rotorred.linear.harmonic import _output_coords  # the DOF coordinates of every dataset
+
     data, coords = {}, {"time": ("time", np.asarray(t, float), {"units": "s", "long_name": "record time"})}
     for prefix, units, dofs in dof_groups(list(outputs)):
         name = "rotation" if prefix else "displacement"
         data[name] = (("time", f"{prefix}output"), np.array([outputs[d] for d in dofs], float).reshape(
             len(dofs), len(t)).T, {"units": units, "long_name": f"recorded {name}"})
-        coords.update(dof_coords(f"{prefix}output", dofs, f"recorded DOF ({name})"))
+        coords.update(_output_coords(f"{prefix}output", dofs, f"recorded DOF ({name})"))
     if contacts:
         flags = {"flag_values": np.array(sorted(STATE_NAMES), np.int8),
                  "flag_meanings": " ".join(STATE_NAMES[k] for k in sorted(STATE_NAMES))}
