@@ -18,6 +18,10 @@ repr, which prints every array, does not replace :meth:`Result.__repr__`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+import numpy as np
+
 #: longest repr of a result (lines, the type's name included)
 MAX_REPR_LINES = 15
 
@@ -42,3 +46,18 @@ class Result:
     def to_xarray(self):
         """The result as an :class:`xarray.Dataset` with named dimensions and ``units`` on every variable."""
         raise NotImplementedError(f"{type(self).__name__}.to_xarray")
+
+
+def label_coordinate(dim: str, labels: Sequence[str], long_name: str) -> tuple:
+    """A dimension coordinate of string labels for :meth:`Result.to_xarray` (``units`` "1")."""
+    return (dim, np.array(labels, dtype=object), {"units": "1", "long_name": long_name})
+
+
+def dof_coordinates(dim: str, dofs: Sequence[tuple[int, str]], long_name: str) -> dict:
+    """Coordinates of a dimension of (node, direction) pairs for :meth:`Result.to_xarray`: labels ``"13:x"``, and
+    the node and the direction (``<dim>_node``, ``<dim>_direction``; ``node`` and ``direction`` for ``output``)."""
+    prefix = "" if dim == "output" else f"{dim}_"
+    return {dim: label_coordinate(dim, [f"{n}:{d}" for n, d in dofs], long_name),
+            f"{prefix}node": (dim, np.array([n for n, _ in dofs], np.int64), {"units": "1", "long_name": "node"}),
+            f"{prefix}direction": (dim, np.array([d for _, d in dofs], dtype=object),
+                                   {"units": "1", "long_name": "direction (x, y, tx, ty)"})}

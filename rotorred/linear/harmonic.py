@@ -47,7 +47,7 @@ import scipy.linalg as sla
 from rotorred import checks, writers
 from rotorred.model.assembly import system_of
 from rotorred.model.loads import Unbalance
-from rotorred.results import Result
+from rotorred.results import Result, dof_coordinates, label_coordinate
 from rotorred.model.operating import Operating
 from rotorred.model.operating import checked as checked_operating
 
@@ -200,9 +200,9 @@ class UnbalanceResponse(Result):
         }
         coords = {"speed": ("speed", self.speeds, {"units": "rad/s", "long_name": f"speed of the "
                                                                                   f"{self.reference_spool} spool"}),
-                  "spool": _labels("spool", list(self.spool_speeds), "spool"),
-                  "excited_spool": _labels("excited_spool", list(excited), "spool carrying an unbalance"),
-                  **_output_coords("output", self.outputs, "response DOF")}
+                  "spool": label_coordinate("spool", list(self.spool_speeds), "spool"),
+                  "excited_spool": label_coordinate("excited_spool", list(excited), "spool carrying an unbalance"),
+                  **dof_coordinates("output", self.outputs, "response DOF")}
         return xr.Dataset(data, coords, attrs={"title": "unbalance response", "reference_spool": self.reference_spool})
 
 
@@ -284,25 +284,10 @@ class FrequencyResponse(Result):
                                 {"units": "rad/s", "long_name": "spool speed held during the sweep"})}
         coords = {"frequency": ("frequency", self.frequencies / (2 * math.pi),
                                 {"units": "Hz", "long_name": "excitation frequency"}),
-                  "spool": _labels("spool", list(self.speeds), "spool"),
-                  **_output_coords("output", self.outputs, "response DOF"),
-                  **_output_coords("input", self.inputs, "force DOF")}
+                  "spool": label_coordinate("spool", list(self.speeds), "spool"),
+                  **dof_coordinates("output", self.outputs, "response DOF"),
+                  **dof_coordinates("input", self.inputs, "force DOF")}
         return xr.Dataset(data, coords, attrs={"title": "receptance FRF"})
-
-
-def _labels(dim: str, labels: Sequence[str], long_name: str) -> tuple:
-    """A dimension coordinate of string labels (``units`` "1")."""
-    return (dim, np.array(labels, dtype=object), {"units": "1", "long_name": long_name})
-
-
-def _output_coords(dim: str, outputs: Sequence[Output], long_name: str) -> dict:
-    """Coordinates of a dimension of (node, direction) pairs: labels ``"13:x"``, and the node and the direction
-    (``<dim>_node``, ``<dim>_direction``; ``node`` and ``direction`` for ``output``)."""
-    prefix = "" if dim == "output" else f"{dim}_"
-    return {dim: _labels(dim, [f"{n}:{d}" for n, d in outputs], long_name),
-            f"{prefix}node": (dim, np.array([n for n, _ in outputs], np.int64), {"units": "1", "long_name": "node"}),
-            f"{prefix}direction": (dim, np.array([d for _, d in outputs], dtype=object),
-                                   {"units": "1", "long_name": "direction (x, y, tx, ty)"})}
 
 
 @dataclass(frozen=True, repr=False)
@@ -375,8 +360,8 @@ class SteadyState(Result):
                 "spool_speed": ("spool", np.array(list(self.speeds.values()), float),
                                 {"units": "rad/s", "long_name": "spool speed"})}
         coords = {"coordinate": ("coordinate", np.arange(n), {"units": "1", "long_name": "model coordinate"}),
-                  "spool": _labels("spool", list(self.speeds), "spool"),
-                  "excited_spool": _labels("excited_spool", list(self.phasors), "spool carrying an unbalance")}
+                  "spool": label_coordinate("spool", list(self.speeds), "spool"),
+                  "excited_spool": label_coordinate("excited_spool", list(self.phasors), "spool carrying an unbalance")}
         return xr.Dataset(data, coords, attrs={"title": "steady unbalance response"})
 
 

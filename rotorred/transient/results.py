@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotorred.results import Result
+from rotorred.results import Result, dof_coordinates
 from rotorred.transient import kernel
 from rotorred.transient.contact import STATE_NAMES, RubPlate, disk_force
 from rotorred.transient.status import LIMIT, NONFINITE, Status
@@ -289,14 +289,13 @@ def record_dataset(t, outputs: dict, contacts=(), attrs: dict | None = None):
     """
     import xarray as xr
 
-    from rotorred.linear.harmonic import _output_coords  # the DOF coordinates of every dataset
 
     data, coords = {}, {"time": ("time", np.asarray(t, float), {"units": "s", "long_name": "record time"})}
     for prefix, units, dofs in dof_groups(list(outputs)):
         name = "rotation" if prefix else "displacement"
         data[name] = (("time", f"{prefix}output"), np.array([outputs[d] for d in dofs], float).reshape(
             len(dofs), len(t)).T, {"units": units, "long_name": f"recorded {name}"})
-        coords.update(_output_coords(f"{prefix}output", dofs, f"recorded DOF ({name})"))
+        coords.update(dof_coordinates(f"{prefix}output", dofs, f"recorded DOF ({name})"))
     if contacts:
         flags = {"flag_values": np.array(sorted(STATE_NAMES), np.int8),
                  "flag_meanings": " ".join(STATE_NAMES[k] for k in sorted(STATE_NAMES))}
