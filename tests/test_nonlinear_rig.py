@@ -114,8 +114,9 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     errors = [abs(lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1) for ln in largest]
     assert iterations <= 5 and max(errors) < 1e-2, errors
     # the solution as a transient's start (RubProblem.final_state): 0.5 s later the transient is still on it
-    again = simulate(sm.model, scene.speeds, 0.5, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
-                     rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=0.4, start=rp.final_state(z))
+    again = simulate(sm.model, Operating.point(scene.speeds), 0.5, scene.solver.dt, loads=Loads(scene.unbalances),
+                     contacts=scene.plates, recording=Recording([(18, "x"), (18, "y")], start=0.4),
+                     start=rp.final_state(z))
     window = again.t >= again.t[-1] - period + 1e-9
     records = unknown_records(scene.plates, again)
     settled = rp.start_from_record(again.t[window], {j: x[window] for j, x in records.items()})

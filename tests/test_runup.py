@@ -87,8 +87,8 @@ def test_run_up_through_the_critical_matches_solve_ivp(k_c):
     W0, alpha, t_end = 240.0, 400.0, 0.45
     profile = SpeedProfile.ramp({"shaft": W0}, {"shaft": W0 + alpha * t_end}, t_end)
     outputs = [(1, d) for d in ("x", "y", "theta_x", "theta_y")]
-    runs = [simulate(disk_rotor(k_c=k_c), profile, t_end, dt, unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"},
-                     outputs=outputs, decimate=decimate, progress=False) for dt, decimate in ((5e-6, 20), (2.5e-6, 40))]
+    runs = [simulate(disk_rotor(k_c=k_c), Operating.profile(profile), t_end, dt, loads=Loads([Unbalance(1, M_E)]),
+                     recording=Recording(outputs, decimate=decimate), control=StepControl(progress=False)) for dt, decimate in ((5e-6, 20), (2.5e-6, 40))]
     np.testing.assert_allclose(runs[0].t, runs[1].t, rtol=0, atol=1e-12)
     rhs, jac = hand_written_rhs(W0, alpha, k_c=k_c)
     ref = solve_ivp(rhs, (0.0, t_end), np.zeros(8), method="Radau", rtol=1e-10, atol=1e-16, jac=jac, t_eval=runs[0].t)
@@ -129,8 +129,8 @@ def passages():
         alpha = lam * omega**2
         t_end = (omega + 10 * math.sqrt(alpha)) / alpha
         profile = SpeedProfile.ramp({"shaft": 0.0}, {"shaft": alpha * t_end}, t_end)
-        res = simulate(model, profile, t_end, 1e-4, unbalances=[Unbalance(1, 1.0)], spool_of={1: "shaft"},
-                       outputs=[(1, "x"), (1, "y")], progress=False)
+        res = simulate(model, Operating.profile(profile), t_end, 1e-4, loads=Loads([Unbalance(1, 1.0)]),
+                       recording=Recording([(1, "x"), (1, "y")]), control=StepControl(progress=False))
         r = np.hypot(res.outputs[(1, "x")], res.outputs[(1, "y")])
         k = int(np.argmax(r))
         out.append((lam, alpha, r[k], alpha * res.t[k]))
@@ -217,11 +217,12 @@ def test_profile_needs_average_acceleration_and_K_G():
     model = disk_rotor()
     profile = SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 1.0)
     with pytest.raises(InputError) as e:
-        simulate(model, profile, 0.1, 1e-4, method="hht", spool_of={1: "shaft"}, progress=False)
+        simulate(model, Operating.profile(profile), 0.1, 1e-4, scheme=Scheme("hht"),
+                 control=StepControl(progress=False))
     assert e.value.field == "method"
     bare = SystemMatrices(M=model.M, K=model.K, C=model.C, G=model.G, dofs=model.dofs)
     with pytest.raises(InputError) as e:
-        simulate(bare, profile, 0.1, 1e-4, spool_of={1: "shaft"}, progress=False)
+        simulate(bare, Operating.profile(profile), 0.1, 1e-4, control=StepControl(progress=False))
     assert e.value.field == "model.K_G['shaft']"
 
 
@@ -246,7 +247,7 @@ def test_energy_balance_of_a_run_up():
 
 def test_energy_balance_needs_the_recorded_state():
     model = disk_rotor()
-    res = simulate(model, {"shaft": 100.0}, 1e-3, 1e-4, spool_of={1: "shaft"}, progress=False)
+    res = simulate(model, Operating.point({"shaft": 100.0}), 1e-3, 1e-4, control=StepControl(progress=False))
     with pytest.raises(InputError) as e:
         energy_balance(model, res, {"shaft": 100.0})
     assert e.value.field == "result.states"
@@ -293,4 +294,4 @@ def test_runup_refuses_speed_dependent_bearings_on_a_varying_spool():
     model = assemble(dataclasses.replace(rotor, bearings=tables))
     with pytest.raises(InputError, match=r"^bearing at node \d+ = 'speed-dependent': is not supported when the speed "
                                          r"of spool 'shaft' varies in time"):
-        simulate(model, SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 0.1), 0.1, 1e-4, rotor=rotor)
+        simulate(model, Operating.profile(SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 0.1)), 0.1, 1e-4)

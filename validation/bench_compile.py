@@ -44,8 +44,8 @@ def worker(loop: str) -> float:
     speeds = scene.speeds
     if loop == "varying speed":
         speeds = SpeedProfile(t=np.array([0.0, 1.0]), speeds={k: np.array([v, 1.01 * v]) for k, v in speeds.items()})
-    res = simulate(model, speeds, 2e-4, 2e-5, unbalances=scene.unbalances, plates=scene.plates, rotor=scene.rotor,
-                   step={"eigenbasis": "eigen", "dense": "dense"}.get(loop, "auto"))  # "auto" takes dense for 10 steps
+    res = simulate(model, Operating.point(speeds), 2e-4, 2e-5, loads=Loads(scene.unbalances), contacts=scene.plates,
+                   scheme=Scheme(step={"eigenbasis": "eigen", "dense": "dense"}.get(loop, "auto")))  # "auto" takes dense for 10 steps
     return res.kernel_load_time
 
 

@@ -27,8 +27,9 @@ def run(model_kind: str, rub: bool, ramp: bool, duration: float):
                                                          "runup.orbits_hz": []})
     model = build_model(scene).model
     speeds = scene.runup.profile if ramp else scene.speeds
-    res = simulate(model, speeds, duration, scene.solver.dt, rotor=scene.rotor, unbalances=scene.unbalances,
-                   plates=scene.plates, outputs=scene.output.dofs, decimate=5, progress=False)
+    res = simulate(model, Operating.point(speeds), duration, scene.solver.dt, loads=Loads(scene.unbalances),
+                   contacts=scene.plates, recording=Recording(scene.output.dofs, decimate=5),
+                   control=StepControl(progress=False))
     return model.M.shape[0], res
 
 

@@ -54,8 +54,8 @@ def slow_ramp(T: float) -> None:
     outputs = [(13, "y"), (14, "y"), (18, "y")]
     t0 = time.perf_counter()
     dt = 5e-5  # Newmark's period error (omega dt)^2/12 moves the 121 Hz mode: 1.1 % near 108 Hz at 1e-4 s
-    res = simulate(model, profile, T, dt, rotor=scene.rotor, unbalances=scene.unbalances, outputs=outputs,
-                   decimate=2, progress=False)
+    res = simulate(model, Operating.profile(profile), T, dt, loads=Loads(scene.unbalances),
+                   recording=Recording(outputs, decimate=2), control=StepControl(progress=False))
     print(f"1. slow ramp: inner 30 -> 84 Hz in {T:g} s (lambda = Omega'/omega^2 = {0.9 * 2 * math.pi * 54 / T / (2 * math.pi * 55.7) ** 2:.1e} "
           f"at the inner 55.7 Hz critical), {res.n_steps} steps of {dt:g} s in {time.perf_counter() - t0:.1f} s "
           f"({res.us_per_step:.2f} us/step)")

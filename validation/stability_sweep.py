@@ -99,8 +99,9 @@ def run_one(rig, model, speeds, dt, K_nr, clearance, mu, t_end: float = T_END) -
     outputs = [(18, "x"), (18, "y")]
     t0 = time.perf_counter()
     try:
-        res = simulate(model, speeds, t_end, dt, rotor=rig, unbalances=UNBALANCES, plates=[plate],
-                       outputs=outputs, decimate=max(1, round(1e-5 / dt)), progress=False)
+        res = simulate(model, Operating.point(speeds), t_end, dt, loads=Loads(UNBALANCES), contacts=[plate],
+                       recording=Recording(outputs, decimate=max(1, round(1e-5 / dt))),
+                       control=StepControl(progress=False))
         outcome, message = "bounded", res.message
     except SimulationDiverged as exc:
         res, outcome, message = exc.result, "diverged", str(exc)
