@@ -17,7 +17,8 @@ from rotorred.scenes.harmonic_balance import base_frequency, rub_problem, unknow
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.contact import disk_force, normal_force, sliding_velocity
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 
 
 @pytest.fixture(scope="module")

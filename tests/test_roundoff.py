@@ -14,7 +14,8 @@ import pytest
 
 from rotorred.scenes.run import build_model, settled_response, settled_state
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Initial, Loads, Recording, simulate
 
 OUT = [(18, "y"), (14, "y")]
 

@@ -22,7 +22,7 @@ from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import Rotor, Spool
 from rotor_files import assert_refused
 from rotorred.model.rotor_file import rotor_from_toml
-from rotorred.transient.newmark import simulate
+from rotorred.transient.newmark import Initial, Loads, Recording, simulate
 
 STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
 L, D = 1.0, 0.05

@@ -16,7 +16,8 @@ from rotorred.scenes.run import build_model, respond, spool_frequencies
 from rotorred.scenes.schema import load_scene
 from rotorred.scenes.tolerance import choose, run_to_tolerance
 from rotorred.signals.compare import outputs_error, record_error
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 
 OUT = [(18, "x"), (18, "y"), (13, "x"), (14, "y")]
 

@@ -57,7 +57,7 @@ from rotorred.linear.campbell import campbell  # noqa: E402
 from rotorred.model.operating import Operating  # noqa: E402
 from rotorred.model.rotor_file import load_rotor  # noqa: E402
 from rotorred.model.loads import Unbalance  # noqa: E402
-from rotorred.transient.newmark import simulate  # noqa: E402
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate  # noqa: E402
 
 CAMPBELL_RPM = np.linspace(0.0, 40000.0, 21)
 N_MODES = 6

@@ -19,7 +19,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate
 
 
 def run(model_kind: str, rub: bool, ramp: bool, duration: float):

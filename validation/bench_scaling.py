@@ -116,7 +116,8 @@ def worker(refine: int, n_modes: int | None, steps: int, repeats: int) -> dict:
 
 def _run(bp, model, case):
     q0, v0 = bp.steady_state(model, case)
-    from rotorred.transient.newmark import simulate
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
     return simulate(model, Operating.point(case.speeds), case.t_end, DT, loads=Loads(case.unbalances),
                     contacts=case.plates, recording=Recording(case.outputs, decimate=DECIMATE),
                     start=Initial(q0=q0, v0=v0), control=StepControl(progress=False))

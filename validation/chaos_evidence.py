@@ -166,7 +166,8 @@ def whole_periods(f_outer: float, duration: float) -> float:
 
 def simulate_from(sc, model, q0, v0, t_end: float, record_start: float = 0.0) -> Run:
     """The scene pipeline's call (rotorred.scenes.run._transient_response) from a given state."""
-    from rotorred.transient.newmark import simulate
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate
 
     s = sc.solver
     res = simulate(model.model, Operating.point(sc.speeds), t_end, s.dt,

@@ -37,7 +37,8 @@ from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scen
 from rotorred.scenes.harmonic_balance import rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 
 OUTPUT = (14, "y")
 

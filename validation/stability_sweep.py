@@ -36,7 +36,8 @@ from rotorred.transient.contact import RubPlate
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
 from rotorred.linear.modal import eigen
-from rotorred.transient.newmark import SimulationDiverged, simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, SimulationDiverged, StepControl, simulate
 from rotorred.linear.reduction import default_boundary_nodes, reduce
 
 DTS = (1e-6, 1e-5, 1e-4, 2e-4)

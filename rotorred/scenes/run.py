@@ -48,7 +48,6 @@ from rotorred.progress import stage
 from rotorred.linear.harmonic import SteadyState, steady_state
 from rotorred.model.operating import Operating
 from rotorred.model.loads import gravity_force
-from rotorred.model.operating import Operating
 from rotorred.scenes.schema import Scene
 from rotorred.signals.classify import Classification, classify
 from rotorred.signals.linefit import FitOptions, LineFit, fit_lines, fit_peaks
