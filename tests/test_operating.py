@@ -202,7 +202,8 @@ def test_simulate_runs_at_the_operatings_spool_speeds(operating, line):
 
 def test_simulate_fills_a_spool_its_profile_leaves_out_by_the_rule():
     """A run-up that gives spool a only (or a and b) runs b and c at their nominal ratios 1.5 and 0.5 to a: the same
-    history, to the last bit, as the profile that gives every spool so; b at ratio 1 instead changes it by 100 %."""
+    history, to the last bit, as the profile that gives every spool so; b at ratio 1 instead changes b's output by 86 %
+    of its largest value (measured)."""
     rotor = three_spools()
     unbalances = rr.Loads([Unbalance(2, 1e-4), Unbalance(12, 2e-4, 1.0), Unbalance(22, 3e-4, 2.0)])
     recording = rr.Recording([(2, "x"), (12, "y"), (22, "x")])
