@@ -536,8 +536,8 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
 
     Raises :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
     """
-    from rotorred.transient.newmark import (Initial, Loads, Recording, Scheme, StepControl,  # loads numba only
-                                            simulate)                                         # when a scene needs it
+    # imported here: numba is loaded only when a scene needs it
+    from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate
     from rotorred.transient.results import SimulationDiverged
 
     s, model = scene.solver, scene_model.model
