@@ -288,5 +288,5 @@ def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme,
     return eig, note
 
 
-__all__ = ["simulate", "Loads", "Scheme", "Recording", "StepControl", "Initial", "TransientResult", "ContactHistory", "FinalState", "SimulationDiverged", "METHODS",
-           "newmark_coefficients", "step_matrices", "OPEN", "SLIP", "STICK"]
+__all__ = ["simulate", "Loads", "Scheme", "Recording", "StepControl", "Initial", "TransientResult", "ContactHistory",
+           "FinalState", "SimulationDiverged", "METHODS", "newmark_coefficients", "step_matrices", "OPEN", "SLIP", "STICK"]

@@ -128,7 +128,8 @@ def _coefficients(method: str, gamma, beta, alpha) -> tuple[float, float, float]
     implied = {"gamma": 0.5 - alpha, "beta": 0.25 * (1.0 - alpha) ** 2}
     for name, value in (("gamma", gamma), ("beta", beta)):
         if value is not None and value != implied[name]:
-            checks.fail(name, value, f"must not be given with method = 'hht' (it follows from alpha: {implied[name]:g})")
+            checks.fail(name, value, "must not be given with method = 'hht' (it follows from alpha: "
+                        f"{implied[name]:g})")
     return implied["gamma"], implied["beta"], alpha
 
 
