@@ -7,8 +7,8 @@ The user-level functions and result types, importable from ``rotorred`` directly
     rotor = rr.load_rotor("seed-rig")
     cd = rr.campbell(rotor, rr.Operating.line(np.linspace(0, 1200, 61)))   # rad/s of the reference spool
     model = rr.reduce_rotor(rotor, extra_nodes=[18], n_modes=24)
-    res = rr.simulate(model, None, 0.5, 2e-5, rotor=rotor, unbalances=[rr.Unbalance(18, 2e-3)],
-                      plates=[rr.RubPlate.for_rotor(rotor, 18)], outputs=[(18, "y")])
+    res = rr.simulate(model, rr.Operating.point(rotor.speeds), 0.5, 2e-5, loads=rr.Loads([rr.Unbalance(18, 2e-3)]),
+                      contacts=[rr.RubPlate.for_rotor(rotor, 18)], recording=rr.Recording([(18, "y")]))
 
 Layers (imports point downwards only; ``tests/test_architecture.py`` checks it):
 ``checks``/``writers``/``provenance`` and ``_generated`` at the bottom, then ``model``, ``linear`` and
@@ -50,6 +50,7 @@ _EXPORTS = {
     "assemble": "rotorred.model.assembly",
     "system_of": "rotorred.model.assembly",
     "SystemMatrices": "rotorred.model.assembly",
+    "system_of": "rotorred.model.assembly",
     "Unbalance": "rotorred.model.loads",
     "SpeedProfile": "rotorred.model.speeds",
     "Operating": "rotorred.model.operating",
@@ -74,6 +75,12 @@ _EXPORTS = {
     "ClampedFreePlate": "rotorred.transient.plate",
     "RigidPlate": "rotorred.transient.plate",
     "simulate": "rotorred.transient.newmark",
+    "Loads": "rotorred.transient.options",
+    "Scheme": "rotorred.transient.options",
+    "Recording": "rotorred.transient.options",
+    "StepControl": "rotorred.transient.options",
+    "Initial": "rotorred.transient.options",
+    "FinalState": "rotorred.transient.results",
     "TransientResult": "rotorred.transient.newmark",
     "SimulationDiverged": "rotorred.transient.newmark",
     "energy_balance": "rotorred.transient.energy",

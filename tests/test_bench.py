@@ -63,9 +63,10 @@ def test_steady_state_is_the_harmonic_solution(bp, tiny):
     """Without contact the run started from steady_state stays on it: q(0.1 s) = q(0) (period 0.1 s)."""
     case, system, _ = tiny
     q0, v0 = bp.steady_state(system, case)
-    from rotorred.transient.newmark import simulate
-    res = simulate(system, case.speeds, 0.1, 1e-5, unbalances=case.unbalances, rotor=case.rotor, q0=q0, v0=v0,
-                   progress=False)
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Initial, Loads, StepControl, simulate
+    res = simulate(system, Operating.point(case.speeds), 0.1, 1e-5, loads=Loads(case.unbalances),
+                   start=Initial(q0=q0, v0=v0), control=StepControl(progress=False))
     # Newmark's phase error at 90 Hz and dt = 1e-5 s: (Omega dt)^2 / 12 per radian, ~1e-4 after 9 cycles
     assert np.max(np.abs(res.final.q - q0)) < 2e-3 * np.max(np.abs(q0))
 

@@ -12,7 +12,8 @@ from rotorred.model.assembly import DofMap, SystemMatrices
 from rotorred.scenes.run import build_model, settled_state
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.eigenstep import MAX_COND, amplification, modal_scaling, real_block_form
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate
 
 
 def _pair(name: str):
@@ -20,10 +21,11 @@ def _pair(name: str):
     sc = load_scene(name)
     s = sc.solver
     model = build_model(sc).model
-    q0, v0 = settled_state(sc, model) if s.start == "settled" else (None, None)
-    kw = dict(rotor=sc.rotor, unbalances=sc.unbalances, plates=sc.plates, outputs=sc.output.dofs, q0=q0, v0=v0,
-              record_start=s.record_start, progress=False)
-    return tuple(simulate(model, sc.speeds, s.duration, s.dt, step=step, **kw) for step in ("dense", "eigen"))
+    start = Initial(*settled_state(sc, model)) if s.start == "settled" else None
+    kw = dict(loads=Loads(sc.unbalances), contacts=sc.plates, recording=Recording(sc.output.dofs, start=s.record_start),
+              start=start, control=StepControl(progress=False))
+    return tuple(simulate(model, Operating.point(sc.speeds), s.duration, s.dt, scheme=Scheme(step=step), **kw)
+                 for step in ("dense", "eigen"))
 
 
 def _worst(a, b) -> float:
@@ -84,14 +86,15 @@ def critically_damped() -> SystemMatrices:
 
 
 def test_defective_amplification_falls_back_to_the_dense_step():
-    kw = dict(q0=[1e-5, 0, 0, 0], spool_of={1: "shaft"}, outputs=[(1, "x")], progress=False)
-    res = simulate(critically_damped(), {"shaft": 0.0}, 1.2, 1e-4, **kw)  # 12 000 steps: long enough for "auto"
+    kw = dict(start=Initial(q0=[1e-5, 0, 0, 0]), recording=Recording([(1, "x")]), control=StepControl(progress=False))
+    at_rest = Operating.point({"shaft": 0.0})
+    res = simulate(critically_damped(), at_rest, 1.2, 1e-4, **kw)  # 12 000 steps: long enough for "auto"
     assert res.step_form.startswith("dense: the amplification matrix is defective")
     assert f"> {MAX_COND:.0e}" in res.step_form
     with pytest.raises(InputError) as e:
-        simulate(critically_damped(), {"shaft": 0.0}, 0.01, 1e-4, step="eigen", **kw)
-    assert e.value.field == "step"
-    hht = simulate(critically_damped(), {"shaft": 0.0}, 0.01, 1e-4, method="hht", **kw)
+        simulate(critically_damped(), at_rest, 0.01, 1e-4, scheme=Scheme(step="eigen"), **kw)
+    assert e.value.field == "scheme.step"
+    hht = simulate(critically_damped(), at_rest, 0.01, 1e-4, scheme=Scheme("hht"), **kw)
     assert hht.step_form.startswith("dense: the eigenbasis step is for average acceleration")
 
 
@@ -104,11 +107,13 @@ def test_auto_keeps_the_dense_step_for_runs_too_short_to_repay_the_eigenbasis():
     model = build_model(sc).model
     n = model.M.shape[0]
     needed = EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n
-    kw = dict(unbalances=sc.unbalances, plates=sc.plates, rotor=sc.rotor, outputs=[(18, "y")], progress=False)
-    short = simulate(model, sc.speeds, (needed - 1) * 2e-5, 2e-5, **kw)
+    kw = dict(loads=Loads(sc.unbalances), contacts=sc.plates, recording=Recording([(18, "y")]),
+              control=StepControl(progress=False))
+    op = Operating.point(sc.speeds)
+    short = simulate(model, op, (needed - 1) * 2e-5, 2e-5, **kw)
     assert short.step_form.startswith("dense:") and f"about {needed} steps" in short.step_form
-    assert simulate(model, sc.speeds, needed * 2e-5, 2e-5, **kw).step_form.startswith("eigenbasis")
-    assert simulate(model, sc.speeds, 0.01, 2e-5, step="eigen", **kw).step_form.startswith("eigenbasis")
+    assert simulate(model, op, needed * 2e-5, 2e-5, **kw).step_form.startswith("eigenbasis")
+    assert simulate(model, op, 0.01, 2e-5, scheme=Scheme(step="eigen"), **kw).step_form.startswith("eigenbasis")
 
 
 def test_a_step_the_eigenbasis_cannot_take_is_taken_by_the_dense_step():
@@ -123,10 +128,11 @@ def test_a_step_the_eigenbasis_cannot_take_is_taken_by_the_dense_step():
     system = SystemMatrices(M=np.diag([1.0, 1.0, 0.01, 0.01]), K=np.diag([1e6, 1e6, 1e4, 1e4]),
                             C=np.diag([20.0, 20.0, 0.2, 0.2]), G={"shaft": np.zeros((4, 4))}, dofs=DofMap((1,)))
     plate = RubPlate(node=1, theta=0.0, clearance=1e-5, K_nr=1e10, c=0.0, mu_s=0.0, mu_d=0.0, disk_radius=0.1)
-    kw = dict(v0=[0.05, 0, 0, 0], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x")], max_newton=6,
-              progress=False)
-    eigen = simulate(system, {"shaft": 0.0}, 0.02, 4e-4, step="eigen", **kw)
-    dense = simulate(system, {"shaft": 0.0}, 0.02, 4e-4, step="dense", **kw)
+    kw = dict(contacts=[plate], recording=Recording([(1, "x")]), start=Initial(v0=[0.05, 0, 0, 0]),
+              control=StepControl(max_newton=6, progress=False))
+    at_rest = Operating.point({"shaft": 0.0})
+    eigen = simulate(system, at_rest, 0.02, 4e-4, scheme=Scheme(step="eigen"), **kw)
+    dense = simulate(system, at_rest, 0.02, 4e-4, scheme=Scheme(step="dense"), **kw)
     assert eigen.step_form.startswith("eigenbasis")
     assert eigen.n_substeps == dense.n_substeps == 2 and eigen.n_steps == dense.n_steps == 50
     x, x_ref = eigen.outputs[(1, "x")], dense.outputs[(1, "x")]

@@ -27,14 +27,14 @@ from rotorred.scenes.schema import load_scene
 from rotorred.transient import kernel
 from rotorred.transient.status import RUNNING
 from rotorred.transient.matrices import contact_rows, force_columns, kernel_plates, plate_parameters, step_levels
-from rotorred.transient.newmark import check_scheme, initial_state, initial_vector, record_buffers, record_plan, \
-    run_kernel
+from rotorred.transient.newmark import (Initial, Scheme, initial_state, initial_vector, record_buffers, record_plan,
+                                        run_kernel)
 
 
 def full_state_run(model, scene, t_end: float, dt: float) -> dict:
     """The pipeline of :func:`rotorred.transient.newmark.simulate` (Newmark, average acceleration), recording
     q and v (all model DOFs), the contact forces and the plates' displacements after every step."""
-    scheme = check_scheme("newmark", None, None, None)
+    scheme = Scheme("newmark")
     n = model.M.shape[0]
     speeds, plates = scene.speeds, tuple(scene.plates)
     M, K, D = np.asarray(model.M, float), np.asarray(model.K, float), np.asarray(model.damping(speeds), float)
@@ -43,7 +43,7 @@ def full_state_run(model, scene, t_end: float, dt: float) -> dict:
     B = contact_rows(model, plates)
     levels = step_levels(M, D, K, B, forces, plates, dt, scheme.gamma, scheme.beta, 0.0, 5)
     q0, v0 = settled_state(scene, model)
-    x0 = initial_vector(n, q0, v0)
+    x0 = initial_vector(n, Initial(q0, v0))
     state = initial_state(M, D, K, B, par, plates, forces, x0)
     plan = record_plan(t_end, dt, 0.0, 1)
     record = record_buffers(plan, np.eye(2 * n), len(plates))  # rows on x = (q, v, a): q and v

@@ -30,14 +30,14 @@ TRANSIENT = """
 import json, logging, os
 logging.basicConfig(format="%(message)s", level=logging.INFO)  # rotorred's warnings and stage lines on stderr
 import rotorred
-from rotorred.model.assembly import assemble
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor_file import load_rotor
 from rotorred.transient.contact import RubPlate
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 rig = load_rotor("seed-rig")
-res = simulate(assemble(rig), None, 0.002, 2e-5, rotor=rig, plates=[RubPlate.for_rotor(rig, 18, clearance=0.0)],
-               unbalances=[Unbalance(18, 1e-3, 0.0)], outputs=[(18, "y")])
+res = simulate(rig, Operating.point(rig.speeds), 0.002, 2e-5, loads=Loads([Unbalance(18, 1e-3, 0.0)]),
+               contacts=[RubPlate.for_rotor(rig, 18, clearance=0.0)], recording=Recording([(18, "y")]))
 try:
     probe = os.path.join(os.path.dirname(rotorred.__file__), "probe")
     open(probe, "w").close()

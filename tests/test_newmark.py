@@ -18,7 +18,9 @@ from rotorred.transient.contact import RubPlate, contact_energy
 from rotorred.model.elements import Bearing, Disk, Material, ShaftElement
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import Rotor, Spool
-from rotorred.transient.newmark import SimulationDiverged, simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import (Initial, Loads, Recording, Scheme, SimulationDiverged, StepControl,
+                                        simulate)
 from rotorred.transient.plate import NavierPlate, RigidPlate
 from rotorred.transient.status import NONFINITE
 
@@ -61,7 +63,7 @@ def test_energy_conserved_linear_undamped(spin):
     rng = np.random.default_rng(1)
     q0 = 1e-4 * rng.standard_normal(n)
     v0 = 1e-2 * rng.standard_normal(n)
-    res = simulate(system, {"shaft": spin}, 1.0, 1e-5, q0=q0, v0=v0)
+    res = simulate(system, Operating.point({"shaft": spin}), 1.0, 1e-5, start=Initial(q0=q0, v0=v0))
     assert res.n_steps == 100_000
     E0, E1 = energy(system, q0, v0), energy(system, res.final.q, res.final.v)
     # Round-off only: each step rounds ~1e-16 relative, accumulating like a random walk
@@ -117,7 +119,7 @@ def test_second_order_against_exact_solution():
     dts = [4e-5, 2e-5, 1e-5, 5e-6]
     errs = []
     for dt in dts:
-        res = simulate(system, speeds, t_end, dt, q0=q0)
+        res = simulate(system, Operating.point(speeds), t_end, dt, start=Initial(q0=q0))
         errs.append(np.max(np.abs(res.final.q - ref)) / np.max(np.abs(ref)))
     order = np.polyfit(np.log(dts), np.log(errs), 1)[0]
     # Newmark's average acceleration is exactly second order; 0.1 allows for the not yet
@@ -134,7 +136,8 @@ def test_hht_second_order_and_damps_high_modes():
     errs = []
     dts = [2e-4, 1e-4, 5e-5]
     for dt in dts:
-        res = simulate(system, {"shaft": 0.0}, 0.1, dt, q0=q0, method="hht", alpha=-0.1)
+        res = simulate(system, Operating.point({"shaft": 0.0}), 0.1, dt, scheme=Scheme("hht", alpha=-0.1),
+                       start=Initial(q0=q0))
         # phase-plane distance to the exact (cos, -sin) orbit point
         errs.append(math.hypot(res.final.q[0] - 1e-4 * math.cos(w * 0.1),
                                res.final.v[0] / w + 1e-4 * math.sin(w * 0.1)) / 1e-4)
@@ -142,10 +145,10 @@ def test_hht_second_order_and_damps_high_modes():
     assert abs(order - 2.0) < 0.1, (order, errs)
     # omega dt = 31: average acceleration keeps the amplitude, HHT damps it away
     stiff = jeffcott(k=(2 * math.pi * 50e3) ** 2)
-    for method, kw in (("newmark", {}), ("hht", {"alpha": -0.3})):
-        res = simulate(stiff, {"shaft": 0.0}, 0.1, 1e-4, q0=q0, method=method, **kw)
+    for scheme in (Scheme("newmark"), Scheme("hht", alpha=-0.3)):
+        res = simulate(stiff, Operating.point({"shaft": 0.0}), 0.1, 1e-4, scheme=scheme, start=Initial(q0=q0))
         E = energy(stiff, res.final.q, res.final.v) / energy(stiff, q0, np.zeros(4))
-        if method == "newmark":
+        if scheme.method == "newmark":
             assert abs(E - 1.0) < 1e-10
         else:
             assert E < 1e-3
@@ -166,7 +169,8 @@ def test_settles_onto_harmonic_response():
     speeds = rig.speeds
     unb = [Unbalance(18, 2e-5, 0.3), Unbalance(3, 3e-5, 1.1)]
     outputs = [(18, "x"), (18, "y"), (13, "x"), (14, "y")]
-    res = simulate(system, speeds, 0.9, 1e-5, unbalances=unb, rotor=rig, outputs=outputs, record_start=0.8)
+    res = simulate(system, Operating.point(speeds), 0.9, 1e-5, loads=Loads(unb),
+                   recording=Recording(outputs, start=0.8))
     ratio = speeds["outer"] / speeds["inner"]
     harm = unbalance_response(system, Operating.line([speeds["inner"]], "inner", ratios={"outer": ratio}), unb, outputs)
     for o in outputs:
@@ -227,8 +231,8 @@ def test_frictionless_impacts_energy_error_second_order(n_plates):
     dts = [1e-5, 5e-6, 2.5e-6]
     errs = []
     for dt in dts:
-        res = simulate(system, {"shaft": 2 * math.pi * 80}, 2.0, dt, v0=v0, plates=plates, spool_of={1: "shaft"},
-                       outputs=[(1, "x"), (1, "y")])
+        res = simulate(system, Operating.point({"shaft": 2 * math.pi * 80}), 2.0, dt, contacts=plates,
+                       recording=Recording([(1, "x"), (1, "y")]), start=Initial(v0=v0))
         E = total_energy(system, res, plates, v0)
         errs.append(np.max(np.abs(E - E0)) / E0)
         impacts = sum(count_impacts(c.state) for c in res.contacts)
@@ -278,8 +282,8 @@ def test_jeffcott_rub_matches_radau():
     plate = RubPlate(node=1, theta=0.3, clearance=1e-5, K_nr=1e8, c=0.5, mu_s=0.2, mu_d=0.15, m_p=0.5,
                      k_n=5e6, k_t=5e6, c_n=100.0, c_t=100.0, disk_radius=0.05)
     Omega, m_e, t_end, dt, dt_rec = 2 * math.pi * 40, 1e-5, 0.2, 2e-6, 1e-4
-    res = simulate(system, {"shaft": Omega}, t_end, dt, unbalances=[Unbalance(1, m_e)], plates=[plate],
-                   spool_of={1: "shaft"}, outputs=[(1, "x"), (1, "y")], decimate=round(dt_rec / dt))
+    res = simulate(system, Operating.point({"shaft": Omega}), t_end, dt, loads=Loads([Unbalance(1, m_e)]),
+                   contacts=[plate], recording=Recording([(1, "x"), (1, "y")], decimate=round(dt_rec / dt)))
     contact = res.contacts[0]
     assert 0.05 < contact.fraction("open") < 0.95  # it does rub, intermittently
     assert np.all(contact.sliding_velocity[contact.state > 0] > 0)  # slip only
@@ -305,7 +309,7 @@ def test_stick_slip_follows_coulomb():
     plate = RubPlate(node=1, theta=0.0, clearance=-1e-4, K_nr=1e10, c=0.0, mu_s=0.3, mu_d=0.2, m_p=0.5,
                      k_n=1e6, k_t=1e5, c_n=2000.0, c_t=0.0, disk_radius=r, bending=RigidPlate())
     dt = 1e-6
-    res = simulate(system, {"shaft": V / r}, 0.1, dt, plates=[plate], spool_of={1: "shaft"})
+    res = simulate(system, Operating.point({"shaft": V / r}), 0.1, dt, contacts=[plate])
     c = res.contacts[0]
     P, T, st = c.normal_force, c.friction_force, c.state
     late = res.t > 0.02  # the preload has settled (plate normal DOF critically damped)
@@ -383,8 +387,9 @@ def test_reduced_matches_full_with_rub():
     spectra = []
     for model in models:
         q0, v0 = linear_steady_state(model, rig, unbalances, rig.speeds)
-        res = simulate(model, None, 0.5, 1e-5, rotor=rig, unbalances=unbalances, plates=[plate], q0=q0, v0=v0,
-                       outputs=[(14, "y")], record_start=0.3, decimate=10)
+        res = simulate(model, Operating.point(rig.speeds), 0.5, 1e-5, loads=Loads(unbalances), contacts=[plate],
+                       recording=Recording([(14, "y")], start=0.3, decimate=10),
+                       start=Initial(q0=q0, v0=v0))
         assert 0.02 < res.contacts[0].fraction("open") < 0.98  # rubbing, intermittently
         y = res.outputs[(14, "y")][:-1]
         spectra.append(2 * np.abs(np.fft.rfft(y)) / len(y))
@@ -402,7 +407,8 @@ def test_divergence_raises_with_partial_results():
     the DOF and the cause, and carries the finite results computed until then."""
     system = jeffcott(k=-(2 * math.pi * 200) ** 2)
     with pytest.raises(SimulationDiverged) as info:
-        simulate(system, {"shaft": 0.0}, 1.0, 1e-4, q0=[1e-6, 0, 0, 0], outputs=[(1, "x")])
+        simulate(system, Operating.point({"shaft": 0.0}), 1.0, 1e-4, recording=Recording([(1, "x")]),
+                 start=Initial(q0=[1e-6, 0, 0, 0]))
     e = info.value
     assert "node 1 x" in str(e) and "non-finite" in str(e) and e.dof == "node 1 x"
     r = e.result
@@ -423,12 +429,13 @@ def test_newton_failure_is_halved_then_reported():
     halving forbidden reported as a divergence naming the plate."""
     system = jeffcott()
     plate = RubPlate(node=1, theta=0.0, clearance=1e-5, K_nr=1e11, c=0.0, mu_s=0.0, mu_d=0.0, disk_radius=0.1)
-    kw = dict(v0=[0.05, 0, 0, 0], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x")])
+    kw = dict(contacts=[plate], recording=Recording([(1, "x")]), start=Initial(v0=[0.05, 0, 0, 0]))
+    at_rest = Operating.point({"shaft": 0.0})
     # this stiff contact needs up to 7 Newton iterations at dt = 2e-4 and 6 at dt / 16
-    ok = simulate(system, {"shaft": 0.0}, 0.02, 2e-4, max_newton=6, **kw)
+    ok = simulate(system, at_rest, 0.02, 2e-4, control=StepControl(max_newton=6), **kw)
     assert ok.n_substeps > 0 and ok.max_newton_per_solve <= 6
     with pytest.raises(SimulationDiverged) as info:
-        simulate(system, {"shaft": 0.0}, 0.02, 2e-4, max_newton=1, max_halvings=0, **kw)
+        simulate(system, at_rest, 0.02, 2e-4, control=StepControl(max_newton=1, max_halvings=0), **kw)
     assert "plate 0 at node 1" in str(info.value) and "Newton" in str(info.value)
     assert np.all(np.isfinite(info.value.result.outputs[(1, "x")]))
 
@@ -441,8 +448,9 @@ def test_halving_levels_are_built_on_first_need(monkeypatch):
 
     system = jeffcott()
     plate = RubPlate(node=1, theta=0.0, clearance=1e-5, K_nr=1e11, c=0.0, mu_s=0.0, mu_d=0.0, disk_radius=0.1)
-    kw = dict(v0=[0.05, 0, 0, 0], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x")], max_newton=6,
-              step="dense")
+    at_rest = Operating.point({"shaft": 0.0})
+    kw = dict(contacts=[plate], recording=Recording([(1, "x")]), start=Initial(v0=[0.05, 0, 0, 0]),
+              control=StepControl(max_newton=6), scheme=Scheme(step="dense"))
     built = []
     real = newmark.step_levels
 
@@ -451,57 +459,76 @@ def test_halving_levels_are_built_on_first_need(monkeypatch):
         return real(*args)
 
     monkeypatch.setattr(newmark, "step_levels", counting)
-    lazy = simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **kw)
+    lazy = simulate(system, at_rest, 0.02, 2e-4, **kw)
     assert lazy.n_substeps > 0 and built == [1, 5]
     monkeypatch.setattr(newmark, "step_levels", lambda *args: real(*args[:-1], 5))  # every level from the start
-    eager = simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **kw)
+    eager = simulate(system, at_rest, 0.02, 2e-4, **kw)
     np.testing.assert_array_equal(lazy.outputs[(1, "x")], eager.outputs[(1, "x")])
     assert lazy.n_substeps == eager.n_substeps
     built.clear()
     monkeypatch.setattr(newmark, "step_levels", counting)
-    simulate(system, {"shaft": 0.0}, 0.02, 2e-4, **{**kw, "plates": [], "max_newton": 50})
+    simulate(system, at_rest, 0.02, 2e-4, **{**kw, "contacts": [], "control": StepControl()})
     assert built == [1]
 
 
 def test_outputs_decimation_and_start():
     system = jeffcott()
-    res = simulate(system, {"shaft": 0.0}, 0.01, 1e-4, q0=[1e-5, 0, 0, 0], outputs=[(1, "x"), (1, "theta_y")],
-                   record_start=0.005, decimate=7)
+    res = simulate(system, Operating.point({"shaft": 0.0}), 0.01, 1e-4,
+                   recording=Recording([(1, "x"), (1, "theta_y")], start=0.005, decimate=7),
+                   start=Initial(q0=[1e-5, 0, 0, 0]))
     np.testing.assert_allclose(res.t, 0.005 + 7e-4 * np.arange(len(res.t)), atol=1e-12)
     assert res.t[-1] <= 0.01 + 1e-12 and set(res.outputs) == {(1, "x"), (1, "theta_y")}
 
 
 def test_bad_input():
+    """Every input is checked before any computation; the error names the parameter and the field."""
     system = jeffcott()
-    sp = {"shaft": 0.0}
+    sp = Operating.point({"shaft": 0.0})
     with pytest.raises(TypeError, match="bogus"):
         simulate(system, sp, 0.01, 1e-4, bogus=1)
     # the one message form of rotorred.checks: <field> = <value>: <what is allowed> (<unit>)
     with pytest.raises(ValueError, match=r"^dt = -0\.0001: must be > 0 \(s\)$"):
         simulate(system, sp, 0.01, -1e-4)
-    with pytest.raises(ValueError, match=r"^method = 'rk4': must be one of 'newmark', 'hht'$"):
-        simulate(system, sp, 0.01, 1e-4, method="rk4")
-    with pytest.raises(ValueError, match=r"^alpha = -0\.5: must lie in \[-0\.333333, 0\]$"):
-        simulate(system, sp, 0.01, 1e-4, method="hht", alpha=-0.5)
-    with pytest.raises(ValueError, match=r"^gamma = 0\.4: must be >= 0\.5$"):
-        simulate(system, sp, 0.01, 1e-4, gamma=0.4)
-    with pytest.raises(ValueError, match=r"^speeds = \{\}: must give the speed of every spool; missing \['shaft'\] \(rad/s\)$"):
-        simulate(system, {}, 0.01, 1e-4)
-    with pytest.raises(ValueError, match="node 7"):
-        simulate(system, sp, 0.01, 1e-4, outputs=[(7, "x")])
-    with pytest.raises(ValueError, match=r"^plates\[0\]\.disk_radius = None: must be given when no rotor is given "
-                                         r"to take it from \(m\)$"):
-        simulate(system, sp, 0.01, 1e-4, plates=[RubPlate(node=1)], spool_of={1: "shaft"})
-    with pytest.raises(ValueError, match=r"^decimate = 0: must be an integer >= 1$"):
-        simulate(system, sp, 0.01, 1e-4, decimate=0)
+    with pytest.raises(ValueError, match=r"^scheme\.method = 'rk4': must be one of 'newmark', 'hht'$"):
+        Scheme("rk4")
+    with pytest.raises(ValueError, match=r"^scheme\.alpha = -0\.5: must lie in \[-0\.333333, 0\]$"):
+        Scheme("hht", alpha=-0.5)
+    with pytest.raises(ValueError, match=r"^scheme\.gamma = 0\.4: must be >= 0\.5$"):
+        Scheme(gamma=0.4)
+    with pytest.raises(ValueError, match=r"^scheme\.gamma = 0\.6: must not be given with method = 'hht' \(it follows "
+                                         r"from alpha: 0\.55\)$"):
+        Scheme("hht", gamma=0.6)
+    assert dataclasses.replace(Scheme("hht"), step="dense").gamma == 0.55  # the values it holds are accepted back
+    with pytest.raises(ValueError, match=r"^operating = 'dict': must be an Operating \(Operating\.point"):
+        simulate(system, {"shaft": 0.0}, 0.01, 1e-4)
+    with pytest.raises(ValueError, match=r"^recording\.outputs\[0\] = \(7, 'x'\): must name a node of the model"):
+        simulate(system, sp, 0.01, 1e-4, recording=Recording([(7, "x")]))
+    with pytest.raises(ValueError, match=r"^contacts\[0\]\.disk_radius = None: must be given when the model has no "
+                                         r"rotor to take it from \(m\)$"):
+        simulate(system, sp, 0.01, 1e-4, contacts=[RubPlate(node=1)])
+    with pytest.raises(ValueError, match=r"^contacts\[0\] = 'plate': must be a RubPlate$"):
+        simulate(system, sp, 0.01, 1e-4, contacts=["plate"])
+    with pytest.raises(ValueError, match=r"^loads\.unbalances\[0\] = 1\.0: must be an Unbalance$"):
+        Loads([1.0])
+    with pytest.raises(ValueError, match=r"^loads\.unbalances\[0\]\.node = 7: must be a node of a spool of the model"):
+        simulate(system, sp, 0.01, 1e-4, loads=Loads([Unbalance(7, 1e-4)]))
+    with pytest.raises(ValueError, match=r"^recording\.decimate = 0: must be an integer >= 1$"):
+        Recording(decimate=0)
+    with pytest.raises(ValueError, match=r"^recording\.start = 0\.02: must not exceed t_end = 0\.01 \(s\)$"):
+        simulate(system, sp, 0.01, 1e-4, recording=Recording(start=0.02))
+    with pytest.raises(ValueError, match=r"^control\.max_newton = 0: must be an integer >= 1$"):
+        StepControl(max_newton=0)
+    with pytest.raises(ValueError, match=r"^recording = 'dict': must be a Recording$"):
+        simulate(system, sp, 0.01, 1e-4, recording={"decimate": 2})
     final = simulate(system, sp, 0.01, 1e-4).final
-    with pytest.raises(ValueError, match=r"^start = 'a FinalState': must not be given with q0 or v0"):
-        simulate(system, sp, 0.01, 1e-4, start=final, q0=[0, 0, 0, 0])
-    with pytest.raises(ValueError, match=r"^start = 'tuple': must be a FinalState \(another run's `final`\)$"):
+    with pytest.raises(ValueError, match=r"^start = 'tuple': must be an Initial\(q0, v0\) or a FinalState \(another "
+                                         r"run's `final`\)$"):
         simulate(system, sp, 0.01, 1e-4, start=(final.q, final.v))
+    with pytest.raises(ValueError, match=r"^start\.q0 = array of shape \(3,\): must have shape \(4,\)$"):
+        simulate(system, sp, 0.01, 1e-4, start=Initial(q0=[0, 0, 0]))
     plate = RubPlate(node=1, disk_radius=0.05)  # the start state holds no plate
     with pytest.raises(ValueError, match=r"^start\.plate = .*: must have shape \(1, 2, 3\)$"):
-        simulate(system, sp, 0.01, 1e-4, start=final, plates=[plate], spool_of={1: "shaft"})
+        simulate(system, sp, 0.01, 1e-4, contacts=[plate], start=final)
 
 
 def test_gravity_settles_to_static_sag():
@@ -519,7 +546,8 @@ def test_gravity_settles_to_static_sag():
     # full: exact to round-off (1e-9 of the sag); reduced: the weight of the interior is carried by 4
     # fixed-interface modes, a truncation error of 6e-5 of the sag (2e-4 allowed)
     for model, tol in ((full, 1e-9), (red, 2e-4)):
-        res = simulate(model, {"shaft": 0.0}, 0.3, 1e-4, gravity=9.81, rotor=rotor, outputs=[(3, "y"), (2, "x")])
+        res = simulate(model, Operating.point({"shaft": 0.0}), 0.3, 1e-4, loads=Loads(gravity=9.81),
+                       recording=Recording([(3, "y"), (2, "x")]))
         assert abs(res.outputs[(3, "y")][-1] - sag[full.dofs.index(3, "y")]) < tol * abs(sag).max()
         assert abs(res.outputs[(2, "x")][-1]) < 1e-15
 
@@ -531,16 +559,15 @@ def test_hht_with_rub_converges_to_same_solution():
     system = jeffcott(m=1.0, k=k, c=2 * 0.05 * math.sqrt(k))
     plate = RubPlate(node=1, theta=0.3, clearance=1e-5, K_nr=1e8, c=0.5, mu_s=0.2, mu_d=0.15, m_p=0.5,
                      k_n=5e6, k_t=5e6, c_n=100.0, c_t=100.0, disk_radius=0.05)
-    kw = dict(unbalances=[Unbalance(1, 1e-5)], plates=[plate], spool_of={1: "shaft"}, outputs=[(1, "x"), (1, "y")],
-              record_start=0.1)
+    kw = dict(loads=Loads([Unbalance(1, 1e-5)]), contacts=[plate], recording=Recording([(1, "x"), (1, "y")], start=0.1))
     Omega = 2 * math.pi * 40
-    sp = {"shaft": Omega}
+    sp = Operating.point({"shaft": Omega})
     t_eval = np.arange(0.1, 0.2 + 1e-12, 1e-5)
     x_ref, y_ref = jeffcott_rub_reference(system, plate, Omega, 1e-5, 0.2, t_eval)
     peak_ref = np.hypot(x_ref, y_ref).max()
     errs = []
     for dt in (4e-5, 2e-5, 1e-5):
-        res = simulate(system, sp, 0.2, dt, method="hht", alpha=-0.05, **kw)
+        res = simulate(system, sp, 0.2, dt, scheme=Scheme("hht", alpha=-0.05), **kw)
         errs.append(abs(np.hypot(*res.outputs.values()).max() - peak_ref) / peak_ref)
     # second order: each halving of dt divides the error by ~4 (measured ratio over two halvings ~12,
     # final error 1.4e-6); require a ratio above 8 and the finest error below 1e-5
@@ -558,7 +585,7 @@ def test_plates_on_two_disk_nodes_conserve_energy():
     v0 = np.zeros(system.n_dof)
     v0[system.dofs.index(3, "x")] = 0.02
     v0[system.dofs.index(2, "y")] = 0.01
-    res = simulate(system, {"shaft": 0.0}, 0.5, 1e-5, v0=v0, plates=plates, rotor=rotor)
+    res = simulate(system, Operating.point({"shaft": 0.0}), 0.5, 1e-5, contacts=plates, start=Initial(v0=v0))
     assert all(count_impacts(c.state) > 10 for c in res.contacts)
     f = res.final
     E = energy(system, f.q, f.v)
@@ -613,8 +640,8 @@ def test_transient_with_bearing_tables_runs_on_the_coefficients_at_its_speed():
     W = 1234.0
 
     def history(r):
-        res = simulate(assemble(r), {"shaft": W}, 0.05, 1e-5, rotor=r, unbalances=[Unbalance(4, 1e-4, 0.0)],
-                       outputs=[(4, "x"), (4, "y")])
+        res = simulate(assemble(r), Operating.point({"shaft": W}), 0.05, 1e-5, loads=Loads([Unbalance(4, 1e-4, 0.0)]),
+                       recording=Recording([(4, "x"), (4, "y")]))
         return np.array(list(res.outputs.values()))
 
     ref = history(dataclasses.replace(rotor, bearings=tuple(t.at(W) for t in tables)))

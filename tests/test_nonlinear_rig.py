@@ -17,7 +17,8 @@ from rotorred.scenes.harmonic_balance import base_frequency, rub_problem, unknow
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.contact import disk_force, normal_force, sliding_velocity
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 
 
 @pytest.fixture(scope="module")
@@ -114,8 +115,9 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     errors = [abs(lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1) for ln in largest]
     assert iterations <= 5 and max(errors) < 1e-2, errors
     # the solution as a transient's start (RubProblem.final_state): 0.5 s later the transient is still on it
-    again = simulate(sm.model, scene.speeds, 0.5, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
-                     rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=0.4, start=rp.final_state(z))
+    again = simulate(sm.model, Operating.point(scene.speeds), 0.5, scene.solver.dt, loads=Loads(scene.unbalances),
+                     contacts=scene.plates, recording=Recording([(18, "x"), (18, "y")], start=0.4),
+                     start=rp.final_state(z))
     window = again.t >= again.t[-1] - period + 1e-9
     records = unknown_records(scene.plates, again)
     settled = rp.start_from_record(again.t[window], {j: x[window] for j, x in records.items()})

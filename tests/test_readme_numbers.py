@@ -151,10 +151,10 @@ def test_step_map_shape_multiply_adds_and_levels():
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
     from rotorred.transient.matrices import contact_rows, force_columns, step_levels
-    from rotorred.transient.newmark import check_scheme, simulate
+    from rotorred.transient.newmark import Scheme, StepControl
 
     assert round(34 * 2 * 34, -2) == 2300 and round(48 * 2 * 48, -2) == 4600
-    n_levels = inspect.signature(simulate).parameters["max_halvings"].default + 1
+    n_levels = StepControl().max_halvings + 1
     assert n_levels == 5
     scene = load_scene("paper-rub")
     model = build_model(scene).model
@@ -163,7 +163,7 @@ def test_step_map_shape_multiply_adds_and_levels():
     forces = force_columns(model, scene.speeds, scene.rotor.spool_of, scene.unbalances, None)
     B = contact_rows(model, scene.plates)
     for method, alpha, width in (("newmark", None, 2), ("hht", -0.05, 3)):
-        s = check_scheme(method, None, None, alpha)
+        s = Scheme(method, alpha=alpha)
         levels = step_levels(M, D, K, B, forces, scene.plates, 2e-5, s.gamma, s.beta, s.alpha, n_levels)
         assert levels.H.shape == (5, m, width * m), method
     assert 2 * 1160**2 * 8 / 1e6 == pytest.approx(21.5, abs=0.05)

@@ -14,7 +14,8 @@ import pytest
 
 from rotorred.scenes.run import build_model, settled_response, settled_state
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Initial, Loads, Recording, simulate
 
 OUT = [(18, "y"), (14, "y")]
 
@@ -26,8 +27,8 @@ def error_against_settled(model_kind: str, dt: float) -> float:
     model = build_model(scene).model
     q0, v0 = settled_state(scene, model)
     plates = [p.with_(clearance=1e-3) for p in scene.plates]
-    res = simulate(model, scene.speeds, 0.004, dt, unbalances=scene.unbalances, plates=plates, rotor=scene.rotor,
-                   outputs=OUT, q0=q0, v0=v0)
+    res = simulate(model, Operating.point(scene.speeds), 0.004, dt, loads=Loads(scene.unbalances), contacts=plates,
+                   recording=Recording(OUT), start=Initial(q0=q0, v0=v0))
     assert res.contacts[0].fraction("open") == 1.0  # before (without) any contact
     ref = settled_response(scene, model, model.output_rows(OUT), res.t)
     return max(np.max(np.abs(res.outputs[d] - ref[j])) / np.max(np.abs(ref[j])) for j, d in enumerate(OUT))

@@ -22,7 +22,7 @@ from rotorred.model.speeds import SpeedProfile
 from rotorred.signals.orders import angle_blocks, order_tracks
 from rotorred.transient import ramp_kernel
 from rotorred.transient.energy import energy_balance
-from rotorred.transient.newmark import simulate
+from rotorred.transient.newmark import Loads, Recording, Scheme, StepControl, simulate
 
 # an overhung disk on a flexible support: x couples with theta_y, y with theta_x (N/m, N, N m)
 MASS, I_D, I_P = 2.0, 0.02, 0.04
@@ -87,8 +87,9 @@ def test_run_up_through_the_critical_matches_solve_ivp(k_c):
     W0, alpha, t_end = 240.0, 400.0, 0.45
     profile = SpeedProfile.ramp({"shaft": W0}, {"shaft": W0 + alpha * t_end}, t_end)
     outputs = [(1, d) for d in ("x", "y", "theta_x", "theta_y")]
-    runs = [simulate(disk_rotor(k_c=k_c), profile, t_end, dt, unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"},
-                     outputs=outputs, decimate=decimate, progress=False) for dt, decimate in ((5e-6, 20), (2.5e-6, 40))]
+    runs = [simulate(disk_rotor(k_c=k_c), Operating.profile(profile), t_end, dt, loads=Loads([Unbalance(1, M_E)]),
+                     recording=Recording(outputs, decimate=decimate), control=StepControl(progress=False))
+            for dt, decimate in ((5e-6, 20), (2.5e-6, 40))]
     np.testing.assert_allclose(runs[0].t, runs[1].t, rtol=0, atol=1e-12)
     rhs, jac = hand_written_rhs(W0, alpha, k_c=k_c)
     ref = solve_ivp(rhs, (0.0, t_end), np.zeros(8), method="Radau", rtol=1e-10, atol=1e-16, jac=jac, t_eval=runs[0].t)
@@ -129,8 +130,8 @@ def passages():
         alpha = lam * omega**2
         t_end = (omega + 10 * math.sqrt(alpha)) / alpha
         profile = SpeedProfile.ramp({"shaft": 0.0}, {"shaft": alpha * t_end}, t_end)
-        res = simulate(model, profile, t_end, 1e-4, unbalances=[Unbalance(1, 1.0)], spool_of={1: "shaft"},
-                       outputs=[(1, "x"), (1, "y")], progress=False)
+        res = simulate(model, Operating.profile(profile), t_end, 1e-4, loads=Loads([Unbalance(1, 1.0)]),
+                       recording=Recording([(1, "x"), (1, "y")]), control=StepControl(progress=False))
         r = np.hypot(res.outputs[(1, "x")], res.outputs[(1, "y")])
         k = int(np.argmax(r))
         out.append((lam, alpha, r[k], alpha * res.t[k]))
@@ -174,10 +175,10 @@ def test_constant_profile_is_the_constant_speed_step():
     """A profile with one breakpoint runs the same equations as constant speeds: the same response to
     round-off (two independent step implementations)."""
     model = disk_rotor()
-    kw = dict(unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"}, outputs=[(1, "x"), (1, "theta_y")],
-              progress=False)
-    a = simulate(model, {"shaft": 300.0}, 0.2, 1e-5, **kw)
-    b = simulate(model, SpeedProfile.constant({"shaft": 300.0}), 0.2, 1e-5, **kw)
+    kw = dict(loads=Loads([Unbalance(1, M_E)]), recording=Recording([(1, "x"), (1, "theta_y")]),
+              control=StepControl(progress=False))
+    a = simulate(model, Operating.point({"shaft": 300.0}), 0.2, 1e-5, **kw)
+    b = simulate(model, Operating.profile(SpeedProfile.constant({"shaft": 300.0})), 0.2, 1e-5, **kw)
     for o in a.outputs:
         assert np.max(np.abs(a.outputs[o] - b.outputs[o])) < 1e-9 * np.max(np.abs(a.outputs[o]))
 
@@ -217,11 +218,12 @@ def test_profile_needs_average_acceleration_and_K_G():
     model = disk_rotor()
     profile = SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 1.0)
     with pytest.raises(InputError) as e:
-        simulate(model, profile, 0.1, 1e-4, method="hht", spool_of={1: "shaft"}, progress=False)
-    assert e.value.field == "method"
+        simulate(model, Operating.profile(profile), 0.1, 1e-4, scheme=Scheme("hht"),
+                 control=StepControl(progress=False))
+    assert e.value.field == "scheme.method"
     bare = SystemMatrices(M=model.M, K=model.K, C=model.C, G=model.G, dofs=model.dofs)
     with pytest.raises(InputError) as e:
-        simulate(bare, profile, 0.1, 1e-4, spool_of={1: "shaft"}, progress=False)
+        simulate(bare, Operating.profile(profile), 0.1, 1e-4, control=StepControl(progress=False))
     assert e.value.field == "model.K_G['shaft']"
 
 
@@ -235,20 +237,21 @@ def test_energy_balance_of_a_run_up():
     by 4.7e-5: the check sees the angular-acceleration terms."""
     W0, alpha, t_end = 240.0, 400.0, 0.45
     profile = SpeedProfile.ramp({"shaft": W0}, {"shaft": W0 + alpha * t_end}, t_end)
-    model, loads = disk_rotor(), dict(unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"})
-    res = simulate(model, profile, t_end, 5e-6, record_state=True, progress=False, **loads)
-    balance = energy_balance(model, res, profile, **loads)
+    model, loads, run_up = disk_rotor(), Loads([Unbalance(1, M_E)]), Operating.profile(profile)
+    res = simulate(model, run_up, t_end, 5e-6, loads=loads, recording=Recording(states=True),
+                   control=StepControl(progress=False))
+    balance = energy_balance(model, res, run_up, loads)
     assert balance.relative_residual < 1.4e-9
     assert balance.damping[-1] > 0.5 * balance.drive[-1] > 0  # the drive's work is mostly dissipated
-    without = energy_balance(dataclasses.replace(model, K_G={"shaft": np.zeros((4, 4))}), res, profile, **loads)
+    without = energy_balance(dataclasses.replace(model, K_G={"shaft": np.zeros((4, 4))}), res, run_up, loads)
     assert without.relative_residual > 1e-5
 
 
 def test_energy_balance_needs_the_recorded_state():
     model = disk_rotor()
-    res = simulate(model, {"shaft": 100.0}, 1e-3, 1e-4, spool_of={1: "shaft"}, progress=False)
+    res = simulate(model, Operating.point({"shaft": 100.0}), 1e-3, 1e-4, control=StepControl(progress=False))
     with pytest.raises(InputError) as e:
-        energy_balance(model, res, {"shaft": 100.0})
+        energy_balance(model, res, Operating.point({"shaft": 100.0}))
     assert e.value.field == "result.states"
 
 
@@ -263,12 +266,13 @@ def test_slow_ramp_is_the_steady_unbalance_response():
     bounds are 2 % and 1 %)."""
     model, T = disk_rotor(), 250.0
     profile = SpeedProfile.ramp({"shaft": 200.0}, {"shaft": 450.0}, T)
-    loads = dict(unbalances=[Unbalance(1, M_E)], spool_of={1: "shaft"})
-    res = simulate(model, profile, T, 1e-4, outputs=[(1, "x"), (1, "y")], decimate=5, progress=False, **loads)
+    unbalances = [Unbalance(1, M_E)]
+    res = simulate(model, Operating.profile(profile), T, 1e-4, loads=Loads(unbalances),
+                   recording=Recording([(1, "x"), (1, "y")], decimate=5), control=StepControl(progress=False))
     blocks = angle_blocks(res.t, [res.outputs[(1, "x")], res.outputs[(1, "y")]], profile.at(res.t)["shaft"][2],
                           revs_per_block=16)
     track = order_tracks(blocks, "shaft", [1.0])[0][0]
-    steady = unbalance_response(model, Operating.line(blocks.speed), loads["unbalances"], [(1, "x")])
+    steady = unbalance_response(model, Operating.line(blocks.speed), unbalances, [(1, "x")])
     W, a, Q = blocks.speed, track.amplitude, np.abs(steady.phasors["shaft"][(1, "x")])
     keep = W > 220.0  # the start from rest has rung out
     W, a, Q = W[keep], a[keep], Q[keep]
@@ -293,4 +297,4 @@ def test_runup_refuses_speed_dependent_bearings_on_a_varying_spool():
     model = assemble(dataclasses.replace(rotor, bearings=tables))
     with pytest.raises(InputError, match=r"^bearing at node \d+ = 'speed-dependent': is not supported when the speed "
                                          r"of spool 'shaft' varies in time"):
-        simulate(model, SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 0.1), 0.1, 1e-4, rotor=rotor)
+        simulate(model, Operating.profile(SpeedProfile.ramp({"shaft": 0.0}, {"shaft": 100.0}, 0.1)), 0.1, 1e-4)

@@ -16,7 +16,7 @@ from rotorred.model.loads import Unbalance
 from rotorred.model.operating import Operating
 from rotorred.model.rotor_file import load_rotor
 from rotorred.transient.energy import energy_balance
-from rotorred.transient.newmark import simulate
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate
 from results_checks import assert_plots, assert_short_repr, assert_shows_itself
 
 OUTPUTS = [(13, "x"), (14, "y")]
@@ -59,9 +59,10 @@ def state(rig):
 @pytest.fixture(scope="module")
 def balance(rig):
     rotor, model, unbalances = rig
-    loads = dict(unbalances=unbalances, spool_of=rotor.spool_of)
-    run = simulate(model, rotor.speeds, 0.01, 1e-4, record_state=True, progress=False, **loads)
-    return energy_balance(model, run, rotor.speeds, **loads)
+    nominal, loads = Operating.point(rotor.speeds), Loads(unbalances)
+    run = simulate(model, nominal, 0.01, 1e-4, loads=loads, recording=Recording(states=True),
+                   control=StepControl(progress=False))
+    return energy_balance(model, run, nominal, loads)
 
 
 # --- the three checks on each type -----------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import Rotor, Spool
 from rotor_files import assert_refused
 from rotorred.model.rotor_file import rotor_from_toml
-from rotorred.transient.newmark import simulate
+from rotorred.transient.newmark import Initial, Loads, Recording, simulate
 
 STEEL = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
 L, D = 1.0, 0.05
@@ -127,7 +127,8 @@ def test_supports_in_craig_bampton_harmonic_and_transient():
     assert errors[0] > errors[1] > errors[2] and errors[2] < 6e-5
     unb = [Unbalance(4, 1e-4, 0.0)]
     X = steady_state(full, Operating.point(Omega), unb).phasors["s"]
-    res = simulate(full, Omega, 0.5, 2e-5, rotor=rotor, unbalances=unb, outputs=[(4, "x")], q0=X.real, v0=-300.0 * X.imag)
+    res = simulate(full, Operating.point(Omega), 0.5, 2e-5, loads=Loads(unb), recording=Recording([(4, "x")]),
+                   start=Initial(q0=X.real, v0=-300.0 * X.imag))
     row = full.output_rows([(4, "x")])[0]
     reference = (row @ X * np.exp(1j * 300.0 * res.t)).real
     assert np.max(np.abs(res.outputs[(4, "x")] - reference)) < 2e-5 * abs(row @ X)

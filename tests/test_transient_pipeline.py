@@ -19,7 +19,7 @@ from rotorred.transient.contact import RubPlate, disk_force
 from rotorred.transient.matrices import (contact_rows, fold_forcing, force_columns, kernel_plates,
                                          newmark_coefficients, plate_parameters, scalar_step, step_levels,
                                          step_matrices)
-from rotorred.transient.newmark import (check_scheme, initial_state, initial_vector, record_buffers, record_plan,
+from rotorred.transient.newmark import (Initial, Scheme, initial_state, initial_vector, record_buffers, record_plan,
                                         run_kernel)
 from rotorred.transient.plate import ClampedFreePlate
 
@@ -106,7 +106,7 @@ def test_contact_operator_matches_a_direct_solve(method, alpha_given):
     D = system.damping(speeds)
     plates = [RubPlate(node=3, theta=0.3, m_p=0.7, k_n=3e6, k_t=2e6, c_n=50.0, c_t=80.0, disk_radius=0.1),
               RubPlate(node=2, theta=2.2, m_p=0.4, bending=ClampedFreePlate(a0=2e6, b0=1.0), disk_radius=0.05)]
-    scheme = check_scheme(method, None, None, alpha_given)
+    scheme = Scheme(method, alpha=alpha_given)
     B = contact_rows(system, plates)
     forces = force_columns(system, speeds, rotor.spool_of, (), None)
     levels = step_levels(system.M, D, system.K, B, forces, plates, 1e-4, scheme.gamma, scheme.beta, scheme.alpha, 3)
@@ -128,7 +128,7 @@ def test_step_levels_shapes():
     B = contact_rows(system, [])
     forces = force_columns(system, {"shaft": 10.0}, {1: "shaft"}, [Unbalance(1, 1e-4)], 9.81)
     for method, alpha, n_hist in (("newmark", None, 8), ("hht", -0.1, 12)):
-        scheme = check_scheme(method, None, None, alpha)
+        scheme = Scheme(method, alpha=alpha)
         lv = step_levels(system.M, system.damping({"shaft": 10.0}), system.K, B, forces, [], 1e-3,
                          scheme.gamma, scheme.beta, scheme.alpha, 4)
         assert lv.H.shape == (4, 4, n_hist) and lv.UF.shape == (4, 3, 4) and lv.Jp.shape == (4, 0, 0)
@@ -146,7 +146,7 @@ def test_initial_state_satisfies_the_equation_of_motion():
     par, _ = plate_parameters([plate], speeds, {1: "shaft"}, None, 1e-10)
     B = contact_rows(system, [plate])
     D = system.damping(speeds)
-    st = initial_state(system.M, D, system.K, B, par, [plate], forces, initial_vector(4, q0, v0))
+    st = initial_state(system.M, D, system.K, B, par, [plate], forces, initial_vector(4, Initial(q0, v0)))
     P, T = st.z
     assert P > 0 and T == pytest.approx(-plate.mu_d * P)  # pressed, slipping along +t (v_rel > 0)
     f = np.array(disk_force(P, T, *plate.normal))
@@ -192,11 +192,11 @@ def test_one_compiled_step_is_the_newmark_step():
     q0, v0 = np.array([1e-5, -2e-5, 1e-4, 0.0]), np.array([0.003, 0.001, 0.0, 0.02])
     h = 1e-3
     for method, alpha in (("newmark", None), ("hht", -0.15)):
-        sch = check_scheme(method, None, None, alpha)
+        sch = Scheme(method, alpha=alpha)
         levels = step_levels(system.M, D, system.K, contact_rows(system, []), forces, [], h, sch.gamma, sch.beta,
                              sch.alpha, 1)
         state = initial_state(system.M, D, system.K, contact_rows(system, []), np.zeros((0, kernel.N_PLATE_PAR)), [],
-                              forces, initial_vector(4, q0, v0))
+                              forces, initial_vector(4, Initial(q0, v0)))
         x = state.x.copy()
         record = record_buffers(record_plan(2 * h, h, 0.0, 1), np.eye(4), 0)
         settings = kernel.Settings(t0=0.0, dt=h, n_halvings=0, newton_tol=1e-10, max_newton=10, limit=1.0)

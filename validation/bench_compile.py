@@ -37,15 +37,17 @@ def worker(loop: str) -> float:
     from rotorred.model.speeds import SpeedProfile
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
-    from rotorred.transient.newmark import simulate
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Loads, Scheme, simulate
 
     scene = load_scene("paper-rub")
     model = build_model(scene).model
     speeds = scene.speeds
     if loop == "varying speed":
         speeds = SpeedProfile(t=np.array([0.0, 1.0]), speeds={k: np.array([v, 1.01 * v]) for k, v in speeds.items()})
-    res = simulate(model, speeds, 2e-4, 2e-5, unbalances=scene.unbalances, plates=scene.plates, rotor=scene.rotor,
-                   step={"eigenbasis": "eigen", "dense": "dense"}.get(loop, "auto"))  # "auto" takes dense for 10 steps
+    step = {"eigenbasis": "eigen", "dense": "dense"}.get(loop, "auto")  # "auto" takes dense for 10 steps
+    res = simulate(model, Operating.point(speeds), 2e-4, 2e-5, loads=Loads(scene.unbalances), contacts=scene.plates,
+                   scheme=Scheme(step=step))
     return res.kernel_load_time
 
 

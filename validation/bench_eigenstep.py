@@ -22,7 +22,8 @@ import numpy as np  # noqa: E402
 
 from rotorred.scenes.run import build_model, settled_state  # noqa: E402
 from rotorred.scenes.schema import load_scene  # noqa: E402
-from rotorred.transient.newmark import simulate  # noqa: E402
+from rotorred.model.operating import Operating  # noqa: E402
+from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate  # noqa: E402
 
 CASES = {"paper-rub, 24 modes": ("paper-rub", {}), "paper-rub, 10 modes": ("paper-rub", {"solver.modes": 10}),
          "paper-rub, full model": ("paper-rub", {"solver.model": "full"}), "paper-normal, 24 modes": ("paper-normal", {})}
@@ -38,13 +39,14 @@ def main() -> None:
         sc = load_scene(scene_name, settings)
         s = sc.solver
         model = build_model(sc).model
-        q0, v0 = settled_state(sc, model) if s.start == "settled" else (None, None)
-        kw = dict(rotor=sc.rotor, unbalances=sc.unbalances, plates=sc.plates, outputs=sc.output.dofs, q0=q0, v0=v0,
-                  record_start=s.record_start, progress=False)
+        start = Initial(*settled_state(sc, model)) if s.start == "settled" else None
+        kw = dict(loads=Loads(sc.unbalances), contacts=sc.plates,
+                  recording=Recording(sc.output.dofs, start=s.record_start), start=start,
+                  control=StepControl(progress=False))
         best, last = {}, {}
         for _ in range(args.repeats):
             for step in ("dense", "eigen"):
-                r = simulate(model, sc.speeds, s.duration, s.dt, step=step, **kw)
+                r = simulate(model, Operating.point(sc.speeds), s.duration, s.dt, scheme=Scheme(step=step), **kw)
                 best[step] = min(best.get(step, np.inf), r.cpu_us_per_step)
                 last[step] = r
         a, b = last["dense"], last["eigen"]

@@ -56,7 +56,9 @@ import numpy as np  # noqa: E402
 
 from rotorred.model.assembly import assemble  # noqa: E402
 from rotorred.model.rotor import Rotor  # noqa: E402
-from rotorred.transient.newmark import SimulationDiverged, simulate  # noqa: E402
+from rotorred.model.operating import Operating  # noqa: E402
+from rotorred.transient.newmark import (Initial, Loads, Recording, Scheme, SimulationDiverged,  # noqa: E402
+                                        StepControl, simulate)
 from rotorred.linear.reduction import default_boundary_nodes, reduce  # noqa: E402
 from rotorred.scenes.run import settled_state  # noqa: E402
 from rotorred.scenes.schema import Scene, load_scene  # noqa: E402
@@ -144,10 +146,10 @@ def reduced_model(case: RubCase, n_modes: int, system=None):
 def run(model, case: RubCase, dt: float, method: str = "newmark", alpha: float | None = None):
     """One rub transient of ``model``; every step recorded (the spectra resample to ``case.sample_dt``)."""
     q0, v0 = steady_state(model, case)
-    kw = {"alpha": alpha} if method == "hht" else {}
-    return simulate(model, case.speeds, case.t_end, dt, unbalances=case.unbalances, plates=case.plates,
-                    rotor=case.rotor, outputs=case.outputs, record_start=case.record_start, method=method,
-                    q0=q0, v0=v0, progress=False, **kw)
+    return simulate(model, Operating.point(case.speeds), case.t_end, dt, loads=Loads(case.unbalances),
+                    contacts=case.plates, scheme=Scheme(method, alpha=alpha if method == "hht" else None),
+                    recording=Recording(case.outputs, start=case.record_start), start=Initial(q0, v0),
+                    control=StepControl(progress=False))
 
 
 @dataclass(frozen=True)

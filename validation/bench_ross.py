@@ -57,7 +57,7 @@ from rotorred.linear.campbell import campbell  # noqa: E402
 from rotorred.model.operating import Operating  # noqa: E402
 from rotorred.model.rotor_file import load_rotor  # noqa: E402
 from rotorred.model.loads import Unbalance  # noqa: E402
-from rotorred.transient.newmark import simulate  # noqa: E402
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate  # noqa: E402
 
 CAMPBELL_RPM = np.linspace(0.0, 40000.0, 21)
 N_MODES = 6
@@ -193,8 +193,9 @@ def compare_transient(rs, rotor, speed_rpm: float = SPEED_RPM, m_e: float = M_E,
     spool = rotor.spools[0].name
     system = assemble(rotor)
     unb = [Unbalance(disk, m_e)]
-    run_ours = lambda: simulate(system, {spool: W}, t_end, dt, unbalances=unb, rotor=rotor,  # noqa: E731
-                                outputs=[(disk, "x"), (disk, "y")], progress=False)
+    run_ours = lambda: simulate(system, Operating.point({spool: W}), t_end, dt, loads=Loads(unb),
+                                recording=Recording([(disk, "x"), (disk, "y")]),
+                                control=StepControl(progress=False))
     run_ours()                                                   # warm-up (kernel load)
     t_ours, s_ours, res = _median_time(run_ours, repeats)
     loop_ours = statistics.median(run_ours().run_time for _ in range(max(repeats, 3)))  # step loop alone (s)

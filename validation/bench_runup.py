@@ -19,7 +19,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate
 
 
 def run(model_kind: str, rub: bool, ramp: bool, duration: float):
@@ -27,8 +28,9 @@ def run(model_kind: str, rub: bool, ramp: bool, duration: float):
                                                          "runup.orbits_hz": []})
     model = build_model(scene).model
     speeds = scene.runup.profile if ramp else scene.speeds
-    res = simulate(model, speeds, duration, scene.solver.dt, rotor=scene.rotor, unbalances=scene.unbalances,
-                   plates=scene.plates, outputs=scene.output.dofs, decimate=5, progress=False)
+    res = simulate(model, Operating.point(speeds), duration, scene.solver.dt, loads=Loads(scene.unbalances),
+                   contacts=scene.plates, recording=Recording(scene.output.dofs, decimate=5),
+                   control=StepControl(progress=False))
     return model.M.shape[0], res
 
 

@@ -116,9 +116,11 @@ def worker(refine: int, n_modes: int | None, steps: int, repeats: int) -> dict:
 
 def _run(bp, model, case):
     q0, v0 = bp.steady_state(model, case)
-    from rotorred.transient.newmark import simulate
-    return simulate(model, case.speeds, case.t_end, DT, unbalances=case.unbalances, plates=case.plates,
-                    rotor=case.rotor, outputs=case.outputs, decimate=DECIMATE, q0=q0, v0=v0, progress=False)
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
+    return simulate(model, Operating.point(case.speeds), case.t_end, DT, loads=Loads(case.unbalances),
+                    contacts=case.plates, recording=Recording(case.outputs, decimate=DECIMATE),
+                    start=Initial(q0=q0, v0=v0), control=StepControl(progress=False))
 
 
 def _subprocess(args: list[str], env: dict | None = None) -> dict:

@@ -166,12 +166,14 @@ def whole_periods(f_outer: float, duration: float) -> float:
 
 def simulate_from(sc, model, q0, v0, t_end: float, record_start: float = 0.0) -> Run:
     """The scene pipeline's call (rotorred.scenes.run._transient_response) from a given state."""
-    from rotorred.transient.newmark import simulate
+    from rotorred.model.operating import Operating
+    from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate
 
     s = sc.solver
-    res = simulate(model.model, sc.speeds, t_end, s.dt, unbalances=sc.unbalances, plates=sc.plates,
-                   rotor=sc.rotor, outputs=sc.output.dofs, record_start=record_start, method=s.method,
-                   gravity=s.gravity or None, q0=q0, v0=v0, progress=False)
+    res = simulate(model.model, Operating.point(sc.speeds), t_end, s.dt,
+                   loads=Loads(sc.unbalances, gravity=s.gravity or None), contacts=sc.plates,
+                   scheme=Scheme(s.method), recording=Recording(sc.output.dofs, start=record_start),
+                   start=Initial(q0=q0, v0=v0), control=StepControl(progress=False))
     return Run(res.t, res.outputs[CHANNEL], res.final.q, res.final.v)
 
 

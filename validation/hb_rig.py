@@ -37,7 +37,8 @@ from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scen
 from rotorred.scenes.harmonic_balance import rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
-from rotorred.transient.newmark import simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, simulate
 
 OUTPUT = (14, "y")
 
@@ -158,8 +159,9 @@ def main() -> None:
 
 def settled_from(scene, sm, rp, z):
     """The coefficients of the last period of a 2 s transient started on the orbit ``z``."""
-    res = simulate(sm.model, scene.speeds, 2.0, scene.solver.dt, unbalances=scene.unbalances, plates=scene.plates,
-                   rotor=scene.rotor, outputs=[(18, "x"), (18, "y")], record_start=1.9, start=rp.final_state(z))
+    res = simulate(sm.model, Operating.point(scene.speeds), 2.0, scene.solver.dt, loads=Loads(scene.unbalances),
+                   contacts=scene.plates, recording=Recording([(18, "x"), (18, "y")], start=1.9),
+                   start=rp.final_state(z))
     window = res.t >= res.t[-1] - 1.0 / rp.f0 + 1e-9
     records = unknown_records(scene.plates, res)
     return rp.start_from_record(res.t[window], {j: x[window] for j, x in records.items()})

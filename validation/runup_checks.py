@@ -40,7 +40,7 @@ from rotorred.scenes.runup import block_revolutions, run_runup
 from rotorred.scenes.schema import load_scene
 from rotorred.signals.orders import angle_blocks, order_tracks
 from rotorred.transient.energy import energy_balance
-from rotorred.transient.newmark import simulate
+from rotorred.transient.newmark import Loads, Recording, StepControl, simulate
 
 HZ = 1 / (2 * math.pi)
 
@@ -54,8 +54,8 @@ def slow_ramp(T: float) -> None:
     outputs = [(13, "y"), (14, "y"), (18, "y")]
     t0 = time.perf_counter()
     dt = 5e-5  # Newmark's period error (omega dt)^2/12 moves the 121 Hz mode: 1.1 % near 108 Hz at 1e-4 s
-    res = simulate(model, profile, T, dt, rotor=scene.rotor, unbalances=scene.unbalances, outputs=outputs,
-                   decimate=2, progress=False)
+    res = simulate(model, Operating.profile(profile), T, dt, loads=Loads(scene.unbalances),
+                   recording=Recording(outputs, decimate=2), control=StepControl(progress=False))
     print(f"1. slow ramp: inner 30 -> 84 Hz in {T:g} s (lambda = Omega'/omega^2 = {0.9 * 2 * math.pi * 54 / T / (2 * math.pi * 55.7) ** 2:.1e} "
           f"at the inner 55.7 Hz critical), {res.n_steps} steps of {dt:g} s in {time.perf_counter() - t0:.1f} s "
           f"({res.us_per_step:.2f} us/step)")
@@ -112,12 +112,13 @@ def energy_on_the_rig() -> None:
     model = build_model(scene).model
     op = scene.speeds
     profile = SpeedProfile.ramp({s: 39 / 70 * w for s, w in op.items()}, {s: 46 / 70 * w for s, w in op.items()}, 1.0)
-    loads = dict(rotor=scene.rotor, unbalances=scene.unbalances)
+    loads, run_up = Loads(scene.unbalances), Operating.profile(profile)
     t0 = time.perf_counter()
-    res = simulate(model, profile, 1.0, 2e-5, record_state=True, progress=False, **loads)
-    balance = energy_balance(model, res, profile, **loads)
-    without = energy_balance(dataclasses.replace(model, K_G={s: 0 * k for s, k in model.K_G.items()}), res, profile,
-                             **loads)
+    res = simulate(model, run_up, 1.0, 2e-5, loads=loads, recording=Recording(states=True),
+                   control=StepControl(progress=False))
+    balance = energy_balance(model, res, run_up, loads)
+    without = energy_balance(dataclasses.replace(model, K_G={s: 0 * k for s, k in model.K_G.items()}), res, run_up,
+                             loads)
     print(f"3. energy balance, inner 39 -> 46 Hz in 1 s ({res.n_steps} steps, {time.perf_counter() - t0:.1f} s): "
           f"drive work {balance.drive[-1]:.4g} J, dissipated {balance.damping[-1]:.4g} J, "
           f"energy change {balance.energy[-1]:.4g} J; relative residual {balance.relative_residual:.2e} "

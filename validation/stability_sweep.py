@@ -36,7 +36,8 @@ from rotorred.transient.contact import RubPlate
 from rotorred.model.rotor_file import load_rotor
 from rotorred.model.loads import Unbalance
 from rotorred.linear.modal import eigen
-from rotorred.transient.newmark import SimulationDiverged, simulate
+from rotorred.model.operating import Operating
+from rotorred.transient.newmark import Loads, Recording, SimulationDiverged, StepControl, simulate
 from rotorred.linear.reduction import default_boundary_nodes, reduce
 
 DTS = (1e-6, 1e-5, 1e-4, 2e-4)
@@ -99,8 +100,9 @@ def run_one(rig, model, speeds, dt, K_nr, clearance, mu, t_end: float = T_END) -
     outputs = [(18, "x"), (18, "y")]
     t0 = time.perf_counter()
     try:
-        res = simulate(model, speeds, t_end, dt, rotor=rig, unbalances=UNBALANCES, plates=[plate],
-                       outputs=outputs, decimate=max(1, round(1e-5 / dt)), progress=False)
+        res = simulate(model, Operating.point(speeds), t_end, dt, loads=Loads(UNBALANCES), contacts=[plate],
+                       recording=Recording(outputs, decimate=max(1, round(1e-5 / dt))),
+                       control=StepControl(progress=False))
         outcome, message = "bounded", res.message
     except SimulationDiverged as exc:
         res, outcome, message = exc.result, "diverged", str(exc)

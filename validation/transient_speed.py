@@ -109,11 +109,23 @@ def measure(rr, model, name: str, rig, plate, unbalances, repeats: int = 3, t_en
     where the tree's ``simulate`` has that option)."""
     import inspect
 
-    kw = dict(rotor=rig, unbalances=unbalances, plates=[plate], outputs=OUTPUTS, decimate=10, progress=False)
-    if step is not None and "step" in inspect.signature(rr.simulate).parameters:
-        kw["step"] = step
-    warm = rr.simulate(model, None, min(t_end, 0.01), DT, **kw)
-    runs = [rr.simulate(model, None, t_end, DT, **kw) for _ in range(repeats)]
+    if "operating" in inspect.signature(rr.simulate).parameters:  # the option types (issue 35)
+        from rotorred.model.operating import Operating
+        from rotorred.transient.newmark import Loads, Recording, Scheme, StepControl
+
+        def run(t):
+            return rr.simulate(model, Operating.point(rig.speeds), t, DT, loads=Loads(unbalances), contacts=[plate],
+                               scheme=Scheme(step=step or "auto"), recording=Recording(OUTPUTS, decimate=10),
+                               control=StepControl(progress=False))
+    else:  # a revision before them
+        kw = dict(rotor=rig, unbalances=unbalances, plates=[plate], outputs=OUTPUTS, decimate=10, progress=False)
+        if step is not None and "step" in inspect.signature(rr.simulate).parameters:
+            kw["step"] = step
+
+        def run(t):
+            return rr.simulate(model, None, t, DT, **kw)
+    warm = run(min(t_end, 0.01))
+    runs = [run(t_end) for _ in range(repeats)]
     r = runs[0]
     cpu = [x.cpu_us_per_step for x in runs]
     return SpeedRow(model=name, n_dof=model.n_dof, n_steps=r.n_steps, cpu_us_min=min(cpu),

@@ -633,17 +633,17 @@ def start_record(scene: Scene, model) -> tuple[np.ndarray, dict] | None:
     transient diverges.
     """
     from rotorred.scenes.harmonic_balance import base_frequency, unknown_records
-    from rotorred.transient.newmark import simulate
+    from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
     from rotorred.transient.results import SimulationDiverged
 
     period = 1.0 / base_frequency(tuple(scene.frequencies_hz.values()))
     dt = period / math.ceil(period / scene.solver.dt - 1e-9)
-    q0, v0 = settled_state(scene, model)
     outputs = [(p.node, d) for p in scene.plates for d in ("x", "y")]
     try:
-        res = simulate(model, scene.speeds, START_PERIODS * period, dt, unbalances=scene.unbalances,
-                       plates=scene.plates, rotor=scene.rotor, outputs=outputs,
-                       record_start=(START_PERIODS - 1) * period, q0=q0, v0=v0, progress=False)
+        res = simulate(model, Operating.point(scene.speeds), START_PERIODS * period, dt,
+                       loads=Loads(scene.unbalances), contacts=scene.plates,
+                       recording=Recording(outputs, start=(START_PERIODS - 1) * period),
+                       start=Initial(*settled_state(scene, model)), control=StepControl(progress=False))
     except SimulationDiverged:
         return None
     last = res.t > res.t[-1] - period + 0.5 * dt
@@ -656,18 +656,21 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
 
     Raises :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
     """
-    from rotorred.transient.newmark import simulate  # loads numba only when a scene needs it
+    # imported here: numba is loaded only when a scene needs it
+    from rotorred.transient.newmark import Initial, Loads, Recording, Scheme, StepControl, simulate
     from rotorred.transient.results import SimulationDiverged
 
     s, model = scene.solver, scene_model.model
-    q0, v0 = settled_state(scene, model) if s.start == "settled" and initial is None else (None, None)
-    kw = {"alpha": s.alpha} if s.method == "hht" else {}
+    if initial is None and s.start == "settled":
+        initial = Initial(*settled_state(scene, model))
     stage("stepping %s: %s, %d steps of %g s to %g s (record from %g s)", scene.name, s.method,
           round(s.duration / s.dt), s.dt, s.duration, s.record_start, logger=LOG)
     try:
-        res = simulate(model, scene.speeds, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
-                       rotor=scene.rotor, outputs=scene.output.dofs, record_start=s.record_start, method=s.method,
-                       gravity=s.gravity or None, q0=q0, v0=v0, start=initial, progress=progress, **kw)
+        res = simulate(model, Operating.point(scene.speeds), s.duration, s.dt,
+                       loads=Loads(scene.unbalances, s.gravity or None), contacts=scene.plates,
+                       scheme=Scheme(s.method, alpha=s.alpha if s.method == "hht" else None),
+                       recording=Recording(scene.output.dofs, start=s.record_start), start=initial,
+                       control=StepControl(progress=progress))
     except SimulationDiverged as exc:
         raise SceneDiverged.of(scene, scene_model, exc, f_L, f_H) from None
     return Response(res.t, res.outputs, res.contacts, "transient", res.n_steps, _counters(res), res.final)

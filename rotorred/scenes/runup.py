@@ -26,6 +26,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from rotorred.model.operating import Operating
 from rotorred.progress import stage
 from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
@@ -408,23 +409,24 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     A diverged transient does not raise: the result holds the record up to the failure, analysed,
     with ``incomplete`` saying when, where and why it stopped.
     """
-    from rotorred.transient.newmark import simulate
+    from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
     from rotorred.transient.results import SimulationDiverged
 
     if scene.runup is None:
         raise ValueError(f"scene {scene.name!r} has no [runup]")
     model = model or build_model(scene)
     s, profile = scene.solver, scene.runup.profile
-    start = dataclasses.replace(scene, speeds=profile.speeds_at(0.0))
-    q0, v0 = settled_state(start, model.model) if s.start == "settled" else (None, None)
+    at_t0 = dataclasses.replace(scene, speeds=profile.speeds_at(0.0))
+    start = Initial(*settled_state(at_t0, model.model)) if s.start == "settled" else None
     t0 = time.perf_counter()
     incomplete = None
     stage("stepping %s through its speed profile: %d steps of %g s to %g s", scene.name, round(s.duration / s.dt),
           s.dt, s.duration)
     try:
-        res = simulate(model.model, profile, s.duration, s.dt, unbalances=scene.unbalances, plates=scene.plates,
-                       rotor=scene.rotor, outputs=scene.output.dofs, decimate=int(round(scene.runup.record_dt / s.dt)),
-                       gravity=s.gravity or None, q0=q0, v0=v0, progress=progress)
+        res = simulate(model.model, Operating.profile(profile, scene.runup.reference), s.duration, s.dt,
+                       loads=Loads(scene.unbalances, s.gravity or None), contacts=scene.plates,
+                       recording=Recording(scene.output.dofs, decimate=int(round(scene.runup.record_dt / s.dt))),
+                       start=start, control=StepControl(progress=progress))
     except SimulationDiverged as exc:
         res, incomplete = exc.result, explain_divergence(scene, exc)
     solve_time = time.perf_counter() - t0

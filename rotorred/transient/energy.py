@@ -21,16 +21,18 @@ order in the record interval.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
 
 import numpy as np
 
 from rotorred import checks
-from rotorred.model.loads import Unbalance
+from rotorred.model.assembly import system_of
+from rotorred.model.operating import Operating
 from rotorred.model.speeds import SpeedProfile
 from rotorred.results import Result
 from rotorred.transient.matrices import contact_rows, force_columns
+from rotorred.transient.options import Loads
 from rotorred.transient.ramp import forces_at, profile_table
+from rotorred.transient.stepping import operating_speeds
 
 
 @dataclass(frozen=True, repr=False)
@@ -108,33 +110,35 @@ def _trapezoid_work(force: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(inc)])
 
 
-def energy_balance(model, result, speeds: Mapping[str, float] | SpeedProfile, *, unbalances: Sequence[Unbalance] = (),
-                   spool_of: Mapping[int, str] | None = None, rotor=None, gravity: float | None = None) -> EnergyBalance:
+def energy_balance(model, result, operating: Operating, loads: Loads = Loads()) -> EnergyBalance:
     """The energy balance (Eq. R5) of ``result``, a :func:`~rotorred.transient.newmark.simulate` run with
-    ``record_state=True`` and the same model, speeds, unbalances and gravity.
+    ``recording=Recording(states=True)`` and the same model, operating condition and loads.
 
     Parameters
     ----------
-    model : SystemMatrices or ReducedSystem
+    model : Rotor, SystemMatrices or ReducedSystem
+        As given to ``simulate`` (:func:`rotorred.model.assembly.system_of`).
     result : TransientResult
-        Recorded with ``record_state=True`` (every step, ``decimate = 1``, for the step's own quadrature).
-    speeds : dict of str to float, or SpeedProfile
-    unbalances, spool_of, rotor, gravity
-        As given to ``simulate``.
+        Recorded with ``Recording(states=True)`` (every step, ``decimate = 1``, for the step's own quadrature).
+    operating : Operating
+        As given to ``simulate``: a point or a profile, every spool's speed by its ratio rule.
+    loads : Loads
+        As given to ``simulate``: the unbalances and gravity.
 
     Returns
     -------
     EnergyBalance
     """
     if result.states is None:
-        checks.fail("result.states", None, "must be recorded: run simulate(..., record_state=True)")
-    profile = speeds if isinstance(speeds, SpeedProfile) else SpeedProfile.constant(speeds)
-    if spool_of is None and rotor is not None:
-        spool_of = rotor.spool_of
+        checks.fail("result.states", None, "must be recorded: run simulate(..., recording=Recording(states=True))")
+    model = system_of(model)
+    speeds, profile = operating_speeds(model, operating)
+    profile = profile or SpeedProfile.constant(speeds)
+    unbalances, gravity, spool_of = loads.unbalances, loads.gravity, model.spool_of
     n = model.M.shape[0]
     q, v = result.states[:, :n], result.states[:, n:]
     spools = model.spools
-    unit = force_columns(model, {s: 1.0 for s in spools}, spool_of or {}, unbalances, gravity)
+    unit = force_columns(model, {s: 1.0 for s in spools}, spool_of, unbalances, gravity)
     F = forces_at(unit, profile_table(profile, spools, unit), result.t)  # (n_rec, n)
     gravity_columns = [j for j, s in enumerate(unit.spool) if s is None]
     F_g = unit.F[:, gravity_columns].sum(axis=1) if gravity_columns else np.zeros(n)

@@ -114,7 +114,7 @@ def force_columns(model, speeds: Mapping[str, float], spool_of: Mapping[int, str
     for k, u in enumerate(unbalances):
         s = spool_of.get(u.node)
         if s not in speeds:
-            checks.fail(f"unbalances[{k}].node", u.node, "must be a node of a spool in spool_of")
+            checks.fail(f"loads.unbalances[{k}].node", u.node, "must be a node of a spool in spool_of")
         W = speeds[s]
         rx, ry = model.output_rows([(u.node, "x"), (u.node, "y")])
         amp = u.m_e * W * W
@@ -174,11 +174,16 @@ def contact_rows(model, plates: Sequence[RubPlate]) -> np.ndarray:
 
 
 def disk_radii(plates: Sequence[RubPlate], rotor) -> list[float]:
-    """The disk radius under each plate (m): the plate's ``disk_radius``, else the rotor's disk at its node."""
+    """The disk radius under each plate (m): the plate's ``disk_radius``, else the disk at its node of ``rotor`` (the
+    rotor the model was built from, or None)."""
     radii = []
     for k, p in enumerate(plates):
         if p.disk_radius is None and rotor is None:
-            checks.fail(f"plates[{k}].disk_radius", None, "must be given when no rotor is given to take it from", "m")
+            checks.fail(f"contacts[{k}].disk_radius", None, "must be given when the model has no rotor to take it "
+                        "from", "m")
+        if p.disk_radius is None and p.node not in {d.node for d in rotor.disks}:
+            checks.fail(f"contacts[{k}].disk_radius", None, f"must be given: the model's rotor has no disk at node "
+                        f"{p.node} to take it from", "m")
         radii.append(p.disk_radius if p.disk_radius is not None else rotor.disk_at(p.node).radius)
     return radii
 
@@ -199,7 +204,7 @@ def plate_parameters(plates: Sequence[RubPlate], speeds: Mapping[str, float], sp
     for k, (p, radius) in enumerate(zip(plates, disk_radii(plates, rotor))):
         s = spool_of.get(p.node)
         if s not in speeds:
-            checks.fail(f"plates[{k}].node", p.node, "must be a node of a spool in spool_of")
+            checks.fail(f"contacts[{k}].node", p.node, "must be a node of a spool in spool_of")
         par[k] = (math.cos(p.theta), math.sin(p.theta), p.clearance, p.offset, p.compliance, p.K_nr, p.c,
                   p.mu_s, p.mu_d, speeds[s] * radius, p.m_p)
         atol[k] = newton_tol * p.K_nr * 1e-9

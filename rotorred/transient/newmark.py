@@ -50,13 +50,12 @@ K. H. Hunt, F. R. E. Crossley, J. Appl. Mech. 42 (1975) 440-445.
 from __future__ import annotations
 
 import time
-from typing import Mapping, Sequence
+from typing import Sequence
 
 import numpy as np
 
 from rotorred import checks
-from rotorred.model.loads import Unbalance
-from rotorred.model.speeds import SpeedProfile
+from rotorred.model.operating import Operating
 from rotorred.transient import eigen_kernel, kernel
 from rotorred.transient.eigenstep import eigen_form, rows_on_y, scheme_excluded, with_record_rows
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate
@@ -65,10 +64,11 @@ from rotorred.transient.matrices import (contact_rows, force_columns, kernel_pla
 from rotorred.transient.ramp import run_profile
 from rotorred.transient.results import ContactHistory, FinalState, SimulationDiverged, TransientResult
 from rotorred.transient.status import NEED_DENSE, NEED_LEVELS, RUNNING
+from rotorred.transient.options import (  # noqa: F401 - the options, also read as newmark.<name>
+    METHODS, STEPS, Initial, Loads, Recording, Scheme, StepControl)
 from rotorred.transient.stepping import (  # noqa: F401 - the pipeline's pieces, also read as newmark.<name>
-    COMPILING_NOTE, METHODS, Loads, RecordPlan, RunOptions, Scheme, check_loads, check_run_options, check_scheme,
-    check_start, initial_state, initial_vector, load_kernel, package_result, record_buffers, record_plan,
-    record_rows, step_bar, whole_steps)
+    COMPILING_NOTE, RecordPlan, Run, check_run, initial_state, initial_vector, load_kernel, package_result,
+    record_buffers, record_plan, record_rows, step_bar, whole_steps)
 
 
 def run_kernel(levels: kernel.Levels, forcing: kernel.Forcing, plates: kernel.Plates, state: kernel.State,
@@ -172,82 +172,43 @@ class _Loops:
 
 
 # ----------------------------------------------------------------------------------- the pipeline
-def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: float, dt: float = 1e-5, *,
-             unbalances: Sequence[Unbalance] = (), plates: Sequence[RubPlate] = (), rotor=None,
-             spool_of: Mapping[int, str] | None = None, outputs: Sequence[tuple[int, str]] = (),
-             record_start: float = 0.0, decimate: int = 1, method: str = "newmark",
-             gamma: float | None = None, beta: float | None = None, alpha: float | None = None,
-             gravity: float | None = None, q0=None, v0=None, start: FinalState | None = None,
-             progress: bool | None = None,
-             newton_tol: float = 1e-10, max_newton: int = 50, max_halvings: int = 4,
-             displacement_limit: float = 1.0, chunk_steps: int | None = None, record_state: bool = False,
-             step: str = "auto", **unknown) -> TransientResult:
+def simulate(model, operating: Operating, t_end: float, dt: float = 1e-5, *, loads: Loads = Loads(),
+             contacts: Sequence[RubPlate] = (), scheme: Scheme = Scheme(), recording: Recording = Recording(),
+             start: Initial | FinalState | None = None, control: StepControl = StepControl()) -> TransientResult:
     """Transient response with unbalance, optional gravity and rub-impact plates.
 
     Parameters
     ----------
-    model : SystemMatrices or ReducedSystem
-        Anything with ``M, K, damping(speeds), output_rows(outputs)``.
-    speeds : dict of str to float, SpeedProfile or None
-        Constant spool speeds (rad/s); None takes ``rotor.speeds``. A
-        :class:`~rotorred.model.speeds.SpeedProfile` runs the speeds it gives in time (a run-up or
-        coast-down, :mod:`rotorred.transient.ramp`): gyroscopic terms at ``Omega_s(t)``, the spin
-        acceleration terms ``Omega_s' K_G,s``, unbalance forces with their tangential part at the
-        spin angle ``int Omega_s dt`` (docs/model.md, Eqs. R1-R4); average-acceleration Newmark only.
+    model : Rotor, SystemMatrices or ReducedSystem
+        The model (:func:`rotorred.model.assembly.system_of`: a rotor is assembled). The rotor it was built from
+        (``model.rotor``) gives the spool of each loaded node and the disk radius under a plate that does not
+        give its ``disk_radius``; a single-spool model built by hand has every node on its spool.
+    operating : Operating
+        The spool speeds (rad/s inside), by the ratio rule of :class:`~rotorred.model.operating.Operating` (a spool
+        left out follows the reference at the nominal ratio). A point (:meth:`Operating.point`) runs at constant
+        speeds. A profile (:meth:`Operating.profile`, :meth:`Operating.ramp`: a run-up or coast-down,
+        :mod:`rotorred.transient.ramp`) runs the speeds in time: gyroscopic terms at ``Omega_s(t)``, the spin
+        acceleration terms ``Omega_s' K_G,s``, unbalance forces with their tangential part at the spin angle
+        ``int Omega_s dt`` (docs/model.md, Eqs. R1-R4); average-acceleration Newmark only.
     t_end : float
         End time (s); the run starts at t = 0.
     dt : float
         Time step (s); default 1e-5.
-    unbalances : sequence of Unbalance
-        Each rotates at the speed of its node's spool, with its phase (rotorred.model.loads).
-    plates : sequence of RubPlate
+    loads : Loads
+        Unbalances (each rotating at the speed of its node's spool, with its phase) and gravity (m/s^2).
+    contacts : sequence of RubPlate
         Rubbing plates; several may face the same or different disks.
-    rotor : Rotor, optional
-        Supplies ``spool_of``, the default ``speeds`` and the disk radius of plates without
-        ``disk_radius``.
-    spool_of : dict of int to str, optional
-        Spool of each node (needed with unbalances or plates when ``rotor`` is not given).
-    outputs : sequence of (int, str)
-        (node, direction) pairs to record.
-    record_start : float
-        Record from this time on (s).
-    decimate : int
-        Record every ``decimate``-th step.
-    method : {"newmark", "hht"}
-    gamma, beta : float, optional
-        Newmark parameters (default 1/2, 1/4); gamma >= 1/2, beta > 0. Not with "hht".
-    alpha : float, optional
-        HHT-α parameter, -1/3 <= alpha <= 0 (default -0.05); only with "hht".
-    gravity : float, optional
-        Gravity acceleration along -y (m/s^2), e.g. 9.81.
-    q0, v0 : array_like, shape (n,), optional
-        Initial displacement and velocity in model coordinates (default 0).
-    start : FinalState, optional
-        Continue another run from its ``final`` state, in place of ``q0, v0``: its displacement,
-        velocity, the plates' own states, the contact forces and slip modes are carried over
-        (the plates must be the same); the time restarts at 0, so give each unbalance the angle
-        it had reached. The speeds may differ (a map's next point).
-    progress : bool, optional
-        Progress bar on stderr; default: shown once a run has taken more than 2 s.
-    newton_tol : float
-        Relative step tolerance of the contact Newton iteration.
-    max_newton : int
-        Newton iterations per solve before the step is halved.
-    max_halvings : int
-        How many times a failing step may be halved.
-    displacement_limit : float
-        A contact-node displacement beyond this (m) is reported as divergence.
-    chunk_steps : int, optional
-        Steps per compiled call (progress granularity).
-    record_state : bool
-        Also record the whole state (q, v) in model coordinates (``result.states``), e.g. for
-        :func:`rotorred.transient.energy.energy_balance`.
-    step : {"auto", "eigen", "dense"}
-        Constant speeds: ``"eigen"`` steps the linear part in the eigenbasis of the average-acceleration
-        amplification matrix, O(n) per step (:mod:`rotorred.transient.eigen_kernel`), the same recurrence as
-        ``"dense"`` (O(n^2)) to rounding; ``"auto"`` (default) takes it wherever it applies and falls back to
-        the dense step where the scheme is not average acceleration or the matrix is (nearly) defective.
-        ``result.step_form`` says which ran and why.
+    scheme : Scheme
+        Newmark-β (default average acceleration) or HHT-α, and the form of the constant-speed step.
+    recording : Recording
+        The (node, direction) outputs, from when, every how many steps, and whether the whole state.
+    start : Initial or FinalState, optional
+        ``Initial(q0, v0)``: displacement and velocity at t = 0 in model coordinates (default rest). A
+        :class:`FinalState` (another run's ``final``) continues that run: its displacement, velocity, the plates'
+        own states, the contact forces and slip modes are carried over (the plates must be the same); the time
+        restarts at 0, so give each unbalance the angle it had reached. The speeds may differ (a map's next point).
+    control : StepControl
+        The contact Newton iteration, step halving, the divergence limit and the progress bar.
 
     Returns
     -------
@@ -255,72 +216,54 @@ def simulate(model, speeds: Mapping[str, float] | SpeedProfile | None, t_end: fl
 
     Raises
     ------
-    TypeError
-        For an unknown option.
     rotorred.checks.InputError
         (a ValueError) For a bad value, before any computation, naming the parameter:
-        ``dt = -0.0001: must be > 0 (s)``.
+        ``dt = -0.0001: must be > 0 (s)``, ``recording.decimate = 0: must be an integer >= 1``.
     SimulationDiverged
         When a step cannot be completed; ``.result`` holds the partial result.
     """
-    if unknown:
-        raise TypeError(f"simulate() got unknown option(s) {sorted(unknown)}")
     t_setup = time.perf_counter()
-    # 1. validate the options
-    scheme = check_scheme(method, gamma, beta, alpha)
-    run = check_run_options(t_end, dt, record_start, decimate, newton_tol, max_newton, max_halvings,
-                            displacement_limit, gravity, chunk_steps)
-    profile = speeds if isinstance(speeds, SpeedProfile) else None
-    loads = check_loads(model, profile.speeds_at(0.0) if profile else speeds, rotor, spool_of, plates, unbalances,
-                        outputs)
-    n = model.M.shape[0]
-    check_start(start, len(loads.plates))
-    x0 = initial_vector(n, q0, v0, start)
-    record_state = checks.boolean("record_state", record_state)
-    step = checks.choice("step", step, STEPS)
-    if profile is not None:
-        return run_profile(model, profile, scheme, run, loads, rotor, x0, start, progress, record_state=record_state)
+    # 1. validate the inputs
+    run = check_run(model, operating, t_end, dt, loads, contacts, scheme, recording, start, control)
+    if run.profile is not None:
+        return run_profile(run)
     # 2. prepare the matrices: forces, plates, step matrices (with the condensed contact operator) per level
-    M, K, D = (np.asarray(model.M, float), np.asarray(model.stiffness(loads.speeds), float),
-               np.asarray(model.damping(loads.speeds), float))
-    forces = force_columns(model, loads.speeds, loads.spool_of, loads.unbalances, run.gravity)
-    par, atol = plate_parameters(loads.plates, loads.speeds, loads.spool_of, rotor, run.newton_tol)
-    B = contact_rows(model, loads.plates)
+    system, speeds, scheme, control = run.system, run.speeds, run.scheme, run.control
+    M, K, D = (np.asarray(system.M, float), np.asarray(system.stiffness(speeds), float),
+               np.asarray(system.damping(speeds), float))
+    forces = force_columns(system, speeds, run.spool_of, run.loads.unbalances, run.loads.gravity)
+    par, atol = plate_parameters(run.plates, speeds, run.spool_of, run.rotor, control.newton_tol)
+    B = contact_rows(system, run.plates)
     contact = kernel_plates(M, B, par, atol)
 
     def step_levels_up_to(n_levels: int) -> kernel.Levels:
-        return step_levels(M, D, K, B, forces, loads.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha, n_levels)
+        return step_levels(M, D, K, B, forces, run.plates, run.dt, scheme.gamma, scheme.beta, scheme.alpha, n_levels)
 
     levels = step_levels_up_to(1)  # the halving levels (dense n x 2n each) are built when a step first needs them
-    state = initial_state(M, D, K, B, par, loads.plates, forces, x0, start)
+    state = initial_state(M, D, K, B, par, run.plates, forces, run.x0, run.start)
     forcing = kernel.Forcing(forces.kind, forces.omega)
-    plan = record_plan(run.t_end, run.dt, run.record_start, run.decimate)
-    eig, step_form = choose_step(step, levels, contact, scheme, M, K, forcing, plan.n_steps)
+    plan = record_plan(run.t_end, run.dt, run.recording.start, run.recording.decimate)
+    eig, step_form = choose_step(scheme.step, levels, contact, scheme, M, K, forcing, plan.n_steps)
     # 3. plan the record (on the eigenbasis state y when the step runs there)
-    rows = record_rows(model, loads.outputs, record_state)
-    record = dense_record = record_buffers(plan, rows, len(loads.plates))
+    rows = record_rows(system, run.recording.outputs, run.recording.states)
+    record = dense_record = record_buffers(plan, rows, len(run.plates))
     if eig is not None:
         rows = rows_on_y(rows, eig.P)
         eig = with_record_rows(eig, rows)
         record = dense_record._replace(rows=np.ascontiguousarray(rows))  # the same buffers, rows on y
     setup_time = time.perf_counter() - t_setup
     # 4. run the kernel
-    settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
-                               max_newton=run.max_newton, limit=run.displacement_limit)
+    settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=control.max_halvings, newton_tol=control.newton_tol,
+                               max_newton=control.max_newton, limit=control.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
     status, run_time, run_cpu_time, load_time, compiled = run_kernel(
         levels, forcing, contact, state, record, settings, diag, plan.n_steps,
-        run.chunk_steps or max(2000, min(plan.n_steps, 100_000)), progress, eig,
-        every_level=(lambda: step_levels_up_to(run.max_halvings + 1)) if run.max_halvings > 0 else None,
+        control.chunk_steps or max(2000, min(plan.n_steps, 100_000)), control.progress, eig,
+        every_level=(lambda: step_levels_up_to(control.max_halvings + 1)) if control.max_halvings > 0 else None,
         dense_record=dense_record)
     # 5. recover and package the results
-    return package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                          (setup_time, run_time, run_cpu_time, load_time, compiled), record_state=record_state,
-                          step_form=step_form)
-
-
-#: the constant-speed step's forms: "auto" (the eigenbasis where it applies, else dense), "eigen", "dense"
-STEPS = ("auto", "eigen", "dense")
+    return package_result(run, plan, record, state, diag, status,
+                          (setup_time, run_time, run_cpu_time, load_time, compiled), step_form=step_form)
 
 
 #: "auto" takes the eigenbasis step for runs of at least EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n steps: below that its
@@ -341,9 +284,9 @@ def choose_step(step: str, levels: kernel.Levels, plates: kernel.Plates, scheme,
                       f"{EIGEN_MIN_STEPS + EIGEN_STEPS_PER_DOF * n} steps at {n} DOFs)")
     eig, note = eigen_form(levels, plates, scheme, M, K, forcing)
     if eig is None and step == "eigen":
-        checks.fail("step", step, f"cannot be used here: {note.removeprefix('dense: ')}")
+        checks.fail("scheme.step", step, f"cannot be used here: {note.removeprefix('dense: ')}")
     return eig, note
 
 
-__all__ = ["simulate", "TransientResult", "ContactHistory", "FinalState", "SimulationDiverged", "METHODS",
-           "newmark_coefficients", "step_matrices", "OPEN", "SLIP", "STICK"]
+__all__ = ["simulate", "Loads", "Scheme", "Recording", "StepControl", "Initial", "TransientResult", "ContactHistory",
+           "FinalState", "SimulationDiverged", "METHODS", "newmark_coefficients", "step_matrices", "OPEN", "SLIP", "STICK"]

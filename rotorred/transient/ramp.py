@@ -1,7 +1,7 @@
 """Transient at spool speeds that vary in time: the Python side of :mod:`rotorred.transient.ramp_kernel`.
 
-:func:`rotorred.transient.stepping.simulate` comes here when its ``speeds`` is a
-:class:`~rotorred.model.speeds.SpeedProfile`. The run is cut into speed intervals, short enough
+:func:`rotorred.transient.newmark.simulate` comes here when its ``operating`` is a profile
+(:meth:`rotorred.model.operating.Operating.profile`). The run is cut into speed intervals, short enough
 that every spool's speed stays within a width of the interval's reference speed (and cut at
 the profile's breakpoints, where the acceleration jumps). Per interval the step matrices of
 the constant-speed step are built at the reference (one factorisation per step size), with
@@ -57,9 +57,9 @@ class SpeedInterval:
 def check_profile_run(model, profile: SpeedProfile, scheme) -> dict:
     """The spin-acceleration matrices of the spools (zero for a spool at constant speed); clear errors for a
     model without them or a scheme other than average acceleration."""
-    if scheme.method != "newmark" or scheme.gamma != 0.5 or scheme.beta != 0.25:
-        checks.fail("method", scheme.method, "must be 'newmark' with gamma = 1/2, beta = 1/4 (average acceleration) "
-                    "when the speeds vary in time")
+    if not scheme.average_acceleration:
+        checks.fail("scheme.method", scheme.method, "must be 'newmark' with gamma = 1/2, beta = 1/4 (average "
+                    "acceleration) when the speeds vary in time")
     acc = profile.accelerations()
     for t in model.tables:
         if np.any(acc[t.spool] != 0.0):
@@ -183,10 +183,20 @@ def forces_at(forces: ForceColumns, table: ramp_kernel.ProfileTable, t) -> np.nd
     return weights @ forces.F.T
 
 
-def run_profile(model, profile: SpeedProfile, scheme, run, loads, rotor, x0, start, progress,
-                rho_target: float = RHO_TARGET, pass_tol: float = PASS_TOL, max_passes: int = MAX_PASSES,
-                record_state: bool = False):
-    """The transient of :func:`rotorred.transient.stepping.simulate` at the speeds of ``profile``.
+def run_profile(run: stepping.Run, rho_target: float = RHO_TARGET, pass_tol: float = PASS_TOL,
+                max_passes: int = MAX_PASSES):
+    """The transient of :func:`rotorred.transient.newmark.simulate` at the speeds of ``run.profile``.
+
+    Parameters
+    ----------
+    run : rotorred.transient.stepping.Run
+        The checked run, its ``profile`` giving every spool's speed in time.
+    rho_target : float
+        Bound of the fixed-point contraction per step (-), which sets the speed intervals' width.
+    pass_tol : float
+        Relative tolerance of the fixed-point passes on the step's dq (-).
+    max_passes : int
+        Passes before a step is halved.
 
     Returns
     -------
@@ -195,46 +205,46 @@ def run_profile(model, profile: SpeedProfile, scheme, run, loads, rotor, x0, sta
         ``n_passes`` the fixed-point passes of all steps.
     """
     t_setup = time.perf_counter()
-    K_G = check_profile_run(model, profile, scheme)
+    model, profile, control = run.system, run.profile, run.control
+    K_G = check_profile_run(model, profile, run.scheme)
     spools = model.spools
     ops = Operators(M=np.asarray(model.M, float), C=np.asarray(model.C, float), K=np.asarray(model.K, float),
                     G=np.array([model.G[s] for s in spools], float), K_G=np.array([K_G[s] for s in spools]))
     # 1. forces per unit Omega^2 (gravity: constant), plates at the speeds of t = 0
-    forces = force_columns(model, {s: 1.0 for s in spools}, loads.spool_of, loads.unbalances, run.gravity)
+    forces = force_columns(model, {s: 1.0 for s in spools}, run.spool_of, run.loads.unbalances, run.loads.gravity)
     constant = ForceColumns(F=forces.F, kind=np.zeros(len(forces.kind), dtype=np.int64),
                             omega=np.zeros(len(forces.kind)), spool=forces.spool)
-    par, atol = plate_parameters(loads.plates, loads.speeds, loads.spool_of, rotor, run.newton_tol)
-    B = contact_rows(model, loads.plates)
+    par, atol = plate_parameters(run.plates, run.speeds, run.spool_of, run.rotor, control.newton_tol)
+    B = contact_rows(model, run.plates)
     contact = kernel_plates(ops.M, B, par, atol)
     index = {s: j for j, s in enumerate(spools)}
     tables = dict(profile=profile_table(profile, spools, forces),
-                  plate_spool=np.array([index[loads.spool_of[p.node]] for p in loads.plates], dtype=np.int64),
-                  plate_radius=np.array(disk_radii(loads.plates, rotor), dtype=float), tol=float(pass_tol),
+                  plate_spool=np.array([index[run.spool_of[p.node]] for p in run.plates], dtype=np.int64),
+                  plate_radius=np.array(disk_radii(run.plates, run.rotor), dtype=float), tol=float(pass_tol),
                   max_passes=int(max_passes))
     # 2. the state at t = 0 (equation of motion at the speeds and accelerations of t = 0)
     s0 = profile.at(0.0)
     W0, A0 = np.array([s0[s][0] for s in spools]), np.array([s0[s][1] for s in spools])
     F0 = ForceColumns(F=forces_at(forces, tables["profile"], 0.0).T, kind=np.zeros(1, dtype=np.int64),
                       omega=np.zeros(1))
-    state = stepping.initial_state(ops.M, ops.D(W0), ops.K_of(A0), B, par, loads.plates, F0, x0, start)
+    state = stepping.initial_state(ops.M, ops.D(W0), ops.K_of(A0), B, par, run.plates, F0, run.x0, run.start)
     # 3. record plan and speed intervals
-    plan = stepping.record_plan(run.t_end, run.dt, run.record_start, run.decimate)
-    record = stepping.record_buffers(plan, stepping.record_rows(model, loads.outputs, record_state), len(loads.plates))
-    n_levels = run.max_halvings + 1
+    plan = stepping.record_plan(run.t_end, run.dt, run.recording.start, run.recording.decimate)
+    rows = stepping.record_rows(model, run.recording.outputs, run.recording.states)
+    record = stepping.record_buffers(plan, rows, len(run.plates))
+    n_levels = control.max_halvings + 1
     widths = interval_widths(ops, np.column_stack([W0, A0]), run.dt, rho_target)
     intervals = speed_intervals(profile, spools, plan.n_steps, run.dt, widths)
     setup_time = time.perf_counter() - t_setup
     # 4. run interval by interval
-    settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=run.max_halvings, newton_tol=run.newton_tol,
-                               max_newton=run.max_newton, limit=run.displacement_limit)
+    settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=control.max_halvings, newton_tol=control.newton_tol,
+                               max_newton=control.max_newton, limit=control.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
-    status, times = _run_intervals(ops, B, constant, loads.plates, intervals, tables, contact, state, record,
-                                   settings, diag, plan.n_steps, n_levels, run.chunk_steps, progress)
+    status, times = _run_intervals(ops, B, constant, run.plates, intervals, tables, contact, state, record,
+                                   settings, diag, plan.n_steps, n_levels, control.chunk_steps, control.progress)
     # 5. package (the state-recording rows after the outputs)
-    result = stepping.package_result(model, scheme, run, loads, plan, record, state, diag, status,
-                                    (setup_time + times[0], *times[1:]), n_factorizations=len(intervals) * n_levels,
-                                    record_state=record_state)
-    return result
+    return stepping.package_result(run, plan, record, state, diag, status, (setup_time + times[0], *times[1:]),
+                                   n_factorizations=len(intervals) * n_levels)
 
 
 def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, record, settings, diag, n_steps,

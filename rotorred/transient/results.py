@@ -158,7 +158,7 @@ class TransientResult(Result):
     n_passes : int
         Fixed-point passes of the steps at varying speeds (0 at constant speeds).
     states : ndarray, shape (n_rec, 2 n), or None
-        With ``record_state``: q and v (model coordinates) at the record times.
+        With ``Recording(states=True)``: q and v (model coordinates) at the record times.
     step_form : str
         Which constant-speed step ran and why (``"eigenbasis, cond(P) = ..."``, ``"dense: ..."``); empty at
         varying speeds.

@@ -7,8 +7,8 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass
-from typing import Mapping, Sequence
+from dataclasses import dataclass, replace
+from typing import Sequence
 
 import numpy as np
 import scipy.linalg as sla
@@ -17,137 +17,146 @@ from rotorred import checks
 from rotorred.progress import bar, stage
 from rotorred.transient import kernel
 from rotorred.transient.contact import OPEN, SLIP, STICK, RubPlate, disk_force, normal_force
+from rotorred.model.assembly import system_of
+from rotorred.model.operating import Operating
+from rotorred.model.speeds import SpeedProfile
 from rotorred.transient.contact_solve import C_PASSES
-from rotorred.model.loads import Unbalance
-from rotorred.transient.matrices import ForceColumns
+from rotorred.transient.matrices import ForceColumns, disk_radii
+from rotorred.transient.options import Initial, Loads, Recording, Scheme, StepControl, within
 from rotorred.transient.results import (FinalState, SimulationDiverged, TransientResult, contact_histories,
                                         failure)
 
 LOG = logging.getLogger(__name__)
 
-METHODS = ("newmark", "hht")
 
+# ----------------------------------------------------------------------------------- 1. the checked run
+@dataclass(frozen=True, eq=False)
+class Run:
+    """One transient, every input checked (:func:`check_run`): what every step loop and the packaging read.
 
-# ----------------------------------------------------------------------------------- 1. options
-@dataclass(frozen=True)
-class Scheme:
-    """The time-integration scheme: ``method`` and its gamma, beta, alpha (-)."""
+    Attributes
+    ----------
+    system : SystemMatrices or ReducedSystem
+        The model (:func:`rotorred.model.assembly.system_of`); its ``rotor`` gives the spool of each node and
+        the disk radius under a plate that does not give it.
+    speeds : dict of str to float
+        Every spool's speed at t = 0 (rad/s), in the model's spool order.
+    profile : SpeedProfile or None
+        Every spool's speed in time (:meth:`rotorred.model.operating.Operating.profile_for`); None at constant
+        speeds.
+    t_end, dt : float
+        End time and time step (s).
+    loads : Loads
+    plates : tuple of RubPlate
+        The contacts.
+    scheme : Scheme
+    recording : Recording
+        Its outputs checked against the model.
+    control : StepControl
+    x0 : ndarray, shape (3 n,)
+        (q0, v0, 0) in model coordinates.
+    start : FinalState or None
+        Another run's final state to continue from.
+    """
 
-    method: str
-    gamma: float
-    beta: float
-    alpha: float
-
-
-def check_scheme(method, gamma, beta, alpha) -> Scheme:
-    """Newmark (gamma >= 1/2, beta > 0; default average acceleration) or HHT-α (-1/3 <= alpha <= 0)."""
-    checks.choice("method", method, METHODS)
-    if method == "newmark":
-        if alpha is not None:
-            checks.fail("alpha", alpha, "must not be given with method = 'newmark' (it applies to 'hht' only)")
-        gamma = checks.number("gamma", 0.5 if gamma is None else gamma, ge=0.5)
-        beta = checks.positive("beta", 0.25 if beta is None else beta)
-        return Scheme(method, gamma, beta, 0.0)
-    for name, value in (("gamma", gamma), ("beta", beta)):
-        if value is not None:
-            checks.fail(name, value, "must not be given with method = 'hht' (it follows from alpha)")
-    alpha = checks.number("alpha", -0.05 if alpha is None else alpha, ge=-1.0 / 3.0, le=0.0)
-    return Scheme(method, 0.5 - alpha, 0.25 * (1.0 - alpha) ** 2, alpha)
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """Checked run options of :func:`simulate` (same names and units)."""
-
+    system: object
+    speeds: dict
+    profile: SpeedProfile | None
     t_end: float
     dt: float
-    record_start: float
-    decimate: int
-    newton_tol: float
-    max_newton: int
-    max_halvings: int
-    displacement_limit: float
-    gravity: float | None
-    chunk_steps: int | None
+    loads: Loads
+    plates: tuple
+    scheme: Scheme
+    recording: Recording
+    control: StepControl
+    x0: np.ndarray
+    start: FinalState | None
+
+    @property
+    def spool_of(self) -> dict[int, str]:
+        """Spool of each node of the model (:class:`rotorred.model.assembly.SpoolSpeedMixin`)."""
+        return self.system.spool_of
+
+    @property
+    def rotor(self):
+        """The rotor the model was built from (or None): the disk radius under a plate that does not give it."""
+        return self.system.rotor
 
 
-def check_run_options(t_end, dt, record_start, decimate, newton_tol, max_newton, max_halvings, displacement_limit,
-                      gravity, chunk_steps) -> RunOptions:
-    """Every scalar option of :func:`simulate`, checked with :mod:`rotorred.checks`."""
+def check_run(model, operating, t_end, dt, loads, contacts, scheme, recording, start, control) -> Run:
+    """Every input of :func:`rotorred.transient.newmark.simulate`, checked before any computation; an error
+    names the parameter (``dt``, ``recording.start``, ``contacts[0]``, ``start.q0``)."""
+    system = system_of(model)
     t_end = checks.positive("t_end", t_end, "s")
     dt = checks.positive("dt", dt, "s")
     if dt > t_end:
         checks.fail("dt", dt, f"must not exceed t_end = {t_end!r}", "s")
-    return RunOptions(
-        t_end=t_end, dt=dt, record_start=checks.number("record_start", record_start, "s", ge=0.0, le=t_end),
-        decimate=checks.integer("decimate", decimate, ge=1),
-        newton_tol=checks.positive("newton_tol", newton_tol),
-        max_newton=checks.integer("max_newton", max_newton, ge=1),
-        max_halvings=checks.integer("max_halvings", max_halvings, ge=0),
-        displacement_limit=checks.positive("displacement_limit", displacement_limit, "m"),
-        gravity=None if gravity is None else checks.number("gravity", gravity, "m/s^2"),
-        chunk_steps=None if chunk_steps is None else checks.integer("chunk_steps", chunk_steps, ge=1))
+    for name, value, cls in (("loads", loads, Loads), ("scheme", scheme, Scheme), ("recording", recording, Recording),
+                             ("control", control, StepControl)):
+        if not isinstance(value, cls):
+            checks.fail(name, type(value).__name__, f"must be a {cls.__name__}")
+    speeds, profile = operating_speeds(system, operating)
+    plates = tuple(checks.sequence("contacts", contacts, _rub_plate))
+    if recording.start > t_end:
+        checks.fail("recording.start", recording.start, f"must not exceed t_end = {t_end!r}", "s")
+    with within("recording"):
+        recording = replace(recording, outputs=tuple(system.full_dofs.checked_outputs(recording.outputs)))
+    _check_spools(system, loads, plates)
+    disk_radii(plates, system.rotor)
+    if start is not None and not isinstance(start, (Initial, FinalState)):
+        checks.fail("start", type(start).__name__, "must be an Initial(q0, v0) or a FinalState (another run's `final`)")
+    n = system.M.shape[0]
+    if isinstance(start, FinalState):
+        _check_final_state(start, n, len(plates))
+    return Run(system=system, speeds=speeds, profile=profile, t_end=t_end, dt=dt, loads=loads, plates=plates,
+               scheme=scheme, recording=recording, control=control, x0=initial_vector(n, start),
+               start=start if isinstance(start, FinalState) else None)
 
 
-@dataclass(frozen=True)
-class Loads:
-    """Checked speeds (rad/s), spool map, plates, unbalances and outputs of :func:`simulate`."""
+def operating_speeds(system, operating) -> tuple[dict[str, float], SpeedProfile | None]:
+    """Every spool's speed at t = 0 (rad/s) and, for a profile, its speeds in time, by the ratio rule of
+    :class:`~rotorred.model.operating.Operating`."""
+    if not isinstance(operating, Operating):
+        checks.fail("operating", type(operating).__name__, "must be an Operating (Operating.point for constant "
+                    "speeds, Operating.profile or Operating.ramp for speeds in time)")
+    if operating.kind == "profile":
+        profile = operating.profile_for(system)
+        return profile.speeds_at(0.0), profile
+    return operating.single(system), None
 
-    speeds: dict
-    spool_of: Mapping[int, str] | None
-    plates: tuple
-    unbalances: tuple
-    outputs: tuple
+
+def _rub_plate(field: str, value) -> RubPlate:
+    if not isinstance(value, RubPlate):
+        checks.fail(field, value, "must be a RubPlate")
+    return value
 
 
-def check_loads(model, speeds, rotor, spool_of, plates, unbalances, outputs) -> Loads:
-    """Speeds of every spool, the spool of each loaded node, plates and unbalances of the right types."""
-    if speeds is None:
-        if rotor is None:
-            raise checks.InputError("speeds", checks.MISSING, "required when no rotor is given", "rad/s")
-        speeds = rotor.speeds
-    speeds = {str(s): checks.non_negative(f"speeds[{s!r}]", w, "rad/s") for s, w in dict(speeds).items()}
-    spools = tuple(model.G)
-    missing = [s for s in spools if s not in speeds]
-    if missing:
-        checks.fail("speeds", speeds, f"must give the speed of every spool; missing {missing}", "rad/s")
-    if spool_of is None and rotor is not None:
-        spool_of = rotor.spool_of
-    if spool_of is None and len(spools) == 1:
-        spool_of = {n: spools[0] for n in model.full_dofs.nodes}
-    outputs = tuple(model.full_dofs.checked_outputs(outputs))
-    plates, unbalances = tuple(plates), tuple(unbalances)
-    for name, items, cls in (("plates", plates, RubPlate), ("unbalances", unbalances, Unbalance)):
+def _check_spools(system, loads: Loads, plates: tuple) -> None:
+    """The node of every unbalance and plate is on a spool of the model (``system.spool_of``)."""
+    spool_of = system.spool_of
+    for field, items in (("loads.unbalances", loads.unbalances), ("contacts", plates)):
         for k, item in enumerate(items):
-            if not isinstance(item, cls):
-                checks.fail(f"{name}[{k}]", item, f"must be a {cls.__name__}")
-    if (plates or unbalances) and spool_of is None:
-        raise checks.InputError("spool_of", checks.MISSING, "required (or rotor) to know the spool of the nodes "
-                                "of unbalances and plates")
-    return Loads(speeds, spool_of, plates, unbalances, outputs)
+            if item.node not in spool_of:
+                why = ("; the model, built by hand with several spools, knows no node's spool: assemble it from a "
+                       "Rotor" if not spool_of else "")
+                checks.fail(f"{field}[{k}].node", item.node, "must be a node of a spool of the model" + why)
 
 
-def initial_vector(n: int, q0, v0, start: FinalState | None = None) -> np.ndarray:
-    """(q0, v0, 0), shape (3 n,), from the optional initial displacement and velocity or the ``start`` state
-    (model coordinates)."""
-    if start is not None:
-        if q0 is not None or v0 is not None:
-            checks.fail("start", "a FinalState", "must not be given with q0 or v0 (it holds both)")
-        q0, v0 = start.q, start.v
+def initial_vector(n: int, start: Initial | FinalState | None = None) -> np.ndarray:
+    """(q0, v0, 0), shape (3 n,), from ``start``'s displacement and velocity (model coordinates; default 0)."""
     x0 = np.zeros(3 * n)
-    for name, vec, off in (("q0", q0, 0), ("v0", v0, n)):
+    if start is None:
+        return x0
+    named = (("q", start.q), ("v", start.v)) if isinstance(start, FinalState) else (("q0", start.q0), ("v0", start.v0))
+    for k, (name, vec) in enumerate(named):
         if vec is not None:
-            x0[off:off + n] = checks.array(name if start is None else f"start.{name[0]}", vec, (n,))
+            x0[k * n:(k + 1) * n] = checks.array(f"start.{name}", vec, (n,))
     return x0
 
 
-def check_start(start: FinalState | None, n_p: int) -> None:
-    """A continued run's plates are the run's plates: ``start`` holds the state of ``n_p`` plates."""
-    if start is None:
-        return
-    if not isinstance(start, FinalState):
-        checks.fail("start", type(start).__name__, "must be a FinalState (another run's `final`)")
-    shapes = {"plate": (n_p, 2, 3), "forces": (n_p, 2), "mode": (n_p,), "sgn": (n_p,)}
+def _check_final_state(start: FinalState, n: int, n_p: int) -> None:
+    """A continued run's plates are the run's plates: ``start`` holds the state of ``n`` DOFs and ``n_p`` plates."""
+    shapes = {"q": (n,), "v": (n,), "plate": (n_p, 2, 3), "forces": (n_p, 2), "mode": (n_p,), "sgn": (n_p,)}
     for name, shape in shapes.items():
         checks.array(f"start.{name}", getattr(start, name), shape)
 
@@ -242,7 +251,7 @@ def whole_steps(x: float) -> int:
     return int(n) if abs(x - n) <= 1e-9 + 1e-12 * abs(x) else int(math.ceil(x))
 
 
-def record_plan(t_end: float, dt: float, record_start: float, decimate: int) -> RecordPlan:
+def record_plan(t_end: float, dt: float, record_start: float = 0.0, decimate: int = 1) -> RecordPlan:
     """Steps and records of a run to ``t_end`` (s): ``t_end / dt`` steps, records from the first step at or after
     ``record_start`` (s), every ``decimate``-th (each count by :func:`whole_steps`)."""
     N = whole_steps(t_end / dt)
@@ -251,12 +260,12 @@ def record_plan(t_end: float, dt: float, record_start: float, decimate: int) -> 
                       n_records=(N - first) // decimate + 1 if first <= N else 0)
 
 
-def record_rows(model, outputs, record_state: bool) -> np.ndarray:
-    """Rows of the record on the state (q, v): the outputs' rows on q, then, with ``record_state``, every q and v
+def record_rows(model, outputs, states: bool) -> np.ndarray:
+    """Rows of the record on the state (q, v): the outputs' rows on q, then, with ``states``, every q and v
     (model coordinates), shape (n_out [+ 2 n], n [or 2 n])."""
     n = model.M.shape[0]
     rows = model.output_rows(outputs) if outputs else np.zeros((0, n))
-    if not record_state:
+    if not states:
         return rows
     return np.vstack([np.hstack([rows, np.zeros_like(rows)]), np.eye(2 * n)])
 
@@ -340,36 +349,36 @@ def step_bar(n_steps: int, dt: float, progress: bool | None):
 
 
 # ----------------------------------------------------------------------------------- 4. result
-def package_result(model, scheme: Scheme, run: RunOptions, loads: Loads, plan: RecordPlan, record: kernel.Record,
-                   state: kernel.State, diag: kernel.Diagnostics, status: int, times: tuple,
-                   n_factorizations: int | None = None, record_state: bool = False,
+def package_result(run: Run, plan: RecordPlan, record: kernel.Record, state: kernel.State, diag: kernel.Diagnostics,
+                   status: int, times: tuple, n_factorizations: int | None = None,
                    step_form: str = "") -> TransientResult:
-    """The :class:`TransientResult` of a run (raises :class:`SimulationDiverged` carrying it if the run failed).
+    """The :class:`TransientResult` of ``run`` (raises :class:`SimulationDiverged` carrying it if the run failed).
 
     ``times`` is (setup time, loop wall time, loop CPU time, kernel load time (s), whether the kernel was compiled)
-    (:func:`load_kernel`); ``n_factorizations``
-    defaults to one per step size; with ``record_state`` the records after the outputs are (q, v).
+    (:func:`load_kernel`); ``n_factorizations`` defaults to one per step size; with ``run.recording.states`` the
+    records after the outputs are (q, v).
     """
-    n, n_p, counters = len(state.x) // 3, len(loads.plates), diag.counters
+    model, scheme, plates, outputs = run.system, run.scheme, run.plates, run.recording.outputs
+    n, n_p, counters = len(state.x) // 3, len(plates), diag.counters
     nr = int(record.count[0])
     t_done = int(counters[kernel.C_STEPS]) * run.dt
     success = status == kernel.RUNNING
     if success:
         message = f"finished: {plan.n_steps} steps of {run.dt:g} s"
     else:
-        message, dof, cause = failure(model, loads.plates, status, diag.err, run.max_halvings, t_done)
+        message, dof, cause = failure(model, plates, status, diag.err, run.control.max_halvings, t_done)
     x = state.x
     final = FinalState(t=t_done, q=x[:n].copy(), v=x[n:2 * n].copy(), a=x[2 * n:].copy(), plate=state.ps.copy(),
                        forces=state.z.reshape(n_p, 2).copy(), mode=state.mode.copy(), sgn=state.sgn.copy())
     result = TransientResult(
-        t=record.t[:nr].copy(), outputs={o: record.y[:nr, j].copy() for j, o in enumerate(loads.outputs)},
-        states=record.y[:nr, len(loads.outputs):].copy() if record_state else None,
-        contacts=contact_histories(loads.plates, record), success=success, status=0 if success else int(status),
+        t=record.t[:nr].copy(), outputs={o: record.y[:nr, j].copy() for j, o in enumerate(outputs)},
+        states=record.y[:nr, len(outputs):].copy() if run.recording.states else None,
+        contacts=contact_histories(plates, record), success=success, status=0 if success else int(status),
         message=message, final=final, method=scheme.method, dt=run.dt, gamma=float(scheme.gamma),
         beta=float(scheme.beta), alpha=float(scheme.alpha), n_steps=int(counters[kernel.C_STEPS]),
         n_substeps=int(counters[kernel.C_SUBSTEPS]), n_newton=int(counters[kernel.C_NEWTON]),
         n_contact_steps=int(counters[kernel.C_CONTACT]), max_newton_per_solve=int(counters[kernel.C_MAXNEWTON]),
-        n_factorizations=run.max_halvings + 1 if n_factorizations is None else n_factorizations,
+        n_factorizations=run.control.max_halvings + 1 if n_factorizations is None else n_factorizations,
         n_passes=int(counters[C_PASSES]), step_form=step_form, setup_time=times[0], run_time=times[1], run_cpu_time=times[2],
         kernel_load_time=times[3], kernel_compiled=bool(times[4]))
     if not success:
