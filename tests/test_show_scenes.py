@@ -37,13 +37,14 @@ def runup_result():
 def transient_result(scene_result):
     """0.1 s of paper-rub's model with its plate, from the settled state, recording x, y and a rotation."""
     from rotorred.scenes.run import build_model, settled_state
-    from rotorred.transient.newmark import simulate
+    from rotorred import Initial, Loads, Operating, Recording, StepControl, simulate
 
     sc = scene_result.scene
     model = build_model(sc).model
     q0, v0 = settled_state(sc, model)
-    return simulate(model, sc.speeds, 0.1, sc.solver.dt, unbalances=sc.unbalances, plates=sc.plates, rotor=sc.rotor,
-                    outputs=[(14, "x"), (14, "y"), (18, "y"), (14, "theta_x")], q0=q0, v0=v0, progress=False)
+    return simulate(model, Operating.point(sc.speeds), 0.1, sc.solver.dt, loads=Loads(sc.unbalances),
+                    contacts=sc.plates, recording=Recording([(14, "x"), (14, "y"), (18, "y"), (14, "theta_x")]),
+                    start=Initial(q0, v0), control=StepControl(progress=False))
 
 
 # --------------------------------------------------------------------------- transient
