@@ -129,6 +129,7 @@ _EXPORTS = {
     "write_outputs": "rotorred.scenes.outputs",
     "run_runup": "rotorred.scenes.runup",
     "continue_scene": "rotorred.scenes.branch",
+    "BranchOptions": "rotorred.scenes.branch",
     "check_key": "rotorred.scenes.branch",
     "SceneBranch": "rotorred.scenes.branch",
     "write_branch": "rotorred.scenes.branch_outputs",

@@ -17,7 +17,7 @@ import pytest
 from rotorred.cli import main
 from rotorred.nonlinear.continuation import continue_branch
 from rotorred.nonlinear.examples import jeffcott
-from rotorred.scenes.branch import SceneBranch, continue_scene
+from rotorred.scenes.branch import BranchOptions, SceneBranch, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
@@ -42,7 +42,7 @@ def test_a_clearance_branch_solves_the_scene_at_each_clearance_and_turns_at_its_
     times (it goes on down: 4 smooth folds at 20 harmonics, 2 at 100 in validation/hb_rig.py), each fold within a step
     of its nearest point, and the peak at 45 um is the linear response's."""
     scene, model = rig
-    branch = continue_scene(scene, model, "rub.clearance", 45e-6, 25e-6, H, N, stability=False)
+    branch = continue_scene(scene, model, "rub.clearance", 45e-6, 25e-6, BranchOptions(H, N, stability=False))
     assert branch.stopped == "reached the end, clearance = 2.5e-05 m"
     for i in np.linspace(0, len(branch.values) - 1, 5).astype(int):
         at = load_scene("paper-rub", {"rub.clearance": float(branch.values[i])})
@@ -60,7 +60,7 @@ def test_a_speed_branch_keeps_the_speed_ratio_and_solves_the_scene_at_each_speed
     """From 90 to 91 Hz on the outer spool, the inner one at 7/9 of it: each point solves the problem built from the
     scene loaded at those two speeds (measured below 1e-9), its base frequency is the outer speed / 9."""
     scene, model = rig
-    branch = continue_scene(scene, model, "speeds.outer", 90.0, 91.0, H, N, stability=False)
+    branch = continue_scene(scene, model, "speeds.outer", 90.0, 91.0, BranchOptions(H, N, stability=False))
     assert branch.stopped.startswith("reached the end, speeds.outer = 91")
     assert np.allclose(branch.f0, branch.values / 9, rtol=1e-12)
     for i in (0, len(branch.values) // 2, len(branch.values) - 1):
@@ -75,7 +75,7 @@ def test_a_branch_in_the_plates_stiffness_solves_the_scene_at_each_stiffness(rig
     loaded with that stiffness (measured below 1e-9, the branch's tolerance), the base frequency stays 10 Hz, and the
     peak falls as the plate stiffens (the plate gives less, the disk is held nearer its clearance)."""
     scene, model = rig
-    branch = continue_scene(scene, model, "rub.k_n", 2e8, 2e9, H, N, stability=False)
+    branch = continue_scene(scene, model, "rub.k_n", 2e8, 2e9, BranchOptions(H, N, stability=False))
     assert branch.stopped.startswith("reached the end, rub.k_n = 2e+09 N/m") and branch.unit == "N/m"
     assert np.all(branch.f0 == 10.0)
     for i in (0, len(branch.values) // 2, len(branch.values) - 1):

@@ -58,12 +58,12 @@ def torus():
 def scene_branch():
     """paper-rub's clearance branch from 45 to 40 um at 20 harmonics, with stability: the free orbit grazing the plate
     near 43 um and losing stability there."""
-    from rotorred.scenes.branch import continue_scene
+    from rotorred.scenes.branch import BranchOptions, continue_scene
     from rotorred.scenes.run import build_model
 
     scene = load_scene("paper-rub")
     model = build_model(scene).model
-    return scene, model, continue_scene(scene, model, "rub.clearance", 45e-6, 40e-6, 20, 128)
+    return scene, model, continue_scene(scene, model, "rub.clearance", 45e-6, 40e-6, BranchOptions(20, 128))
 
 
 @pytest.fixture(scope="module")

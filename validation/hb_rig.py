@@ -33,7 +33,7 @@ import numpy as np
 from rotorred.nonlinear.hb import solve
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.balance_harmonics import cold_solution
-from rotorred.scenes.branch import STABILITY_SUBSTEPS, cold_start, continue_scene
+from rotorred.scenes.branch import STABILITY_SUBSTEPS, BranchOptions, cold_start, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
@@ -104,7 +104,7 @@ def by_clearance(scene, sm):
     time between the continuation's reports: a point carries the corrections that failed before it), and the settled
     transient at every point's clearance (warm, solve time only)."""
     stamps = []
-    branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, 100, 2048, stability=False,
+    branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, BranchOptions(100, 2048, stability=False),
                             progress=lambda p, v: stamps.append(time.perf_counter()))
     per_point = branch.solve_time / (len(branch.values) - 1)
     costs = np.diff(stamps)  # points 2 .. p - 1

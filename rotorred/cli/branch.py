@@ -65,7 +65,7 @@ def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
     from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
     from rotorred.cli.run import _settings
-    from rotorred import build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
+    from rotorred import BranchOptions, build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
     key, start, stop = _param(args.param)
@@ -82,7 +82,7 @@ def run(args) -> int:
     interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
     progress.stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
     with _Progress(key) as tracing:
-        branch = continue_scene(scene, model, key, start, stop, H, N, tol=tol, stability=not args.no_stability,
+        branch = continue_scene(scene, model, key, start, stop, BranchOptions(H, N, tol, not args.no_stability),
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
     for f in _write(branch, out, tuple(interrupts), record):

@@ -50,7 +50,7 @@ from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_pro
 from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.writers import signals_held
 
-__all__ = ["KEYS", "PLATE_KEYS", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "dof_name",
+__all__ = ["KEYS", "PLATE_KEYS", "BranchOptions", "SceneFamily", "SceneBranch", "check_key", "cold_start", "continue_scene", "dof_name",
            "scene_at"]
 
 #: the plate's numbers a branch follows besides its clearance, and their units: the supports' (Eq. 7), the law's
@@ -388,9 +388,42 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
     return solve(family.at(clearance), branch.z[i], omega, tol=tol).z
 
 
-def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: int, *, tol: float = 1e-9,
-                   stability: bool = True, max_points: int = 400, progress=None,
-                   interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> SceneBranch:
+@dataclass(frozen=True)
+class BranchOptions:
+    """The truncation, accuracy and extent of a branch (:func:`continue_scene`).
+
+    Parameters
+    ----------
+    harmonics : int
+        Harmonics H of the base frequency f_0, >= 1 (default 50).
+    samples : int
+        AFT samples N a period, even and >= 2 H + 2 (default 1024).
+    tol : float
+        Relative residual of every point, > 0 (-).
+    stability : bool
+        Floquet multipliers of every point (monodromy; the slow part).
+    max_points : int
+        Most points traced, >= 2.
+    """
+
+    harmonics: int = 50
+    samples: int = 1024
+    tol: float = 1e-9
+    stability: bool = True
+    max_points: int = 400
+
+    def __post_init__(self):
+        H = checks.integer("harmonics", self.harmonics, ge=1)
+        N = checks.integer("samples", self.samples, ge=2 * H + 2)
+        if N % 2:
+            checks.fail("samples", N, "must be even")
+        checks.positive("tol", self.tol)
+        checks.boolean("stability", self.stability)
+        checks.integer("max_points", self.max_points, ge=2)
+
+
+def continue_scene(scene, model, key: str, start: float, end: float, options: BranchOptions = BranchOptions(), *,
+                   progress=None, interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> SceneBranch:
     """The branch of ``scene``'s rub response on ``model`` as ``key`` goes from ``start`` to ``end``.
 
     Parameters
@@ -403,13 +436,8 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
         ``rub.clearance``, ``speeds.<spool>`` or a plate's number ``rub.<number>`` (:data:`KEYS`).
     start, end : float
         The key's first and last value (in its unit, :data:`KEYS`).
-    H, N : int
-        Harmonics of f_0 and AFT samples a period.
-    tol : float
-        Relative residual of every point.
-    stability : bool
-        Floquet multipliers of every point (monodromy).
-    max_points : int
+    options : BranchOptions
+        Harmonics, AFT samples, tolerance, stability and the most points.
     progress : callable, optional
         ``progress(points, value)`` as the branch grows (last with every point traced), then ``progress(0, None)`` as
         the stability starts and ``progress(i, None)`` as each point's is found.
@@ -421,6 +449,9 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     -------
     SceneBranch
     """
+    if not isinstance(options, BranchOptions):
+        checks.fail("options", type(options).__name__, "must be a BranchOptions")
+    H, N, tol, stability = options.harmonics, options.samples, options.tol, options.stability
     family, to_value, rub_at = _family(scene, model, key, start, end, H, N)
     t0 = time.perf_counter()
     first = rub_at(start)
@@ -429,7 +460,7 @@ def continue_scene(scene, model, key: str, start: float, end: float, H: int, N: 
     s_start, s_end = to_value(start, inverse=True), to_value(end, inverse=True)
     scale = max(float(np.linalg.norm(z0)), abs(s_end - s_start))  # the steps: a few hundred along a branch
     branch = continue_branch(family, z0, s_start, s_end, ds=0.01 * scale,
-                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=max_points, tol=tol, curved=True,
+                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=options.max_points, tol=tol, curved=True,
                              stability=False, interrupts=interrupts,
                              progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
     t2 = time.perf_counter()
