@@ -57,9 +57,10 @@ def assert_dataset_round_trips(result: Result, tmp_path):
     return ds
 
 
-def assert_shows_itself(result: Result, tmp_path, **plot_options):
-    """All three: a short repr, a Figure, a dataset that round-trips through NetCDF."""
-    assert isinstance(result, Result)
+def assert_shows_itself(result: Result, tmp_path, of: type, **plot_options):
+    """All three: a short repr, a Figure, a dataset that round-trips through NetCDF, of a result of type ``of``
+    (tests/test_public_api.py finds every exported result type named here)."""
+    assert type(result) is of and isinstance(result, Result)
     assert_short_repr(result)
     assert_plots(result, **plot_options)
     assert_dataset_round_trips(result, tmp_path)

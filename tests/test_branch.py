@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rotorred.cli import main
-from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
 from rotorred.nonlinear.examples import jeffcott
 from rotorred.scenes.branch import BranchOptions, SceneBranch, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem
@@ -126,8 +126,8 @@ def test_an_interrupt_keeps_the_points_so_far():
     def progress(points, omega):
         if points == 6:
             raise KeyboardInterrupt
-    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ds=0.1, stability=False,
-                             progress=progress)
+    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0,
+                             ContinuationOptions(ds=0.1, stability=False), progress=progress)
     assert len(branch.omega) == 6 and branch.stopped.startswith("interrupted (SIGINT) at omega = ")
     assert branch.interrupt == "SIGINT"
     assert max(problem.evaluate(z, w).relative for z, w in zip(branch.z, branch.omega)) < 1e-10
@@ -299,7 +299,7 @@ def test_the_tolerance_chooses_the_harmonics_by_the_convergence_of_the_response(
     problem, and the change bounds the error of what is returned: against the next truncation, solved here from it,
     the error is below the estimate (measured at tol = 0.05: 100 harmonics, estimate 0.027, error 0.0030), and the
     observed order of the ladder's changes is above 1 (measured 3.9), the condition under which it does."""
-    from rotorred.nonlinear.hb import solve
+    from rotorred.nonlinear.hb import solve_periodic
     from rotorred.scenes.balance_harmonics import balance_to_tolerance, padded, response_change, samples_for
 
     scene, model = rig
@@ -309,7 +309,7 @@ def test_the_tolerance_chooses_the_harmonics_by_the_convergence_of_the_response(
     assert (rp.problem.harmonics.H, rp.problem.harmonics.N) == (choice.harmonics, choice.samples)
     assert rp.problem.evaluate(z, rp.omega).relative < 1e-9
     fine = rub_problem(scene, model, 2 * choice.harmonics, samples_for(2 * choice.harmonics))
-    z_fine = solve(fine.problem, padded(z, fine), fine.omega, tol=1e-9).z
+    z_fine = solve_periodic(fine.problem, padded(z, fine), fine.omega, tol=1e-9).z
     error = response_change(rp, z, fine, z_fine, dofs)
     assert error < choice.estimate
     assert np.log2(choice.steps[-2][1] / choice.estimate) > 1.0

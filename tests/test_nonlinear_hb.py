@@ -12,17 +12,17 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
 from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott
 from rotorred.nonlinear.forces import CircularClearance
 from rotorred.nonlinear.fourier import Harmonics
-from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve_periodic
 
 def duffing_branch(H: int):
     problem = duffing(H)
     z0 = np.zeros(problem.size)
     z0[1] = F / (1 - 0.25)  # the linear response at omega = 0.5
-    return problem, continue_branch(problem, z0, 0.5, 2.5, ds=0.05, ds_max=0.05)
+    return problem, continue_branch(problem, z0, 0.5, 2.5, ContinuationOptions(ds=0.05, ds_max=0.05))
 
 
 @pytest.fixture(scope="module")
@@ -62,8 +62,9 @@ def test_a_curved_prediction_follows_the_same_branch_in_fewer_iterations():
     form's (measured 3.2e-14), the same 265 points (the steps are ds_max), in fewer Newton iterations: 1.39 a point on
     average against 2.07 with the tangent."""
     problem = duffing(1, 128)
-    branches = [continue_branch(problem, np.zeros(problem.size), 0.5, 2.5, ds=0.05, ds_max=0.05, stability=False,
-                                curved=curved) for curved in (False, True)]
+    branches = [continue_branch(problem, np.zeros(problem.size), 0.5, 2.5,
+                                ContinuationOptions(ds=0.05, ds_max=0.05, stability=False, curved=curved))
+                for curved in (False, True)]
     tangent, curved = branches
     A, w = curved.amplitude(0), curved.omega
     assert np.max(np.abs(((1 - w**2 + 0.75 * K3 * A**2) ** 2 + (C * w) ** 2) * A**2 - F**2)) < 2e-11
@@ -85,7 +86,7 @@ def test_duffing_converges_with_harmonics_to_the_transient(branch7):
         p = duffing(H)
         z0 = np.zeros(p.size)
         z0[:min(p.size, problem7.size)] = upper[:min(p.size, problem7.size)]
-        z = solve(p, z0, 1.3).z
+        z = solve_periodic(p, z0, 1.3).z
         amplitudes[H] = np.hypot(z[1], z[2])
     errors = [abs(amplitudes[H] / amplitudes[9] - 1) for H in (1, 3, 5)]
     assert errors[0] > 300 * errors[1] > 300**2 * errors[2]
@@ -121,7 +122,7 @@ def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
     problem = jeffcott(5, 128)
     z0 = np.zeros(problem.size)
     z0[2] = z0[5] = E_UNB * 0.25 / (1 - 0.25)
-    branch = continue_branch(problem, z0, 0.5, 12.0, ds=0.1, ds_max=0.5, stability=False)
+    branch = continue_branch(problem, z0, 0.5, 12.0, ContinuationOptions(ds=0.1, ds_max=0.5, stability=False))
     radius = branch.amplitude(0)
     samples = np.array([np.hypot(*problem.samples(z, w)[0].T).min() for z, w in zip(branch.z, branch.omega)])
     full = samples > GAP * (1 + 1e-6)
@@ -150,7 +151,7 @@ def test_a_branch_that_comes_back_onto_its_path_stops_there():
     problem = jeffcott(5, 128)
     z0 = np.zeros(problem.size)
     z0[2] = z0[5] = E_UNB * 0.25 / (1 - 0.25)
-    branch = continue_branch(problem, z0, 0.5, 12.0, ds=0.11, ds_max=0.5, stability=False)
+    branch = continue_branch(problem, z0, 0.5, 12.0, ContinuationOptions(ds=0.11, ds_max=0.5, stability=False))
     assert branch.stopped.startswith("the branch came back onto its own path at omega = ")
     assert "a closed loop, followed once" in branch.stopped and len(branch.omega) < 400
     assert [f.smooth for f in branch.folds] == [True, False]
@@ -162,7 +163,7 @@ def test_a_point_that_does_not_converge_says_so():
     problem = duffing(3)
     with pytest.raises(NotConverged, match=r"^harmonic balance did not converge at omega = 1\.3 rad/s: relative "
                                            r"residual .* > 1e-10 after 1 Newton iterations \(iteration limit\)$"):
-        solve(problem, np.zeros(problem.size), 1.3, max_iter=1)
+        solve_periodic(problem, np.zeros(problem.size), 1.3, max_iter=1)
 
 
 # --- independent references ---------------------------------------------------------------------------------
@@ -174,7 +175,7 @@ def _point_near(branch, omega: float, upper: bool | None, problem) -> np.ndarray
     assert len(crossings) == 3
     by_amplitude = sorted(crossings, key=lambda i: A[i])
     i = by_amplitude[-1] if upper else by_amplitude[0] if upper is False else by_amplitude[1]
-    z = solve(problem, branch.z[i], omega).z
+    z = solve_periodic(problem, branch.z[i], omega).z
     return z
 
 
@@ -280,7 +281,8 @@ def four_dof():
     contact = (CircularClearance((0, 1), GAP, K_C),)
     full = PeriodicProblem(M, D, K, h, forcing, contact)
     condensed = CondensedProblem(M, D, K, h, (0, 1), forcing, contact)
-    branch = continue_branch(full, np.zeros(full.size), 0.3, 3.0, ds=0.05, ds_max=0.2, stability=False)
+    branch = continue_branch(full, np.zeros(full.size), 0.3, 3.0,
+                             ContinuationOptions(ds=0.05, ds_max=0.2, stability=False))
     return full, condensed, h, branch
 
 
@@ -314,8 +316,8 @@ def test_condensation_onto_the_contact_dofs_equals_the_full_system(four_dof):
         if np.min(np.abs(radius - GAP)) < 1e-3:  # grazing: differences would straddle the kink
             continue
         checked += 1
-        z_full = solve(full, z_full, omega, tol=1e-13).z  # both to a tolerance tighter than the branch's
-        solution = solve(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=1e-13)
+        z_full = solve_periodic(full, z_full, omega, tol=1e-13).z  # both to a tolerance tighter than the branch's
+        solution = solve_periodic(condensed, 1.01 * z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega, tol=1e-13)
         z, ev = solution.z, solution.evaluation
         worst[0] = max(worst[0], np.max(np.abs(z - z_full.reshape(h.size, 4)[:, :2].reshape(-1))))
         worst[1] = max(worst[1], np.max(np.abs(condensed.recover(z, omega) - z_full)))
@@ -360,7 +362,7 @@ def test_the_monodromy_of_a_condensed_problem_is_the_full_systems(four_dof):
     i = int(np.argmax(radius))
     assert radius[i] > GAP  # in contact all round
     z_full, omega = branch.z[i], branch.omega[i]
-    z = solve(condensed, z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega).z
+    z = solve_periodic(condensed, z_full.reshape(h.size, 4)[:, :2].reshape(-1), omega).z
     a = floquet_by_monodromy(full, z_full, omega, 4)
     b = floquet_by_monodromy(condensed, z, omega, 4)
     assert abs(a.max_real - b.max_real) < 1e-14

@@ -11,7 +11,7 @@ import pytest
 from rotorred.checks import InputError
 from rotorred.nonlinear.condensed import ClearanceFamily
 from rotorred.nonlinear.forces import PlateRub
-from rotorred.nonlinear.hb import solve
+from rotorred.nonlinear.hb import solve_periodic
 from rotorred.scenes.balance_harmonics import FROM_RECORD, cold_solution
 from rotorred.scenes.harmonic_balance import base_frequency, rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
@@ -108,7 +108,7 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     window = result.t >= result.t[-1] - period + 1e-9  # the last period, whole
     records = unknown_records(scene.plates, result)
     z0 = rp.start_from_record(result.t[window], {j: x[window] for j, x in records.items()})
-    solution = solve(rp.problem, z0, rp.omega)
+    solution = solve_periodic(rp.problem, z0, rp.omega)
     z, iterations = solution.z, solution.iterations
     lines = rp.lines(z, (14, "y"))
     largest = sorted(result.analyses[(14, "y")].fit.lines, key=lambda ln: -ln.amplitude)[:10]

@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 from rotorred.checks import InputError
 from rotorred.nonlinear.forces import CubicSpring
 from rotorred.nonlinear.fourier import Harmonics, alias_free_samples
-from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve_periodic
 from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
 
 # the cubic oscillator x'' + C x' + x + K3 x^3 = F1 cos(w1 t) + F2 cos(w2 t), both tones near its resonance
@@ -147,7 +147,7 @@ def test_linear_system_at_two_incommensurate_frequencies_is_the_closed_form():
         assert np.max(np.abs(Q[h.index(k1, k2)] - ref)) < 3e-14 * np.max(np.abs(ref))
     others = [i for i in range(h.n_orders) if i not in (h.index(1, 0), h.index(0, 1))]
     assert np.max(np.abs(Q[others])) < 1e-15
-    z_dense = solve(problem, np.zeros(problem.size), w[0]).z
+    z_dense = solve_periodic(problem, np.zeros(problem.size), w[0]).z
     assert np.max(np.abs(z_dense - sol.z)) < 2e-14 * np.max(np.abs(sol.z))
     assert sol.iterations == 1 and sol.history[0] == pytest.approx(1.0)  # linear: one Newton step from 0
 
@@ -207,7 +207,7 @@ def test_torus_at_commensurate_frequencies_is_the_periodic_balance():
         f[1], f[3] = F1, F2
         return f, np.zeros(hp.size)
     periodic = PeriodicProblem(np.eye(1), C * np.eye(1), np.eye(1), hp, forcing, (CubicSpring(0, K3),))
-    zp = solve(periodic, periodic.linear_response(w1), w1).z
+    zp = solve_periodic(periodic, periodic.linear_response(w1), w1).z
     Qp = np.concatenate([[zp[0]], zp[1::2] - 1j * zp[2::2]])
     for H, tol in ((7, 2e-7), (9, 1e-9)):
         problem = cubic_oscillator(H, (w1, 2 * w1))

@@ -8,6 +8,8 @@ import math
 import numpy as np
 import pytest
 
+import rotorred as rr
+
 from rotorred.checks import InputError
 from rotorred.linear.campbell import WHIRL_LABELS, campbell
 from rotorred.linear.harmonic import frequency_response, steady_state, unbalance_response
@@ -67,7 +69,7 @@ def balance(rig):
 
 # --- the three checks on each type -----------------------------------------------------------------------------
 def test_campbell_result_shows_itself(diagram, tmp_path):
-    assert_shows_itself(diagram, tmp_path, operating_speed=440.0)
+    assert_shows_itself(diagram, tmp_path, of=rr.CampbellResult, operating_speed=440.0)
     text = repr(diagram)
     first = diagram.critical_speeds[0]
     assert f"{first.speed_rpm:.6g} rpm: {first.line}, mode {first.mode}" in text
@@ -78,17 +80,17 @@ def test_a_whirl_table_and_a_diagram_without_critical_speeds_show_themselves(rig
     """One speed (the whirl table of `rotorred campbell --speeds 3000`): its points, the lines from rest; a sweep
     below every crossing: no critical speed, an empty `critical` dimension in the dataset."""
     table = campbell(rig[0], Operating.line([300.0]))
-    assert_shows_itself(table, tmp_path)
+    assert_shows_itself(table, tmp_path, of=rr.CampbellResult)
     assert "at 2864.79 rpm of the inner spool" in repr(table)
     below = campbell(rig[0], Operating.line([0.0, 20.0, 40.0]))
     assert below.critical_speeds == ()
-    assert_shows_itself(below, tmp_path)
+    assert_shows_itself(below, tmp_path, of=rr.CampbellResult)
     assert below.to_xarray().sizes["critical"] == 0
 
 
 def test_critical_speed_shows_itself_and_marks_a_diagram(diagram, tmp_path):
     critical = diagram.critical_speeds[0]
-    assert_shows_itself(critical, tmp_path)
+    assert_shows_itself(critical, tmp_path, of=rr.CriticalSpeed)
     fig = diagram.plot()
     ax = fig.axes[0]
     n_lines = len(ax.lines)
@@ -98,7 +100,7 @@ def test_critical_speed_shows_itself_and_marks_a_diagram(diagram, tmp_path):
 
 
 def test_unbalance_response_shows_itself_in_both_kinds(response, tmp_path):
-    assert_shows_itself(response, tmp_path)  # Bode, the default
+    assert_shows_itself(response, tmp_path, of=rr.UnbalanceResponse)  # Bode, the default
     assert_plots(response, kind="polar")
     bode, polar = response.plot(), response.plot(kind="polar")
     assert len(bode.axes) == 2 * len(OUTPUTS) and len(polar.axes) == len(OUTPUTS)
@@ -110,12 +112,12 @@ def test_unbalance_response_shows_itself_in_both_kinds(response, tmp_path):
 
 
 def test_frequency_response_shows_itself(frf, tmp_path):
-    assert_shows_itself(frf, tmp_path)
+    assert_shows_itself(frf, tmp_path, of=rr.FrequencyResponse)
     assert len(frf.plot().axes) == 2
 
 
 def test_steady_state_shows_itself_and_a_node_orbit(state, rig, tmp_path):
-    assert_shows_itself(state, tmp_path)
+    assert_shows_itself(state, tmp_path, of=rr.SteadyState)
     model = rig[1]
     fig = state.plot(model=model, node=13, revolutions=2.0)
     orbit = fig.axes[0].lines[0].get_xydata()  # µm
@@ -130,7 +132,7 @@ def test_steady_state_shows_itself_and_a_node_orbit(state, rig, tmp_path):
 
 
 def test_energy_balance_shows_itself(balance, tmp_path):
-    assert_shows_itself(balance, tmp_path)
+    assert_shows_itself(balance, tmp_path, of=rr.EnergyBalance)
     assert f"relative {balance.relative_residual:.3g}" in repr(balance)
 
 

@@ -6,15 +6,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+import rotorred as rr
 from matplotlib.figure import Figure
 
 from results_checks import assert_dataset_round_trips, assert_plots, assert_short_repr, assert_shows_itself
 from rotorred.maps.spec import Axis, MapSpec
 from rotorred.maps.store import PointStore
-from rotorred.nonlinear.continuation import continue_branch
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
 from rotorred.nonlinear.examples import F, duffing, jeffcott
 from rotorred.nonlinear.forces import CubicSpring
-from rotorred.nonlinear.hb import solve
+from rotorred.nonlinear.hb import solve_periodic
 from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.schema import load_scene
@@ -30,7 +32,7 @@ def periodic(request):
     (harmonic 1 alone); the Duffing oscillator (1 DOF, 7 harmonics) at omega = 1.6, on its lower branch (odd
     harmonics)."""
     problem, omega = (jeffcott(5, 128), 0.98) if request.param == "jeffcott" else (duffing(7), 1.6)
-    return problem, solve(problem, problem.linear_response(omega), omega)
+    return problem, solve_periodic(problem, problem.linear_response(omega), omega)
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +41,7 @@ def duffing_branch():
     problem = duffing(3)
     z0 = np.zeros(problem.size)
     z0[1] = F / (1 - 0.25)  # the linear response at omega = 0.5
-    return problem, continue_branch(problem, z0, 0.5, 2.5, ds=0.1, ds_max=0.2)
+    return problem, continue_branch(problem, z0, 0.5, 2.5, ContinuationOptions(ds=0.1, ds_max=0.2))
 
 
 @pytest.fixture(scope="module")
@@ -78,7 +80,7 @@ def map_run(tmp_path_factory):
 
 def test_a_periodic_solution_shows_itself(periodic, tmp_path):
     problem, solution = periodic
-    assert_shows_itself(solution, tmp_path)
+    assert_shows_itself(solution, tmp_path, of=rr.PeriodicSolution)
     text = repr(solution)
     assert f"omega = {solution.omega:g} rad/s" in text and f"{problem.n} DOFs, {problem.harmonics.H} harmonics" in text
 
@@ -109,7 +111,7 @@ def test_a_periodic_solutions_dataset_is_its_coefficients_and_its_waveforms_spec
 
 def test_a_branch_shows_itself(duffing_branch, tmp_path):
     problem, branch = duffing_branch
-    assert_shows_itself(branch, tmp_path)
+    assert_shows_itself(branch, tmp_path, of=rr.Branch)
     text = repr(branch)
     assert "in omega (rad/s)" in text and "turns: 2, at omega = " in text and "stopped: reached the end" in text
 
@@ -136,7 +138,8 @@ def test_an_interrupted_branch_says_so_in_short_lines(tmp_path):
     def progress(points, omega):
         if points == 6:
             raise KeyboardInterrupt
-    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ds=0.1, progress=progress)
+    branch = continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0, ContinuationOptions(ds=0.1),
+                             progress=progress)
     text = assert_short_repr(branch)
     assert "stopped: interrupted (SIGINT) at omega = " in text and "6 points from 0.5 to" in text
     assert len(assert_plots(branch).axes[0].lines[0].get_xdata()) == 6
@@ -152,8 +155,9 @@ def test_a_branch_in_a_family_shows_the_familys_parameter(scene_branch, tmp_path
     family = ClearanceFamily(rp.problem, rp.omega)
     z = rp.problem.linear_response(rp.omega)
     scale = float(np.linalg.norm(z))
-    branch = continue_branch(family, z, 45e-6, 44e-6, ds=0.05 * scale, ds_min=1e-10 * scale, ds_max=0.12 * scale,
-                             stability=False, tol=1e-9)
+    branch = continue_branch(family, z, 45e-6, 44e-6,
+                             ContinuationOptions(ds=0.05 * scale, ds_min=1e-10 * scale, ds_max=0.12 * scale,
+                                                 stability=False, tol=1e-9))
     ds = assert_dataset_round_trips(branch, tmp_path)
     assert ds["parameter"].attrs["long_name"] == "clearance" and ds["parameter"].attrs["units"] == "m"
     np.testing.assert_array_equal(ds["parameter"].values, branch.omega)
@@ -163,7 +167,7 @@ def test_a_branch_in_a_family_shows_the_familys_parameter(scene_branch, tmp_path
 
 
 def test_a_torus_shows_itself(torus, tmp_path):
-    assert_shows_itself(torus[1], tmp_path)
+    assert_shows_itself(torus[1], tmp_path, of=rr.TorusSolution)
     assert "w = (0.8, 1.13137" in repr(torus[1])
 
 
@@ -182,7 +186,7 @@ def test_a_torus_dataset_is_its_coefficients_and_the_recovered_lines(torus):
 
 def test_a_scene_branch_shows_itself(scene_branch, tmp_path):
     branch = scene_branch[2]
-    assert_shows_itself(branch, tmp_path)
+    assert_shows_itself(branch, tmp_path, of=rr.SceneBranch)
     text = repr(branch)
     assert "branch of paper-rub in rub.clearance (µm)" in text and "from 45 to 39.7" in text
 
@@ -203,7 +207,7 @@ def test_a_scene_branchs_dataset_is_the_scene_solved_at_each_value(scene_branch)
 
 def test_a_map_shows_itself_in_each_of_its_figures(map_run, tmp_path):
     spec, out, run = map_run
-    assert_shows_itself(run, tmp_path)
+    assert_shows_itself(run, tmp_path, of=rr.MapRun)
     assert "map of paper-rub over rub.clearance (2 values)" in repr(run)
     for kind in ("waterfall", "bifurcation"):
         assert_plots(run, kind=kind)

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+
+import rotorred as rr
 from matplotlib.figure import Figure
 
 from results_checks import assert_shows_itself
@@ -50,7 +52,7 @@ def transient_result(scene_result):
 # --------------------------------------------------------------------------- transient
 def test_transient_result_shows_itself(transient_result, tmp_path):
     res = transient_result
-    assert_shows_itself(res, tmp_path)
+    assert_shows_itself(res, tmp_path, of=rr.TransientResult)
     text = repr(res)
     assert "newmark" in text and "node 14 theta_x: peak" in text and "plate 0 at node 18" in text
 
@@ -93,7 +95,7 @@ def test_spectrum_shows_itself(tmp_path):
     t = np.arange(20_000) * dt
     x = 3e-6 * np.cos(2 * np.pi * 90.0 * t) + 1e-6 * np.cos(2 * np.pi * 70.0 * t)
     spec = settled_spectrum(x, dt, 70.0, 90.0)
-    assert_shows_itself(spec, tmp_path)
+    assert_shows_itself(spec, tmp_path, of=rr.Spectrum)
     assert "largest amplitude 3e-06" in repr(spec).replace("3.00000", "3")  # the 90 Hz tone, on its bin
     ds = spec.to_xarray()
     np.testing.assert_array_equal(ds.amplitude.values, spec.amplitudes)
@@ -115,7 +117,7 @@ def _synthetic_track():
 
 def test_order_track_shows_itself(tmp_path):
     track = _synthetic_track()
-    assert_shows_itself(track, tmp_path)
+    assert_shows_itself(track, tmp_path, of=rr.OrderTrack)
     text = repr(track)
     assert "order 1 of the inner spool" in text and "angle-domain resampling" in text
     np.testing.assert_allclose(track.amplitude, 2e-6, rtol=1e-3)  # a tone on its order reads its amplitude
@@ -130,7 +132,7 @@ def test_order_track_shows_itself(tmp_path):
 
 # --------------------------------------------------------------------------- scenes
 def test_scene_result_shows_itself(scene_result, tmp_path):
-    assert_shows_itself(scene_result, tmp_path)
+    assert_shows_itself(scene_result, tmp_path, of=rr.SceneResult)
     text = repr(scene_result)
     assert "scene paper-rub" in text and "transient response at f_L = 70 Hz, f_H = 90 Hz" in text
     assert "plate 0 at node 18" in text and "without the rub" in text
@@ -202,7 +204,7 @@ def test_scene_plot_options(scene_result):
 
 
 def test_runup_result_shows_itself(runup_result, tmp_path):
-    assert_shows_itself(runup_result, tmp_path)
+    assert_shows_itself(runup_result, tmp_path, of=rr.RunupResult)
     for kind in ("orders", "waterfall", "orbits"):
         assert isinstance(runup_result.plot(kind=kind), Figure)
         ax = Figure().subplots()

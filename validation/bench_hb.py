@@ -86,7 +86,7 @@ import numpy as np  # noqa: E402
 import scipy  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
-from rotorred.nonlinear.continuation import continue_branch  # noqa: E402
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch  # noqa: E402
 from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott  # noqa: E402
 from rotorred.nonlinear.hb import PeriodicProblem  # noqa: E402
 
@@ -215,8 +215,9 @@ def run_rotorred(case: Case, repeats: int, stability: bool) -> Run:
     w0, w1 = case.omega
 
     def go():
-        return continue_branch(problem, z0, w0, w1, ds=case.ds0, ds_min=DS_MIN, ds_max=case.ds_max,
-                               max_points=MAX_POINTS, tol=TOL, stability=stability)
+        return continue_branch(problem, z0, w0, w1,
+                               ContinuationOptions(ds=case.ds0, ds_min=DS_MIN, ds_max=case.ds_max,
+                                                   max_points=MAX_POINTS, tol=TOL, stability=stability))
     try:
         t, branch = _best(go, repeats)
     except Exception as exc:  # a failure of the continuation is a result to report, not a crash
@@ -238,8 +239,10 @@ def profile_rotorred(case: Case, top: int = 15) -> str:
     points, note = 0, ""
     prof.enable()
     try:
-        points = len(continue_branch(problem, z0, *case.omega, ds=case.ds0, ds_min=DS_MIN, ds_max=case.ds_max,
-                                     max_points=MAX_POINTS, tol=TOL, stability=False).omega)
+        points = len(
+                     continue_branch(problem, z0, *case.omega,
+                                     ContinuationOptions(ds=case.ds0, ds_min=DS_MIN, ds_max=case.ds_max,
+                                                         max_points=MAX_POINTS, tol=TOL, stability=False)).omega)
     except Exception as exc:  # profile what ran
         note = f" (the continuation raised {type(exc).__name__})"
     prof.disable()

@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from rotorred.nonlinear.hb import solve
+from rotorred.nonlinear.hb import solve_periodic
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.scenes.balance_harmonics import cold_solution
 from rotorred.scenes.branch import STABILITY_SUBSTEPS, BranchOptions, cold_start, continue_scene
@@ -56,7 +56,7 @@ def from_transient(scene, sm, result, largest, records, H: int, N: int):
     window = result.t >= result.t[-1] - 1.0 / rp.f0 + 1e-9
     z0 = rp.start_from_record(result.t[window], {j: x[window] for j, x in records.items()})
     t0 = time.perf_counter()
-    solution = solve(rp.problem, z0, rp.omega)
+    solution = solve_periodic(rp.problem, z0, rp.omega)
     z, iterations = solution.z, solution.iterations
     elapsed = time.perf_counter() - t0
     lines = rp.lines(z, OUTPUT)

@@ -15,7 +15,7 @@ with ``G`` the block-diagonal real form of ``(Z_k^-1)_cc`` (per harmonic ``[[Re 
 Its Jacobian is analytic: ``I + G (T(df/dq) + omega T(df/dv)(nabla (x) I))``, and ``dR/domega`` uses
 ``dZ^-1/domega = -Z^-1 (dZ/domega) Z^-1``. The response of every DOF is recovered from the solution
 (:meth:`CondensedProblem.recover`). The interface is :class:`rotorred.nonlinear.hb.PeriodicProblem`'s, so
-:func:`rotorred.nonlinear.hb.solve` and :func:`rotorred.nonlinear.continuation.continue_branch` take it.
+:func:`rotorred.nonlinear.hb.solve_periodic` and :func:`rotorred.nonlinear.continuation.continue_branch` take it.
 """
 
 from __future__ import annotations

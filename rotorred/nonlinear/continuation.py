@@ -31,12 +31,12 @@ from scipy.optimize import brentq
 
 from rotorred import checks
 from rotorred.nonlinear.fourier import to_phasors
-from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, coefficient_variables, solve
+from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, coefficient_variables, solve_periodic
 from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
 from rotorred.results import Result
 
-__all__ = ["Fold", "Branch", "INTERRUPTS", "STABILITY_FLAGS", "continue_branch", "interrupt_name", "parameter_of",
+__all__ = ["Fold", "Branch", "ContinuationOptions", "INTERRUPTS", "STABILITY_FLAGS", "continue_branch", "interrupt_name", "parameter_of",
            "stability_variable"]
 
 #: the exceptions that end a branch where it is, its points kept, and the signal each stands for (a caller may name
@@ -220,9 +220,47 @@ class _Point:
     clean: bool = False  # reached by an arclength step at its first try (no halving): the branch is smooth there
 
 
-def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float, *,
-                    ds: float = 0.05, ds_min: float = 1e-6, ds_max: float = 0.2, max_points: int = 5000,
-                    tol: float = 1e-10, stability: bool = True, progress=None, curved: bool = False,
+@dataclass(frozen=True)
+class ContinuationOptions:
+    """The steps, accuracy and extent of a branch (:func:`continue_branch`).
+
+    Parameters
+    ----------
+    ds, ds_min, ds_max : float
+        Initial, least and largest arclength step (in the units of (z, omega)), 0 < ds_min <= ds <= ds_max.
+    max_points : int
+        Most points traced, >= 2.
+    tol : float
+        Relative residual of every point (:func:`rotorred.nonlinear.hb.solve_periodic`), > 0 (-).
+    stability : bool
+        Compute each point's Floquet exponents (Hill's method).
+    curved : bool
+        Predict to second order where the branch is smooth (:func:`_arclength`): fewer corrector iterations a point
+        where each costs much (the rig's condensed problem: 2 in place of 3). Off by default: on a small problem with
+        kinks it lets the steps grow past what the kinks allow (the Jeffcott rotor at H = 10, N = 1024 then jumped
+        from the free branch above resonance to the one below, at ds_max = 0.5, and traced its loop twice).
+    """
+
+    ds: float = 0.05
+    ds_min: float = 1e-6
+    ds_max: float = 0.2
+    max_points: int = 5000
+    tol: float = 1e-10
+    stability: bool = True
+    curved: bool = False
+
+    def __post_init__(self):
+        checks.positive("ds_min", self.ds_min)
+        checks.number("ds", self.ds, ge=self.ds_min)
+        checks.number("ds_max", self.ds_max, ge=self.ds)
+        checks.integer("max_points", self.max_points, ge=2)
+        checks.positive("tol", self.tol)
+        checks.boolean("stability", self.stability)
+        checks.boolean("curved", self.curved)
+
+
+def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float,
+                    options: ContinuationOptions = ContinuationOptions(), *, progress=None,
                     interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> Branch:
     """Follow the branch through ``z0`` at ``omega_start`` until omega passes ``omega_end`` (either direction).
 
@@ -233,20 +271,10 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         A start for the first point (e.g. the linear response).
     omega_start, omega_end : float
         Response frequencies (rad/s), > 0.
-    ds, ds_min, ds_max : float
-        Initial, least and largest arclength step (in the units of (z, omega)).
-    max_points : int
-    tol : float
-        Relative residual of every point (:func:`rotorred.nonlinear.hb.solve`).
-    stability : bool
-        Compute each point's Floquet exponents (Hill's method).
+    options : ContinuationOptions
+        Steps, tolerance, stability, the most points and the predictor.
     progress : callable, optional
         ``progress(points, omega)`` after each point.
-    curved : bool
-        Predict to second order where the branch is smooth (:func:`_arclength`): fewer corrector iterations a point
-        where each costs much (the rig's condensed problem: 2 in place of 3). Off by default: on a small problem with
-        kinks it lets the steps grow past what the kinks allow (the Jeffcott rotor at H = 10, N = 1024 then jumped
-        from the free branch above resonance to the one below, at ds_max = 0.5, and traced its loop twice).
     interrupts : mapping of exception type to str
         The exceptions that end the branch where it is, and the signal each stands for (default SIGINT's
         ``KeyboardInterrupt``; empty: none, they propagate): the points so far are returned, ``stopped`` and
@@ -256,10 +284,15 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     -------
     Branch
     """
+    if not isinstance(options, ContinuationOptions):
+        checks.fail("options", type(options).__name__, "must be a ContinuationOptions")
+    o = options
+    ds, ds_min, ds_max, max_points, tol, stability, curved = (o.ds, o.ds_min, o.ds_max, o.max_points, o.tol,
+                                                             o.stability, o.curved)
     checks.positive("omega_start", omega_start, "rad/s")
     checks.positive("omega_end", omega_end, "rad/s")
     direction = 1.0 if omega_end > omega_start else -1.0
-    start = solve(problem, z0, omega_start, tol=tol)
+    start = solve_periodic(problem, z0, omega_start, tol=tol)
     y = np.append(start.z, omega_start)
     first = _Point(y, _tangent(problem, y, None, direction, start.evaluation), start.iterations)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
@@ -494,7 +527,7 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
     """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
     just traced."""
     try:
-        found = solve(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
+        found = solve_periodic(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
     except NotConverged:
         return None
     y = np.append(found.z, omega)

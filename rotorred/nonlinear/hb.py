@@ -10,7 +10,7 @@ with ``nabla`` the d/dtheta operator on one DOF's coefficients and ``(x)`` the K
 the AFT of the nonlinear forces (:mod:`rotorred.nonlinear.forces`). The Jacobian is analytic: the chain rule
 through the AFT, ``dF_nl/dz = T(df/dq) + omega T(df/dv) (nabla (x) I)``, with ``T(d)`` the coefficient matrix
 of multiplying by the sampled derivative ``d`` (:meth:`Harmonics.toeplitz`), and ``dR/domega`` likewise.
-:func:`solve` is Newton's method with a backtracking line search; it returns a :class:`PeriodicSolution` (the
+:func:`solve_periodic` is Newton's method with a backtracking line search; it returns a :class:`PeriodicSolution` (the
 coefficients, their amplitudes per harmonic and DOF, and how Newton got there); a point that does not converge raises
 :class:`NotConverged` with its residual and is never returned as a solution.
 """
@@ -28,7 +28,7 @@ from rotorred.nonlinear.fourier import Harmonics, to_phasors
 from rotorred.nonlinear.lowrank import factored
 from rotorred.results import Result
 
-__all__ = ["PeriodicProblem", "PeriodicSolution", "Evaluation", "NotConverged", "solve", "coefficient_variables",
+__all__ = ["PeriodicProblem", "PeriodicSolution", "Evaluation", "NotConverged", "solve_periodic", "coefficient_variables",
            "harmonic_dataset", "checked_matrices", "checked_unknowns",
            "sampled_forces", "force_coefficients", "transformed_forces", "local_forces"]
 
@@ -294,7 +294,7 @@ def toeplitz_pair(h: Harmonics, dq: np.ndarray, dv: np.ndarray) -> tuple[np.ndar
 
 @dataclass(frozen=True, repr=False)
 class PeriodicSolution(Result):
-    """A converged periodic solution of harmonic balance (:func:`solve`): its coefficients and how Newton got there.
+    """A converged periodic solution of harmonic balance (:func:`solve_periodic`): its coefficients and how Newton got there.
 
     Attributes
     ----------
@@ -395,8 +395,8 @@ def harmonic_dataset(Q: np.ndarray, orders, frequencies, dofs, variables: dict, 
         attrs=attrs)
 
 
-def solve(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
-          max_halvings: int = 30) -> PeriodicSolution:
+def solve_periodic(problem: PeriodicProblem, z0: np.ndarray, omega: float, *, tol: float = 1e-10, max_iter: int = 40,
+                   max_halvings: int = 30) -> PeriodicSolution:
     """The periodic solution near ``z0`` at ``omega`` by Newton's method with a backtracking line search.
 
     Parameters

@@ -436,7 +436,7 @@ class TorusProblem:
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
-        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve` takes the problem; ``omega`` is ignored: the base
+        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve_periodic` takes the problem; ``omega`` is ignored: the base
         frequencies are fixed, and ``dR_domega`` is NaN, not defined)."""
         def jacobian():
             lin = self._linearise(z)

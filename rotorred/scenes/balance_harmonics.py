@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotorred.nonlinear.hb import NotConverged, solve
+from rotorred.nonlinear.hb import NotConverged, solve_periodic
 from rotorred.scenes.branch import cold_start
 from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
 
@@ -194,7 +194,7 @@ def cold_solution(scene, model, H: int, N: int, record=None) -> tuple[RubProblem
 def _newton(rp: RubProblem, z0: np.ndarray) -> np.ndarray | None:
     """Newton from ``z0`` (to the cold start's tolerance), or None if it does not converge."""
     try:
-        return solve(rp.problem, z0, rp.omega, tol=TOL).z
+        return solve_periodic(rp.problem, z0, rp.omega, tol=TOL).z
     except NotConverged:
         return None
 

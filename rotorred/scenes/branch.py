@@ -42,8 +42,9 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import INTERRUPTS, continue_branch, interrupt_name, stability_variable
-from rotorred.nonlinear.hb import Evaluation, NotConverged, solve
+from rotorred.nonlinear.continuation import (INTERRUPTS, ContinuationOptions, continue_branch, interrupt_name,
+                                             stability_variable)
+from rotorred.nonlinear.hb import Evaluation, NotConverged, solve_periodic
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.results import Result
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
@@ -373,7 +374,7 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
     """
     z_lin = problem.linear_response(omega)
     try:
-        return solve(problem, z_lin, omega, tol=tol).z
+        return solve_periodic(problem, z_lin, omega, tol=tol).z
     except NotConverged:
         pass
     family = ClearanceFamily(problem, omega)
@@ -381,11 +382,12 @@ def cold_start(problem, omega: float, tol: float = 1e-9) -> np.ndarray:
     reach = float(np.max(problem.samples(z_lin, omega)[0][:, idx] @ rub.gradient))
     clearance = rub.plate.clearance
     scale = max(float(np.linalg.norm(z_lin)), reach)
-    branch = continue_branch(family, z_lin, max(1.05 * reach, 1.05 * clearance), clearance, ds=0.05 * scale,
-                             ds_min=1e-10 * scale, ds_max=0.12 * scale, stability=False, tol=tol,
+    branch = continue_branch(family, z_lin, max(1.05 * reach, 1.05 * clearance), clearance,
+                             ContinuationOptions(ds=0.05 * scale, ds_min=1e-10 * scale, ds_max=0.12 * scale,
+                                                 stability=False, tol=tol),
                              interrupts={})  # no point of the branch yet: an interrupt is raised as it came
     i = int(np.argmin(np.abs(branch.omega - clearance)))
-    return solve(family.at(clearance), branch.z[i], omega, tol=tol).z
+    return solve_periodic(family.at(clearance), branch.z[i], omega, tol=tol).z
 
 
 @dataclass(frozen=True)
@@ -459,9 +461,10 @@ def continue_scene(scene, model, key: str, start: float, end: float, options: Br
     t1 = time.perf_counter()
     s_start, s_end = to_value(start, inverse=True), to_value(end, inverse=True)
     scale = max(float(np.linalg.norm(z0)), abs(s_end - s_start))  # the steps: a few hundred along a branch
-    branch = continue_branch(family, z0, s_start, s_end, ds=0.01 * scale,
-                             ds_min=1e-10 * scale, ds_max=0.015 * scale, max_points=options.max_points, tol=tol, curved=True,
-                             stability=False, interrupts=interrupts,
+    branch = continue_branch(family, z0, s_start, s_end,
+                             ContinuationOptions(ds=0.01 * scale, ds_min=1e-10 * scale, ds_max=0.015 * scale,
+                                                 max_points=options.max_points, tol=tol, curved=True, stability=False),
+                             interrupts=interrupts,
                              progress=None if progress is None else (lambda p, s: progress(p, to_value(s))))
     t2 = time.perf_counter()
     values, dofs, interrupt = np.array([to_value(s) for s in branch.omega]), _output_dofs(scene), branch.interrupt
