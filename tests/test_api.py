@@ -10,10 +10,10 @@ import numpy as np
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
-def _python_example() -> str:
+def _python_example(which: int = 0) -> str:
     text = README.read_text()
     section = text[text.index("## Python\n"):]
-    return re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    return re.findall(r"```python\n(.*?)```", section, re.S)[which]
 
 
 def test_readme_example_runs(capsys):
@@ -33,6 +33,24 @@ def test_readme_example_runs(capsys):
     res = namespace["res"]
     assert res.success and res.contacts[0].fraction("open") < 1.0  # the plate is touched
     assert np.all(np.isfinite(res.outputs[(14, "y")]))
+
+
+def test_readme_results_example_runs(capsys, tmp_path, monkeypatch):
+    """The README's second block, after the first: a summary, a figure and a CF NetCDF file from a result."""
+    from rotorred.writers import read_netcdf
+
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(_python_example(0), str(README), "exec"), namespace)
+    capsys.readouterr()
+    exec(compile(_python_example(1), str(README), "exec"), namespace)
+    out = capsys.readouterr().out
+    assert out.startswith("CampbellResult:") and "critical speed" in out and "TransientResult:" in out
+    assert len(out.splitlines()) <= 2 * 15 and "array(" not in out
+    assert (tmp_path / "campbell.png").stat().st_size > 10_000
+    ds = read_netcdf(tmp_path / "campbell.nc")
+    assert ds["frequency"].attrs["units"] == "Hz" and ds["speed"].attrs["units"] == "rad/s"
+    np.testing.assert_array_equal(ds["frequency"].values, namespace["cd"].frequencies_hz)
 
 
 def test_exports_are_the_modules_objects():
