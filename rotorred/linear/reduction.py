@@ -163,7 +163,7 @@ class ReducedSystem(SpoolSpeedMixin):
     M, K, C : ndarray, shape (m, m)
         Reduced mass (kg), stiffness (N/m) and damping (N s/m): ``T^T X T``.
     G : dict of str to ndarray, shape (m, m)
-        Reduced gyroscopic matrix of each spool per unit spin speed: ``T^T G_s T``.
+        Reduced gyroscopic matrix of each spool per unit spin speed (1 rad/s): ``T^T G_s T``.
     T : ndarray, shape (n, m)
         Recovery map, full physical coordinates ``q = T p``.
     full_dofs : DofMap
@@ -224,9 +224,16 @@ class ReducedSystem(SpoolSpeedMixin):
     def physical_index(self, node: int, direction: str) -> int:
         """Index of the boundary DOF ``direction`` at ``node`` in reduced coordinates.
 
+        Parameters
+        ----------
+        node : int
+            A boundary node (:attr:`boundary_nodes`).
+        direction : {"x", "y", "theta_x", "theta_y"}
+            The DOF at the node (``"tx"``, ``"ty"`` also accepted).
+
         Raises
         ------
-        ValueError
+        InputError
             If ``node`` is not a boundary node (its DOFs are then not reduced coordinates;
             use :meth:`output_rows` to recover them).
         """
@@ -253,11 +260,33 @@ class ReducedSystem(SpoolSpeedMixin):
         return self.T[idx, :].copy()
 
     def recover(self, p: np.ndarray) -> np.ndarray:
-        """Full physical coordinates ``T p``; ``p`` shape (m,) or (m, k) -> (n,) or (n, k)."""
+        """Full physical coordinates ``T p``; ``p`` shape (m,) or (m, k) -> (n,) or (n, k).
+
+        Parameters
+        ----------
+        p : ndarray, shape (m,) or (m, k)
+            Reduced coordinates (boundary DOFs in m or rad, then modal coordinates), one column per instant.
+
+        Returns
+        -------
+        ndarray, shape (n,) or (n, k)
+            Physical displacements (m) and rotations (rad) in the full model's DOF order.
+        """
         return self.T @ p
 
     def project(self, F: np.ndarray) -> np.ndarray:
-        """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k)."""
+        """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k).
+
+        Parameters
+        ----------
+        F : ndarray, shape (n,) or (n, k)
+            Forces (N) and moments (N m) on the full model's DOFs, one column per instant.
+
+        Returns
+        -------
+        ndarray, shape (m,) or (m, k)
+            The force on the reduced coordinates.
+        """
         return self.T.T @ F
 
     def summary(self) -> list[str]:
@@ -276,7 +305,25 @@ class ReducedSystem(SpoolSpeedMixin):
 
 def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:
     """Bearing nodes and their pedestals, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF
-    order."""
+    order.
+
+    Parameters
+    ----------
+    rotor : Rotor
+        The rotor to reduce.
+    extra_nodes : sequence of int
+        Further nodes to keep, e.g. rub or output nodes.
+
+    Returns
+    -------
+    tuple of int
+        The boundary nodes of a Craig–Bampton reduction (:func:`reduce_rotor`).
+
+    Raises
+    ------
+    InputError
+        If a node of ``extra_nodes`` is not a shaft node of ``rotor``.
+    """
     extra = [checks.node(f"extra_nodes[{i}]", n, rotor.spool_of) for i, n in enumerate(extra_nodes)]
     nodes = {b.node for b in rotor.bearings} | {b.link for b in rotor.bearings if b.link is not None}
     for b in rotor.intershaft_bearings:

@@ -371,7 +371,18 @@ class LineFit:
         return np.array([ln.frequency_hz for ln in self.lines])
 
     def evaluate(self, t) -> np.ndarray:
-        """The fitted model ``mean + sum a cos(2 pi f t + phase)`` at times ``t`` (s), shape of ``t``."""
+        """The fitted model ``mean + sum a cos(2 pi f t + phase)`` at times ``t`` (s), shape of ``t``.
+
+        Parameters
+        ----------
+        t : array_like, any shape
+            Times (s), on the fitted record's own (absolute) clock.
+
+        Returns
+        -------
+        ndarray, shape of ``t``
+            The model, in the unit of the fitted signal (m for a displacement).
+        """
         t = checks.array("t", t, unit="s")
         out = np.full(t.shape, self.mean)
         for ln in self.lines:
