@@ -115,7 +115,7 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
     spool : str
         The spool whose excitation line is crossed.
     harmonic : float
-        Multiple h of that spool's speed.
+        Multiple h of that spool's speed (-).
     mode : int
         Column of :attr:`CampbellResult.frequencies` (0-based tracked mode).
     frequency : float
@@ -294,7 +294,7 @@ class CampbellResult(Result):
         ``dOmega_s / dOmega`` of each spool (-): its ratio to the reference spool (1 for the reference), 0 for a
         spool held at a fixed speed.
     harmonics : tuple of float
-        Multiples of each spool's speed used as excitation lines.
+        Multiples of each spool's speed used as excitation lines (-).
     rotor_name : str
     stability_changes : tuple of StabilityChange
         Speeds where a (non rigid-body) mode's log decrement crosses zero, sorted by speed: where it
@@ -752,6 +752,12 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
     Returns
     -------
     CampbellResult
+
+    Raises
+    ------
+    InputError
+        If ``model`` or ``operating`` is not one the analysis takes, the speeds are not increasing, a spool's
+        speed does not follow (:meth:`Operating.lines`), or ``n_modes`` or a harmonic is out of range.
     """
     Omega, h, lines, reference, sm = _setup(model, operating, harmonics)
     n_available = sm.n_dof  # at most one frequency per DOF
@@ -838,6 +844,11 @@ def default_mode_count(model, operating: Operating, *, harmonics: Sequence[float
     Returns
     -------
     ModeCount
+
+    Raises
+    ------
+    InputError
+        As :func:`campbell`, or if ``margin`` < 1.
     """
     Omega, h, lines, _, sm = _setup(model, operating, harmonics)
     return _mode_count(sm, lines, Omega, h, checks.number("margin", margin, ge=1.0))

@@ -563,6 +563,12 @@ def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalan
     -------
     UnbalanceResponse
         Phasors of shape (n,) per excited spool and output (m).
+
+    Raises
+    ------
+    InputError
+        If a spool's speed does not follow from ``operating`` (:meth:`Operating.lines`), ``outputs`` is empty,
+        or an unbalance or an output names a DOF the model does not have.
     """
     model = system_of(model)
     operating = checked_operating(operating)
@@ -639,6 +645,12 @@ def frequency_response(model, operating: Operating, inputs: Sequence[Output], ou
     -------
     FrequencyResponse
         ``H`` of shape (n, len(outputs), len(inputs)) (m/N).
+
+    Raises
+    ------
+    InputError
+        If ``operating`` is not one point, ``inputs`` or ``outputs`` is empty or names a DOF the model does not
+        have, or a frequency is negative.
     """
     model = system_of(model)
     speeds = checked_operating(operating).single(model)

@@ -180,7 +180,8 @@ class ReducedSystem(SpoolSpeedMixin):
     selection : ModeSelection
         Record of how ``n_modes`` was chosen.
     K_G : dict of str to ndarray, shape (m, m)
-        Reduced spin-acceleration matrix of each spool per unit angular acceleration: ``T^T K_G,s T``.
+        Reduced spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2):
+        ``T^T K_G,s T``.
     tables : tuple of TabulatedSupport
         The full model's speed-dependent bearings on the reduced coordinates (rows ``R T``): their change with
         speed is exact when the bearing's node is a boundary node, as the constraint and fixed-interface modes
@@ -625,18 +626,35 @@ def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | N
     Parameters
     ----------
     rotor : Rotor
+        The rotor to reduce.
     extra_nodes : sequence of int
         Additional boundary nodes (e.g. the rub node, output nodes).
-    n_modes, cutoff, band, target, n_check, response
-        As in :func:`reduce`.
+    n_modes : int, optional
+        Number of fixed-interface modes to keep (0 gives Guyan reduction).
+    cutoff : float, optional
+        Keep the fixed-interface modes with natural frequency <= ``cutoff`` (rad/s).
+    band : (float, float), optional
+        Frequency band of interest (rad/s) whose whirl modes the automatic count checks.
+    target : float
+        Relative whirl-frequency error target of the automatic count (-).
+    n_check : int, optional
+        Without a band, the automatic count checks the ``n_check`` lowest whirl modes.
+    response : ResponseCheck, optional
+        An extra requirement of the automatic count: the unbalance response error at most ``response.target``.
+        (All as in :func:`reduce`, whose Notes give the automatic count.)
     speed_factors : sequence of float
-        Factors (>= 0) of the nominal speeds at which the automatic count is checked.
+        Factors (>= 0, -) of the nominal speeds at which the automatic count is checked.
     system : SystemMatrices, optional
         ``assemble(rotor)`` if already at hand.
 
     Returns
     -------
     ReducedSystem
+
+    Raises
+    ------
+    InputError
+        If a node of ``extra_nodes`` is not a node of ``rotor``, or a setting of :func:`reduce` is out of range.
     """
     factors = tuple(float(f) for f in checks.vector("speed_factors", speed_factors, ge=0.0))
     boundary = default_boundary_nodes(rotor, extra_nodes)

@@ -151,6 +151,7 @@ class SystemMatrices(SpoolSpeedMixin):
         Skew-symmetric gyroscopic matrix of each spool per unit spin speed (1 rad/s; kg m^2): the
         model's damping at speeds ``Omega_s`` is ``C + sum_s Omega_s G_s``.
     dofs : DofMap
+        The DOF numbering: node and direction of each coordinate.
     K_G : dict of str to ndarray, shape (n, n)
         Spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2), ``A_s`` of
         ``G_s = A_s - A_s^T``; needed only when a spool's speed varies (empty for a model built by hand).

@@ -343,6 +343,7 @@ class Disk:
     Parameters
     ----------
     node : int
+        The shaft node the disk sits at.
     m : float
         Mass (kg).
     I_d : float
@@ -418,6 +419,7 @@ class Bearing(_Support):
     Parameters
     ----------
     node : int
+        The shaft (or pedestal) node the bearing holds.
     k_xx, k_yy, k_xy, k_yx : float
         Stiffness coefficients (N/m), any sign (a seal's direct stiffness may be negative); the force on the shaft is
         -K [x, y] (-K [x - x_link, y - y_link] with a link).
@@ -486,6 +488,7 @@ class Support:
     Parameters
     ----------
     node : int
+        The node supported.
     kind : str
         ``"pinned"`` or ``"clamped"``.
     name : str
@@ -538,6 +541,7 @@ class BearingTable:
     Parameters
     ----------
     node : int
+        The shaft (or pedestal) node the bearing holds.
     speeds : sequence of float, shape (p,)
         Spool speeds of the table (rad/s), >= 0 and strictly increasing, at least 2.
     k_xx, k_yy, k_xy, k_yx : float or sequence of float, shape (p,)
@@ -662,6 +666,7 @@ class IntershaftBearing(_Support):
     Parameters
     ----------
     node_a, node_b : int
+        The nodes joined, on two different spools.
     k_xx, k_yy, k_xy, k_yx : float
         Stiffness (N/m).
     c_xx, c_yy, c_xy, c_yx : float

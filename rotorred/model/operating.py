@@ -261,6 +261,12 @@ class Operating:
         -------
         dict of str to SpoolLine
             In the model's spool order; the reference first has slope 1.
+
+        Raises
+        ------
+        InputError
+            If a spool named in ``ratios``, ``fixed`` or the profile is not a spool of ``model``, or a spool's
+            speed is not stated where no nominal ratio to the reference follows from the model.
         """
         spools, nominal = _spools_and_nominal(model)
         reference = self.reference_of(model)

@@ -236,8 +236,9 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     ds, ds_min, ds_max : float
         Initial, least and largest arclength step (in the units of (z, omega)).
     max_points : int
+        Most points traced; the branch stops there and says so in ``stopped``.
     tol : float
-        Relative residual of every point (:func:`rotorred.nonlinear.hb.solve`).
+        Relative residual of every point (:func:`rotorred.nonlinear.hb.solve`) (-).
     stability : bool
         Compute each point's Floquet exponents (Hill's method).
     progress : callable, optional

@@ -481,6 +481,14 @@ def continue_scene(scene, model, key: str, start: float, end: float, options: Br
     Returns
     -------
     SceneBranch
+
+    Raises
+    ------
+    InputError
+        If ``options`` is not a :class:`BranchOptions`, or the branch cannot follow ``key`` in ``scene``
+        (:func:`check_key`).
+    NotConverged
+        If no periodic solution is found at ``start`` (:func:`cold_start`).
     """
     if not isinstance(options, BranchOptions):
         checks.fail("options", type(options).__name__, "must be a BranchOptions")
