@@ -95,11 +95,33 @@ class InputError(ValueError):
         return f"{where}{self.field} = {fmt_value(self.value)}: {self.requirement}{unit}"
 
     def within(self, prefix: str) -> InputError:
-        """The same error with the field path prefixed (``"rub[0]"`` + ``"clearance"``)."""
+        """The same error with the field path prefixed (``"rub[0]"`` + ``"clearance"``).
+
+        Parameters
+        ----------
+        prefix : str
+            Path of the table or option that holds the field (``"rub[0]"``).
+
+        Returns
+        -------
+        InputError
+            A new error whose ``field`` is ``prefix`` joined with this error's field.
+        """
         return type(self)(join(prefix, self.field), self.value, self.requirement, self.unit, self.source)
 
     def from_source(self, source: str) -> InputError:
-        """The same error, naming the file (or built-in) it came from."""
+        """The same error, naming the file (or built-in) it came from.
+
+        Parameters
+        ----------
+        source : str
+            Path of the file, or name of the built-in, the value was read from.
+
+        Returns
+        -------
+        InputError
+            A new error with ``source`` set.
+        """
         return type(self)(self.field, self.value, self.requirement, self.unit, source)
 
 

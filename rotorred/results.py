@@ -40,7 +40,19 @@ class Result:
         return "\n".join([f"{type(self).__name__}:"] + [f"  {line}" for line in lines])
 
     def plot(self, ax=None, **options):
-        """Draw the result into ``ax`` (a new figure when None); return the matplotlib Figure."""
+        """Draw the result into ``ax`` (a new figure when None); return the matplotlib Figure.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            Options of the type's drawing function in :mod:`rotorred.plots`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         raise NotImplementedError(f"{type(self).__name__}.plot")
 
     def to_xarray(self):

@@ -115,7 +115,7 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
     spool : str
         The spool whose excitation line is crossed.
     harmonic : float
-        Multiple h of that spool's speed.
+        Multiple h of that spool's speed (-).
     mode : int
         Column of :attr:`CampbellResult.frequencies` (0-based tracked mode).
     frequency : float
@@ -163,8 +163,19 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
 
     def plot(self, ax=None, **options):
         """Mark the crossing (rpm, Hz) with its excitation line; into a Campbell diagram's axes it annotates
-        that critical speed (:func:`rotorred.plots.campbell.draw_critical_speed`, its options). Returns the
-        Figure."""
+        that critical speed (:func:`rotorred.plots.campbell.draw_critical_speed`, its options).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            ``figsize`` (in) of a new figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.campbell import draw_critical_speed
 
         return draw_critical_speed(self, ax, **options)
@@ -283,7 +294,7 @@ class CampbellResult(Result):
         ``dOmega_s / dOmega`` of each spool (-): its ratio to the reference spool (1 for the reference), 0 for a
         spool held at a fixed speed.
     harmonics : tuple of float
-        Multiples of each spool's speed used as excitation lines.
+        Multiples of each spool's speed used as excitation lines (-).
     rotor_name : str
     stability_changes : tuple of StabilityChange
         Speeds where a (non rigid-body) mode's log decrement crosses zero, sorted by speed: where it
@@ -331,6 +342,7 @@ class CampbellResult(Result):
 
     @property
     def n_modes(self) -> int:
+        """Number of tracked modes (columns of :attr:`frequencies`)."""
         return self.frequencies.shape[1]
 
     @property
@@ -354,7 +366,20 @@ class CampbellResult(Result):
         """Write the critical speeds, one row each: the reference spool's speed (rpm), the excitation line,
         the excited spool's speed (rpm), the mode, its frequency (Hz), whirl, log dec and damping ratio at
         the crossing, and the margin to ``operating_speed`` (rad/s of the reference spool), in % of it
-        (positive: the critical speed lies above the operating point; empty without one)."""
+        (positive: the critical speed lies above the operating point; empty without one).
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file to write.
+        operating_speed : float, optional
+            Operating speed of the reference spool (rad/s), > 0 for a margin; None or 0: no margin.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
         def margin(c):
             return "" if not operating_speed else f"{100.0 * (c.speed - operating_speed) / operating_speed:.4f}"
 
@@ -422,8 +447,20 @@ class CampbellResult(Result):
         return "stable over the sweep (no log dec < 0)"
 
     def plot(self, ax=None, **options):
-        """Draw the Campbell diagram (:func:`rotorred.plots.campbell.draw_campbell`, whose options it takes:
-        ``operating_speed`` (rad/s), ``title``, ``max_frequency_hz``, ``figsize``); return the Figure."""
+        """Draw the Campbell diagram (:func:`rotorred.plots.campbell.draw_campbell`); return the Figure.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            Those of :func:`~rotorred.plots.campbell.draw_campbell`: ``operating_speed`` (rad/s),
+            ``title``, ``max_frequency_hz`` (Hz), ``figsize`` (in).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.campbell import draw_campbell
 
         return draw_campbell(self, ax, **options)
@@ -468,6 +505,16 @@ class CampbellResult(Result):
 
         Speeds with 10 significant digits, frequencies with 9, log decrements with 6. The
         diagram itself is drawn by :meth:`plot`.
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file to write.
+
+        Returns
+        -------
+        Path
+            ``path``.
         """
         n_s, n_m = self.frequencies.shape
         speed = np.repeat(self.speeds_rpm, n_m)
@@ -705,6 +752,12 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
     Returns
     -------
     CampbellResult
+
+    Raises
+    ------
+    InputError
+        If ``model`` or ``operating`` is not one the analysis takes, the speeds are not increasing, a spool's
+        speed does not follow (:meth:`Operating.lines`), or ``n_modes`` or a harmonic is out of range.
     """
     Omega, h, lines, reference, sm = _setup(model, operating, harmonics)
     n_available = sm.n_dof  # at most one frequency per DOF
@@ -791,6 +844,11 @@ def default_mode_count(model, operating: Operating, *, harmonics: Sequence[float
     Returns
     -------
     ModeCount
+
+    Raises
+    ------
+    InputError
+        As :func:`campbell`, or if ``margin`` < 1.
     """
     Omega, h, lines, _, sm = _setup(model, operating, harmonics)
     return _mode_count(sm, lines, Omega, h, checks.number("margin", margin, ge=1.0))

@@ -68,6 +68,7 @@ class UnbalanceResponse(Result):
     speeds : ndarray, shape (n,)
         Reference spool speed at each sweep point (rad/s).
     reference_spool : str
+        The spool whose speed :attr:`speeds` gives.
     spool_speeds : dict of str to ndarray, shape (n,)
         Speed of every spool (rad/s) at each sweep point (:meth:`Operating.speeds`).
     outputs : tuple of (int, str)
@@ -93,11 +94,27 @@ class UnbalanceResponse(Result):
         return tuple(self.phasors)
 
     def amplitude(self, output: Output, spool: str) -> np.ndarray:
-        """|Q| (m) of ``output`` at ``spool``'s frequency, shape (n,)."""
+        """|Q| (m) of ``output`` at ``spool``'s frequency, shape (n,).
+
+        Parameters
+        ----------
+        output : (int, str)
+            (node, direction) of a DOF of :attr:`outputs`, e.g. ``(13, "x")``.
+        spool : str
+            A spool carrying an unbalance (:attr:`excited_spools`).
+        """
         return np.abs(self.phasors[spool][tuple(output)])
 
     def phase(self, output: Output, spool: str) -> np.ndarray:
-        """arg Q (rad) of ``output`` at ``spool``'s frequency, shape (n,)."""
+        """arg Q (rad) of ``output`` at ``spool``'s frequency, shape (n,): ``q(t) = |Q| cos(Omega_s t + arg Q)``.
+
+        Parameters
+        ----------
+        output : (int, str)
+            (node, direction) of a DOF of :attr:`outputs`, e.g. ``(13, "x")``.
+        spool : str
+            A spool carrying an unbalance (:attr:`excited_spools`).
+        """
         return np.angle(self.phasors[spool][tuple(output)])
 
     def peak(self, output: Output) -> np.ndarray:
@@ -105,6 +122,11 @@ class UnbalanceResponse(Result):
 
         Phasors of spools at the same speed are added first; the magnitudes of the
         resulting distinct-frequency phasors are then summed.
+
+        Parameters
+        ----------
+        output : (int, str)
+            (node, direction) of a DOF of :attr:`outputs`, e.g. ``(13, "x")``.
         """
         output = tuple(output)
         total = np.zeros(len(self.speeds))
@@ -118,7 +140,20 @@ class UnbalanceResponse(Result):
         return total
 
     def time_history(self, output: Output, t: np.ndarray) -> np.ndarray:
-        """q(t) (m) of ``output`` at every sweep point, shape (n, len(t)); the superposed signal."""
+        """q(t) (m) of ``output`` at every sweep point, shape (n, len(t)); the superposed signal.
+
+        Parameters
+        ----------
+        output : (int, str)
+            (node, direction) of a DOF of :attr:`outputs`, e.g. ``(13, "x")``.
+        t : array_like, shape (m,)
+            Times (s).
+
+        Returns
+        -------
+        ndarray, shape (n, m)
+            ``sum_s Re(Q_s e^{i Omega_s t})`` (m) at each sweep point (row) and time (column).
+        """
         t = np.asarray(t, dtype=float)
         out = np.zeros((len(self.speeds), len(t)))
         for s in self.phasors:
@@ -133,6 +168,16 @@ class UnbalanceResponse(Result):
         Columns: ``<spool> speed (rpm)`` for every spool, then for every output and excited
         spool ``node N dir @<spool> amplitude (um)`` and ``... phase (deg)``, then
         ``node N dir peak bound (um)``.
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file to write.
+
+        Returns
+        -------
+        Path
+            ``path``.
         """
         path = Path(path)
         header = [f"{s} speed (rpm)" for s in self.spool_speeds]
@@ -169,7 +214,25 @@ class UnbalanceResponse(Result):
         ``kind="bode"`` (default): amplitude (µm, log) and phase (deg) against the reference speed (rpm), a
         column per output (:func:`rotorred.plots.harmonic.draw_bode`); ``kind="polar"``: the phasor tips
         (:func:`rotorred.plots.harmonic.draw_polar`). Into a given ``ax`` (one panel), Bode draws the
-        amplitudes and polar the phasor tips of every output. ``options``: ``title``.
+        amplitudes and polar the phasor tips of every output.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        kind : {"bode", "polar"}
+            The kind of plot.
+        **options
+            ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Raises
+        ------
+        InputError
+            If ``kind`` is neither ``"bode"`` nor ``"polar"``.
         """
         from rotorred.plots.harmonic import draw_bode, draw_polar
 
@@ -233,11 +296,30 @@ class FrequencyResponse(Result):
     operating: Operating | None = None
 
     def h(self, output: Output, input: Output) -> np.ndarray:  # noqa: A002 - FRF vocabulary
-        """Receptance (m/N) from ``input`` to ``output``, shape (n,)."""
+        """Receptance (m/N) from ``input`` to ``output``, shape (n,).
+
+        Parameters
+        ----------
+        output : (int, str)
+            (node, direction) of a response DOF of :attr:`outputs`.
+        input : (int, str)
+            (node, direction) of a force DOF of :attr:`inputs`.
+        """
         return self.H[:, self.outputs.index(tuple(output)), self.inputs.index(tuple(input))]
 
     def write_csv(self, path: str | Path) -> Path:
-        """Write |H| (m/N) and phase (deg) of every pair against frequency (Hz)."""
+        """Write |H| (m/N) and phase (deg) of every pair against frequency (Hz).
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file to write.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
         path = Path(path)
         header, cols = ["frequency (Hz)"], [self.frequencies / (2 * math.pi)]
         for o in self.outputs:
@@ -265,8 +347,19 @@ class FrequencyResponse(Result):
 
     def plot(self, ax=None, **options):
         """Bode plot of every pair, |H| (m/N, log) above the phase (deg) against frequency (Hz)
-        (:func:`rotorred.plots.harmonic.draw_frf`; into a given ``ax``, |H| only); ``options``: ``title``.
-        Returns the Figure."""
+        (:func:`rotorred.plots.harmonic.draw_frf`; into a given ``ax``, |H| only).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.harmonic import draw_frf
 
         return draw_frf(self, ax, **options)
@@ -302,8 +395,8 @@ class SteadyState(Result):
     speeds : dict of str to float
         Spool speeds (rad/s).
     phasors : dict of str to ndarray, shape (n,), complex
-        Complex amplitude of every model coordinate for the unbalances of each spool, at that
-        spool's frequency ``speeds[spool]``.
+        Complex amplitude of every model coordinate (m, rad; modal coordinates of a reduced model) for the
+        unbalances of each spool, at that spool's frequency ``speeds[spool]``.
     operating : Operating or None
         The operating point.
     """
@@ -313,11 +406,23 @@ class SteadyState(Result):
     operating: Operating | None = None
 
     def displacement(self, t: float) -> np.ndarray:
-        """q(t) = sum_s Re(Q_s e^{i Omega_s t}) (model coordinates), shape (n,)."""
+        """q(t) = sum_s Re(Q_s e^{i Omega_s t}) (model coordinates), shape (n,).
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        """
         return sum(np.real(Q * np.exp(1j * self.speeds[s] * t)) for s, Q in self.phasors.items())
 
     def velocity(self, t: float) -> np.ndarray:
-        """q'(t) = sum_s Re(i Omega_s Q_s e^{i Omega_s t}), shape (n,)."""
+        """q'(t) = sum_s Re(i Omega_s Q_s e^{i Omega_s t}) (m/s, rad/s), shape (n,).
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        """
         return sum(np.real(1j * self.speeds[s] * Q * np.exp(1j * self.speeds[s] * t))
                    for s, Q in self.phasors.items())
 
@@ -336,6 +441,17 @@ class SteadyState(Result):
         what a rotordynamics engineer checks of a steady state (its size and shape, the rosette of two spools,
         the initial condition a transient starts from). By default, without a model (the result holds only
         model coordinates): the amplitude |Q| of every model coordinate per excited spool.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            Those of :func:`~rotorred.plots.harmonic.draw_steady_state` (``model``, ``node``, ...).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
         """
         from rotorred.plots.harmonic import draw_steady_state
 
@@ -447,6 +563,12 @@ def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalan
     -------
     UnbalanceResponse
         Phasors of shape (n,) per excited spool and output (m).
+
+    Raises
+    ------
+    InputError
+        If a spool's speed does not follow from ``operating`` (:meth:`Operating.lines`), ``outputs`` is empty,
+        or an unbalance or an output names a DOF the model does not have.
     """
     model = system_of(model)
     operating = checked_operating(operating)
@@ -523,6 +645,12 @@ def frequency_response(model, operating: Operating, inputs: Sequence[Output], ou
     -------
     FrequencyResponse
         ``H`` of shape (n, len(outputs), len(inputs)) (m/N).
+
+    Raises
+    ------
+    InputError
+        If ``operating`` is not one point, ``inputs`` or ``outputs`` is empty or names a DOF the model does not
+        have, or a frequency is negative.
     """
     model = system_of(model)
     speeds = checked_operating(operating).single(model)

@@ -163,7 +163,7 @@ class ReducedSystem(SpoolSpeedMixin):
     M, K, C : ndarray, shape (m, m)
         Reduced mass (kg), stiffness (N/m) and damping (N s/m): ``T^T X T``.
     G : dict of str to ndarray, shape (m, m)
-        Reduced gyroscopic matrix of each spool per unit spin speed: ``T^T G_s T``.
+        Reduced gyroscopic matrix of each spool per unit spin speed (1 rad/s): ``T^T G_s T``.
     T : ndarray, shape (n, m)
         Recovery map, full physical coordinates ``q = T p``.
     full_dofs : DofMap
@@ -180,7 +180,8 @@ class ReducedSystem(SpoolSpeedMixin):
     selection : ModeSelection
         Record of how ``n_modes`` was chosen.
     K_G : dict of str to ndarray, shape (m, m)
-        Reduced spin-acceleration matrix of each spool per unit angular acceleration: ``T^T K_G,s T``.
+        Reduced spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2):
+        ``T^T K_G,s T``.
     tables : tuple of TabulatedSupport
         The full model's speed-dependent bearings on the reduced coordinates (rows ``R T``): their change with
         speed is exact when the bearing's node is a boundary node, as the constraint and fixed-interface modes
@@ -224,9 +225,16 @@ class ReducedSystem(SpoolSpeedMixin):
     def physical_index(self, node: int, direction: str) -> int:
         """Index of the boundary DOF ``direction`` at ``node`` in reduced coordinates.
 
+        Parameters
+        ----------
+        node : int
+            A boundary node (:attr:`boundary_nodes`).
+        direction : {"x", "y", "theta_x", "theta_y"}
+            The DOF at the node (``"tx"``, ``"ty"`` also accepted).
+
         Raises
         ------
-        ValueError
+        InputError
             If ``node`` is not a boundary node (its DOFs are then not reduced coordinates;
             use :meth:`output_rows` to recover them).
         """
@@ -253,11 +261,33 @@ class ReducedSystem(SpoolSpeedMixin):
         return self.T[idx, :].copy()
 
     def recover(self, p: np.ndarray) -> np.ndarray:
-        """Full physical coordinates ``T p``; ``p`` shape (m,) or (m, k) -> (n,) or (n, k)."""
+        """Full physical coordinates ``T p``; ``p`` shape (m,) or (m, k) -> (n,) or (n, k).
+
+        Parameters
+        ----------
+        p : ndarray, shape (m,) or (m, k)
+            Reduced coordinates (boundary DOFs in m or rad, then modal coordinates), one column per instant.
+
+        Returns
+        -------
+        ndarray, shape (n,) or (n, k)
+            Physical displacements (m) and rotations (rad) in the full model's DOF order.
+        """
         return self.T @ p
 
     def project(self, F: np.ndarray) -> np.ndarray:
-        """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k)."""
+        """Generalised force ``T^T F`` of a full force vector ``F``, shape (n,) or (n, k).
+
+        Parameters
+        ----------
+        F : ndarray, shape (n,) or (n, k)
+            Forces (N) and moments (N m) on the full model's DOFs, one column per instant.
+
+        Returns
+        -------
+        ndarray, shape (m,) or (m, k)
+            The force on the reduced coordinates.
+        """
         return self.T.T @ F
 
     def summary(self) -> list[str]:
@@ -276,7 +306,25 @@ class ReducedSystem(SpoolSpeedMixin):
 
 def default_boundary_nodes(rotor: Rotor, extra_nodes: Sequence[int] = ()) -> tuple[int, ...]:
     """Bearing nodes and their pedestals, both nodes of every inter-shaft bearing, and ``extra_nodes``, in DOF
-    order."""
+    order.
+
+    Parameters
+    ----------
+    rotor : Rotor
+        The rotor to reduce.
+    extra_nodes : sequence of int
+        Further nodes to keep, e.g. rub or output nodes.
+
+    Returns
+    -------
+    tuple of int
+        The boundary nodes of a Craig–Bampton reduction (:func:`reduce_rotor`).
+
+    Raises
+    ------
+    InputError
+        If a node of ``extra_nodes`` is not a shaft node of ``rotor``.
+    """
     extra = [checks.node(f"extra_nodes[{i}]", n, rotor.spool_of) for i, n in enumerate(extra_nodes)]
     nodes = {b.node for b in rotor.bearings} | {b.link for b in rotor.bearings if b.link is not None}
     for b in rotor.intershaft_bearings:
@@ -578,18 +626,35 @@ def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | N
     Parameters
     ----------
     rotor : Rotor
+        The rotor to reduce.
     extra_nodes : sequence of int
         Additional boundary nodes (e.g. the rub node, output nodes).
-    n_modes, cutoff, band, target, n_check, response
-        As in :func:`reduce`.
+    n_modes : int, optional
+        Number of fixed-interface modes to keep (0 gives Guyan reduction).
+    cutoff : float, optional
+        Keep the fixed-interface modes with natural frequency <= ``cutoff`` (rad/s).
+    band : (float, float), optional
+        Frequency band of interest (rad/s) whose whirl modes the automatic count checks.
+    target : float
+        Relative whirl-frequency error target of the automatic count (-).
+    n_check : int, optional
+        Without a band, the automatic count checks the ``n_check`` lowest whirl modes.
+    response : ResponseCheck, optional
+        An extra requirement of the automatic count: the unbalance response error at most ``response.target``.
+        (All as in :func:`reduce`, whose Notes give the automatic count.)
     speed_factors : sequence of float
-        Factors (>= 0) of the nominal speeds at which the automatic count is checked.
+        Factors (>= 0, -) of the nominal speeds at which the automatic count is checked.
     system : SystemMatrices, optional
         ``assemble(rotor)`` if already at hand.
 
     Returns
     -------
     ReducedSystem
+
+    Raises
+    ------
+    InputError
+        If a node of ``extra_nodes`` is not a node of ``rotor``, or a setting of :func:`reduce` is out of range.
     """
     factors = tuple(float(f) for f in checks.vector("speed_factors", speed_factors, ge=0.0))
     boundary = default_boundary_nodes(rotor, extra_nodes)

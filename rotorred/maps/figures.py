@@ -58,6 +58,8 @@ def draw(ds, spec: MapSpec, kind: str = "bifurcation", ax=None, *, direction: st
     spec : MapSpec
     kind : {"bifurcation", "lines", "waterfall", "heatmap"}
         The figure (module docstring); "heatmap" needs two varied keys.
+    ax : matplotlib Axes or pair of Axes, optional
+        Axes to draw into; default a new figure.
     direction : str, optional
         The sweep of "lines", "waterfall" and "heatmap" (default: the first).
     quantity : {"class", "contact", "explained", "amplitude"}

@@ -54,7 +54,7 @@ class MapRun(Result):
     incomplete : str or None
         Why the map stopped early (the folder is marked INCOMPLETE), or None.
     wall_time : float
-        s.
+        Time the run took (s).
     """
 
     spec: MapSpec
@@ -67,6 +67,8 @@ class MapRun(Result):
     wall_time: float
 
     def summary(self) -> list[str]:
+        """The map's scene, keys and sweeps, the points run, resumed and failed, the classes found, and whether it
+        stopped early."""
         spec, done = self.spec, int(np.count_nonzero(self.dataset["status"].values != ""))
         counts = Counter(str(k) for k in self.dataset["kind"].values.ravel() if k)
         lines = [f"map of {spec.scene} over " + " x ".join(f"{a.key} ({len(a.values)} values)" for a in spec.axes)
@@ -84,8 +86,28 @@ class MapRun(Result):
         """One figure of the map (:func:`rotorred.maps.figures.draw`): ``kind`` "bifurcation" (the default: the
         Poincare samples of every sweep along the first key), "lines" (line amplitudes and contact of one sweep; ``ax``
         a pair of axes), "waterfall" (the labelled lines of one sweep) or "heatmap" (``quantity`` "class", "contact",
-        "explained" or "amplitude" of one sweep over the first two keys); ``direction``: the sweep (default the
-        first)."""
+        "explained" or "amplitude" of one sweep over the first two keys).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into (a pair of axes for "lines"); default a new figure.
+        kind : {"bifurcation", "lines", "waterfall", "heatmap"}
+            The figure; "heatmap" needs two varied keys.
+        direction : str, optional
+            The sweep of "lines", "waterfall" and "heatmap" (:attr:`MapSpec.directions`); default the first.
+        quantity : {"class", "contact", "explained", "amplitude"}
+            The heat map's quantity.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Raises
+        ------
+        InputError
+            If ``kind`` is unknown or ``direction`` is not a sweep of the map.
+        """
         from rotorred.maps.figures import draw
 
         return draw(self.dataset, self.spec, kind, ax, direction=direction, quantity=quantity)
@@ -127,6 +149,7 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     Parameters
     ----------
     spec : MapSpec
+        The map: base scene, varied keys and their values, sweeps.
     out : str or Path
         Output folder; its ``points/`` are kept between runs.
     workers : int, optional
@@ -141,6 +164,15 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     provenance : rotorred.provenance.Provenance, optional
         What made the map (the command line's, with the base scene): written as ``scene.toml``, at the top of
         ``map.txt`` and as attributes of ``map.nc``.
+
+    Returns
+    -------
+    MapRun
+
+    Raises
+    ------
+    InputError
+        If a point's scene is invalid, or the folder holds points of another map, before any point runs.
     """
     t0 = time.perf_counter()
     scenes = spec.scenes()  # 1. every point validated before anything runs
@@ -202,7 +234,21 @@ def _write(run: MapRun, folder: OutputFolder, figures: bool, provenance: Provena
 
 
 def format_map(ds, spec: MapSpec) -> str:
-    """Text table of a map: per point, the class, settling time, explained share, contact and peak orbit."""
+    """Text table of a map: per point, the class, settling time (s), explained share, contact fraction and
+    number of impacts.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The map's dataset (:func:`rotorred.maps.store.to_dataset`, :attr:`MapRun.dataset`).
+    spec : MapSpec
+        The map; its keys are printed in their display units (:func:`rotorred.scenes.keys.key_unit`).
+
+    Returns
+    -------
+    str
+        A heading line and the table, a row per point on disk.
+    """
     status = ds["status"].values
     rows = []
     for at in zip(*np.nonzero(status != "")):

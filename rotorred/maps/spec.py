@@ -43,6 +43,7 @@ class Axis:
 
     @property
     def label(self) -> str:
+        """The key and its unit, e.g. ``"speeds.outer (Hz)"``."""
         return f"{self.key} ({key_unit(self.key)[1]})"
 
 
@@ -79,6 +80,7 @@ class MapSpec:
         ``(spool, r)``: that spool turns at ``r`` times the varied speed (``--ratio``); only with a
         ``speeds.<spool>`` continuation axis.
     direction : {"up", "down", "both"}
+        Sweep direction along the continuation axis; "both" runs up, then down.
     cold : bool
         Every point from the scene's own start (no continuation).
     limit : float, optional
@@ -127,18 +129,32 @@ class MapSpec:
     # ------------------------------------------------------------------ grid
     @property
     def shape(self) -> tuple[int, ...]:
+        """Number of values of each axis."""
         return tuple(len(a.values) for a in self.axes)
 
     @property
     def directions(self) -> tuple[str, ...]:
+        """The sweeps run: ``("up",)``, ``("down",)`` or ``("up", "down")``."""
         return ("up", "down") if self.direction == "both" else (self.direction,)
 
     @property
     def n_points(self) -> int:
+        """Number of points run: grid points times sweeps."""
         return math.prod(self.shape) * len(self.directions)
 
     def settings_at(self, index: tuple[int, ...]) -> dict:
-        """The scene overrides of grid point ``index``: fixed settings, varied keys, ratio-bound speeds."""
+        """The scene overrides of grid point ``index``: fixed settings, varied keys, ratio-bound speeds.
+
+        Parameters
+        ----------
+        index : tuple of int, length len(axes)
+            Grid index: the position in each axis's values.
+
+        Returns
+        -------
+        dict of str to value
+            Scene key to value, in scene units (Hz for speeds, m for a clearance).
+        """
         out = dict(self.settings)
         for axis, i in zip(self.axes, index):
             out[axis.key] = axis.values[i]
@@ -147,7 +163,18 @@ class MapSpec:
         return out
 
     def scene_at(self, index: tuple[int, ...]) -> Scene:
-        """The validated scene of grid point ``index`` (loaded once)."""
+        """The validated scene of grid point ``index`` (loaded once).
+
+        Parameters
+        ----------
+        index : tuple of int, length len(axes)
+            Grid index: the position in each axis's values.
+
+        Raises
+        ------
+        InputError
+            If the scene with the point's settings is invalid, naming the key.
+        """
         index = tuple(index)
         if index not in self._scenes:
             self._scenes[index] = load_scene(self.scene, self.settings_at(index))
@@ -159,8 +186,19 @@ class MapSpec:
 
     def check_size(self, force: bool = False) -> None:
         """Every point's scene validated and within the size limits (:mod:`rotorred.scenes.budget`), and the
-        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS``; ``force`` lets a
-        map beyond them go on."""
+        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS``.
+
+        Parameters
+        ----------
+        force : bool
+            Let a map beyond the size limits go on.
+
+        Raises
+        ------
+        InputError
+            If a point's scene is invalid or asks for ``solver.tolerance``, or (without ``force``) a point or
+            the whole map is beyond the size limits.
+        """
         from rotorred.scenes import budget
 
         total = 0

@@ -142,14 +142,16 @@ class SystemMatrices(SpoolSpeedMixin):
     Attributes
     ----------
     M : ndarray, shape (n, n)
-        Mass (translational + rotary), symmetric positive definite.
+        Mass (translational + rotary), symmetric positive definite (kg; kg m^2 on rotations).
     K : ndarray, shape (n, n)
-        Stiffness of shafts, bearings and inter-shaft bearings.
+        Stiffness of shafts, bearings and inter-shaft bearings (N/m; N m/rad on rotations).
     C : ndarray, shape (n, n)
-        Damping of bearings, inter-shaft bearings and Rayleigh shaft damping.
+        Damping of bearings, inter-shaft bearings and Rayleigh shaft damping (N s/m; N m s/rad on rotations).
     G : dict of str to ndarray, shape (n, n)
-        Skew-symmetric gyroscopic matrix of each spool per unit spin speed (1 rad/s).
+        Skew-symmetric gyroscopic matrix of each spool per unit spin speed (1 rad/s; kg m^2): the
+        model's damping at speeds ``Omega_s`` is ``C + sum_s Omega_s G_s``.
     dofs : DofMap
+        The DOF numbering: node and direction of each coordinate.
     K_G : dict of str to ndarray, shape (n, n)
         Spin-acceleration matrix of each spool per unit angular acceleration (1 rad/s^2), ``A_s`` of
         ``G_s = A_s - A_s^T``; needed only when a spool's speed varies (empty for a model built by hand).
@@ -176,6 +178,7 @@ class SystemMatrices(SpoolSpeedMixin):
 
     @property
     def n_dof(self) -> int:
+        """Number of coordinates ``n`` of the model."""
         return self.M.shape[0]
 
     @property
@@ -184,7 +187,20 @@ class SystemMatrices(SpoolSpeedMixin):
         return self.dofs
 
     def physical_index(self, node: int, direction: str) -> int:
-        """Index of the physical DOF ``direction`` at ``node`` in this model's coordinates."""
+        """Index of the physical DOF ``direction`` at ``node`` in this model's coordinates.
+
+        Parameters
+        ----------
+        node : int
+            A node of the model.
+        direction : {"x", "y", "theta_x", "theta_y"}
+            The DOF at the node (``"tx"``, ``"ty"`` also accepted; :data:`rotorred.model.dofs.DIRECTIONS`).
+
+        Raises
+        ------
+        InputError
+            If ``node`` is not a node of the model, ``direction`` is unknown or the DOF is fixed by a support.
+        """
         return self.dofs.index(node, direction)
 
     def output_rows(self, outputs) -> np.ndarray:
@@ -257,6 +273,17 @@ def system_of(model, field_name: str = "model"):
 
     Every analysis reads its model through this one protocol (:class:`SpoolSpeedMixin`).
 
+    Parameters
+    ----------
+    model : Rotor, SystemMatrices or ReducedSystem
+        The model as the caller gives it.
+    field_name : str
+        The argument or key the error names.
+
+    Returns
+    -------
+    SystemMatrices or ReducedSystem
+
     Raises
     ------
     rotorred.checks.InputError
@@ -276,10 +303,12 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     Parameters
     ----------
     rotor : Rotor
+        The rotor; its tabulated bearings enter ``K`` and ``C`` at its nominal speeds (docs/model.md §10).
 
     Returns
     -------
     SystemMatrices
+        ``M``, ``K``, ``C``, ``G`` and ``K_G`` in the DOF order of :class:`rotorred.model.dofs.DofMap`.
     """
     n_internal = sum(e.n_internal for s in rotor.spools for e in s.all_elements)
     dofs = DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals))

@@ -306,7 +306,20 @@ class ShaftElement:
         return _gen.timoshenko_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
 
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
-        """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line."""
+        """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line.
+
+        Parameters
+        ----------
+        n : int
+            Number of elements, >= 1; each has length ``L / n`` (m).
+        new_nodes : list of int, length n - 1
+            Numbers of the inner nodes, from ``left`` to ``right``.
+
+        Returns
+        -------
+        list of ShaftElement, length n
+            From ``left`` to ``right``; a tapered element's diameters (m) follow its linear taper.
+        """
         chain = [self.left, *new_nodes, self.right]
         return [ShaftElement(chain[i], chain[i + 1], self.L / n, along(self.D_o, self.D_o_right, i / n),
                              along(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
@@ -330,6 +343,7 @@ class Disk:
     Parameters
     ----------
     node : int
+        The shaft node the disk sits at.
     m : float
         Mass (kg).
     I_d : float
@@ -405,6 +419,7 @@ class Bearing(_Support):
     Parameters
     ----------
     node : int
+        The shaft (or pedestal) node the bearing holds.
     k_xx, k_yy, k_xy, k_yx : float
         Stiffness coefficients (N/m), any sign (a seal's direct stiffness may be negative); the force on the shaft is
         -K [x, y] (-K [x - x_link, y - y_link] with a link).
@@ -473,6 +488,7 @@ class Support:
     Parameters
     ----------
     node : int
+        The node supported.
     kind : str
         ``"pinned"`` or ``"clamped"``.
     name : str
@@ -525,6 +541,7 @@ class BearingTable:
     Parameters
     ----------
     node : int
+        The shaft (or pedestal) node the bearing holds.
     speeds : sequence of float, shape (p,)
         Spool speeds of the table (rad/s), >= 0 and strictly increasing, at least 2.
     k_xx, k_yy, k_xy, k_yx : float or sequence of float, shape (p,)
@@ -579,7 +596,23 @@ class BearingTable:
 
     def at(self, Omega: float) -> Bearing:
         """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated in speed (:attr:`interpolation`);
-        outside the table held at its ends or extrapolated along the interpolant's end tangents (:attr:`extrapolate`)."""
+        outside the table held at its ends or extrapolated along the interpolant's end tangents (:attr:`extrapolate`).
+
+        Parameters
+        ----------
+        Omega : float
+            Speed of the bearing's spool (rad/s), >= 0.
+
+        Returns
+        -------
+        Bearing
+            Stiffness (N/m) and damping (N s/m) coefficients at ``Omega`` (docs/model.md §10).
+
+        Raises
+        ------
+        InputError
+            If ``Omega`` < 0, or linear extrapolation gives a direct damping coefficient below 0.
+        """
         Omega = checks.non_negative("Omega", Omega, "rad/s")
         values = {c: self._value(c, Omega) for c in COEFFICIENTS}
         for c in DIRECT_DAMPING:
@@ -605,7 +638,13 @@ class BearingTable:
         return float(v[end] + tangent * (Omega - W[end]))
 
     def covers(self, Omega: float) -> bool:
-        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies)."""
+        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies).
+
+        Parameters
+        ----------
+        Omega : float
+            Spool speed (rad/s).
+        """
         return self.speeds[0] <= Omega <= self.speeds[-1]
 
 
@@ -627,6 +666,7 @@ class IntershaftBearing(_Support):
     Parameters
     ----------
     node_a, node_b : int
+        The nodes joined, on two different spools.
     k_xx, k_yy, k_xy, k_yx : float
         Stiffness (N/m).
     c_xx, c_yy, c_xy, c_yx : float

@@ -24,6 +24,7 @@ class Unbalance:
     Parameters
     ----------
     node : int
+        The shaft node the unbalance sits at; it turns with that node's spool.
     m_e : float
         Unbalance magnitude, mass times eccentricity (kg m), >= 0.
     phase : float

@@ -65,7 +65,18 @@ class SpoolLine:
     how: str
 
     def at(self, Omega):
-        """The spool's speed (rad/s) at reference speed(s) ``Omega`` (rad/s)."""
+        """The spool's speed (rad/s) at reference speed(s) ``Omega`` (rad/s).
+
+        Parameters
+        ----------
+        Omega : float or array_like, shape (n,)
+            Speed(s) of the reference spool (rad/s).
+
+        Returns
+        -------
+        ndarray, shape of ``Omega``
+            ``slope * Omega + offset`` (rad/s).
+        """
         return self.slope * np.asarray(Omega, dtype=float) + self.offset
 
 
@@ -130,6 +141,18 @@ class Operating:
 
         The first spool given is the reference; a spool of the model left out follows it at the
         nominal ratio (:meth:`lines`).
+
+        Parameters
+        ----------
+        speeds : dict of str to float
+            Speed of each spool given (``unit``), >= 0; at least one.
+        unit : {"rad/s", "rpm", "Hz"}
+            Unit of ``speeds``; kept for display.
+
+        Raises
+        ------
+        InputError
+            If ``speeds`` is empty, a speed is negative or ``unit`` is unknown.
         """
         speeds = checks.table("speeds", speeds)
         if not speeds:
@@ -155,6 +178,12 @@ class Operating:
         fixed : dict of str to float, optional
             Speeds of spools held fixed along the line (``unit``).
         unit : {"rad/s", "rpm", "Hz"}
+            Unit of ``Omega`` and ``fixed``; kept for display.
+
+        Raises
+        ------
+        InputError
+            If a speed is negative, or a spool is both at a ratio and fixed.
         """
         fixed = {s: to_rad_s(checks.non_negative(f"fixed[{s!r}]", w, unit), unit)
                  for s, w in checks.table("fixed", fixed or {}).items()}
@@ -163,13 +192,42 @@ class Operating:
 
     @classmethod
     def profile(cls, speed_profile: SpeedProfile, reference: str | None = None, unit: str = "rad/s") -> Operating:
-        """Speeds in time (a run-up, a coast-down, a measured table), :class:`SpeedProfile` in rad/s."""
+        """Speeds in time (a run-up, a coast-down, a measured table), :class:`SpeedProfile` in rad/s.
+
+        Parameters
+        ----------
+        speed_profile : SpeedProfile
+            Speeds of the spools it names (rad/s) at its breakpoints (s); a spool of the model it
+            leaves out follows the reference (:meth:`profile_for`).
+        reference : str, optional
+            The reference spool; default the profile's first spool.
+        unit : {"rad/s", "rpm", "Hz"}
+            Unit to display the speeds in (the profile itself is in rad/s).
+        """
         return cls(np.zeros(0), reference, speed_profile=speed_profile, unit=unit)
 
     @classmethod
     def ramp(cls, start: Mapping[str, float], end: Mapping[str, float], duration: float, hold: float = 0.0,
              unit: str = "rad/s") -> Operating:
-        """A linear ramp from ``start`` to ``end`` speeds (``unit``) over ``duration`` (s), after ``hold`` (s)."""
+        """A linear ramp from ``start`` to ``end`` speeds (``unit``) over ``duration`` (s), after ``hold`` (s).
+
+        Parameters
+        ----------
+        start, end : dict of str to float
+            Speed of each spool at the start and at the end of the ramp (``unit``), >= 0; the same
+            spools in both. The first spool of ``start`` is the reference.
+        duration : float
+            Length of the ramp (s), > 0.
+        hold : float
+            Time at the ``start`` speeds before the ramp begins (s), >= 0.
+        unit : {"rad/s", "rpm", "Hz"}
+            Unit of ``start`` and ``end``; kept for display.
+
+        Raises
+        ------
+        InputError
+            If a speed is negative, the spools of ``start`` and ``end`` differ, or ``duration`` is not > 0.
+        """
         start = {s: to_rad_s(checks.non_negative(f"start[{s!r}]", w, unit), unit)
                  for s, w in checks.table("start", start).items()}
         end = {s: to_rad_s(checks.non_negative(f"end[{s!r}]", w, unit), unit)
@@ -203,6 +261,12 @@ class Operating:
         -------
         dict of str to SpoolLine
             In the model's spool order; the reference first has slope 1.
+
+        Raises
+        ------
+        InputError
+            If a spool named in ``ratios``, ``fixed`` or the profile is not a spool of ``model``, or a spool's
+            speed is not stated where no nominal ratio to the reference follows from the model.
         """
         spools, nominal = _spools_and_nominal(model)
         reference = self.reference_of(model)
@@ -235,25 +299,73 @@ class Operating:
         return out
 
     def reference_of(self, model) -> str:
-        """The reference spool for ``model``: the one given, or the model's first spool."""
+        """The reference spool for ``model``: the one given, or the model's first spool.
+
+        Parameters
+        ----------
+        model : Rotor, SystemMatrices or ReducedSystem
+            Anything with ``spools`` and ``nominal_speeds`` (:meth:`lines`).
+
+        Raises
+        ------
+        InputError
+            If the reference given is not a spool of ``model``.
+        """
         spools, _ = _spools_and_nominal(model)
         if self.reference is None and self.speed_profile is not None and self.speed_profile.spools:
             return checks.choice("reference", self.speed_profile.spools[0], spools)
         return checks.choice("reference", spools[0] if self.reference is None else self.reference, spools)
 
     def speeds(self, model) -> dict[str, np.ndarray]:
-        """Speed of every spool of ``model`` at each point of the line (rad/s), each shape (n,)."""
+        """Speed of every spool of ``model`` at each point of the line (rad/s), each shape (n,).
+
+        Parameters
+        ----------
+        model : Rotor, SystemMatrices or ReducedSystem
+            Anything with ``spools`` and ``nominal_speeds`` (:meth:`lines`).
+
+        Raises
+        ------
+        InputError
+            If this is a profile, or a spool's speed does not follow (:meth:`lines`).
+        """
         self._not_a_profile("speeds")
         return {s: line.at(self.Omega) for s, line in self.lines(model).items()}
 
     def at(self, model, k: int = 0) -> dict[str, float]:
-        """Speed of every spool of ``model`` at point ``k`` of the line (rad/s)."""
+        """Speed of every spool of ``model`` at point ``k`` of the line (rad/s).
+
+        Parameters
+        ----------
+        model : Rotor, SystemMatrices or ReducedSystem
+            Anything with ``spools`` and ``nominal_speeds`` (:meth:`lines`).
+        k : int
+            Index of the point along the line (negative counts from the end).
+
+        Raises
+        ------
+        InputError
+            If this is a profile, or ``k`` is out of range.
+        """
         self._not_a_profile("at")
         k = checks.integer("k", k, ge=-self.n_points, le=self.n_points - 1)
         return {s: float(line.at(self.Omega[k])) for s, line in self.lines(model).items()}
 
     def single(self, model, field_name: str = "operating") -> dict[str, float]:
-        """The spool speeds (rad/s) of an analysis that runs at one point: a point, or a line of one speed."""
+        """The spool speeds (rad/s) of an analysis that runs at one point: a point, or a line of one speed.
+
+        Parameters
+        ----------
+        model : Rotor, SystemMatrices or ReducedSystem
+            Anything with ``spools`` and ``nominal_speeds`` (:meth:`lines`).
+        field_name : str
+            The option or key the error names.
+
+        Raises
+        ------
+        InputError
+            If this is a line of several speeds or a profile.
+        """
         if self.kind != "point":
             checks.fail(field_name, self.describe(), "must be one operating point (Operating.point), not a "
                         f"{self.kind}")
@@ -261,7 +373,23 @@ class Operating:
 
     def profile_for(self, model) -> SpeedProfile:
         """The profile with every spool of ``model``: a spool it leaves out follows the reference (the rule of
-        :meth:`lines`) at each breakpoint; a point gives a constant profile."""
+        :meth:`lines`) at each breakpoint; a point gives a constant profile.
+
+        Parameters
+        ----------
+        model : Rotor, SystemMatrices or ReducedSystem
+            Anything with ``spools`` and ``nominal_speeds`` (:meth:`lines`).
+
+        Returns
+        -------
+        SpeedProfile
+            Speeds of every spool of ``model`` (rad/s) at the profile's breakpoints (s).
+
+        Raises
+        ------
+        InputError
+            If the profile leaves out the reference spool, or this is a line of several speeds.
+        """
         if self.speed_profile is None:
             return SpeedProfile.constant(self.single(model))
         p = self.speed_profile

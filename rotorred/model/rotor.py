@@ -337,12 +337,34 @@ class Rotor:
         return {s.name: s.speed for s in self.spools}
 
     def spool(self, name: str) -> Spool:
-        """The spool called ``name``."""
+        """The spool called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Name of a spool of the rotor.
+
+        Raises
+        ------
+        InputError
+            If no spool is called ``name``.
+        """
         checks.choice("spool", name, [s.name for s in self.spools])
         return next(s for s in self.spools if s.name == name)
 
     def disk_at(self, node: int) -> Disk:
-        """The disk at ``node``."""
+        """The disk at ``node``.
+
+        Parameters
+        ----------
+        node : int
+            A node that carries a disk.
+
+        Raises
+        ------
+        InputError
+            If no disk is at ``node``.
+        """
         for d in self.disks:
             if d.node == node:
                 return d
@@ -405,6 +427,16 @@ class Rotor:
 
         The original nodes keep their numbers; new nodes are numbered from
         ``max(nodes) + 1`` on, element by element along each spool.
+
+        Parameters
+        ----------
+        n : int
+            Number of elements each shaft element (and sleeve) becomes, >= 1; 1 returns the rotor itself.
+
+        Raises
+        ------
+        InputError
+            If ``n`` < 1.
         """
         n = checks.integer("n", n, ge=1)
         if n == 1:
@@ -422,7 +454,18 @@ class Rotor:
         return dataclasses.replace(self, spools=tuple(spools), name=f"{self.name} refined({n})")
 
     def with_speeds(self, speeds: Mapping[str, float]) -> Rotor:
-        """Return a copy whose spools have the nominal speeds ``speeds`` (rad/s)."""
+        """Return a copy whose spools have the nominal speeds ``speeds`` (rad/s).
+
+        Parameters
+        ----------
+        speeds : dict of str to float
+            Nominal speed of each spool given (rad/s); a spool left out keeps its speed.
+
+        Raises
+        ------
+        InputError
+            If ``speeds`` names a spool the rotor does not have.
+        """
         checks.keys("speeds", speeds, [s.name for s in self.spools])
         spools = tuple(dataclasses.replace(s, speed=float(speeds.get(s.name, s.speed))) for s in self.spools)
         return dataclasses.replace(self, spools=spools)
@@ -432,7 +475,20 @@ class Rotor:
         return dataclasses.replace(self, intershaft_bearings=())
 
     def only_spool(self, name: str) -> Rotor:
-        """Return the spool ``name`` alone, with its disks and ground bearings."""
+        """Return the spool ``name`` alone, with its disks and ground bearings.
+
+        Its supports, and the pedestals its bearings stand on, stay; inter-shaft bearings go.
+
+        Parameters
+        ----------
+        name : str
+            Name of a spool of the rotor.
+
+        Raises
+        ------
+        InputError
+            If no spool is called ``name``.
+        """
         s = self.spool(name)
         nodes = set(s.nodes)
         linked = {b.link for b in self.bearings if b.node in nodes and b.link is not None}  # its pedestals

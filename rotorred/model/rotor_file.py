@@ -119,7 +119,27 @@ def load_rotor(spec: str | Path) -> Rotor:
 def read_rotor(spec: str | Path) -> tuple[Rotor, dict[str, Any]]:
     """The rotor of a preset name or a TOML file (:func:`load_rotor`) and its rotor-file document: the parsed
     tables as written (a ROSS file's converted, :func:`rotor_document`), which :func:`rotor_from_dict` makes the
-    same rotor again, and :func:`rotorred.writers.toml_text` writes as a rotor file."""
+    same rotor again, and :func:`rotorred.writers.toml_text` writes as a rotor file.
+
+    Parameters
+    ----------
+    spec : str or Path
+        A preset name (:func:`presets`) or the path of a rotor file, or of a rotor saved by ROSS 3 (TOML).
+
+    Returns
+    -------
+    rotor : Rotor
+    document : dict
+        The rotor-file tables in the file's units (speeds in rpm or rad/s, phases in degrees or rad, as the
+        file gives them; the rest SI).
+
+    Raises
+    ------
+    RotorFileError
+        For a file that does not describe a valid rotor, naming the file and the key.
+    FileNotFoundError
+        If ``spec`` is neither a preset nor an existing file.
+    """
     spec_str = str(spec)
     if spec_str in presets():
         text = resources.files("rotorred.model.presets").joinpath(f"{spec_str}.toml").read_text()

@@ -60,7 +60,13 @@ class SpeedProfile:
     # ------------------------------------------------------------------------------- constructors
     @classmethod
     def constant(cls, speeds: Mapping[str, float]) -> SpeedProfile:
-        """Every spool at a constant speed (rad/s)."""
+        """Every spool at a constant speed (rad/s).
+
+        Parameters
+        ----------
+        speeds : dict of str to float
+            Speed of each spool (rad/s), >= 0.
+        """
         return cls(np.zeros(1), {s: [w] for s, w in dict(speeds).items()})
 
     @classmethod
@@ -69,6 +75,21 @@ class SpeedProfile:
         """A linear ramp from ``start`` to ``end`` speeds (rad/s) over ``duration`` (s), after ``hold`` (s) at ``start``.
 
         A coast-down is a ramp with ``end`` below ``start``.
+
+        Parameters
+        ----------
+        start, end : dict of str to float
+            Speed of each spool at the start and at the end of the ramp (rad/s), >= 0; ``end`` names
+            the spools of ``start``.
+        duration : float
+            Length of the ramp (s), > 0.
+        hold : float
+            Time at the ``start`` speeds before the ramp begins (s), >= 0.
+
+        Raises
+        ------
+        InputError
+            If ``duration`` is not > 0, ``hold`` < 0, a speed < 0, or the spools of ``end`` differ.
         """
         duration = checks.positive("duration", duration, "s")
         hold = checks.non_negative("hold", hold, "s")
@@ -81,6 +102,7 @@ class SpeedProfile:
     # ------------------------------------------------------------------------------- evaluation
     @property
     def spools(self) -> tuple[str, ...]:
+        """Names of the spools the profile gives, in its order."""
         return tuple(self.speeds)
 
     @property
@@ -108,7 +130,13 @@ class SpeedProfile:
 
     def at(self, t) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """``(Omega, Omega', phi)`` of each spool at times ``t`` (s): speed (rad/s), acceleration (rad/s^2)
-        and spin angle (rad), each of the shape of ``t``."""
+        and spin angle (rad), each of the shape of ``t``.
+
+        Parameters
+        ----------
+        t : float or array_like, shape (m,)
+            Time(s) (s); before 0 the speeds are those at 0, after :attr:`duration` those at the end.
+        """
         t = np.asarray(t, dtype=float)
         k = self._segment(t)
         tau = t - self.t[k]
@@ -117,15 +145,32 @@ class SpeedProfile:
                 for s, w in self.speeds.items()}
 
     def speed(self, t) -> dict[str, np.ndarray]:
-        """Speed of each spool at times ``t`` (rad/s)."""
+        """Speed of each spool at times ``t`` (rad/s), each of the shape of ``t``.
+
+        Parameters
+        ----------
+        t : float or array_like, shape (m,)
+            Time(s) (s); before 0 the speeds are those at 0, after :attr:`duration` those at the end.
+        """
         return {s: v[0] for s, v in self.at(t).items()}
 
     def speeds_at(self, t: float) -> dict[str, float]:
-        """Speeds at one time ``t`` (s), as the ``speeds`` dict of a constant-speed analysis (rad/s)."""
+        """Speeds at one time ``t`` (s), as the ``speeds`` dict of a constant-speed analysis (rad/s).
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        """
         return {s: float(v[0]) for s, v in self.at(float(t)).items()}
 
     def kernel_table(self, spools) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The breakpoint table of the compiled step, spools in the order ``spools``.
+
+        Parameters
+        ----------
+        spools : sequence of str, length n_s
+            Spool names, each one the profile gives (the model's order).
 
         Returns
         -------

@@ -85,6 +85,8 @@ def draw_critical_speed(critical: CriticalSpeed, ax=None, *, figsize: tuple[floa
     critical : CriticalSpeed
     ax : matplotlib Axes, optional
         Axes to draw into; default a new figure of ``figsize`` (in).
+    figsize : (float, float)
+        Size of a new figure (in).
 
     Returns
     -------

@@ -174,7 +174,7 @@ class SceneBranch(Result):
     key, unit : str
         The varied scene key and its unit (:data:`KEYS`).
     values : ndarray, shape (p,)
-        The key at each point.
+        The key at each point (``unit``: m for a clearance, Hz for a speed).
     f0 : ndarray, shape (p,)
         Base frequency of each point (Hz).
     dofs : tuple of (int, str)
@@ -195,8 +195,9 @@ class SceneBranch(Result):
         Why the branch ended ("reached the end, ...", or where and why it stopped; "interrupted (SIGINT) while ..."
         with where, the points traced and those with their stability).
     iterations : ndarray, shape (p,)
+        Newton iterations of each point.
     start_time, solve_time, stability_time : float
-        Seconds: the cold start, the continuation, the stability of every point.
+        Wall time of the cold start, the continuation and the stability of every point (s).
     interrupt : str
         The signal that ended the branch ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "".
     """
@@ -267,6 +268,8 @@ class SceneBranch(Result):
         return (1e6, "µm") if self.key == "rub.clearance" else (1.0, self.unit)
 
     def summary(self) -> list[str]:
+        """The key's range, the peak's range (µm), the turns, the stability and its changes, why the branch
+        stopped, and the times."""
         xs, xu = self.shown
         p, known = len(self.values), int(np.count_nonzero(self.known))
         turns = [f"{xs * v:.6g}{'' if smooth else ' (corner)'}" for v, smooth in self.folds]
@@ -286,8 +289,21 @@ class SceneBranch(Result):
 
     def plot(self, ax=None, *, dof: int = 0, title: str | None = None):
         """The peak of output DOF ``dofs[dof]`` (µm) against the key: stable solid, unstable dashed, stability not
-        computed grey, folds, corners and stability changes marked (:func:`rotorred.plots.branch.plot_branch`);
-        ``title`` default: the scene's (and INCOMPLETE with the signal of an interrupted branch)."""
+        computed grey, folds, corners and stability changes marked (:func:`rotorred.plots.branch.plot_branch`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        dof : int
+            Position of the output DOF in :attr:`dofs`.
+        title : str, optional
+            Default: the scene's (and INCOMPLETE with the signal of an interrupted branch).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.branch import plot_branch
 
         xs, xu = self.shown
@@ -335,7 +351,24 @@ def dof_name(dof) -> str:
 def check_key(scene, key: str, start: float, end: float | None = None) -> None:
     """Refuse, before anything is computed, a key the branch cannot follow in ``scene`` (:data:`KEYS`), a scene
     without a plate, speeds that are not commensurate at ``start`` (for a speed key) or now, and a plate's number the
-    plate refuses at ``start`` or ``end``."""
+    plate refuses at ``start`` or ``end``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The rub scene the branch starts from.
+    key : str
+        The varied key: ``"rub.clearance"``, ``"speeds.<spool>"`` or a plate's number (:data:`KEYS`).
+    start : float
+        The key's first value, > 0 (its unit in :data:`KEYS`: m for a clearance, Hz for a speed).
+    end : float, optional
+        The key's last value, > 0 (same unit).
+
+    Raises
+    ------
+    InputError
+        Naming ``--param`` (or the scene, or the plate's field) and what is allowed.
+    """
     if not scene.plates:
         checks.fail("SCENE", scene.name, "must have a rub plate ([[rub]]): the branch is of the rub response")
     spools = tuple(scene.speeds)
@@ -450,6 +483,14 @@ def continue_scene(scene, model, key: str, start: float, end: float, options: Br
     Returns
     -------
     SceneBranch
+
+    Raises
+    ------
+    InputError
+        If ``options`` is not a :class:`BranchOptions`, or the branch cannot follow ``key`` in ``scene``
+        (:func:`check_key`).
+    NotConverged
+        If no periodic solution is found at ``start`` (:func:`cold_start`).
     """
     if not isinstance(options, BranchOptions):
         checks.fail("options", type(options).__name__, "must be a BranchOptions")

@@ -21,7 +21,19 @@ __all__ = ["format_branch", "write_branch"]
 
 def format_branch(branch) -> str:
     """A summary: the points, the folds, where it stopped, the stable share and the times (an interrupted branch's
-    first line says so: "INCOMPLETE: interrupted (SIGINT) ...")."""
+    first line says so: "INCOMPLETE: interrupted (SIGINT) ...").
+
+    Parameters
+    ----------
+    branch : SceneBranch
+        The branch (:func:`rotorred.scenes.branch.continue_scene`).
+
+    Returns
+    -------
+    str
+        A table of at most ~25 points (the key in its shown unit, peak in µm, largest multiplier modulus,
+        stability), then the turns, stability changes, why it stopped and the times (s).
+    """
     xs, xu = branch.shown
     dof = dof_name(branch.dofs[0])
     rows = [[f"{xs * v:.4g}", f"{1e6 * p:.3f}", "-" if np.isnan(m) else f"{m:.3f}", STABILITY_FLAGS[f]]
@@ -43,7 +55,17 @@ def write_branch(branch, folder, provenance: Provenance | None = None) -> None:
     (:meth:`SceneBranch.to_xarray <rotorred.scenes.branch.SceneBranch.to_xarray>`), ``branch.png``
     (:meth:`SceneBranch.plot <rotorred.scenes.branch.SceneBranch.plot>`) and ``branch.txt``; a ``provenance``
     (:class:`rotorred.provenance.Provenance`, with the base scene) is written as ``scene.toml``, on top of
-    ``branch.txt`` and as attributes of ``branch.nc``."""
+    ``branch.txt`` and as attributes of ``branch.nc``.
+
+    Parameters
+    ----------
+    branch : SceneBranch
+        The branch.
+    folder : rotorred.writers.OutputFolder
+        The open output folder; the files are staged, and written when it commits.
+    provenance : Provenance, optional
+        What made the branch (the command line's, with the base scene).
+    """
     from rotorred.plots.axes import save_figure  # matplotlib only when figures are written
 
     dof = dof_name(branch.dofs[0])

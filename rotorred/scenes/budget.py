@@ -77,6 +77,7 @@ class Estimate:
     fields: dict
 
     def describe(self) -> str:
+        """One line: the steps, the recorded samples and their memory, the model's DOFs and its matrices' memory."""
         parts = [f"{self.steps:.3g} steps" if self.steps else "",
                  f"{self.samples:.3g} recorded samples ({format_bytes(self.record_bytes)})" if self.samples else "",
                  f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
@@ -123,7 +124,20 @@ class Estimate:
 
 
 def model_estimate(rotor) -> tuple[int, int]:
-    """(DOFs, bytes of the dense matrices) of ``rotor``'s finite-element model (4 DOFs per node)."""
+    """(DOFs, bytes of the dense matrices) of ``rotor``'s finite-element model (4 DOFs per node).
+
+    Parameters
+    ----------
+    rotor : Rotor
+        The rotor; a hierarchical element adds 4 internal DOFs.
+
+    Returns
+    -------
+    n_dof : int
+        Degrees of freedom of the full model.
+    bytes : int
+        Memory of the dense n x n matrices the linear analyses hold at once (bytes).
+    """
     n = 4 * len(rotor.nodes) + 4 * sum(1 for e in _elements(rotor) if getattr(e, "element", "") == "hierarchical")
     return n, _DENSE_MATRICES * 8 * n * n
 
@@ -134,7 +148,18 @@ def _elements(rotor):
 
 
 def scene_estimate(scene) -> Estimate:
-    """Steps, record and model size of a scene's run (the run and its no-rub comparison)."""
+    """Steps, record and model size of a scene's run (the run and its no-rub comparison).
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene (:func:`rotorred.scenes.schema.load_scene`).
+
+    Returns
+    -------
+    Estimate
+        Check it with :meth:`Estimate.check`.
+    """
     s = scene.solver
     runup = getattr(scene, "runup", None)
     transient = runup is not None or not (scene.is_linear and s.start == "settled")

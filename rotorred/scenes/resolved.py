@@ -36,7 +36,19 @@ _NAVIER = {"plate_a": "a", "plate_b": "b", "plate_h": "h", "plate_E": "E", "plat
 
 
 def scene_toml(scene: Scene) -> str:
-    """The resolved scene as the text of a scene file (:func:`scene_document`)."""
+    """The resolved scene as the text of a scene file (:func:`scene_document`).
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene; its defaults are written out, in the units of a scene file (speeds in Hz,
+        angles in degrees, the rest SI).
+
+    Returns
+    -------
+    str
+        TOML text that :func:`rotorred.scenes.schema.load_scene` reads back to the same scene.
+    """
     return toml_text(scene_document(scene))
 
 

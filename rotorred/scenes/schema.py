@@ -387,8 +387,27 @@ def parse_setting(text: str, option: str = "--set") -> tuple[str, list]:
     """Parse ``"section.key=v1,v2,..."`` or ``"section.key=start:stop:n"`` into (key, values).
 
     Values are TOML values (numbers, strings, booleans); a bare word is a string.
-    ``start:stop:n`` gives ``n`` evenly spaced numbers (n >= 2). ``option`` names the command-line
-    option in messages.
+    ``start:stop:n`` gives ``n`` evenly spaced numbers (n >= 2).
+
+    Parameters
+    ----------
+    text : str
+        The setting, e.g. ``"rub.clearance=10e-6,20e-6"`` or ``"speeds.outer=60:110:51"`` (values in
+        scene units: Hz for speeds, m for a clearance).
+    option : str
+        The command-line option the messages name.
+
+    Returns
+    -------
+    key : str
+        The scene key, e.g. ``"rub.clearance"``.
+    values : list
+        The values, at least one.
+
+    Raises
+    ------
+    InputError
+        If ``text`` is not of either form.
     """
     checks.string(option, text)
     key, _, rhs = text.partition("=")

@@ -29,7 +29,20 @@ def table_dof(result) -> tuple[int, str]:
 
 def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
     """Text summary: set-up, peaks, contact, impacts, the labelled lines (paper's Table 1 form); an incomplete result's
-    first line says so (:meth:`rotorred.provenance.Provenance.on_top` keeps it first under the provenance)."""
+    first line says so (:meth:`rotorred.provenance.Provenance.on_top` keeps it first under the provenance).
+
+    Parameters
+    ----------
+    result : SceneResult
+        The scene's run (:func:`rotorred.scenes.run.run_scene`).
+    files : list of Path
+        Files written, listed at the end.
+
+    Returns
+    -------
+    str
+        Blocks separated by blank lines; peaks in µm, speeds in rpm and Hz, line frequencies in Hz.
+    """
     parts = [_incomplete(result), _setup(result), _peaks(result), _range_warnings(result),
              _contacts(result), _lines(result) if result.spectra else "", _line_fit(result)]
     if files:

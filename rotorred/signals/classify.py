@@ -111,7 +111,7 @@ class PoincareSamples:
     x, velocity : ndarray, shape (n,)
         Interpolated response and its time derivative (units of x, and per s).
     y : ndarray or None, shape (n,)
-        Second channel, if given.
+        Second channel (units of ``x``), if given.
     interpolation_error, velocity_error : float
         Bounds of the spline errors (module docstring), units of x and x/s.
     """
@@ -144,6 +144,12 @@ def poincare_samples(t, x, frequency_hz: float, *, t_start: float | None = None,
     Returns
     -------
     PoincareSamples
+
+    Raises
+    ------
+    InputError
+        If ``t`` is not increasing or has fewer than 5 samples, ``x`` (or ``y``) is not of its shape,
+        ``frequency_hz`` is not in (0, 1/dt) or ``t_start`` lies outside the record.
     """
     from scipy.interpolate import CubicSpline  # 0.2 s to import: after a scene's record, not before it
 
@@ -303,13 +309,13 @@ class Classification:
     torus : Torus
         Torus of the line fit.
     explained_share : float
-        Of the line fit on the part classified.
+        Of the line fit on the part classified (-).
     zero_one_K : float
         0-1 test on the Poincare samples of x (NaN with fewer than 100 samples).
     curve_share : float or None
         Share of the Poincare samples a smooth closed curve explains (rank-2 lattices only).
     residual_peak_share : float
-        Share of the residual's spectral energy in its 10 strongest peaks.
+        Share of the residual's spectral energy in its 10 strongest peaks (-).
     poincare : PoincareSamples
     fit : LineFit
         Line fit of the part classified (the settled part, or the last half).
@@ -379,17 +385,23 @@ def classify(t, x, f_L: float, f_H: float, *, y=None, settling: Settling | None 
     f_L, f_H : float
         Spool frequencies (Hz).
     y : array_like, shape (N,), optional
-        Second channel, sampled into the Poincare section too.
+        Second channel (units of ``x``), sampled into the Poincare section too.
     settling : Settling, optional
         Of this record; default :func:`rotorred.signals.settling.settling_time` with its defaults.
     explained_min, chaos_K, broadband_max : float
-        Thresholds of the rules (module docstring).
+        Thresholds of the rules (-; module docstring).
     options : FitOptions, optional
         Of :func:`rotorred.signals.linefit.fit_lines`.
 
     Returns
     -------
     Classification
+
+    Raises
+    ------
+    InputError
+        If ``t`` is not increasing or has fewer than 32 samples, a threshold is out of range, or ``settling``
+        is not a :class:`Settling`.
     """
     t = checks.vector("t", t, "s", min_len=32, increasing=True)
     x = checks.vector("x", x, min_len=32)

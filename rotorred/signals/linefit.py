@@ -231,7 +231,7 @@ class FittedLine:
     frequency_hz : float
         Exact frequency of the first label, ``m f_H + n f_L`` (Hz).
     amplitude : float
-        Units of the signal.
+        Amplitude a of the line (units of the signal, m for a displacement).
     phase : float
         (rad), relative to the record's own time t.
     standard_error : float
@@ -324,7 +324,7 @@ class LineFit:
         What the lines do not explain: the strongest peaks of the residual, strongest first
         (:func:`fit_lines`), or the spectrum's peaks near no line, by frequency (:func:`fit_peaks`).
     residual : ndarray, shape (N,)
-        ``x`` minus the fitted mean and lines.
+        ``x`` minus the fitted mean and lines (units of the signal).
     residual_spectrum : Spectrum
         Hann amplitude spectrum of the residual.
     trials : tuple of TorusTrial
@@ -371,7 +371,23 @@ class LineFit:
         return np.array([ln.frequency_hz for ln in self.lines])
 
     def evaluate(self, t) -> np.ndarray:
-        """The fitted model ``mean + sum a cos(2 pi f t + phase)`` at times ``t`` (s), shape of ``t``."""
+        """The fitted model ``mean + sum a cos(2 pi f t + phase)`` at times ``t`` (s), shape of ``t``.
+
+        Parameters
+        ----------
+        t : array_like, any shape
+            Times (s), on the fitted record's own (absolute) clock.
+
+        Returns
+        -------
+        ndarray, shape of ``t``
+            The model, in the unit of the fitted signal (m for a displacement).
+
+        Raises
+        ------
+        InputError
+            If a time is not finite.
+        """
         t = checks.array("t", t, unit="s")
         out = np.full(t.shape, self.mean)
         for ln in self.lines:
@@ -891,6 +907,11 @@ def fit_lines(t, x, f_L: float, f_H: float, *, options: FitOptions | None = None
     Returns
     -------
     LineFit
+
+    Raises
+    ------
+    InputError
+        If the record is not uniform or too short, ``f_L`` or ``f_H`` is not > 0, or an option is out of range.
     """
     grid, x = _record(t, x)
     o = _checked_fit_options(options)
@@ -931,8 +952,8 @@ def fit_peaks(t, x, f_L: float, f_H: float, *, spectrum: Spectrum | None = None,
         ``spectrum.dt`` the sample interval; default :func:`rotorred.signals.spectra.settled_spectrum` (the last
         whole common periods on a rectangular window, else flat-top).
     threshold : float
-        Peaks below ``threshold`` times the spectrum's largest non-DC amplitude are ignored, in (0, 1]
-        (default 0.005, 0.5 %).
+        Peaks below ``threshold`` times the spectrum's largest non-DC amplitude are ignored, in (0, 1] (-;
+        default 0.005, 0.5 %).
     torus : (int, int)
         Sub-harmonic orders (k, j) of the candidates ``(m/k) f_H + (n/j) f_L``; (1, 2) admits the half-integer
         multiples of f_L of the paper's experiment (f_H + 3f_L/2).
@@ -946,6 +967,12 @@ def fit_peaks(t, x, f_L: float, f_H: float, *, spectrum: Spectrum | None = None,
     LineFit
         The lines at the peaks, by increasing frequency (``n_significant``: how many); ``unlabelled`` the peaks at
         no line, by increasing frequency; ``explained_share`` that of these lines.
+
+    Raises
+    ------
+    InputError
+        If the record is not uniform, ``f_L`` or ``f_H`` is not > 0, ``spectrum`` is not of the record's last
+        samples, or a setting is out of range.
     """
     grid, x = _record(t, x)
     f_L = checks.positive("f_L", f_L, "Hz")

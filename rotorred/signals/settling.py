@@ -88,7 +88,7 @@ class Settling:
     time : float
         Settling time (s): start of the earliest agreeing window; NaN when not settled.
     tol : float
-        Relative tolerance used.
+        Relative tolerance used (-).
     window, step : float
         Window length and step (s).
     starts : ndarray, shape (n_windows,)
@@ -197,11 +197,11 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
     f_L, f_H : float
         Spool frequencies (Hz).
     tol : float
-        Relative tolerance of the window states, in (0, 1); default 0.02 (module docstring).
+        Relative tolerance of the window states, in (0, 1) (-); default 0.02 (module docstring).
     window : float, optional
         Window length (s); default: module docstring, step 2.
     n_cycles : float
-        Periods of the slowest labelled line in a default window (speeds not commensurate).
+        Periods of the slowest labelled line in a default window (speeds not commensurate), > 0 (-).
     reference : LineFit, optional
         A fit of the end of this record (same f_L, f_H) that chooses the tracked lines, in place
         of the fit of the last quarter (``options`` are then not used for it).
@@ -212,6 +212,12 @@ def settling_time(t, x, f_L: float, f_H: float, *, tol: float = TOLERANCE, windo
     Returns
     -------
     Settling
+
+    Raises
+    ------
+    InputError
+        If ``t`` is not increasing or has fewer than 32 samples, or ``tol``, ``n_cycles`` or ``window`` is out of
+        range.
     """
     t = checks.vector("t", t, "s", min_len=32, increasing=True)
     x = checks.vector("x", x, min_len=32)
