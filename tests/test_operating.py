@@ -219,3 +219,26 @@ def test_simulate_fills_a_spool_its_profile_leaves_out_by_the_rule():
                                   full)
     other = history(Operating.ramp({"a": 20.0, "b": 20.0}, {"a": 100.0, "b": 100.0}, 0.05))
     assert np.max(np.abs(other[1] - full[1])) > 0.3 * np.max(np.abs(full[1]))
+
+
+@pytest.mark.parametrize("operating, expected", [
+    # the reference at rest: the spools at the nominal ratio stand still too, a given spool turns
+    (Operating.point({"c": 0.0, "a": 2 * np.pi * 20.0}), {"a": 2 * np.pi * 20.0, "b": 0.0, "c": 0.0}),
+    # every spool turning: c follows the reference b at its nominal ratio 1/3
+    (Operating.point({"b": 2 * np.pi * 30.0, "a": 2 * np.pi * 20.0}),
+     {"a": 2 * np.pi * 20.0, "b": 2 * np.pi * 30.0, "c": 2 * np.pi * 10.0}),
+])
+def test_harmonic_balance_runs_at_the_operatings_spool_speeds(operating, expected):
+    """harmonic_balance (its start's transient and the balance itself) asks the three-spool model for its matrices
+    at the spool speeds the rule gives, written out here by hand, and at no other; the base frequency is their
+    greatest common divisor (20 and 10 Hz)."""
+    rotor = three_spools()
+    model = _Recording.of(rotor)
+    unbalances = [u for u in (Unbalance(2, 1e-4), Unbalance(12, 1e-4, 1.0), Unbalance(22, 1e-4, 2.0))
+                  if expected[model.spool_of[u.node]] > 0]
+    model.taken()
+    result = rr.harmonic_balance(model, operating, rr.Loads(unbalances), [rr.RubPlate(node=2, disk_radius=0.1)],
+                                 rr.BalanceOptions(harmonics=8, samples=64, dt=1e-4))
+    assert {tuple(c.items()) for c in model.taken()} == {tuple({s: round(w, 9) for s, w in expected.items()}.items())}
+    assert result.speeds == pytest.approx(expected, rel=1e-15)
+    assert result.problem.f0 == pytest.approx(min(w for w in expected.values() if w > 0) / (2 * np.pi), rel=1e-12)

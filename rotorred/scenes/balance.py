@@ -1,0 +1,296 @@
+"""The periodic rub response of a rotor at an operating point by harmonic balance, from Python:
+``harmonic_balance(model, operating, loads, contacts, options)``.
+
+The same problem as a scene's ``solver.method = "harmonic-balance"`` (docs/model.md §15,
+:mod:`rotorred.scenes.harmonic_balance`): the spool speeds must be commensurate, the base frequency
+``f_0`` is their greatest common divisor, each spool's unbalance is a harmonic of it, and the unknowns are
+the Fourier coefficients of each rub disk's x, y and its plate's u_n, u_t. The speeds come from the
+:class:`rotorred.model.operating.Operating` point by its one rule, the model through
+:func:`rotorred.model.assembly.system_of`. The solution is found as a scene's is, by the same functions: Newton
+from the fit of a short transient's last period (5 periods of f_0 from the settled linear state,
+:func:`rotorred.scenes.run.start_record`), else a cold start up through coarser truncations
+(:func:`rotorred.scenes.balance_harmonics.cold_solution`). A rub response can have several periodic solutions at
+one operating point; starting from the transient finds the one the rotor settles onto from its linear orbit. (On
+paper-rub at 20 harmonics, Newton from the linear response alone reached another: node 14 y's 130 Hz line 0.70 µm,
+against 1.27 µm on the solution the transient leads to.)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.model.assembly import system_of
+from rotorred.model.operating import Operating, checked as checked_operating
+from rotorred.model.rotor import Rotor
+from rotorred.nonlinear.fourier import to_phasors
+from rotorred.nonlinear.hb import coefficient_variables, solve_periodic
+from rotorred.results import Result, dof_coordinates
+from rotorred.scenes.balance_harmonics import TOL, cold_solution, samples_for
+from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
+from rotorred.scenes.run import start_record
+from rotorred.scenes.schema import SolverSpec
+from rotorred.transient.contact import RubPlate
+from rotorred.transient.options import Loads
+
+__all__ = ["BalanceOptions", "RubCase", "RubBalance", "harmonic_balance"]
+
+
+@dataclass(frozen=True)
+class BalanceOptions:
+    """The truncation and accuracy of a harmonic balance, and the DOFs it reports (:func:`harmonic_balance`).
+
+    Parameters
+    ----------
+    harmonics : int
+        Harmonics H of the base frequency f_0, >= 1 (default 50; ``validation/hb_harmonics.py`` measures how the
+        response converges with H).
+    samples : int, optional
+        AFT samples N a period, even and >= 2 H + 2; default 20.48 H rounded up to even (2048 for 100).
+    dt : float
+        Time step of the short transient the solution starts from (s), > 0; the step used is the next one at or below
+        it that divides the period 1 / f_0.
+    outputs : sequence of (int, str)
+        Model DOFs (node, direction) reported; default x and y of every rub node.
+
+    Every solution is solved to a relative residual of 1e-9 (:data:`rotorred.scenes.balance_harmonics.TOL`).
+    """
+
+    harmonics: int = 50
+    samples: int | None = None
+    dt: float = 2e-5
+    outputs: Sequence[tuple[int, str]] = ()
+
+    def __post_init__(self):
+        H = checks.integer("options.harmonics", self.harmonics, ge=1)
+        if self.samples is not None:
+            N = checks.integer("options.samples", self.samples, ge=2 * H + 2)
+            if N % 2:
+                checks.fail("options.samples", N, "must be even")
+        checks.positive("options.dt", self.dt, "s")
+        object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
+
+    @property
+    def n_samples(self) -> int:
+        """N: the samples given, or the default for the harmonics."""
+        return self.samples if self.samples is not None else samples_for(self.harmonics)
+
+
+@dataclass(frozen=True)
+class RubCase:
+    """What a scene's harmonic balance reads of it (:func:`rotorred.scenes.harmonic_balance.rub_problem`,
+    :func:`rotorred.scenes.run.start_record`): the rotor, the spool speeds, the unbalances, the plates and the time
+    step of the start's transient (a :class:`rotorred.scenes.schema.Scene` is one too).
+
+    Attributes
+    ----------
+    rotor : Rotor
+    speeds : dict of str to float
+        Speed of every spool (rad/s).
+    unbalances : tuple of Unbalance
+    plates : tuple of RubPlate
+        Each with its disk radius.
+    solver : SolverSpec
+        Its ``dt`` (s) is the start's time step; no gravity.
+    """
+
+    rotor: Rotor
+    speeds: Mapping[str, float]
+    unbalances: tuple
+    plates: tuple
+    solver: SolverSpec
+
+    @property
+    def frequencies_hz(self) -> dict[str, float]:
+        """Spool frequencies (Hz)."""
+        return {s: w / (2 * math.pi) for s, w in self.speeds.items()}
+
+
+@dataclass(frozen=True, repr=False)
+class RubBalance(Result):
+    """The periodic rub response of a rotor at an operating point (:func:`harmonic_balance`).
+
+    Attributes
+    ----------
+    problem : RubProblem
+        The condensed problem solved (its model, base frequency and harmonics).
+    z : ndarray, shape ((2H + 1) n_u,)
+        The solution: harmonic-major Fourier coefficients of the unknowns (m).
+    iterations : int
+        Newton iterations of the last solve.
+    residual : float
+        Relative residual at ``z`` (-).
+    outputs : tuple of (int, str)
+        The model DOFs reported.
+    operating : Operating
+        The operating point.
+    speeds : dict of str to float
+        Speed of every spool there (rad/s).
+    """
+
+    problem: RubProblem
+    z: np.ndarray
+    iterations: int
+    residual: float
+    outputs: tuple
+    operating: Operating
+    speeds: Mapping[str, float]
+
+    @property
+    def H(self) -> int:
+        """The highest harmonic of f_0."""
+        return self.problem.problem.harmonics.H
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Frequency k f_0 of each harmonic k = 0..H, shape (H + 1,) (Hz)."""
+        return np.arange(self.H + 1) * self.problem.f0
+
+    @property
+    def phasors(self) -> np.ndarray:
+        """Complex amplitude ``Q_k = a_k - i b_k`` of each harmonic k and output, shape (H + 1, n_outputs) (m or rad):
+        harmonic k of an output is ``Re(Q_k exp(2 pi i k f_0 t))``."""
+        C = np.column_stack([self.problem.coefficients(self.z, dof) for dof in self.outputs])
+        return to_phasors(C)
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        """Amplitude of each harmonic k and output, shape (H + 1, n_outputs) (m or rad)."""
+        return np.abs(self.phasors)
+
+    def waveform(self, dof: tuple[int, str], t) -> np.ndarray:
+        """The model DOF ``dof`` at the times ``t`` (s).
+
+        Parameters
+        ----------
+        dof : (int, str)
+            A model DOF (node, direction).
+        t : array_like, shape (m,)
+            Times (s); the phase origin is t = 0.
+
+        Returns
+        -------
+        ndarray, shape (m,)
+            Displacement (m) or rotation (rad).
+        """
+        return self.problem.record(self.z, np.asarray(t, float), [tuple(dof)])[0][tuple(dof)]
+
+    def summary(self) -> list[str]:
+        """The operating point, the truncation, the convergence and each output's strongest harmonics."""
+        p = self.problem
+        lines = [f"harmonic balance of {p.model.name or 'the rotor'} at {self.operating.describe()}",
+                 f"f_0 = {p.f0:.6g} Hz, {self.H} harmonics, {p.problem.harmonics.N} samples a period; "
+                 f"{len(p.problem.dofs)} unknowns",
+                 f"{self.iterations} Newton iterations, relative residual {self.residual:.3g}"]
+        A = self.amplitudes
+        for j, dof in enumerate(self.outputs[:8]):
+            top = np.argsort(-A[:, j])[:3]
+            lines.append(f"node {dof[0]} {dof[1]}: " + ", ".join(
+                f"{1e6 * A[k, j]:.4g} µm at {self.frequencies[k]:.6g} Hz" for k in top if A[k, j] > 0))
+        if len(self.outputs) > 8:
+            lines.append(f"... {len(self.outputs) - 8} more outputs")
+        return lines
+
+    def plot(self, ax=None, *, title: str | None = None):
+        """The amplitude of each harmonic of each output at its frequency (µm, log scale).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Where to draw (default: a new figure).
+        title : str, optional
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from rotorred.plots.branch import plot_harmonics
+
+        return plot_harmonics(self.frequencies, self.amplitudes, [f"node {n} {d}" for n, d in self.outputs], ax,
+                              title=title)
+
+    def to_xarray(self):
+        """Dims harmonic, output: ``cos`` a_k, ``sin`` b_k and ``amplitude`` (m); ``frequency`` (Hz); the spool speeds
+        (rad/s) on dim spool; f_0, iterations and residual as attributes."""
+        import xarray as xr
+
+        spools = list(self.speeds)
+        return xr.Dataset(
+            {**coefficient_variables(self.phasors, ("harmonic", "output")),
+             "spool_speed": ("spool", np.array([self.speeds[s] for s in spools]),
+                             {"units": "rad/s", "long_name": "spool speed"})},
+            coords={"harmonic": ("harmonic", np.arange(self.H + 1), {"units": "1", "long_name": "harmonic k of f_0"}),
+                    "frequency": ("harmonic", self.frequencies, {"units": "Hz", "long_name": "frequency k f_0"}),
+                    "spool": ("spool", np.array(spools, dtype=object), {"units": "1", "long_name": "spool"}),
+                    **dof_coordinates("output", self.outputs, "reported DOF")},
+            attrs={"f0_hz": self.problem.f0, "iterations": self.iterations, "residual": self.residual})
+
+
+def harmonic_balance(model, operating: Operating, loads: Loads, contacts: Sequence[RubPlate],
+                     options: BalanceOptions = BalanceOptions()) -> RubBalance:
+    """The periodic rub response of ``model`` at the ``operating`` point by harmonic balance (docs/model.md §15).
+
+    Parameters
+    ----------
+    model : Rotor, SystemMatrices or ReducedSystem
+        Built from a rotor (:func:`rotorred.model.assembly.system_of`); each rub node's x and y must be its own
+        coordinates (a boundary node of a reduced model: ``reduce_rotor(rotor, extra_nodes=[node])``).
+    operating : Operating
+        One point whose spool speeds are commensurate (their greatest common divisor f_0 >= 0.1 Hz).
+    loads : Loads
+        The unbalances; no gravity (a static load has no periodic balance here).
+    contacts : sequence of RubPlate
+        At least one plate; a plate without ``disk_radius`` takes its disk's from the rotor.
+    options : BalanceOptions
+        Harmonics, AFT samples, tolerance and the DOFs reported.
+
+    Returns
+    -------
+    RubBalance
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For a bad input, before any computation: incommensurate speeds, no plate, gravity, a rub node that is not a
+        coordinate of the model.
+    rotorred.nonlinear.hb.NotConverged
+        If Newton does not reach a solution from the transient's record nor from a cold start.
+    """
+    system = system_of(model)
+    if system.rotor is None:
+        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor): the plates' "
+                    "spools and disks are the rotor's")
+    operating = checked_operating(operating)
+    speeds = operating.single(system)
+    case = RubCase(system.rotor, speeds, _unbalances(loads), _plates(contacts, system.rotor),
+                   SolverSpec(dt=options.dt, method="harmonic-balance"))
+    outputs = options.outputs or tuple((p.node, d) for p in case.plates for d in ("x", "y"))
+    for k, dof in enumerate(outputs):
+        system.full_dofs.checked_outputs([dof], f"options.outputs[{k}]")
+    H, N = options.harmonics, options.n_samples
+    rub_problem(case, system, H, N)  # every check of the problem before the transient runs
+    rp, z, _ = cold_solution(case, system, H, N, record=start_record(case, system))
+    final = solve_periodic(rp.problem, z, rp.omega, tol=TOL)  # the iterations and residual at z
+    return RubBalance(rp, final.z, final.iterations, final.residual, outputs, operating, dict(speeds))
+
+
+def _unbalances(loads: Loads) -> tuple:
+    if not isinstance(loads, Loads):
+        checks.fail("loads", type(loads).__name__, "must be a Loads")
+    if loads.gravity:
+        checks.fail("loads.gravity", loads.gravity, "must be None: harmonic balance here has no static load", "m/s^2")
+    return tuple(loads.unbalances)
+
+
+def _plates(contacts, rotor: Rotor) -> tuple:
+    plates = checks.sequence("contacts", list(contacts), min_len=1)
+    out = []
+    for k, p in enumerate(plates):
+        if not isinstance(p, RubPlate):
+            checks.fail(f"contacts[{k}]", type(p).__name__, "must be a RubPlate")
+        out.append(p if p.disk_radius is not None else p.with_(disk_radius=rotor.disk_at(p.node).radius))
+    return tuple(out)
