@@ -23,6 +23,7 @@ from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.rotor import Rotor, Spool
 from rotorred.model.rotor_file import load_rotor
+from test_operating import three_spools
 
 VALIDATION = Path(__file__).resolve().parents[1] / "validation"
 
@@ -549,15 +550,6 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off
 
 
-def _three_spools(speeds=(100.0, 0.0, 0.0)) -> Rotor:
-    steel = Material("steel", E=2.1e11, rho=7850.0, nu=0.3)
-    spools = tuple(Spool(name, tuple(ShaftElement(first + i, first + i + 1, 0.1, 0.03, 0.0, steel) for i in range(4)),
-                         speed=w) for name, first, w in zip(("a", "b", "c"), (0, 10, 20), speeds))
-    disks = tuple(Disk(first + 2, 5.0, 0.02, 0.04) for first in (0, 10, 20))
-    bearings = tuple(Bearing(k_xx=1e7, k_yy=1e7, c_xx=50.0, c_yy=50.0, node=n) for n in (0, 4, 10, 14, 20, 24))
-    return Rotor(spools, disks=disks, bearings=bearings, name="three")
-
-
 def test_three_spools_take_ratios_by_name():
     """Ratios to the reference spool by name, for any number of spools: the same diagram as a rotor whose
     nominal speeds have those ratios (two paths, equal to the last bit); a spool without a ratio keeps its
@@ -565,18 +557,18 @@ def test_three_spools_take_ratios_by_name():
     from rotorred.cli.campbell import ratios_to_reference
 
     speeds = np.linspace(0.0, 800.0, 9)
-    by_name = campbell(_three_spools(), Operating.line(speeds, ratios={"b": 1.5, "c": 0.5}), n_modes=6)
-    by_nominal = campbell(_three_spools((100.0, 150.0, 50.0)), Operating.line(speeds), n_modes=6)
+    by_name = campbell(three_spools((100.0, 0.0, 0.0)), Operating.line(speeds, ratios={"b": 1.5, "c": 0.5}), n_modes=6)
+    by_nominal = campbell(three_spools((100.0, 150.0, 50.0)), Operating.line(speeds), n_modes=6)
     assert by_name.speed_ratios == {"a": 1.0, "b": 1.5, "c": 0.5}
     np.testing.assert_array_equal(by_name.frequencies, by_nominal.frequencies)
     assert [c.line for c in by_name.critical_speeds] == [c.line for c in by_nominal.critical_speeds]
-    assert campbell(_three_spools((100.0, 150.0, 50.0)), Operating.line(speeds, ratios={"c": 2.0})).speed_ratios == \
+    assert campbell(three_spools((100.0, 150.0, 50.0)), Operating.line(speeds, ratios={"c": 2.0})).speed_ratios == \
         {"a": 1.0, "b": 1.5, "c": 2.0}
     with pytest.raises(InputError, match=r"^operating = .*: must state the speed of spool\(s\) \['c'\] \(ratios= or "
                                          r"fixed=\): the nominal speed of the reference spool 'a' is 0"):
-        campbell(_three_spools((0.0, 0.0, 0.0)), Operating.line(speeds, ratios={"b": 1.5}))
+        campbell(three_spools((0.0, 0.0, 0.0)), Operating.line(speeds, ratios={"b": 1.5}))
     with pytest.raises(InputError, match=r"^--ratio = 1\.5: must be SPOOL=R for rotor 'three' with 3 spool\(s\)"):
-        ratios_to_reference(1.5, _three_spools(), None)
+        ratios_to_reference(1.5, three_spools((100.0, 0.0, 0.0)), None)
 
 
 def test_campbell_of_the_craig_bampton_model_converges_to_the_full_one(tmp_path, capsys):
