@@ -141,8 +141,20 @@ class Branch(Result):
         return np.array([to_phasors(zi.reshape(-1, self.n)) for zi in self.z])
 
     def amplitude(self, dof: int, order: int = 1) -> np.ndarray:
-        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of the unknown ``dof`` at each point,
-        shape (p,)."""
+        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of the unknown ``dof`` at each point.
+
+        Parameters
+        ----------
+        dof : int
+            Position of the DOF among the unknowns, 0 to n - 1.
+        order : int
+            The harmonic k, 0 to H.
+
+        Returns
+        -------
+        ndarray, shape (p,)
+            (m; rad for a rotation DOF).
+        """
         n = self.n
         if order == 0:
             return np.abs(self.z[:, dof])
@@ -150,6 +162,7 @@ class Branch(Result):
         return np.hypot(a, b)
 
     def summary(self) -> list[str]:
+        """The parameter's range, the size, the turns, the stability, the largest amplitude and why it stopped."""
         name, unit = self.parameter
         p, k = len(self.values), int(np.count_nonzero(self.known))
         folds = [f"{f.value:.6g}{'' if f.smooth else ' (corner)'}" for f in self.folds]
@@ -164,7 +177,23 @@ class Branch(Result):
 
     def plot(self, ax=None, *, dof: int = 0, order: int = 1, title: str | None = None):
         """The amplitude of harmonic ``order`` of the unknown ``dof`` (µm) against the parameter: stable solid, unstable
-        dashed, stability not computed grey, folds and corners marked (:func:`rotorred.plots.branch.plot_branch`)."""
+        dashed, stability not computed grey, folds and corners marked (:func:`rotorred.plots.branch.plot_branch`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        dof : int
+            Position of the DOF among the unknowns, 0 to n - 1.
+        order : int
+            The harmonic k, 0 to H.
+        title : str, optional
+            The figure's title.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.branch import plot_branch
 
         name, unit = self.parameter
@@ -267,8 +296,8 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     Parameters
     ----------
     problem : PeriodicProblem
-    z0 : ndarray
-        A start for the first point (e.g. the linear response).
+    z0 : ndarray, shape (problem.size,)
+        A start for the first point (e.g. the linear response; m, rad for a rotation DOF).
     omega_start, omega_end : float
         Response frequencies (rad/s), > 0.
     options : ContinuationOptions
@@ -283,6 +312,13 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     Returns
     -------
     Branch
+
+    Raises
+    ------
+    InputError
+        If ``options`` is not a ContinuationOptions, or ``omega_start`` or ``omega_end`` is not > 0.
+    NotConverged
+        If the first point does not converge (a later point that does not ends the branch instead).
     """
     if not isinstance(options, ContinuationOptions):
         checks.fail("options", type(options).__name__, "must be a ContinuationOptions")

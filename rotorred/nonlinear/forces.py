@@ -54,6 +54,20 @@ class CubicSpring:
         return (self.dof,)
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
+        """The force ``k3 q^3`` and its derivatives at the AFT samples.
+
+        Parameters
+        ----------
+        q, v : ndarray, shape (N, 1)
+            Displacement (m) and velocity (m/s) of :attr:`dof` at each sample.
+
+        Returns
+        -------
+        f : ndarray, shape (N, 1)
+            The force (N).
+        df_dq, df_dv : ndarray, shape (N, 1, 1)
+            ``3 k3 q^2`` (N/m) and zeros (N s/m).
+        """
         f = self.k3 * q**3
         return f, (3.0 * self.k3 * q**2)[:, :, None], np.zeros(q.shape + (1,))
 
@@ -84,6 +98,20 @@ class CircularClearance:
         object.__setattr__(self, "k_c", checks.positive("k_c", self.k_c, "N/m"))
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
+        """The contact force ``k_c (r - g) (x, y) / r`` (0 for ``r <= g``) and its derivatives at the AFT samples.
+
+        Parameters
+        ----------
+        q, v : ndarray, shape (N, 2)
+            Displacements (m) and velocities (m/s) of the x and y DOFs at each sample.
+
+        Returns
+        -------
+        f : ndarray, shape (N, 2)
+            The force on (x, y) (N).
+        df_dq, df_dv : ndarray, shape (N, 2, 2)
+            Its Jacobians (N/m) and zeros (N s/m): no friction, no damping.
+        """
         r = np.hypot(q[:, 0], q[:, 1])
         touching = r > self.gap
         safe = np.where(touching, r, 1.0)
@@ -128,6 +156,20 @@ class PlateRub:
         object.__setattr__(self, "surface_speed", checks.number("surface_speed", self.surface_speed, "m/s"))
 
     def evaluate(self, q: np.ndarray, v: np.ndarray):
+        """The forces ``P n - T t`` on the disk and ``(-P, T)`` on the plate, and their derivatives, at the AFT samples.
+
+        Parameters
+        ----------
+        q, v : ndarray, shape (N, 4)
+            Displacements (m) and velocities (m/s) of (x, y, u_n, u_t) at each sample.
+
+        Returns
+        -------
+        f : ndarray, shape (N, 4)
+            The forces on (x, y, u_n, u_t) (N), zero out of contact.
+        df_dq, df_dv : ndarray, shape (N, 4, 4)
+            Their Jacobians (N/m) and (N s/m), rank one at each sample.
+        """
         plate, grad, (N, m) = self.plate, self.gradient, q.shape
         f, dq, dv = np.zeros((N, m)), np.zeros((N, m, m)), np.zeros((N, m, m))
         _plate_rub(q @ grad - plate.clearance, v @ grad, self.slip_sign(v), grad, plate.mu_d,
@@ -135,8 +177,19 @@ class PlateRub:
         return f, dq, dv
 
     def slip_sign(self, v: np.ndarray) -> np.ndarray:
-        """sign(v_rel) at the samples of the velocities ``v`` (N, 4) (:func:`rotorred.transient.contact.sliding_velocity`,
-        the rim speed given as Omega r)."""
+        """sign(v_rel) of ``v_rel = Omega r + (x', y') . t - u_t'`` at the samples
+        (:func:`rotorred.transient.contact.sliding_velocity`, the rim speed given as Omega r).
+
+        Parameters
+        ----------
+        v : ndarray, shape (N, 4)
+            Velocities of (x, y, u_n, u_t) at each sample (m/s).
+
+        Returns
+        -------
+        ndarray, shape (N,)
+            -1, 0 or 1 (-).
+        """
         return np.sign(sliding_velocity(self.plate, self.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]))
 
     @property
@@ -146,8 +199,23 @@ class PlateRub:
         return np.array([math.cos(self.plate.theta), math.sin(self.plate.theta), -1.0, 0.0])
 
     def with_clearance(self, clearance: float) -> PlateRub:
-        """The same rub at another clearance (m): a copy with the clearance checked alone, the rest checked already (a
-        branch in the clearance asks one at every evaluation; the whole plate's checks were a quarter of one)."""
+        """The same rub at another clearance: a copy with the clearance checked alone, the rest checked already (a
+        branch in the clearance asks one at every evaluation; the whole plate's checks were a quarter of one).
+
+        Parameters
+        ----------
+        clearance : float
+            The plate's clearance (m).
+
+        Returns
+        -------
+        PlateRub
+
+        Raises
+        ------
+        InputError
+            If ``clearance`` is not a finite number.
+        """
         plate, rub = copy.copy(self.plate), copy.copy(self)
         object.__setattr__(plate, "clearance", checks.number("clearance", clearance, "m"))
         object.__setattr__(rub, "plate", plate)

@@ -142,8 +142,18 @@ class Harmonics:
         object.__setattr__(self, "_index", index)
 
     def rows_at(self, theta: np.ndarray) -> np.ndarray:
-        """The rows ``[1, cos theta, sin theta, ..., cos H theta, sin H theta]`` at the angles ``theta`` (rad), shape
-        (len(theta), 2H + 1): coefficients -> values there (``E`` at the AFT instants)."""
+        """The rows ``[1, cos theta, sin theta, ..., cos H theta, sin H theta]`` at the angles ``theta``: coefficients
+        -> values there (``E`` at the AFT instants).
+
+        Parameters
+        ----------
+        theta : array_like, shape (m,)
+            Angles ``omega t`` (rad).
+
+        Returns
+        -------
+        ndarray, shape (m, 2H + 1)
+        """
         theta = np.asarray(theta, float)
         k = np.arange(1, self.H + 1)
         rows = np.empty((len(theta), 2 * self.H + 1))
@@ -161,23 +171,76 @@ class Harmonics:
         return np.concatenate([[0], np.repeat(np.arange(1, self.H + 1), 2)])
 
     def samples(self, z: np.ndarray, n: int) -> np.ndarray:
-        """``q(theta_j)``, shape (N, n), of the harmonic-major coefficients ``z`` of ``n`` DOFs."""
+        """``q(theta_j)`` at the N AFT instants of the harmonic-major coefficients ``z`` of ``n`` DOFs.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients ``[a_0, a_1, b_1, ..., a_H, b_H]``, each block the n DOFs (m; rad for a
+            rotation DOF).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape (N, n)
+            The values, in the units of ``z``.
+        """
         return self.synthesised(z.reshape(self.size, n))
 
     def rates(self, z: np.ndarray, n: int) -> np.ndarray:
-        """``dq/dtheta (theta_j)``, shape (N, n): multiply by omega for dq/dt."""
+        """``dq/dtheta (theta_j)`` at the N AFT instants: multiply by omega for dq/dt.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients of ``n`` DOFs (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape (N, n)
+            The rates per radian of ``theta``, in the units of ``z``.
+        """
         return self.synthesised(self.derivative(z, n).reshape(self.size, n))
 
     def motion(self, z: np.ndarray, n: int, omega: float) -> tuple[np.ndarray, np.ndarray]:
-        """Displacements and velocities ``q(theta_j)``, ``omega dq/dtheta (theta_j)``, shape (N, n) each, of the
-        harmonic-major coefficients ``z`` of ``n`` DOFs at frequency ``omega`` (rad/s): one synthesis of both."""
+        """Displacements and velocities ``q(theta_j)``, ``omega dq/dtheta (theta_j)`` of the harmonic-major
+        coefficients ``z`` of ``n`` DOFs at frequency ``omega``: one synthesis of both.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+        omega : float
+            The fundamental frequency (rad/s).
+
+        Returns
+        -------
+        q, v : ndarray, shape (N, n)
+            Displacements (m) and velocities (m/s) at the N AFT instants.
+        """
         both = self.synthesised(np.hstack([z.reshape(self.size, n), self.derivative(z, n).reshape(self.size, n)]))
         return both[:, :n], omega * both[:, n:]
 
     def synthesised(self, Z: np.ndarray) -> np.ndarray:
-        """``E Z``: the samples of coefficients ``Z`` (2H + 1, n), by the product or, for a large N (2H + 1)
+        """``E Z``: the samples of coefficients ``Z``, by the product or, for a large N (2H + 1)
         (:data:`SYNTHESIS_BY_FFT`), by an inverse real FFT of the spectrum ``X_0 = N a_0``, ``X_k = N (a_k - i b_k) / 2``
-        (the same sums: equal to 1.2e-12 of unit coefficients at H = 100, test)."""
+        (the same sums: equal to 1.2e-12 of unit coefficients at H = 100, test).
+
+        Parameters
+        ----------
+        Z : ndarray, shape (2H + 1, p)
+            Coefficients ``[a_0, a_1, b_1, ..., a_H, b_H]`` (rows) of p signals (columns), any units.
+
+        Returns
+        -------
+        ndarray, shape (N, p)
+            The values at the N AFT instants, in the units of ``Z``.
+        """
         if self.N * self.size <= SYNTHESIS_BY_FFT:
             return self.E @ Z
         X = np.zeros((self.N // 2 + 1, Z.shape[1]), complex)
@@ -186,16 +249,41 @@ class Harmonics:
         return np.fft.irfft(X, n=self.N, axis=0)
 
     def derivative(self, z: np.ndarray, n: int) -> np.ndarray:
-        """The harmonic-major coefficients of dq/dtheta, ``(nabla (x) I_n) z``, shape ((2H + 1) n,): (a_k, b_k)' =
-        k (b_k, -a_k), written out (not the dense product with ``nabla``)."""
+        """The harmonic-major coefficients of dq/dtheta, ``(nabla (x) I_n) z``: (a_k, b_k)' = k (b_k, -a_k), written
+        out (not the dense product with ``nabla``).
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients of ``n`` DOFs (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape ((2H + 1) n,)
+            In the units of ``z`` per radian of ``theta``.
+        """
         Z, out = z.reshape(self.size, n), np.zeros((self.size, n))
         k = np.arange(1, self.H + 1)[:, None]
         out[1::2], out[2::2] = k * Z[2::2], -k * Z[1::2]
         return out.reshape(-1)
 
     def times_derivative(self, X: np.ndarray, n: int) -> np.ndarray:
-        """``X (nabla (x) I_n)`` for X of shape (p, (2H + 1) n): a permutation and scaling of X's columns,
-        (a_k, b_k) <- (-k b_k, k a_k), not a dense product."""
+        """``X (nabla (x) I_n)``: a permutation and scaling of X's columns, (a_k, b_k) <- (-k b_k, k a_k), not a dense
+        product.
+
+        Parameters
+        ----------
+        X : ndarray, shape (p, (2H + 1) n)
+            A matrix acting on harmonic-major coefficients (e.g. a Toeplitz matrix, :meth:`toeplitz`).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape (p, (2H + 1) n)
+        """
         H = self.H
         X3 = X.reshape(X.shape[0], self.size, n)
         out = np.zeros_like(X3)
@@ -205,15 +293,37 @@ class Harmonics:
         return out.reshape(X.shape)
 
     def coefficients(self, f: np.ndarray) -> np.ndarray:
-        """The harmonic-major coefficients of samples ``f`` (N, n): the first H + 1 terms of the DFT, as the matrix
-        product ``forward @ f`` where that is the cheaper (:data:`MATRIX_US`), else by the FFT (pyFFTW). Both are
-        the same DFT (test: equal to 1.7e-14 on unit coefficients)."""
+        """The harmonic-major coefficients of samples ``f``: the first H + 1 terms of the DFT, as the matrix product
+        ``forward @ f`` where that is the cheaper (:data:`MATRIX_US`), else by the FFT (pyFFTW). Both are the same DFT
+        (test: equal to 1.7e-14 on unit coefficients).
+
+        Parameters
+        ----------
+        f : ndarray, shape (N, n)
+            Values at the N AFT instants of n signals (e.g. forces, N).
+
+        Returns
+        -------
+        ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients, in the units of ``f``.
+        """
         if MATRIX_US * (self.H + 1) * self.N < FFT_US[0] + FFT_US[1] * self.N:
             return (self.forward @ f).reshape(-1)
         return self.coefficients_fft(f)
 
     def coefficients_fft(self, f: np.ndarray) -> np.ndarray:
-        """:meth:`coefficients` by the FFT (pyFFTW plans of :func:`rotorred.signals.spectra.rfft`)."""
+        """:meth:`coefficients` by the FFT (pyFFTW plans of :func:`rotorred.signals.spectra.rfft`).
+
+        Parameters
+        ----------
+        f : ndarray, shape (N, n)
+            Values at the N AFT instants of n signals.
+
+        Returns
+        -------
+        ndarray, shape ((2H + 1) n,)
+            Harmonic-major coefficients, in the units of ``f``.
+        """
         X = rfft(f)  # every column at once
         out = np.empty((self.size, f.shape[1]))
         out[0] = X[0].real / self.N
@@ -222,11 +332,22 @@ class Harmonics:
         return out.reshape(-1)
 
     def toeplitz(self, d: np.ndarray) -> np.ndarray:
-        """The coefficients of ``d(theta) p(theta)`` as a matrix acting on those of ``p``, for samples ``d`` of a
-        Jacobian, shape (N, n, n): ``forward diag(d) E`` per DOF pair, harmonic-major, shape ((2H+1) n,) * 2. It is
-        the chain rule through the AFT (and the Hill matrix of ``d``). Written out for small N (2H + 1); else from the
-        spectrum, where entries of ``d`` that are multiples of one another (a rub's Jacobian is rank 1, each entry a
-        constant times dP/dp) share one block, computed once (the rig's evaluation: 133 -> 51 ms at H = 100)."""
+        """The coefficients of ``d(theta) p(theta)`` as a matrix acting on those of ``p``: ``forward diag(d) E`` per
+        DOF pair, harmonic-major. It is the chain rule through the AFT (and the Hill matrix of ``d``). Written out for
+        small N (2H + 1); else from the spectrum, where entries of ``d`` that are multiples of one another (a rub's
+        Jacobian is rank 1, each entry a constant times dP/dp) share one block, computed once (the rig's evaluation:
+        133 -> 51 ms at H = 100).
+
+        Parameters
+        ----------
+        d : ndarray, shape (N, n, n)
+            A Jacobian sampled at the N AFT instants (e.g. df/dq (N/m) or df/dv (N s/m)).
+
+        Returns
+        -------
+        ndarray, shape ((2H + 1) n, (2H + 1) n)
+            In the units of ``d``.
+        """
         n = d.shape[1]
         flat = d.reshape(self.N, n * n)
         if self.N * self.size < TOEPLITZ_BY_SAMPLES:  # cheap: every pair written out
@@ -241,7 +362,17 @@ class Harmonics:
         return self._assembled(blocks, n)
 
     def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
-        """:meth:`toeplitz` as the product ``forward diag(d) E`` written out for every pair (the definition)."""
+        """:meth:`toeplitz` as the product ``forward diag(d) E`` written out for every pair (the definition).
+
+        Parameters
+        ----------
+        d : ndarray, shape (N, n, n)
+            A Jacobian sampled at the N AFT instants.
+
+        Returns
+        -------
+        ndarray, shape ((2H + 1) n, (2H + 1) n)
+        """
         n = d.shape[1]
         return self._assembled(self._blocks_by_samples(d.reshape(self.N, n * n)), n)
 

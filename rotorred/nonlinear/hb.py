@@ -145,7 +145,18 @@ class PeriodicProblem:
         return self.harmonics.size * self.n
 
     def linear(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
-        """``L(omega)`` and ``dL/domega``, shape (size, size)."""
+        """``L(omega) = I (x) K + omega^2 nabla^2 (x) M + omega nabla (x) D(omega)`` and ``dL/domega``.
+
+        Parameters
+        ----------
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        L, dL_domega : ndarray, shape (size, size)
+            (N/m) and (N s/m).
+        """
         o = self._ops
         L = o["IK"] + omega**2 * o["N2M"] + omega * o["ND"]
         dL = 2.0 * omega * o["N2M"] + o["ND"]
@@ -155,17 +166,56 @@ class PeriodicProblem:
         return L, dL
 
     def linear_response(self, omega: float) -> np.ndarray:
-        """The coefficients of the response without the nonlinear forces, ``L(omega)^-1 F_ex(omega)``."""
+        """The coefficients of the response without the nonlinear forces, ``L(omega)^-1 F_ex(omega)``.
+
+        Parameters
+        ----------
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (size,)
+            Harmonic-major coefficients (m; rad for a rotation DOF): a start for :func:`solve_periodic`.
+        """
         return sla.solve(self.linear(omega)[0], self.forcing(omega)[0])
 
     def samples(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
-        """Displacements and velocities at the AFT instants, shape (N, n) each."""
+        """Displacements and velocities at the AFT instants (:meth:`Harmonics.motion`).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        q, v : ndarray, shape (N, n)
+            (m) and (m/s).
+        """
         h = self.harmonics
         return h.motion(z, self.n, omega)
 
     def nonlinear(self, z: np.ndarray, omega: float):
         """The nonlinear force's coefficients and the Toeplitz matrices of its derivatives, T(df/dq) and
-        T(df/dv)."""
+        T(df/dv) (:meth:`Harmonics.toeplitz`).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        F_nl : ndarray, shape (size,)
+            Coefficients of the nonlinear forces (N).
+        Tq, Tv : ndarray, shape (size, size)
+            T(df/dq) (N/m) and T(df/dv) (N s/m).
+        """
         q, v = self.samples(z, omega)
         return transformed_forces(self.harmonics, self.force_columns, q, v)
 
@@ -180,11 +230,34 @@ class PeriodicProblem:
         return [(force, list(force.dofs)) for force in self.forces]
 
     def velocity_matrix(self, omega: float) -> np.ndarray:
-        """D(omega) = D + omega D1 (N s/m)."""
+        """D(omega) = D + omega D1 (N s/m).
+
+        Parameters
+        ----------
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (n, n)
+        """
         return self.D if self.D1 is None else self.D + omega * self.D1
 
     def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
-        """The residual at ``(z, omega)``, and its analytic derivatives on first use (:class:`Evaluation`)."""
+        """The residual ``R(z, omega) = L(omega) z + F_nl(z, omega) - F_ex(omega)`` (N), and its analytic derivatives on
+        first use.
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        Evaluation
+        """
         L, dL = self.linear(omega)
         F, dF = self.forcing(omega)
         q, v = self.samples(z, omega)
@@ -208,7 +281,20 @@ class PeriodicProblem:
 
     def hill_matrices(self, z: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(A2, A1, A0)`` of the Hill quadratic eigenproblem ``(lambda^2 A2 + lambda A1 + A0) p = 0`` of the
-        perturbation ``e^{lambda t} p(t)`` about the solution ``z`` (``A0`` is ``dR/dz``)."""
+        perturbation ``e^{lambda t} p(t)`` about the solution ``z`` (``A0`` is ``dR/dz``).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of a periodic solution (m; rad for a rotation DOF).
+        omega : float
+            Its response frequency (rad/s).
+
+        Returns
+        -------
+        A2, A1, A0 : ndarray, shape (size, size)
+            (kg), (N s/m) and (N/m).
+        """
         _, Tq, Tv = self.nonlinear(z, omega)
         eye = np.eye(self.harmonics.size)
         A2 = np.kron(eye, self.M)
@@ -348,6 +434,7 @@ class PeriodicSolution(Result):
         return np.arange(self.H + 1) * self.omega / (2.0 * np.pi)
 
     def summary(self) -> list[str]:
+        """The frequency, the size, how Newton converged, and the three strongest harmonics."""
         largest = self.amplitudes.max(axis=1)
         strongest = [k for k in np.argsort(-largest)[:3] if largest[k] > 1e-9 * largest.max()]  # above round-off
         top = ", ".join(f"{k} ({self.amplitudes[k].max():.4g} m at DOF {self.dofs[int(np.argmax(self.amplitudes[k]))]})"
@@ -358,8 +445,22 @@ class PeriodicSolution(Result):
                 f"strongest harmonics k: {top}"]
 
     def plot(self, ax=None, *, dofs=None, title: str | None = None):
-        """The amplitude of each harmonic at its frequency, a stem a DOF (µm, log scale); ``dofs``: positions among
-        :attr:`dofs` (default all, at most the 6 largest)."""
+        """The amplitude of each harmonic at its frequency (Hz), a stem a DOF (µm, log scale)
+        (:func:`rotorred.plots.branch.plot_harmonics`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        dofs : sequence of int, optional
+            Positions among :attr:`dofs` to draw; default all, at most the 6 largest.
+        title : str, optional
+            The figure's title.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.branch import plot_harmonics
 
         return plot_harmonics(self.frequencies, self.amplitudes, [f"DOF {d}" for d in self.dofs], ax, columns=dofs,

@@ -5,10 +5,9 @@ equation into the quadratic eigenproblem ``(lambda^2 A2 + lambda A1 + A0) p = 0`
 (:meth:`PeriodicProblem.hill_matrices`), solved as a first-order problem of size 2 (2H + 1) n. Its eigenvalues
 are the Floquet exponents, each repeated at ``lambda + i j omega`` for every shift j within the truncation.
 
-**Sorting** (which 2 n eigenvalues are the exponents): each eigenvector's displacement part is split over the
-harmonic orders, and the 2 n eigenvalues whose eigenvectors have the lowest mean order (the |p_h|^2-weighted
-mean of h) are kept: the exponent's own representative carries its motion on the lowest harmonics, its
-shifted copies on harmonics shifted by j (the symmetric sorting of Lazarus & Thomas, C. R. Mecanique 338, 2010).
+**Sorting** (which 2 n eigenvalues are the exponents): the 2 n eigenvalues of smallest ``|Im lambda|`` are kept:
+an exponent's copies lie ``j omega`` apart along the imaginary axis, and its own representative is the one nearest
+the real axis (on sorting Hill's eigenvalues: Lazarus & Thomas, C. R. Mecanique 338, 2010).
 Tested on systems with known exponents: a linear oscillator (its eigenvalues, exactly) and the Duffing
 oscillator's branches against long transients.
 
@@ -68,7 +67,24 @@ class Floquet:
 
 
 def floquet(problem, z: np.ndarray, omega: float) -> Floquet:
-    """Floquet exponents of the periodic solution ``z`` at ``omega`` by Hill's method with symmetric sorting."""
+    """Floquet exponents of the periodic solution ``z`` at ``omega`` by Hill's method: the eigenvalues of the Hill
+    quadratic eigenproblem (:meth:`PeriodicProblem.hill_matrices`) in first-order form, the 2 n of smallest
+    ``|Im lambda|`` kept.
+
+    Parameters
+    ----------
+    problem : PeriodicProblem
+        Anything with ``hill_matrices(z, omega)`` and ``n`` (:meth:`PeriodicProblem.hill_matrices`).
+    z : ndarray, shape ((2H + 1) n,)
+        The solution's harmonic-major coefficients (m; rad for a rotation DOF).
+    omega : float
+        Its response frequency (rad/s).
+
+    Returns
+    -------
+    Floquet
+        The 2 n exponents (1/s).
+    """
     A2, A1, A0 = problem.hill_matrices(z, omega)
     m = A0.shape[0]
     A2_inv = sla.inv(A2)
@@ -86,8 +102,8 @@ def floquet_by_monodromy(problem, z: np.ndarray, omega: float, substeps: int = 4
     Parameters
     ----------
     problem : PeriodicProblem or CondensedProblem
-    z : ndarray
-        The solution's coefficients.
+    z : ndarray, shape ((2H + 1) n,)
+        The solution's harmonic-major coefficients on the problem's ``dofs`` (m; rad for a rotation DOF).
     omega : float
         Its base frequency (rad/s).
     substeps : int

@@ -144,11 +144,37 @@ class TorusHarmonics:
         return self.N1 * self.N2
 
     def frequencies(self, w) -> np.ndarray:
-        """``k . w`` of each order (rad/s if ``w`` is), shape (K,); signed."""
+        """``k . w`` of each order, signed.
+
+        Parameters
+        ----------
+        w : (float, float)
+            The base frequencies (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (K,)
+            (rad/s).
+        """
         return self.orders @ np.asarray(w, float)
 
     def index(self, k1: int, k2: int) -> int:
-        """The position of the order ``(k1, k2)`` or of its negative in :attr:`orders` (the line is the same)."""
+        """The position of the order ``(k1, k2)`` or of its negative in :attr:`orders` (the line is the same).
+
+        Parameters
+        ----------
+        k1, k2 : int
+            The order's multiples of ``w_1`` and ``w_2``.
+
+        Returns
+        -------
+        int
+
+        Raises
+        ------
+        InputError
+            If neither the order nor its negative is in the truncated set.
+        """
         if k1 < 0 or (k1 == 0 and k2 < 0):
             k1, k2 = -k1, -k2
         hit = np.flatnonzero((self.orders[:, 0] == k1) & (self.orders[:, 1] == k2))
@@ -165,17 +191,56 @@ class TorusHarmonics:
 
     # ----------------------------------------------------------------------------------------------- AFT
     def phasors(self, z: np.ndarray, n: int) -> np.ndarray:
-        """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of the coefficients of ``n`` DOFs, shape (K, n):
-        the line of order k is ``Re(Q_k exp(i k . theta))``."""
+        """Complex amplitudes ``Q_k = a_k - i b_k`` (``Q_0 = a_0``) of the coefficients of ``n`` DOFs: the line of
+        order k is ``Re(Q_k exp(i k . theta))``.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2K - 1) n,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape (K, n), complex
+            In the units of ``z``.
+        """
         return to_phasors(z.reshape(self.size, n))
 
     def from_phasors(self, Q: np.ndarray) -> np.ndarray:
-        """Harmonic-major coefficients of the complex amplitudes ``Q`` (K, n) (the inverse of :meth:`phasors`)."""
+        """Harmonic-major coefficients of complex amplitudes (the inverse of :meth:`phasors`).
+
+        Parameters
+        ----------
+        Q : array_like, shape (K, n), complex
+            ``Q_k = a_k - i b_k`` of each order (row) and DOF (column), any units (m for a response, N for a
+            forcing).
+
+        Returns
+        -------
+        ndarray, shape ((2K - 1) n,)
+            In the units of ``Q``.
+        """
         return from_phasors(np.asarray(Q)).reshape(-1)
 
     def transfer(self, z: np.ndarray, n: int, target: TorusHarmonics) -> np.ndarray:
         """The coefficients ``z`` of ``n`` DOFs on the orders of ``target`` (orders ``target`` has and this set lacks
-        start at 0; the others are dropped): a solution as the start of a larger truncation."""
+        start at 0; the others are dropped): a solution as the start of a larger truncation.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2K - 1) n,)
+            Harmonic-major coefficients on this set's orders (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+        target : TorusHarmonics
+            The other truncation.
+
+        Returns
+        -------
+        ndarray, shape ((2 target.n_orders - 1) n,)
+        """
         Q = self.phasors(z, n)
         out = np.zeros((target.n_orders, n), complex)
         position = {(int(a), int(b)): i for i, (a, b) in enumerate(self.orders)}
@@ -186,8 +251,20 @@ class TorusHarmonics:
         return target.from_phasors(out)
 
     def samples(self, z: np.ndarray, n: int) -> np.ndarray:
-        """``q`` on the grid, shape (N_1 N_2, n), of the harmonic-major coefficients ``z`` of ``n`` DOFs (inverse
-        FFT)."""
+        """``q`` on the grid of the harmonic-major coefficients ``z`` of ``n`` DOFs (inverse 2-D FFT).
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2K - 1) n,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+
+        Returns
+        -------
+        ndarray, shape (N_1 N_2, n)
+            In the units of ``z``, theta_1 major (:meth:`angles`).
+        """
         Q = self.phasors(z, n)
         C = np.zeros((self.n_samples, n), complex)
         C[self._plus[1:]] = 0.5 * Q[1:]
@@ -197,7 +274,22 @@ class TorusHarmonics:
         return q.reshape(self.n_samples, n)
 
     def derivative(self, z: np.ndarray, n: int, w) -> np.ndarray:
-        """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``, shape ((2K - 1) n,)."""
+        """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2K - 1) n,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+        w : (float, float)
+            The base frequencies (rad/s).
+
+        Returns
+        -------
+        ndarray, shape ((2K - 1) n,)
+            In the units of ``z`` per second (m/s).
+        """
         c = z.reshape(self.size, n)
         wk = self.frequencies(w)[1:, None]
         out = np.zeros_like(c)
@@ -205,12 +297,42 @@ class TorusHarmonics:
         return out.reshape(-1)
 
     def rates(self, z: np.ndarray, n: int, w) -> np.ndarray:
-        """``dq/dt`` on the grid, shape (N_1 N_2, n) (units of q per s for ``w`` in rad/s)."""
+        """``dq/dt`` on the grid.
+
+        Parameters
+        ----------
+        z : ndarray, shape ((2K - 1) n,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        n : int
+            DOFs.
+        w : (float, float)
+            The base frequencies (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (N_1 N_2, n)
+            In the units of ``z`` per second (m/s).
+        """
         return self.samples(self.derivative(z, n, w), n)
 
     def times_derivative(self, X: np.ndarray, n: int, w) -> np.ndarray:
-        """``X (Omega (x) I_n)`` for X of shape (p, (2K - 1) n), Omega the derivative operator of :meth:`derivative`:
-        columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k), a scaling and permutation, not a product."""
+        """``X (Omega (x) I_n)``, Omega the derivative operator of :meth:`derivative`: columns
+        (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k), a scaling and permutation, not a product.
+
+        Parameters
+        ----------
+        X : ndarray, shape (p, (2K - 1) n)
+            A matrix acting on harmonic-major coefficients (e.g. a Toeplitz matrix, :meth:`toeplitz`).
+        n : int
+            DOFs.
+        w : (float, float)
+            The base frequencies (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (p, (2K - 1) n)
+            In the units of ``X`` times (rad/s).
+        """
         X3 = X.reshape(X.shape[0], self.size, n)
         wk = self.frequencies(w)[None, 1:, None]
         out = np.zeros_like(X3)
@@ -218,8 +340,18 @@ class TorusHarmonics:
         return out.reshape(X.shape)
 
     def coefficients(self, f: np.ndarray) -> np.ndarray:
-        """The harmonic-major coefficients of samples ``f`` (N_1 N_2, n) on the orders (2-D FFT), shape
-        ((2K - 1) n,)."""
+        """The harmonic-major coefficients of samples ``f`` on the orders (2-D FFT).
+
+        Parameters
+        ----------
+        f : ndarray, shape (N_1 N_2, n)
+            Values on the grid (theta_1 major) of n signals (e.g. forces, N).
+
+        Returns
+        -------
+        ndarray, shape ((2K - 1) n,)
+            In the units of ``f``.
+        """
         n = f.shape[1]
         S = np.fft.fft2(f.reshape(self.N1, self.N2, n), axes=(0, 1)).reshape(self.n_samples, n) / self.n_samples
         c = S[self._plus]
@@ -238,8 +370,19 @@ class TorusHarmonics:
         return E
 
     def toeplitz_blocks(self, columns: np.ndarray) -> np.ndarray:
-        """``T(d)`` of each sampled column ``d`` of ``columns`` (N_1 N_2, p), from its 2-D spectrum (module docstring),
-        shape (p, 2K - 1, 2K - 1). Written in place, a real part at a time (the blocks are large: 2K - 1 = 7000)."""
+        """``T(d)`` of each sampled column ``d`` of ``columns``, from its 2-D spectrum (module docstring). Written in
+        place, a real part at a time (the blocks are large: 2K - 1 = 7000).
+
+        Parameters
+        ----------
+        columns : ndarray, shape (N_1 N_2, p)
+            p sampled Jacobian entries on the grid (e.g. df/dq (N/m)).
+
+        Returns
+        -------
+        ndarray, shape (p, 2K - 1, 2K - 1)
+            In the units of ``columns``.
+        """
         p, K = columns.shape[1], self.n_orders
         S = np.fft.fft2(columns.reshape(self.N1, self.N2, p), axes=(0, 1)).reshape(self.n_samples, p) / self.n_samples
         real, imag = np.ascontiguousarray(S.real.T), np.ascontiguousarray(S.imag.T)
@@ -259,12 +402,33 @@ class TorusHarmonics:
         return out
 
     def toeplitz(self, d: np.ndarray) -> np.ndarray:
-        """``T(d)`` for sampled Jacobians ``d`` (N_1 N_2, n, n), harmonic-major, shape ((2K - 1) n,) * 2."""
+        """``T(d)``, harmonic-major: the coefficients of ``d(theta) p(theta)`` as a matrix acting on those of ``p``.
+
+        Parameters
+        ----------
+        d : ndarray, shape (N_1 N_2, n, n)
+            A Jacobian sampled on the grid (e.g. df/dq (N/m) or df/dv (N s/m)).
+
+        Returns
+        -------
+        ndarray, shape ((2K - 1) n, (2K - 1) n)
+            In the units of ``d``.
+        """
         n = d.shape[1]
         return _assembled(self.toeplitz_blocks(d.reshape(self.n_samples, n * n)), n)
 
     def toeplitz_by_samples(self, d: np.ndarray) -> np.ndarray:
-        """:meth:`toeplitz` as its definition, ``forward diag(d) E`` per DOF pair: sums over the samples."""
+        """:meth:`toeplitz` as its definition, ``forward diag(d) E`` per DOF pair: sums over the samples.
+
+        Parameters
+        ----------
+        d : ndarray, shape (N_1 N_2, n, n)
+            A Jacobian sampled on the grid.
+
+        Returns
+        -------
+        ndarray, shape ((2K - 1) n, (2K - 1) n)
+        """
         n = d.shape[1]
         E = self.basis_matrix()
         forward = E.T * (2.0 / self.n_samples)
@@ -274,9 +438,31 @@ class TorusHarmonics:
 
     def fit(self, t: np.ndarray, x: np.ndarray, w, within: tuple[int, int] | None = None) -> np.ndarray:
         """Coefficients of one DOF fitted by least squares to a record ``x(t)`` on the orders' lines at ``theta = w t``
-        (phase origin t = 0), shape (2K - 1,) (:func:`rotorred.signals.linefit.fit_frequencies`: the lines must be
-        at least 2 / T apart and from 0). With ``within = (h1, h2)`` only the orders with ``|k_1| <= h1`` and
-        ``|k_2| <= h2`` are fitted (the others are 0): a cheaper start for a large set."""
+        (phase origin t = 0) (:func:`rotorred.signals.linefit.fit_frequencies`: the lines must be at least 2 / T apart
+        and from 0).
+
+        Parameters
+        ----------
+        t : ndarray, shape (m,)
+            Times of the record (s), span T.
+        x : ndarray, shape (m,)
+            The record (m; rad for a rotation DOF).
+        w : (float, float)
+            The base frequencies (rad/s).
+        within : (int, int), optional
+            ``(h1, h2)``: fit only the orders with ``|k_1| <= h1`` and ``|k_2| <= h2`` (the others are 0), a cheaper
+            start for a large set; default all.
+
+        Returns
+        -------
+        ndarray, shape (2K - 1,)
+            Harmonic-major coefficients, in the units of ``x``.
+
+        Raises
+        ------
+        InputError
+            If the fitted lines are closer than :func:`rotorred.signals.linefit.fit_frequencies` resolves in T.
+        """
         from rotorred.signals.linefit import fit_frequencies
 
         f = self.frequencies(w) / (2 * math.pi)
@@ -377,7 +563,18 @@ class TorusProblem:
         return self.harmonics.frequencies(self.w)
 
     def samples(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Displacements and velocities of the ``dofs`` on the grid, shape (N_1 N_2, len(dofs)) each."""
+        """Displacements and velocities of the ``dofs`` on the grid.
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+
+        Returns
+        -------
+        q, v : ndarray, shape (N_1 N_2, len(dofs))
+            (m) and (m/s).
+        """
         h = self.harmonics
         return h.samples(z, self.n), h.rates(z, self.n, self.w)
 
@@ -399,7 +596,19 @@ class TorusProblem:
         return self._compliance().z_lin
 
     def apply(self, X: np.ndarray) -> np.ndarray:
-        """``G X`` on the harmonic-major rows of X (a vector or a matrix), G applied an order at a time."""
+        """``G X`` on the harmonic-major rows of X, G (the dynamic compliance ``Z_k^-1`` of the ``dofs``, m/N) applied
+        an order at a time.
+
+        Parameters
+        ----------
+        X : ndarray, shape (size,) or (size, p)
+            Harmonic-major force coefficients (N).
+
+        Returns
+        -------
+        ndarray, shape of ``X``
+            (m).
+        """
         g = self._compliance()
         return _block_product(g.G0, g.Gk, X.reshape(self.size, -1), self.n).reshape(X.shape)
 
@@ -409,7 +618,18 @@ class TorusProblem:
         return float(np.linalg.norm(self.linear_response())) or 1.0
 
     def residual(self, z: np.ndarray) -> np.ndarray:
-        """``R(z) = z - z_lin + G F_nl(z)``, shape (size,) (no Jacobian: for line searches)."""
+        """``R(z) = z - z_lin + G F_nl(z)`` (no Jacobian: for line searches).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+
+        Returns
+        -------
+        ndarray, shape (size,)
+            (m).
+        """
         q, v = self.samples(z)
         f = sampled_forces(self._local_forces, q, v)[0]
         return z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
@@ -436,8 +656,19 @@ class TorusProblem:
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
-        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve_periodic` takes the problem; ``omega`` is ignored: the base
-        frequencies are fixed, and ``dR_domega`` is NaN, not defined)."""
+        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve_periodic` takes the problem).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+        omega : float, optional
+            Ignored: the base frequencies are fixed, and ``dR_domega`` is NaN, not defined.
+
+        Returns
+        -------
+        Evaluation
+        """
         def jacobian():
             lin = self._linearise(z)
             T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
@@ -447,7 +678,18 @@ class TorusProblem:
     def newton_step(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The residual at ``z`` and Newton's step ``-J^-1 R``, through the Woodbury identity on the rank r of the DOF
         patterns: ``J = I + X Y``, ``X = G (I (x) U)``, ``Y = sum_t kron(T_t, U^T A_t V) (I (x) V^T)``, so that
-        ``J^-1 = I - X (I + Y X)^-1 Y`` needs one dense solve of size (2K - 1) r (r = 1 for a rub)."""
+        ``J^-1 = I - X (I + Y X)^-1 Y`` needs one dense solve of size (2K - 1) r (r = 1 for a rub).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+
+        Returns
+        -------
+        R, step : ndarray, shape (size,)
+            The residual and the step (m).
+        """
         lin = self._linearise(z)
         if not lin.terms:
             return lin.R, -lin.R
@@ -464,7 +706,19 @@ class TorusProblem:
 
     # ----------------------------------------------------------------------------------------------- recovery
     def recover(self, z: np.ndarray) -> np.ndarray:
-        """Complex amplitudes ``Q_k`` of every DOF (the line ``Re(Q_k exp(i k . theta))``), shape (K, n_all)."""
+        """Complex amplitudes ``Q_k`` of every DOF of the system (the line ``Re(Q_k exp(i k . theta))``) from the
+        solution on the ``dofs``.
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+
+        Returns
+        -------
+        ndarray, shape (K, n_all), complex
+            (m; rad for a rotation DOF), n_all the DOFs of ``M``.
+        """
         g = self._compliance()
         q, v = self.samples(z)
         f = self.harmonics.coefficients(sampled_forces(self._local_forces, q, v)[0])
@@ -556,6 +810,7 @@ class TorusSolution(Result):
         return np.abs(self.harmonics.frequencies(self.w)) / (2.0 * math.pi)
 
     def summary(self) -> list[str]:
+        """The base frequencies, the orders and grid, how Newton converged, and the three strongest lines."""
         h, f = self.harmonics, np.array(self.w) / (2.0 * math.pi)
         amplitudes = self.amplitudes
         strongest = np.argsort(-amplitudes.max(axis=1))[:3]
@@ -569,8 +824,22 @@ class TorusSolution(Result):
                 f"strongest lines (k1, k2): {top}"]
 
     def plot(self, ax=None, *, dofs=None, title: str | None = None):
-        """The amplitude of each order's line at its frequency ``|k . w| / (2 pi)``, a stem a DOF (µm, log scale);
-        ``dofs``: positions among :attr:`dofs` (default all, at most the 6 largest)."""
+        """The amplitude of each order's line at its frequency ``|k . w| / (2 pi)`` (Hz), a stem a DOF (µm, log scale)
+        (:func:`rotorred.plots.branch.plot_harmonics`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        dofs : sequence of int, optional
+            Positions among :attr:`dofs` to draw; default all, at most the 6 largest.
+        title : str, optional
+            The figure's title.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.branch import plot_harmonics
 
         return plot_harmonics(self.frequencies, self.amplitudes, [f"DOF {d}" for d in self.dofs], ax, columns=dofs,
