@@ -141,7 +141,26 @@ class RubPlate:
 
     @classmethod
     def for_rotor(cls, rotor, node: int = 18, **kwargs) -> RubPlate:
-        """A plate at ``node`` of ``rotor`` with ``disk_radius`` taken from the rotor's disk there."""
+        """A plate at ``node`` of ``rotor`` with ``disk_radius`` taken from the rotor's disk there.
+
+        Parameters
+        ----------
+        rotor : Rotor
+            The rotor the plate rubs.
+        node : int
+            A node of ``rotor`` that carries a disk of radius > 0.
+        **kwargs
+            The other fields of :class:`RubPlate` (``clearance`` (m), ``theta`` (rad), ...).
+
+        Returns
+        -------
+        RubPlate
+
+        Raises
+        ------
+        InputError
+            If no disk is at ``node``, its radius is 0, or a field in ``kwargs`` is invalid.
+        """
         disk = rotor.disk_at(node)
         if disk.radius <= 0:
             checks.fail("node", node, "must carry a disk with a radius > 0; else give disk_radius")

@@ -81,8 +81,19 @@ class EnergyBalance(Result):
         return lines
 
     def plot(self, ax=None, **options):
-        """The terms of the balance (J) against time (s) (:func:`rotorred.plots.energy.draw_energy`, its options:
-        ``title``, ``figsize``); return the Figure."""
+        """The terms of the balance (J) against time (s) (:func:`rotorred.plots.energy.draw_energy`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            ``title``, ``figsize`` (in).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.energy import draw_energy
 
         return draw_energy(self, ax, **options)

@@ -158,7 +158,18 @@ class NavierPlate:
         object.__setattr__(self, "compliance", 4.0 / (math.pi**4 * self.a * self.b * D) * s)
 
     def deflection(self, F: float) -> float:
-        """Deflection W (m) at the contact point under the load ``F`` (N)."""
+        """Deflection ``W = lam F`` at the contact point (Eq. 10).
+
+        Parameters
+        ----------
+        F : float
+            Load at the contact point (N).
+
+        Returns
+        -------
+        float
+            W (m).
+        """
         return self.compliance * F
 
 
@@ -202,7 +213,18 @@ class ClampedFreePlate:
         object.__setattr__(self, "offset", self.b0 / self.a0)
 
     def deflection(self, F: float) -> float:
-        """Deflection W (m) at the contact point under the load ``F`` >= 0 (N)."""
+        """Deflection ``W = (F + b0) / a0`` at the contact point (Eq. 11).
+
+        Parameters
+        ----------
+        F : float
+            Load at the contact point (N), >= 0.
+
+        Returns
+        -------
+        float
+            W (m).
+        """
         return (F + self.b0) / self.a0
 
 
@@ -214,5 +236,16 @@ class RigidPlate:
     offset: float = field(init=False, default=0.0)
 
     def deflection(self, F: float) -> float:
-        """Always 0 (m)."""
+        """Deflection at the contact point: always 0.
+
+        Parameters
+        ----------
+        F : float
+            Load at the contact point (N).
+
+        Returns
+        -------
+        float
+            0 (m).
+        """
         return 0.0

@@ -215,8 +215,19 @@ class TransientResult(Result):
 
     def plot(self, ax=None, **options):
         """The recorded outputs against time and, when recorded, each plate's contact forces
-        (:func:`rotorred.plots.scene.draw_transient`, whose options it takes: ``t_window`` (s), ``title``); into a
-        given ``ax``, the displacements. Returns the Figure."""
+        (:func:`rotorred.plots.scene.draw_transient`); into a given ``ax``, the displacements.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            ``t_window`` (s), ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.scene import draw_transient
 
         return draw_transient(self, ax, **options)
