@@ -125,8 +125,19 @@ class FigurePool:
                 self._submitting.submit(self._executor.submit, _ready)
 
     def submit(self, job) -> Drawing:
-        """Draw ``job`` (a callable taking no argument, picklable) in a worker, or here with no workers. Returns at
-        once: the job is handed to the workers by the pool's thread, once they have started."""
+        """Draw ``job`` in a worker, or here with no workers. Returns at once: the job is handed to the workers by the
+        pool's thread, once they have started.
+
+        Parameters
+        ----------
+        job : callable
+            Takes no argument, picklable (e.g. one of the jobs of :func:`rotorred.plots.scene.scene_figures`); returns
+            what :meth:`Drawing.result` gives (the figure's path).
+
+        Returns
+        -------
+        Drawing
+        """
         if self._executor is None:
             return Drawing(job, None)
         return Drawing(job, self._submitting.submit(self._executor.submit, job))

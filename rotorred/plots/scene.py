@@ -554,7 +554,18 @@ def scene_figures(result, out: str | Path) -> list[partial]:
 
 def scene_frames(scene) -> list[tuple]:
     """The frame keys (:func:`prepare_frames`) of the figures :func:`scene_figures` draws for ``scene``: known before
-    it is solved (the Poincare plot's, drawn when the analysis has samples)."""
+    it is solved (the Poincare plot's, drawn when the analysis has samples).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its ``output`` (plots, nodes, directions) sets the frames.
+
+    Returns
+    -------
+    list of tuple
+        One key a figure, for :class:`rotorred.plots.pool.FigurePool`'s ``frames``.
+    """
     output = scene.output
     plots, n_nodes, n_directions = output.plots, len(output.nodes), len(output.directions)
     keys = []

@@ -140,10 +140,26 @@ def write_data(result: SceneResult, out: str | Path, provenance: Provenance | No
 
 
 def submit_figures(result: SceneResult, out: str | Path, pool, which: str = "all") -> list:
-    """The scene's figures as :class:`rotorred.plots.pool.Drawing` s, drawn by ``pool`` (None: drawn now, here), none
-    for a scene without plots or an incomplete result. ``which``: "all"; "record", those drawn from the record alone
-    (:func:`rotorred.plots.scene.record_figures`: from ``run_scene``'s ``on_record``, while the analysis runs); or
-    "analysis", the others."""
+    """The scene's figures as :class:`rotorred.plots.pool.Drawing` s, none for a scene without plots or an incomplete
+    result.
+
+    Parameters
+    ----------
+    result : SceneResult
+        The scene's result.
+    out : str or Path
+        Folder the figures are written to.
+    pool : rotorred.plots.pool.FigurePool or None
+        Draws the figures; None: drawn now, here.
+    which : {"all", "record", "analysis"}
+        "all"; "record", those drawn from the record alone (:func:`rotorred.plots.scene.record_figures`: from
+        ``run_scene``'s ``on_record``, while the analysis runs); or "analysis", the others.
+
+    Returns
+    -------
+    list of Drawing
+        Each one's ``result()`` is the path of its PNG.
+    """
     from rotorred.plots import scene as figures  # matplotlib only when figures are written
     from rotorred.plots.pool import FigurePool
 

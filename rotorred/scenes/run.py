@@ -179,19 +179,64 @@ class SceneResult(Result):
         return self.analyses.get(table_dof(self.scene))
 
     def peak(self, dof) -> float:
-        """Largest |displacement| of ``dof`` in the window (m); 0 for an empty (diverged) record."""
+        """Largest |displacement| of ``dof`` in the window; 0 for an empty (diverged) record.
+
+        Parameters
+        ----------
+        dof : (int, str)
+            (node, direction) of a recorded DOF, e.g. ``(18, "y")``.
+
+        Returns
+        -------
+        float
+            (m; rad for a rotation).
+        """
         return float(np.max(np.abs(self.outputs[tuple(dof)]), initial=0.0))
 
     def contact_fraction(self, plate: int = 0) -> float:
-        """Fraction of the recorded samples in which plate ``plate`` touches (slip or stick)."""
+        """Fraction of the recorded samples in which plate ``plate`` touches (slip or stick); 0 without plates.
+
+        Parameters
+        ----------
+        plate : int
+            Position of the plate among the scene's rub plates.
+
+        Returns
+        -------
+        float
+            0 to 1 (-).
+        """
         return 1.0 - self.contacts[plate].fraction("open") if self.contacts else 0.0
 
     def n_impacts(self, plate: int = 0) -> int:
-        """Number of contact onsets (open -> slip/stick) of plate ``plate`` in the window."""
+        """Number of contact onsets (open -> slip/stick) of plate ``plate`` in the window; 0 without plates.
+
+        Parameters
+        ----------
+        plate : int
+            Position of the plate among the scene's rub plates.
+
+        Returns
+        -------
+        int
+        """
         return self.contacts[plate].n_impacts() if self.contacts else 0
 
     def line_amplitude(self, dof, m, n) -> float:
-        """Amplitude (m) of the line m f_H + n f_L of ``dof`` (its first label), 0 if it is not at a peak."""
+        """Amplitude of the line ``m f_H + n f_L`` of ``dof`` (its first label), 0 if it is not at a peak.
+
+        Parameters
+        ----------
+        dof : (int, str)
+            (node, direction) of a recorded DOF of a complete result (:attr:`lines`).
+        m, n : int
+            The multiples of f_H and f_L.
+
+        Returns
+        -------
+        float
+            (m; rad for a rotation).
+        """
         for ln in self.lines[tuple(dof)].lines:
             if ln.m == m and ln.n == n:
                 return ln.amplitude
@@ -224,13 +269,28 @@ class SceneResult(Result):
         return lines
 
     def plot(self, ax=None, kind: str = "waveforms", **options):
-        """Draw one of the scene's figures as ``rotorred run`` writes it (:func:`rotorred.plots.scene.draw_scene`);
-        return the Figure.
+        """Draw one of the scene's figures as ``rotorred run`` writes it (:func:`rotorred.plots.scene.draw_scene`).
 
-        ``kind``: "waveforms" (default, every recorded DOF against time, the normal run overlaid), "spectra" (of one
-        node, ``node=``, default the first, with the labelled lines), "orbits" (x and y recorded) or "poincare" (the
-        table DOF's Poincare section). Other options go to the drawing (``t_window``, ``f_max``, ``log_y``,
-        ``title``, ...). Into a given ``ax``, every panel's series are drawn.
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw every panel's series into; default a new figure.
+        kind : {"waveforms", "spectra", "orbits", "poincare"}
+            "waveforms" (default, every recorded DOF against time (µm, µrad), the normal run overlaid), "spectra"
+            (of one node, ``node=``, default the first, with the labelled lines; Hz), "orbits" (x and y recorded) or
+            "poincare" (the table DOF's Poincare section).
+        **options
+            ``node`` (int, for "spectra"), and the drawing's options: ``t_window`` ((float, float), s), ``f_max``
+            (Hz), ``log_y``, ``title``, ...
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Raises
+        ------
+        InputError
+            If ``kind`` is unknown or has no data in this result, or ``node`` is not a recorded node.
         """
         from rotorred.plots.scene import draw_scene
 
@@ -353,6 +413,16 @@ def build_model(scene: Scene) -> SceneModel:
     mode count is the fewest whose receptance from the unbalance and rub DOFs to the recorded DOFs is within
     :data:`rotorred.scenes.modes.AUTO_TARGET` of the full model's (:func:`rotorred.scenes.modes.choose_modes`;
     an unbalance node may join the boundary, or the full model be used).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its ``solver`` says full or reduced, and the modes (``modes``, ``cutoff_hz`` (Hz)).
+
+    Returns
+    -------
+    SceneModel
+        The model, its label and its build time (s).
     """
     from rotorred.linear.reduction import reduce_rotor
     from rotorred.scenes.modes import AUTO_TARGET, choose_modes
@@ -481,6 +551,13 @@ def run_scene(scene: Scene, model: SceneModel | None = None, *, compare_normal: 
     Returns
     -------
     SceneResult
+
+    Raises
+    ------
+    ValueError
+        If ``model`` was built for a different rotor, solver model or rub nodes than ``scene``, or no spool turns.
+    SceneDiverged
+        If the transient diverges; its ``partial`` holds the record up to then.
     """
     if model is None:
         model = build_model(scene)
@@ -732,7 +809,24 @@ class SceneDiverged(RuntimeError):
 
     @classmethod
     def of(cls, scene: Scene, scene_model: SceneModel, exc, f_L: float, f_H: float) -> SceneDiverged:
-        """The scene-level error of the transient's ``SimulationDiverged`` ``exc``."""
+        """The scene-level error of the transient's ``SimulationDiverged`` ``exc``.
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene that diverged.
+        scene_model : SceneModel
+            Its model (:func:`build_model`).
+        exc : rotorred.transient.results.SimulationDiverged
+            The transient's error, with its partial result.
+        f_L, f_H : float
+            Lower and higher spool frequency (Hz).
+
+        Returns
+        -------
+        SceneDiverged
+            Its message says where and why in the scene's terms, its :attr:`partial` the record up to then.
+        """
         message = explain_divergence(scene, exc)
         res = exc.result
         partial = SceneResult(scene=scene, t=res.t, outputs=res.outputs, contacts=res.contacts, spectra={},

@@ -184,12 +184,27 @@ class RunupResult(Result):
         return lines
 
     def plot(self, ax=None, kind: str = "amplitude", **options):
-        """Draw one of the run-up's figures as ``rotorred run`` writes it (:func:`rotorred.plots.runup.draw_runup`);
-        return the Figure.
+        """Draw one of the run-up's figures as ``rotorred run`` writes it (:func:`rotorred.plots.runup.draw_runup`).
 
-        ``kind``: "amplitude" (default: the largest orbit radius and the 1x tracks against the reference speed, per
-        node, with the critical speeds and rubs; ``node=`` into a given ``ax``), "orders" (every order track;
-        ``dof=``), "waterfall" (of the table DOF) or "orbits" (the snapshots at ``runup.orbits_hz``).
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        kind : {"amplitude", "orders", "waterfall", "orbits"}
+            "amplitude" (default: the largest orbit radius and the 1x tracks (µm) against the reference speed (Hz),
+            per node, with the critical speeds and rubs), "orders" (every order track), "waterfall" (of the table
+            DOF) or "orbits" (the snapshots at ``runup.orbits_hz``).
+        **options
+            ``node`` (int) of "amplitude" into a given ``ax``, ``dof`` of "orders".
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Raises
+        ------
+        InputError
+            If ``kind`` is unknown, or the result has no data for it.
         """
         from rotorred.plots.runup import draw_runup
 
@@ -408,6 +423,25 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
 
     A diverged transient does not raise: the result holds the record up to the failure, analysed,
     with ``incomplete`` saying when, where and why it stopped.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with a ``[runup]`` (its speed profile, record step (s) and reference spool).
+    model : SceneModel, optional
+        The scene's model (:func:`rotorred.scenes.run.build_model`); default built here.
+    progress : bool, optional
+        Progress bar on stderr; None (default): shown on a terminal once the run has taken 1 s
+        (:class:`rotorred.transient.options.StepControl`).
+
+    Returns
+    -------
+    RunupResult
+
+    Raises
+    ------
+    ValueError
+        If the scene has no ``[runup]``.
     """
     from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
     from rotorred.transient.results import SimulationDiverged

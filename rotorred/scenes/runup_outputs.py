@@ -83,9 +83,25 @@ def _criticals_csv(result: RunupResult, path: Path) -> Path:
 
 def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path | None = None,
                         provenance: Provenance | None = None) -> list[Path]:
-    """Write figures, data and ``summary.txt`` into ``out``; returns the paths (named in ``shown``). A
-    ``provenance`` (:class:`rotorred.provenance.Provenance`) is written as ``scene.toml``, on top of the summary and
-    as attributes of the NPZ and .mat."""
+    """Write figures, data and ``summary.txt`` into ``out``; returns the paths (named in ``shown``).
+
+    Parameters
+    ----------
+    result : RunupResult
+        The run-up (:func:`rotorred.scenes.runup.run_runup`).
+    out : str or Path
+        Folder the files are written to (created if missing).
+    shown : str or Path, optional
+        Folder the summary names the files in (the final folder when ``out`` is a staging folder,
+        :class:`rotorred.writers.OutputFolder`); default ``out``.
+    provenance : rotorred.provenance.Provenance, optional
+        What made the result: written as ``scene.toml``, on top of the summary and as attributes of the NPZ and .mat.
+
+    Returns
+    -------
+    list of Path
+        The files, in ``shown``.
+    """
     from rotorred.plots.runup import plot_runup  # matplotlib only when figures are written
 
     out = Path(out)
@@ -119,7 +135,20 @@ def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path 
 
 
 def format_runup_summary(result: RunupResult, files=()) -> str:
-    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files."""
+    """What the run-up shows: setup, peaks against speed, critical speeds, rub intervals, cost, files.
+
+    Parameters
+    ----------
+    result : RunupResult
+        The run-up.
+    files : sequence of Path
+        The files written, listed last; default none.
+
+    Returns
+    -------
+    str
+        Lines of text: speeds in Hz and rpm, amplitudes in µm, times in s.
+    """
     ref, sc = result.reference, result.scene
     c = result.counters
     speeds = " / ".join(f"{s} {w[0] * HZ:.1f} -> {w[-1] * HZ:.1f} Hz" for s, w in result.speeds.items())

@@ -149,9 +149,21 @@ def choose(scene: Scene) -> Settings:
 
 
 def run_to_tolerance(scene: Scene, **options):
-    """Choose the settings of ``scene`` (:func:`choose`) and run them (:func:`rotorred.scenes.run.run_scene` with
-    ``options``); the result's ``settings`` says what was chosen. A scene without a tolerance runs as it is, and so
-    does a harmonic balance (its tolerance chooses the harmonics: :mod:`rotorred.scenes.balance_harmonics`)."""
+    """Choose the settings of ``scene`` (:func:`choose`) and run them (:func:`rotorred.scenes.run.run_scene`); the
+    result's ``settings`` says what was chosen. A scene without a tolerance runs as it is, and so does a harmonic
+    balance (its tolerance chooses the harmonics: :mod:`rotorred.scenes.balance_harmonics`).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; ``solver.tolerance`` (-) is the relative error the settings are chosen for.
+    **options
+        Options of :func:`rotorred.scenes.run.run_scene`.
+
+    Returns
+    -------
+    SceneResult
+    """
     from rotorred.scenes.run import run_scene
 
     if scene.solver.tolerance is None or scene.solver.method == "harmonic-balance":  # that chooses its harmonics

@@ -70,16 +70,38 @@ class OrderTrack(Result):
 
     def plot(self, ax=None, **options):
         """The amplitude against the spool's speed (Hz, rpm on top), as a run-up's order tracks are drawn
-        (:func:`rotorred.plots.runup.draw_order_track`, whose options it takes: ``scale`` and ``unit`` (default µm
-        from m), ``title``); return the Figure."""
+        (:func:`rotorred.plots.runup.draw_order_track`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        **options
+            ``scale`` and ``unit`` (default µm from m), ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.runup import draw_order_track
 
         return draw_order_track(self, ax, **options)
 
     def to_xarray(self, units: str = "m"):
         """The track as an :class:`xarray.Dataset`: dimension ``block``, variables ``time`` (s, the block's centre),
-        ``speed`` (rad/s, the spool's mean), ``amplitude`` in ``units`` (the signal's, which a track does not know:
-        m, as rotorred's displacements, by default) and ``phase`` (rad); spool, order and method as attributes."""
+        ``speed`` (rad/s, the spool's mean), ``amplitude`` in ``units`` and ``phase`` (rad); spool, order and method as
+        attributes.
+
+        Parameters
+        ----------
+        units : str
+            The signal's units, which a track does not know (UDUNITS text); default "m", as rotorred's
+            displacements.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
         import xarray as xr
 
         return xr.Dataset(
@@ -120,16 +142,24 @@ def angle_blocks(t, signals, angle, revs_per_block: int = 16, samples_per_rev: i
     Parameters
     ----------
     t : array_like, shape (n,)
-        Record times (s), increasing.
-    signals : array_like, shape (n_signals, n)
+        Record times (s), increasing, at least 4.
+    signals : array_like, shape (n_signals, n) or (n,)
+        The signals at ``t``, any units (m for displacements).
     angle : array_like, shape (n,)
         Spin angle of the spool at ``t`` (rad), non-decreasing (a spool at rest holds its angle).
     revs_per_block, samples_per_rev : int
+        Revolutions a block, >= 1 (blocks overlap by half), and samples a revolution, >= 8.
 
     Returns
     -------
     AngleBlocks
         No block when the record turns the spool less than ``revs_per_block`` revolutions.
+
+    Raises
+    ------
+    InputError
+        If ``t`` is not increasing, ``signals`` or ``angle`` does not match it, ``angle`` decreases, or a count is
+        below its bound.
     """
     t = checks.vector("t", t, "s", min_len=4, increasing=True)
     angle = checks.array("angle", angle, t.shape, "rad")
@@ -160,11 +190,26 @@ def angle_blocks(t, signals, angle, revs_per_block: int = 16, samples_per_rev: i
 
 
 def order_tracks(blocks: AngleBlocks, spool: str, orders) -> list[list[OrderTrack]]:
-    """Every order of ``orders`` in every signal of ``blocks`` (resampled in the angle of ``spool``).
+    """Every order of ``orders`` in every signal of ``blocks`` (resampled in the angle of ``spool``): a single-bin DFT
+    of each Hann-windowed block at the order, its phase against the spin angle.
+
+    Parameters
+    ----------
+    blocks : AngleBlocks
+        The signals resampled in the spool's angle (:func:`angle_blocks`).
+    spool : str
+        The spool whose angle ``blocks`` follows (named in each track).
+    orders : array_like, shape (k,)
+        Orders (cycles per revolution of ``spool``, -), > 0.
 
     Returns
     -------
     list (per signal) of list (per order) of OrderTrack
+
+    Raises
+    ------
+    InputError
+        If an order is not > 0.
     """
     orders = checks.vector("orders", orders, gt=0.0)
     n_signals, n_blocks, m = blocks.values.shape

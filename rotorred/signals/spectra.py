@@ -340,7 +340,23 @@ class Spectrum(Result):
         return self.n_samples * self.dt
 
     def amplitude_at(self, frequency_hz: float) -> float:
-        """Amplitude at the bin nearest to ``frequency_hz`` (signal units)."""
+        """Amplitude at the bin nearest to ``frequency_hz``.
+
+        Parameters
+        ----------
+        frequency_hz : float
+            Frequency (Hz), 0 to the last bin's.
+
+        Returns
+        -------
+        float
+            In the signal's units (m for a displacement).
+
+        Raises
+        ------
+        InputError
+            If ``frequency_hz`` is outside 0 to the last bin's frequency.
+        """
         frequency_hz = checks.number("frequency_hz", frequency_hz, "Hz", ge=0.0, le=float(self.frequencies[-1]))
         return float(self.amplitudes[int(round(frequency_hz / self.df))])
 
@@ -356,17 +372,40 @@ class Spectrum(Result):
         return lines + textwrap.wrap(self.note, 110, max_lines=4, placeholder=" ...")
 
     def plot(self, ax=None, *, label: str = "amplitude", **options):
-        """Draw the spectrum (:func:`rotorred.plots.scene.draw_spectra`, whose options it takes: ``f_max`` (Hz),
-        ``log_y``, ``scale`` and ``unit`` (default µm from m), ``title``), its line labelled ``label``; return the
-        Figure."""
+        """Draw the spectrum (:func:`rotorred.plots.scene.draw_spectra`) against frequency (Hz).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        label : str
+            The line's label in the legend.
+        **options
+            ``f_max`` (Hz), ``log_y``, ``scale`` and ``unit`` (default µm from m), ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from rotorred.plots.scene import draw_spectra
 
         return draw_spectra({label: self}, ax, **options)
 
     def to_xarray(self, units: str = "m"):
         """The spectrum as an :class:`xarray.Dataset`: dimension ``frequency`` (coordinate, Hz), variable
-        ``amplitude`` in ``units`` (the signal's, which a Spectrum does not know: m, as rotorred's displacements, by
-        default), scalars ``df`` (Hz) and ``dt`` (s); window, samples, amplitude error and note as attributes."""
+        ``amplitude`` in ``units``, scalars ``df`` (Hz) and ``dt`` (s); window, samples, amplitude error and note as
+        attributes.
+
+        Parameters
+        ----------
+        units : str
+            The signal's units, which a Spectrum does not know (UDUNITS text); default "m", as rotorred's
+            displacements.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
         import xarray as xr
 
         return xr.Dataset(
@@ -401,6 +440,11 @@ def amplitude_spectrum(x, dt: float, window: str = "rectangular") -> Spectrum:
     -------
     Spectrum
         ``frequencies`` (Hz) and ``amplitudes`` (units of ``x``), shape (n // 2 + 1,).
+
+    Raises
+    ------
+    InputError
+        If ``x`` is not a finite real vector of at least 2 samples, ``dt`` is not > 0, or ``window`` is unknown.
 
     Notes
     -----

@@ -139,6 +139,11 @@ def energy_balance(model, result, operating: Operating, loads: Loads = Loads()) 
     Returns
     -------
     EnergyBalance
+
+    Raises
+    ------
+    InputError
+        If ``result`` has no recorded states.
     """
     if result.states is None:
         checks.fail("result.states", None, "must be recorded: run simulate(..., recording=Recording(states=True))")
