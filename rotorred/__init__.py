@@ -149,6 +149,7 @@ _EXPORTS = {
     "write_outputs": "rotorred.scenes.outputs",
     "run_runup": "rotorred.scenes.runup",
     "harmonic_balance": "rotorred.scenes.balance",
+    "continue_balance": "rotorred.scenes.balance",
     "BalanceOptions": "rotorred.scenes.balance",
     "RubBalance": "rotorred.scenes.balance",
     "continue_scene": "rotorred.scenes.branch",

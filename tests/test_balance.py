@@ -70,3 +70,32 @@ def test_bad_input_is_refused_before_computing(rig):
                             rr.Loads(scene.unbalances), scene.plates)
     with pytest.raises(rr.InputError, match=r"^options.samples = 41: must be an integer >= 42"):
         rr.BalanceOptions(20, 41)
+
+
+def test_a_speed_line_is_the_scenes_branch_in_its_speed(rig):
+    """continue_balance along the outer spool's speed line 90 -> 91 Hz (inner at the nominal ratio 70/90) is the
+    scene's branch in speeds.outer (tests/test_branch.py): the same values within 1e-9 (measured 4.1e-11: the inner
+    speed from the rotor's nominal ratio differs from the scene's 70 Hz in its last bits) and peaks within 1e-8
+    (measured 1.2e-9: points solved to a residual of 1e-9 at those values); every spool keeps its harmonic of f_0."""
+    scene, sm = rig
+    branch = rr.continue_balance(sm.model, rr.Operating.line([90.0, 91.0], "outer", unit="Hz"),
+                                 rr.Loads(scene.unbalances), scene.plates, rr.BranchOptions(H, N, stability=False),
+                                 nodes=[14, 18])
+    by_key = rr.continue_scene(scene, sm.model, "speeds.outer", 90.0, 91.0, rr.BranchOptions(H, N, stability=False))
+    np.testing.assert_allclose(branch.values, by_key.values, rtol=1e-9)
+    for dof in set(branch.dofs) & set(by_key.dofs):
+        np.testing.assert_allclose(branch.peaks[:, branch.dofs.index(dof)], by_key.peaks[:, by_key.dofs.index(dof)],
+                                   rtol=1e-8)
+    assert branch.dofs[0] == (14, "y") and (18, "x") in branch.dofs
+    assert branch.values[0] == 90.0 and branch.stopped.startswith("reached the end, speeds.outer = 91")
+    np.testing.assert_allclose(branch.f0, branch.values / 9.0, rtol=1e-12)  # outer at 9 f_0, inner at 7
+
+
+def test_a_speed_line_with_a_fixed_spool_is_refused(rig):
+    scene, sm = rig
+    with pytest.raises(rr.InputError, match=r"must turn every spool at a ratio to the reference; \['inner'\] at a "
+                                            r"fixed speed"):
+        rr.continue_balance(sm.model, rr.Operating.line([90.0, 91.0], "outer", fixed={"inner": 70.0}, unit="Hz"),
+                            rr.Loads(scene.unbalances), scene.plates)
+    with pytest.raises(rr.InputError, match=r"must be a speed line of at least two speeds"):
+        rr.continue_balance(sm.model, rr.Operating.point(scene.speeds), rr.Loads(scene.unbalances), scene.plates)

@@ -242,3 +242,20 @@ def test_harmonic_balance_runs_at_the_operatings_spool_speeds(operating, expecte
     assert {tuple(c.items()) for c in model.taken()} == {tuple({s: round(w, 9) for s, w in expected.items()}.items())}
     assert result.speeds == pytest.approx(expected, rel=1e-15)
     assert result.problem.f0 == pytest.approx(min(w for w in expected.values() if w > 0) / (2 * np.pi), rel=1e-12)
+
+
+def test_continue_balance_keeps_the_operatings_ratios_along_its_branch():
+    """continue_balance along a's speed line (b, c at the nominal ratios 1.5 and 0.5) asks the three-spool model for
+    its matrices only at speeds on the line: b = 1.5 a and c = 0.5 a at every call (to the 1e-9 rad/s the recording
+    rounds to), a from 20 Hz on."""
+    rotor = three_spools()
+    model = _Recording.of(rotor)
+    model.taken()
+    branch = rr.continue_balance(model, Operating.line([20.0, 20.2], "a", unit="Hz"), rr.Loads([Unbalance(2, 1e-4)]),
+                                 [rr.RubPlate(node=2, disk_radius=0.1)],
+                                 rr.BranchOptions(harmonics=8, samples=64, stability=False, max_points=6))
+    calls = model.taken()
+    assert len(calls) > 3 and len(branch.values) >= 2
+    for c in calls:
+        assert c["b"] == pytest.approx(1.5 * c["a"], abs=2e-9) and c["c"] == pytest.approx(0.5 * c["a"], abs=2e-9)
+        assert c["a"] >= 2 * np.pi * 20.0 * (1 - 1e-6)

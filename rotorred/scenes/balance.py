@@ -1,5 +1,6 @@
-"""The periodic rub response of a rotor at an operating point by harmonic balance, from Python:
-``harmonic_balance(model, operating, loads, contacts, options)``.
+"""The periodic rub response of a rotor by harmonic balance, from Python: at an operating point,
+``harmonic_balance(model, operating, loads, contacts, options)``, and along a speed line, continued through its
+folds with each point's stability, ``continue_balance(model, operating, loads, contacts, options)``.
 
 The same problem as a scene's ``solver.method = "harmonic-balance"`` (docs/model.md §15,
 :mod:`rotorred.scenes.harmonic_balance`): the spool speeds must be commensurate, the base frequency
@@ -31,13 +32,14 @@ from rotorred.nonlinear.fourier import to_phasors
 from rotorred.nonlinear.hb import coefficient_variables, solve_periodic
 from rotorred.results import Result, dof_coordinates
 from rotorred.scenes.balance_harmonics import TOL, cold_solution, samples_for
+from rotorred.scenes.branch import BranchOptions, SceneBranch, check_key, continue_scene
 from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
 from rotorred.scenes.run import start_record
-from rotorred.scenes.schema import SolverSpec
+from rotorred.scenes.schema import OutputSpec, Scene, SolverSpec
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.options import Loads
 
-__all__ = ["BalanceOptions", "RubCase", "RubBalance", "harmonic_balance"]
+__all__ = ["BalanceOptions", "RubCase", "RubBalance", "harmonic_balance", "continue_balance"]
 
 
 @dataclass(frozen=True)
@@ -276,6 +278,70 @@ def harmonic_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     rp, z, _ = cold_solution(case, system, H, N, record=start_record(case, system))
     final = solve_periodic(rp.problem, z, rp.omega, tol=TOL)  # the iterations and residual at z
     return RubBalance(rp, final.z, final.iterations, final.residual, outputs, operating, dict(speeds))
+
+
+def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequence[RubPlate],
+                     options: BranchOptions = BranchOptions(), *, nodes: Sequence[int] = (),
+                     progress=None) -> SceneBranch:
+    """The branch of the periodic rub response of ``model`` along the ``operating`` speed line, from its first speed
+    to its last, by harmonic balance with pseudo-arclength continuation through the folds, with each point's Floquet
+    stability (docs/model.md §15; :func:`rotorred.scenes.branch.continue_scene` in ``speeds.<reference>``).
+
+    Parameters
+    ----------
+    model : Rotor, SystemMatrices or ReducedSystem
+        Built from a rotor; each rub node's x and y must be its own coordinates.
+    operating : Operating
+        A speed line of at least two speeds (the first and last are the branch's ends), every other spool at a ratio
+        to the reference (stated or nominal): along the branch every spool keeps its harmonic of the base frequency
+        f_0, which moves with the speed. A spool at a fixed speed is refused (its harmonic would change along the
+        line: the response is then quasi-periodic).
+    loads : Loads
+        The unbalances; no gravity.
+    contacts : sequence of RubPlate
+        At least one plate; a plate without ``disk_radius`` takes its disk's from the rotor.
+    options : BranchOptions
+        Harmonics, AFT samples, tolerance, stability and the most points.
+    nodes : sequence of int
+        Nodes whose x and y peaks the branch reports (default: the rub nodes); the first node's y is the response
+        the branch is drawn by.
+    progress : callable, optional
+        As for :func:`rotorred.scenes.branch.continue_scene`.
+
+    Returns
+    -------
+    SceneBranch
+        Its values are the reference spool's speed (Hz).
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For a bad input, before any computation.
+    """
+    system = system_of(model)
+    if system.rotor is None:
+        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor)")
+    operating = checked_operating(operating)
+    if operating.kind != "line":
+        checks.fail("operating", operating.describe(), "must be a speed line of at least two speeds (its ends)")
+    lines = operating.lines(system)
+    fixed = [s for s, line in lines.items() if line.how == "fixed"]
+    if fixed:
+        checks.fail("operating", operating.describe(), f"must turn every spool at a ratio to the reference; {fixed} "
+                    "at a fixed speed would change its harmonic of f_0 along the line (a quasi-periodic response)")
+    reference = operating.reference_of(system)
+    plates = _plates(contacts, system.rotor)
+    nodes = tuple(checks.node(f"nodes[{k}]", n, system.full_dofs.nodes) for k, n in enumerate(nodes)) or \
+        tuple(dict.fromkeys(p.node for p in plates))
+    scene = Scene(name=system.rotor.name or "rotor", description=f"branch along {operating.describe()}",
+                  rotor=system.rotor, rotor_source="python", speeds=operating.at(system, 0),
+                  unbalances=_unbalances(loads), plates=plates,
+                  solver=SolverSpec(method="harmonic-balance", harmonics=options.harmonics, samples=options.samples),
+                  output=OutputSpec(nodes=nodes, table=(nodes[0], "y")))
+    key = f"speeds.{reference}"
+    start, end = (float(operating.Omega[i]) / (2 * math.pi) for i in (0, -1))
+    check_key(scene, key, start, end)
+    return continue_scene(scene, system, key, start, end, options, progress=progress)
 
 
 def _unbalances(loads: Loads) -> tuple:
