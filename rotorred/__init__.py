@@ -148,6 +148,8 @@ _EXPORTS = {
     "SceneResult": "rotorred.scenes.run",
     "write_outputs": "rotorred.scenes.outputs",
     "run_runup": "rotorred.scenes.runup",
+    "runup": "rotorred.scenes.runup",
+    "RunupOptions": "rotorred.scenes.runup",
     "harmonic_balance": "rotorred.scenes.balance",
     "continue_balance": "rotorred.scenes.balance",
     "BalanceOptions": "rotorred.scenes.balance",

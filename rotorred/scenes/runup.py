@@ -1,6 +1,7 @@
 """Run a run-up (or coast-down) scene: the transient at the ``[runup]`` speeds, and what it shows.
 
-:func:`run_runup` steps the scene's model through its speed profile
+:func:`run_runup` steps a scene's model through its speed profile, and :func:`runup` does the same from Python for a
+model and an :class:`rotorred.model.operating.Operating` profile (a scene built from them). Either steps the model
 (:mod:`rotorred.transient.ramp`) from rest or from the steady state at the initial speeds, then:
 
 * order tracks of every spool's ``runup.orders`` at every recorded DOF (angle-domain resampling,
@@ -26,11 +27,12 @@ from fractions import Fraction
 
 import numpy as np
 
+from rotorred import checks
 from rotorred.model.operating import Operating
 from rotorred.progress import stage
 from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
-from rotorred.scenes.schema import Scene
+from rotorred.scenes.schema import OutputSpec, RunupSpec, Scene, SolverSpec
 from rotorred.signals.orders import OrderTrack, angle_blocks, order_tracks, overall_amplitude
 from rotorred.signals.waterfall import Waterfall, waterfall
 
@@ -468,6 +470,114 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     return analyse(scene, model, res, solve_time, incomplete)
 
 
+@dataclass(frozen=True)
+class RunupOptions:
+    """The time step, the record and what a run-up shows (:func:`runup`; a scene's ``[solver]`` and ``[runup]``).
+
+    Parameters
+    ----------
+    dt : float
+        Time step (s), > 0; average-acceleration Newmark (docs/model.md §7).
+    record_dt : float
+        Record interval (s), a whole number of steps.
+    orders : sequence of float
+        Orders tracked for every spool (cycles per revolution), > 0.
+    orbits_hz : sequence of float
+        Speeds of the reference spool (Hz) where orbit snapshots are taken.
+    revs_per_block : int
+        Revolutions per block of the order tracks (:mod:`rotorred.signals.orders`), >= 1.
+    nodes : sequence of int
+        Nodes whose x and y are recorded (default: the unbalance and rub nodes); the last node's y is the table DOF
+        of the waterfall.
+    start : {"settled", "rest"}
+        From the linear steady state at the first speeds, or from rest.
+    """
+
+    dt: float = 2e-5
+    record_dt: float = 1e-4
+    orders: tuple = (1.0,)
+    orbits_hz: tuple = ()
+    revs_per_block: int = 8
+    nodes: tuple = ()
+    start: str = "settled"
+
+    def __post_init__(self):
+        dt = checks.positive("options.dt", self.dt, "s")
+        record_dt = checks.positive("options.record_dt", self.record_dt, "s")
+        if abs(record_dt / dt - round(record_dt / dt)) > 1e-9 * record_dt / dt or record_dt < dt:
+            checks.fail("options.record_dt", record_dt, f"must be a whole number of steps of {dt:g} s", "s")
+        object.__setattr__(self, "orders", checks.sequence(
+            "options.orders", tuple(self.orders), lambda f, v: checks.positive(f, v), min_len=1))
+        object.__setattr__(self, "orbits_hz", checks.sequence(
+            "options.orbits_hz", tuple(self.orbits_hz), lambda f, v: checks.positive(f, v, "Hz")))
+        checks.integer("options.revs_per_block", self.revs_per_block, ge=1)
+        object.__setattr__(self, "nodes", tuple(checks.integer(f"options.nodes[{k}]", n) for k, n in
+                                                enumerate(self.nodes)))
+        checks.choice("options.start", self.start, ("settled", "rest"))
+
+
+def runup(model, operating: Operating, loads, contacts=(), options: RunupOptions = RunupOptions(),
+          progress: bool | None = None) -> RunupResult:
+    """A run-up or coast-down of ``model`` through the ``operating`` profile, and what it shows: order tracks, overall
+    amplitude, waterfall, orbits, rub intervals and the Campbell critical speeds in range (the module docstring).
+
+    Parameters
+    ----------
+    model : Rotor, SystemMatrices or ReducedSystem
+        Built from a rotor (:func:`rotorred.model.assembly.system_of`).
+    operating : Operating
+        A speed profile (:meth:`Operating.ramp`, :meth:`Operating.profile`); a spool it leaves out follows the
+        reference at the rule's ratio (:meth:`Operating.profile_for`). It ends at its last breakpoint.
+    loads : Loads
+        Unbalances and gravity (:class:`rotorred.transient.options.Loads`).
+    contacts : sequence of RubPlate
+        Rub plates (default none); a plate without ``disk_radius`` takes its disk's from the rotor.
+    options : RunupOptions
+        Time step, record, orders, orbits, recorded nodes and start.
+    progress : bool, optional
+        Progress bar on stderr (None: on a terminal once the run has taken 1 s).
+
+    Returns
+    -------
+    RunupResult
+        Its ``scene`` is the scene built from these inputs.
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For a bad input, before any computation.
+    """
+    from rotorred.model.assembly import system_of
+    from rotorred.model.operating import checked as checked_operating
+    from rotorred.transient.options import Loads
+
+    system = system_of(model)
+    if system.rotor is None:
+        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor)")
+    operating = checked_operating(operating)
+    if operating.kind != "profile":
+        checks.fail("operating", operating.describe(), "must be a speed profile (Operating.ramp, Operating.profile)")
+    if not isinstance(loads, Loads):
+        checks.fail("loads", type(loads).__name__, "must be a Loads")
+    profile, reference = operating.profile_for(system), operating.reference_of(system)
+    plates = tuple(p if p.disk_radius is not None else p.with_(disk_radius=system.rotor.disk_at(p.node).radius)
+                   for p in contacts)
+    nodes = options.nodes or tuple(dict.fromkeys([u.node for u in loads.unbalances] + [p.node for p in plates]))
+    if not nodes:
+        checks.fail("options.nodes", (), "must name a node to record (there is no unbalance or plate to default to)")
+    for k, n in enumerate(nodes):
+        checks.node(f"options.nodes[{k}]", n, system.full_dofs.nodes)
+    scene = Scene(name=system.rotor.name or "rotor", description=f"run-up along {operating.describe()}",
+                  rotor=system.rotor, rotor_source="python", speeds=profile.speeds_at(0.0),
+                  unbalances=tuple(loads.unbalances), plates=plates,
+                  solver=SolverSpec(dt=options.dt, duration=profile.duration, record_start=0.0, start=options.start,
+                                    gravity=loads.gravity or 0.0),
+                  output=OutputSpec(nodes=nodes, table=(nodes[-1], "y")),
+                  runup=RunupSpec(profile, reference, options.orders, options.orbits_hz, options.record_dt,
+                                  options.revs_per_block))
+    return run_runup(scene, SceneModel(system, f"{system.n_dof}-DOF model", 0.0, ()), progress)
+
+
 def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete: str | None) -> RunupResult:
     """Tracks, overall amplitude, waterfall, orbits, rub intervals and critical speeds of a run-up's record."""
     t0 = time.perf_counter()
@@ -493,4 +603,5 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
                        incomplete=incomplete)
 
 
-__all__ = ["RunupResult", "RubInterval", "OrbitSnapshot", "OrderTrack", "run_runup", "block_revolutions"]
+__all__ = ["RunupResult", "RubInterval", "OrbitSnapshot", "OrderTrack", "RunupOptions", "run_runup", "runup",
+           "block_revolutions"]

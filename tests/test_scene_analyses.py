@@ -1,4 +1,4 @@
-"""harmonic_balance(model, operating, loads, contacts, options): the periodic rub response from Python."""
+"""The scene analyses from Python, on (model, operating, loads, contacts, options): harmonic_balance, continue_balance, runup."""
 
 from __future__ import annotations
 
@@ -99,3 +99,25 @@ def test_a_speed_line_with_a_fixed_spool_is_refused(rig):
                             rr.Loads(scene.unbalances), scene.plates)
     with pytest.raises(rr.InputError, match=r"must be a speed line of at least two speeds"):
         rr.continue_balance(sm.model, rr.Operating.point(scene.speeds), rr.Loads(scene.unbalances), scene.plates)
+
+
+def test_a_runup_from_python_is_the_scenes_runup(tmp_path):
+    """runup(model, Operating.profile, ...) given a run-up scene's model, profile, loads, plates and options is the
+    scene's run-up (run_runup): the same record at every recorded DOF and the same 1x order tracks (measured equal:
+    one implementation, one scene built from the inputs), and a profile that gives only the reference spool is filled
+    by the Operating rule to the scene's (the outer spool at 90/70 of the inner one)."""
+    sc = rr.load_scene("runup-rub", {"runup.to": 0.4, "runup.duration": 0.5, "runup.orbits_hz": [20.0]})
+    sm = rr.build_model(sc)
+    by_scene = rr.run_runup(sc, sm, progress=False)
+    r = sc.runup
+    only_inner = rr.SpeedProfile(r.profile.t, {"inner": r.profile.speeds["inner"]})
+    result = rr.runup(sm.model, rr.Operating.profile(only_inner), rr.Loads(sc.unbalances), sc.plates,
+                      rr.RunupOptions(dt=sc.solver.dt, record_dt=r.record_dt, orders=r.orders, nodes=sc.output.nodes,
+                                      orbits_hz=r.orbits_hz, revs_per_block=r.revs_per_block), progress=False)
+    np.testing.assert_allclose(result.scene.runup.profile.speeds["outer"], r.profile.speeds["outer"], rtol=1e-15)
+    for dof, x in by_scene.outputs.items():
+        np.testing.assert_array_equal(result.outputs[dof], x)
+    assert len(result.tracks) == len(by_scene.tracks) > 0
+    for a, b in zip(result.tracks, by_scene.tracks):
+        np.testing.assert_array_equal(a.amplitude, b.amplitude)
+    assert_shows_itself(result, tmp_path, of=rr.RunupResult)
