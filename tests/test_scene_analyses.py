@@ -1,4 +1,5 @@
-"""The scene analyses from Python, on (model, operating, loads, contacts, options): harmonic_balance, continue_balance, runup."""
+"""The scene analyses from Python on (model, operating, loads, contacts, options): harmonic_balance, continue_balance
+and runup."""
 
 from __future__ import annotations
 
