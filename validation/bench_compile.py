@@ -42,11 +42,12 @@ def worker(loop: str) -> float:
 
     scene = load_scene("paper-rub")
     model = build_model(scene).model
-    speeds = scene.speeds
+    operating = Operating.point(scene.speeds)
     if loop == "varying speed":
-        speeds = SpeedProfile(t=np.array([0.0, 1.0]), speeds={k: np.array([v, 1.01 * v]) for k, v in speeds.items()})
+        operating = Operating.profile(SpeedProfile(t=np.array([0.0, 1.0]), speeds={k: np.array([v, 1.01 * v])
+                                                                                   for k, v in scene.speeds.items()}))
     step = {"eigenbasis": "eigen", "dense": "dense"}.get(loop, "auto")  # "auto" takes dense for 10 steps
-    res = simulate(model, Operating.point(speeds), 2e-4, 2e-5, loads=Loads(scene.unbalances), contacts=scene.plates,
+    res = simulate(model, operating, 2e-4, 2e-5, loads=Loads(scene.unbalances), contacts=scene.plates,
                    scheme=Scheme(step=step))
     return res.kernel_load_time
 

@@ -27,8 +27,8 @@ def run(model_kind: str, rub: bool, ramp: bool, duration: float):
     scene = load_scene("runup-rub" if rub else "runup", {"solver.model": model_kind, "runup.duration": duration,
                                                          "runup.orbits_hz": []})
     model = build_model(scene).model
-    speeds = scene.runup.profile if ramp else scene.speeds
-    res = simulate(model, Operating.point(speeds), duration, scene.solver.dt, loads=Loads(scene.unbalances),
+    operating = Operating.profile(scene.runup.profile) if ramp else Operating.point(scene.speeds)
+    res = simulate(model, operating, duration, scene.solver.dt, loads=Loads(scene.unbalances),
                    contacts=scene.plates, recording=Recording(scene.output.dofs, decimate=5),
                    control=StepControl(progress=False))
     return model.M.shape[0], res

@@ -107,7 +107,7 @@ def by_clearance(scene, sm):
     branch = continue_scene(scene, sm.model, "rub.clearance", 20e-6, 5e-6, BranchOptions(100, 2048, stability=False),
                             progress=lambda p, v: stamps.append(time.perf_counter()))
     per_point = branch.solve_time / (len(branch.values) - 1)
-    costs = np.diff(stamps)  # points 2 .. p - 1
+    costs = np.diff(stamps[:-1])  # points 2 .. p - 1 (the last stamp: continue_scene's report of the whole branch)
     print(f"  {len(branch.values)} points from 20 to 5 um in {branch.solve_time:.3f} s: {1e3 * per_point:.1f} ms a "
           f"point (median {1e3 * np.median(costs):.1f}, largest {1e3 * costs.max():.1f} ms; cold start at 20 um "
           f"{branch.start_time:.2f} s); {branch.stopped}")
