@@ -10,11 +10,17 @@ The user-level functions and result types, importable from ``rotorred`` directly
     res = rr.simulate(model, rr.Operating.point(rotor.speeds), 0.5, 2e-5, loads=rr.Loads([rr.Unbalance(18, 2e-3)]),
                       contacts=[rr.RubPlate.for_rotor(rotor, 18)], recording=rr.Recording([(18, "y")]))
 
+Every analysis takes ``(model, operating, ...)``: a Rotor, an assembled or a reduced model, and an
+:class:`~rotorred.model.operating.Operating` (a point, a speed line or a profile; docs/model.md §17). Every result
+shows itself: a short ``repr``, ``plot(ax=None)`` returning a Figure, ``to_xarray()`` with units
+(:class:`rotorred.results.Result`). The command line imports rotorred only through these names.
+
 Layers (imports point downwards only; ``tests/test_architecture.py`` checks it):
-``checks``/``writers``/``provenance`` and ``_generated`` at the bottom, then ``model``, ``linear`` and
-``signals``, ``transient``, ``plots`` (the only layer besides ``cli`` that imports
-matplotlib), ``scenes``, ``cli``. The names below are loaded on first use, so
-``import rotorred`` costs little and never loads matplotlib or numba.
+``checks``/``writers``/``progress``/``provenance``/``results`` and ``_generated`` at the bottom, then ``model``,
+``linear`` and ``signals``, ``transient``, ``nonlinear``, ``plots`` (the only layer besides ``cli`` that imports
+matplotlib; a result's ``plot`` method imports its drawing when called), ``scenes``, ``maps``, this package's
+public names, and ``cli``. The names below are loaded on first use, so ``import rotorred`` costs little and never
+loads matplotlib or numba.
 """
 
 from __future__ import annotations
