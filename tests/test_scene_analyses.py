@@ -122,3 +122,21 @@ def test_a_runup_from_python_is_the_scenes_runup(tmp_path):
     for a, b in zip(result.tracks, by_scene.tracks):
         np.testing.assert_array_equal(a.amplitude, b.amplitude)
     assert_shows_itself(result, tmp_path, of=rr.RunupResult)
+
+
+def test_a_scene_built_from_python_writes_a_scene_file_that_reads_back_to_it():
+    """The scene runup builds from its inputs (and continue_balance's) is written by scene_toml, as a command's
+    scene.toml is: its rotor inline (rotor_table), unbalances and plates from the objects, the profile as a table
+    in Hz; reading the text back gives the same rotor, unbalances and plates to the bit, and the speeds and the
+    profile within 1 ulp where no number of Hz reads back exactly (a scene file gives speeds in Hz only)."""
+    from rotorred.scenes.schema import scene_from_toml
+
+    sc = rr.load_scene("runup-rub", {"runup.to": 0.2, "runup.duration": 0.05, "runup.orbits_hz": []})
+    u = [rr.Unbalance(11, 1e-5, 0.1234567), *sc.unbalances[1:]]  # a phase with no exact number of degrees or one
+    result = rr.runup(sc.rotor, rr.Operating.profile(sc.runup.profile), rr.Loads(u), sc.plates,
+                      rr.RunupOptions(dt=1e-4, record_dt=1e-4, nodes=(18,)), progress=False)
+    back = scene_from_toml(rr.scene_toml(result.scene))
+    assert back.rotor == sc.rotor and back.speeds == pytest.approx(result.scene.speeds, rel=2.3e-16)
+    assert back.unbalances == tuple(u) and back.plates == sc.plates
+    for s in sc.runup.profile.spools:
+        np.testing.assert_allclose(back.runup.profile.speeds[s], result.scene.runup.profile.speeds[s], rtol=2.3e-16)

@@ -20,9 +20,10 @@ import math
 
 import numpy as np
 
+from rotorred.model.rotor_writer import rotor_table
 from rotorred.scenes.schema import RunupSpec, Scene
 from rotorred.transient.plate import ClampedFreePlate, NavierPlate
-from rotorred.writers import toml_text
+from rotorred.writers import exact_in_unit, toml_text
 
 __all__ = ["scene_document", "scene_toml"]
 
@@ -54,28 +55,34 @@ def scene_toml(scene: Scene) -> str:
 
 def scene_document(scene: Scene) -> dict:
     """The tables of a scene file reproducing ``scene`` (module docstring)."""
-    written = scene.data
+    written = scene.data  # empty for a scene built in Python (rotorred.scenes.balance, runup): the objects' own values
     doc = {"name": scene.name, "description": scene.description, "rotor": _rotor(scene),
-           "speeds": _speeds(scene, written.get("speeds") or {}),
-           "unbalance": [_unbalance(u, w) for u, w in zip(scene.unbalances, written.get("unbalance", []))],
-           "rub": [_rub(p, w) for p, w in zip(scene.plates, written.get("rub", []))],
+           "speeds": _speeds(scene, written.get("speeds") or {}, built=not written),
+           "unbalance": [_unbalance(u, w) for u, w in zip(scene.unbalances,
+                                                          written.get("unbalance") or [{}] * len(scene.unbalances))],
+           "rub": [_rub(p, w) for p, w in zip(scene.plates, written.get("rub") or [{}] * len(scene.plates))],
            "solver": _solver(scene.solver), "output": _output(scene.output)}
     if scene.runup is not None:
-        doc["runup"] = _runup(scene.runup, written["runup"])
+        doc["runup"] = _runup(scene.runup, written.get("runup") or {"table": _profile_table(scene)})
     return {k: v for k, v in doc.items() if v != []}
 
 
 def _rotor(scene: Scene) -> dict:
-    """``[rotor]``: the rayleigh values in effect and the rotor's own tables inline."""
+    """``[rotor]``: the rayleigh values in effect and the rotor's own tables inline (as read, or, for a scene built in
+    Python, written by :func:`rotorred.model.rotor_writer.rotor_table`)."""
     alpha, beta = scene.rotor.rayleigh
-    return {"rayleigh_alpha": alpha, "rayleigh_beta": beta, **scene.rotor_data}
+    return {"rayleigh_alpha": alpha, "rayleigh_beta": beta, **(scene.rotor_data or rotor_table(scene.rotor))}
 
 
-def _speeds(scene: Scene, written: dict) -> dict:
-    """Every spool's speed (Hz): as written, else the rotor's nominal speed when its Hz value reads back exactly."""
+def _speeds(scene: Scene, written: dict, built: bool = False) -> dict:
+    """Every spool's speed (Hz): as written, else its Hz value when it reads back exactly; else left to the rotor's
+    nominal speed (the same default) in a scene read from a file, and written within 1 ulp in a scene ``built`` in
+    Python, whose speeds need not be the nominal ones."""
     out = {}
     for spool, w in scene.speeds.items():
         hz = written[spool] if spool in written else _exact_hz(w)
+        if hz is None and built:
+            hz = w / (2 * math.pi)
         if hz is not None:
             out[spool] = hz
     return out
@@ -92,14 +99,28 @@ def _exact_hz(w: float) -> float | None:
 
 
 def _unbalance(u, written: dict) -> dict:
-    phase = {"phase_rad": written["phase_rad"]} if "phase_rad" in written else {
-        "phase_deg": written.get("phase_deg", PHASE_DEG)}
+    """An ``[[unbalance]]`` entry: the phase as written, else (a scene built in Python) in degrees where a number
+    reads back to it exactly, else in rad."""
+    if "phase_rad" in written or "phase_deg" in written:
+        phase = {k: written[k] for k in ("phase_rad", "phase_deg") if k in written}
+    elif not written and u.phase != math.radians(PHASE_DEG):
+        deg = exact_in_unit(u.phase, math.radians, math.degrees(u.phase))
+        phase = {"phase_deg": deg} if deg is not None else {"phase_rad": u.phase}
+    else:
+        phase = {"phase_deg": PHASE_DEG}
     return {"node": u.node, "m_e": u.m_e, **phase}
 
 
 def _rub(plate, written: dict) -> dict:
     """A ``[[rub]]`` entry: node, angle and name, every number of the plate and of its bending model."""
-    out = {"node": plate.node, "theta_deg": written.get("theta_deg", THETA_DEG), "name": plate.name}
+    if written:
+        theta = written.get("theta_deg", THETA_DEG)
+    else:  # a scene built in Python: the plate's own angle (the reader converts by math.radians)
+        theta = exact_in_unit(plate.theta, math.radians, math.degrees(plate.theta))
+        if theta is None:
+            raise ValueError(f"rub at node {plate.node}: theta = {plate.theta!r} rad has no number of degrees that "
+                             "reads back to it; a scene file gives the angle in degrees")
+    out = {"node": plate.node, "theta_deg": theta, "name": plate.name}
     out.update({k: getattr(plate, k) for k in _RUB_NUMBERS})
     bending = plate.bending
     if isinstance(bending, NavierPlate):
@@ -137,6 +158,21 @@ def _output(o) -> dict:
         out["f_max_hz"] = o.f_max_hz
     out["compare_normal"] = o.compare_normal
     return out
+
+
+def _profile_table(scene: Scene) -> list[list[float]]:
+    """A scene built in Python: its speed profile as ``runup.table`` rows [t (s), each spool's speed (Hz) in the
+    rotor's order], each speed the number of Hz that reads back to it exactly where there is one (the reader
+    multiplies by 2 pi, which reaches about 1 float in 6: the others read back within 1 ulp, as a scene file's table
+    gives speeds in Hz only)."""
+    p = scene.runup.profile
+    spools = [s.name for s in scene.rotor.spools]
+
+    def hz(w: float) -> float:
+        estimate = float(w) / (2 * math.pi)
+        exact = exact_in_unit(float(w), lambda f: 2 * math.pi * f, estimate)
+        return estimate if exact is None else exact
+    return [[float(t)] + [hz(p.speeds[s][k]) for s in spools] for k, t in enumerate(p.t)]
 
 
 def _runup(r: RunupSpec, written: dict) -> dict:

@@ -568,7 +568,8 @@ def runup(model, operating: Operating, loads, contacts=(), options: RunupOptions
     for k, n in enumerate(nodes):
         checks.node(f"options.nodes[{k}]", n, system.full_dofs.nodes)
     scene = Scene(name=system.rotor.name or "rotor", description=f"run-up along {operating.describe()}",
-                  rotor=system.rotor, rotor_source="python", speeds=profile.speeds_at(0.0),
+                  rotor=system.rotor, rotor_source="python",
+                  speeds={s: float(np.max(w)) for s, w in profile.speeds.items()},  # a scene's [speeds]: > 0
                   unbalances=tuple(loads.unbalances), plates=plates,
                   solver=SolverSpec(dt=options.dt, duration=profile.duration, record_start=0.0, start=options.start,
                                     gravity=loads.gravity or 0.0),
