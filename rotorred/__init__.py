@@ -170,6 +170,8 @@ _EXPORTS = {
     "MapSpec": "rotorred.maps.spec",
     "Axis": "rotorred.maps.spec",
     "run_map": "rotorred.maps.run",
+    "envelope_map": "rotorred.maps.envelope",
+    "MapOptions": "rotorred.maps.envelope",
     "MapRun": "rotorred.maps.run",
     "format_map": "rotorred.maps.run",
     "RunupResult": "rotorred.scenes.runup",
