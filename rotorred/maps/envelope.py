@@ -22,8 +22,9 @@ from pathlib import Path
 from rotorred import checks
 from rotorred.maps.run import MapRun, run_map
 from rotorred.maps.spec import DIRECTIONS, Axis, MapSpec
-from rotorred.model.assembly import SystemMatrices, system_of
+from rotorred.model.assembly import SystemMatrices
 from rotorred.model.operating import Operating, checked as checked_operating
+from rotorred.scenes.built import built_scene, checked_loads, load_nodes, plates_on, recorded_nodes, rotor_model
 from rotorred.scenes.resolved import scene_toml
 from rotorred.scenes.schema import OutputSpec, Scene, SolverSpec
 from rotorred.transient.contact import RubPlate
@@ -118,9 +119,7 @@ def envelope_map(model, operating: Operating, loads: Loads, contacts: Sequence[R
     rotorred.checks.InputError
         For a bad input, before any point runs.
     """
-    system = system_of(model)
-    if system.rotor is None:
-        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor)")
+    system = rotor_model(model)
     operating = checked_operating(operating)
     if operating.kind == "profile":
         checks.fail("operating", operating.describe(), "must be a speed line (a point is a map of one speed)")
@@ -142,17 +141,10 @@ def envelope_map(model, operating: Operating, loads: Loads, contacts: Sequence[R
 
 def _scene(model, system, operating: Operating, loads: Loads, contacts, options: MapOptions) -> Scene:
     """The scene of the map's first point: the model as a ``[solver]`` model, the loads, plates and outputs."""
-    if not isinstance(loads, Loads):
-        checks.fail("loads", type(loads).__name__, "must be a Loads")
-    rotor = system.rotor
-    plates = tuple(p if p.disk_radius is not None else p.with_(disk_radius=rotor.disk_at(p.node).radius)
-                   for p in contacts)
-    nodes = options.nodes or tuple(dict.fromkeys([u.node for u in loads.unbalances] + [p.node for p in plates]))
-    if not nodes:
-        checks.fail("options.nodes", (), "must name a node to record (there is no unbalance or plate to default to)")
-    for k, n in enumerate(nodes):
-        checks.node(f"options.nodes[{k}]", n, rotor.spool_of)
-    if model is rotor:
+    loads = checked_loads(loads)
+    plates = plates_on(contacts, system.rotor)
+    nodes = recorded_nodes(options.nodes, load_nodes(loads, plates), system)
+    if model is system.rotor:
         settings = {}  # the scene default: a reduced model, its modes chosen for the outputs
     elif isinstance(system, SystemMatrices):
         settings = dict(model="full")
@@ -160,8 +152,6 @@ def _scene(model, system, operating: Operating, loads: Loads, contacts, options:
         settings = dict(model="reduced", modes=system.n_modes, boundary_nodes=tuple(system.boundary_nodes))
     solver = SolverSpec(dt=options.dt, duration=options.duration, record_start=options.record_start,
                         gravity=loads.gravity or 0.0, **settings)
-    return Scene(name=rotor.name or "rotor", description=f"map along {operating.describe()}", rotor=rotor,
-                 rotor_source="python", speeds=operating.at(system, 0), unbalances=tuple(loads.unbalances),
-                 plates=plates, solver=solver,
-                 output=OutputSpec(nodes=nodes, table=options.table or (nodes[0], "y"), plots=(), formats=(),
-                                   compare_normal=False))
+    return built_scene(system, f"map along {operating.describe()}", operating.at(system, 0), loads, plates, solver,
+                       OutputSpec(nodes=nodes, table=options.table or (nodes[0], "y"), plots=(), formats=(),
+                                  compare_normal=False))

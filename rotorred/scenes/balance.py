@@ -25,21 +25,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotorred import checks
-from rotorred.model.assembly import system_of
 from rotorred.model.operating import Operating, checked as checked_operating
-from rotorred.model.rotor import Rotor
 from rotorred.nonlinear.fourier import to_phasors
-from rotorred.nonlinear.hb import coefficient_variables, solve_periodic
+from rotorred.nonlinear.hb import coefficient_variables
 from rotorred.results import Result, dof_coordinates
-from rotorred.scenes.balance_harmonics import TOL, cold_solution, samples_for
+from rotorred.scenes.balance_harmonics import cold_solution, samples_for
 from rotorred.scenes.branch import BranchOptions, SceneBranch, check_key, continue_scene
+from rotorred.scenes.built import built_scene, checked_loads, plates_on, recorded_nodes, rotor_model
 from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
 from rotorred.scenes.run import start_record
-from rotorred.scenes.schema import OutputSpec, Scene, SolverSpec
+from rotorred.scenes.schema import OutputSpec, SolverSpec
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.options import Loads
 
-__all__ = ["BalanceOptions", "RubCase", "RubBalance", "harmonic_balance", "continue_balance"]
+__all__ = ["BalanceOptions", "RubBalance", "harmonic_balance", "continue_balance"]
 
 
 @dataclass(frozen=True)
@@ -82,36 +81,6 @@ class BalanceOptions:
         return self.samples if self.samples is not None else samples_for(self.harmonics)
 
 
-@dataclass(frozen=True)
-class RubCase:
-    """What a scene's harmonic balance reads of it (:func:`rotorred.scenes.harmonic_balance.rub_problem`,
-    :func:`rotorred.scenes.run.start_record`): the rotor, the spool speeds, the unbalances, the plates and the time
-    step of the start's transient (a :class:`rotorred.scenes.schema.Scene` is one too).
-
-    Attributes
-    ----------
-    rotor : Rotor
-    speeds : dict of str to float
-        Speed of every spool (rad/s).
-    unbalances : tuple of Unbalance
-    plates : tuple of RubPlate
-        Each with its disk radius.
-    solver : SolverSpec
-        Its ``dt`` (s) is the start's time step; no gravity.
-    """
-
-    rotor: Rotor
-    speeds: Mapping[str, float]
-    unbalances: tuple
-    plates: tuple
-    solver: SolverSpec
-
-    @property
-    def frequencies_hz(self) -> dict[str, float]:
-        """Spool frequencies (Hz)."""
-        return {s: w / (2 * math.pi) for s, w in self.speeds.items()}
-
-
 @dataclass(frozen=True, repr=False)
 class RubBalance(Result):
     """The periodic rub response of a rotor at an operating point (:func:`harmonic_balance`).
@@ -122,8 +91,8 @@ class RubBalance(Result):
         The condensed problem solved (its model, base frequency and harmonics).
     z : ndarray, shape ((2H + 1) n_u,)
         The solution: harmonic-major Fourier coefficients of the unknowns (m).
-    iterations : int
-        Newton iterations of the last solve.
+    start : str
+        How the solution was started (:data:`rotorred.scenes.balance_harmonics.FROM_RECORD` or ``COLD``).
     residual : float
         Relative residual at ``z`` (-).
     outputs : tuple of (int, str)
@@ -136,7 +105,7 @@ class RubBalance(Result):
 
     problem: RubProblem
     z: np.ndarray
-    iterations: int
+    start: str
     residual: float
     outputs: tuple
     operating: Operating
@@ -187,7 +156,7 @@ class RubBalance(Result):
         lines = [f"harmonic balance of {p.model.name or 'the rotor'} at {self.operating.describe()}",
                  f"f_0 = {p.f0:.6g} Hz, {self.H} harmonics, {p.problem.harmonics.N} samples a period; "
                  f"{len(p.problem.dofs)} unknowns",
-                 f"{self.iterations} Newton iterations, relative residual {self.residual:.3g}"]
+                 f"relative residual {self.residual:.3g}; started by {self.start}"]
         A = self.amplitudes
         for j, dof in enumerate(self.outputs[:8]):
             top = np.argsort(-A[:, j])[:3]
@@ -217,7 +186,7 @@ class RubBalance(Result):
 
     def to_xarray(self):
         """Dims harmonic, output: ``cos`` a_k, ``sin`` b_k and ``amplitude`` (m); ``frequency`` (Hz); the spool speeds
-        (rad/s) on dim spool; f_0, iterations and residual as attributes."""
+        (rad/s) on dim spool; f_0, the start and the residual as attributes."""
         import xarray as xr
 
         spools = list(self.speeds)
@@ -229,7 +198,7 @@ class RubBalance(Result):
                     "frequency": ("harmonic", self.frequencies, {"units": "Hz", "long_name": "frequency k f_0"}),
                     "spool": ("spool", np.array(spools, dtype=object), {"units": "1", "long_name": "spool"}),
                     **dof_coordinates("output", self.outputs, "reported DOF")},
-            attrs={"f0_hz": self.problem.f0, "iterations": self.iterations, "residual": self.residual})
+            attrs={"f0_hz": self.problem.f0, "start": self.start, "residual": self.residual})
 
 
 def harmonic_balance(model, operating: Operating, loads: Loads, contacts: Sequence[RubPlate],
@@ -262,22 +231,20 @@ def harmonic_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     rotorred.nonlinear.hb.NotConverged
         If Newton does not reach a solution from the transient's record nor from a cold start.
     """
-    system = system_of(model)
-    if system.rotor is None:
-        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor): the plates' "
-                    "spools and disks are the rotor's")
+    system = rotor_model(model)
     operating = checked_operating(operating)
     speeds = operating.single(system)
-    case = RubCase(system.rotor, speeds, _unbalances(loads), _plates(contacts, system.rotor),
-                   SolverSpec(dt=options.dt, method="harmonic-balance"))
-    outputs = options.outputs or tuple((p.node, d) for p in case.plates for d in ("x", "y"))
+    plates = plates_on(contacts, system.rotor, min_len=1)
+    scene = built_scene(system, f"harmonic balance at {operating.describe()}", speeds, _unbalances(loads), plates,
+                        SolverSpec(dt=options.dt, method="harmonic-balance"), OutputSpec())
+    outputs = options.outputs or tuple((p.node, d) for p in plates for d in ("x", "y"))
     for k, dof in enumerate(outputs):
         system.full_dofs.checked_outputs([dof], f"options.outputs[{k}]")
     H, N = options.harmonics, options.n_samples
-    rub_problem(case, system, H, N)  # every check of the problem before the transient runs
-    rp, z, _ = cold_solution(case, system, H, N, record=start_record(case, system))
-    final = solve_periodic(rp.problem, z, rp.omega, tol=TOL)  # the iterations and residual at z
-    return RubBalance(rp, final.z, final.iterations, final.residual, outputs, operating, dict(speeds))
+    rub_problem(scene, system, H, N)  # every check of the problem before the transient runs
+    rp, z, start = cold_solution(scene, system, H, N, record=start_record(scene, system))
+    residual = rp.problem.evaluate(z, rp.omega).relative
+    return RubBalance(rp, z, start, residual, outputs, operating, dict(speeds))
 
 
 def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequence[RubPlate],
@@ -318,9 +285,7 @@ def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     rotorred.checks.InputError
         For a bad input, before any computation.
     """
-    system = system_of(model)
-    if system.rotor is None:
-        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor)")
+    system = rotor_model(model)
     operating = checked_operating(operating)
     if operating.kind != "line":
         checks.fail("operating", operating.describe(), "must be a speed line of at least two speeds (its ends)")
@@ -330,33 +295,19 @@ def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequen
         checks.fail("operating", operating.describe(), f"must turn every spool at a ratio to the reference; {fixed} "
                     "at a fixed speed would change its harmonic of f_0 along the line (a quasi-periodic response)")
     reference = operating.reference_of(system)
-    plates = _plates(contacts, system.rotor)
-    nodes = tuple(checks.node(f"nodes[{k}]", n, system.full_dofs.nodes) for k, n in enumerate(nodes)) or \
-        tuple(dict.fromkeys(p.node for p in plates))
-    scene = Scene(name=system.rotor.name or "rotor", description=f"branch along {operating.describe()}",
-                  rotor=system.rotor, rotor_source="python", speeds=operating.at(system, 0),
-                  unbalances=_unbalances(loads), plates=plates,
-                  solver=SolverSpec(method="harmonic-balance", harmonics=options.harmonics, samples=options.samples),
-                  output=OutputSpec(nodes=nodes, table=(nodes[0], "y")))
+    plates = plates_on(contacts, system.rotor, min_len=1)
+    nodes = recorded_nodes(nodes, [p.node for p in plates], system, "nodes")
+    scene = built_scene(system, f"branch along {operating.describe()}", operating.at(system, 0), _unbalances(loads),
+                        plates, SolverSpec(method="harmonic-balance", harmonics=options.harmonics,
+                                           samples=options.samples), OutputSpec(nodes=nodes, table=(nodes[0], "y")))
     key = f"speeds.{reference}"
     start, end = (float(operating.Omega[i]) / (2 * math.pi) for i in (0, -1))
     check_key(scene, key, start, end)
     return continue_scene(scene, system, key, start, end, options, progress=progress)
 
 
-def _unbalances(loads: Loads) -> tuple:
-    if not isinstance(loads, Loads):
-        checks.fail("loads", type(loads).__name__, "must be a Loads")
-    if loads.gravity:
+def _unbalances(loads: Loads) -> Loads:
+    """``loads`` without gravity: a static load has no periodic balance here."""
+    if checked_loads(loads).gravity:
         checks.fail("loads.gravity", loads.gravity, "must be None: harmonic balance here has no static load", "m/s^2")
-    return tuple(loads.unbalances)
-
-
-def _plates(contacts, rotor: Rotor) -> tuple:
-    plates = checks.sequence("contacts", list(contacts), min_len=1)
-    out = []
-    for k, p in enumerate(plates):
-        if not isinstance(p, RubPlate):
-            checks.fail(f"contacts[{k}]", type(p).__name__, "must be a RubPlate")
-        out.append(p if p.disk_radius is not None else p.with_(disk_radius=rotor.disk_at(p.node).radius))
-    return tuple(out)
+    return loads

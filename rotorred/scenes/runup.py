@@ -28,10 +28,11 @@ from fractions import Fraction
 import numpy as np
 
 from rotorred import checks
-from rotorred.model.operating import Operating
+from rotorred.model.operating import Operating, checked as checked_operating
 from rotorred.progress import stage
 from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
+from rotorred.scenes.built import built_scene, checked_loads, load_nodes, plates_on, recorded_nodes, rotor_model
 from rotorred.scenes.schema import OutputSpec, RunupSpec, Scene, SolverSpec
 from rotorred.signals.orders import OrderTrack, angle_blocks, order_tracks, overall_amplitude
 from rotorred.signals.waterfall import Waterfall, waterfall
@@ -406,7 +407,6 @@ def orbit_snapshots(scene: Scene, t: np.ndarray, speeds: dict, outputs: dict) ->
 def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
     """Campbell critical speeds of the reference spool within the swept range, at the profile's final ratios."""
     from rotorred.linear.campbell import campbell
-    from rotorred.model.operating import Operating
 
     ref = scene.runup.reference
     final = {s: float(v[-1]) for s, v in speeds.items()}
@@ -547,34 +547,21 @@ def runup(model, operating: Operating, loads, contacts=(), options: RunupOptions
     rotorred.checks.InputError
         For a bad input, before any computation.
     """
-    from rotorred.model.assembly import system_of
-    from rotorred.model.operating import checked as checked_operating
-    from rotorred.transient.options import Loads
-
-    system = system_of(model)
-    if system.rotor is None:
-        checks.fail("model", type(model).__name__, "must be built from a Rotor (assemble, reduce_rotor)")
+    system = rotor_model(model)
     operating = checked_operating(operating)
     if operating.kind != "profile":
         checks.fail("operating", operating.describe(), "must be a speed profile (Operating.ramp, Operating.profile)")
-    if not isinstance(loads, Loads):
-        checks.fail("loads", type(loads).__name__, "must be a Loads")
+    loads = checked_loads(loads)
     profile, reference = operating.profile_for(system), operating.reference_of(system)
-    plates = tuple(p if p.disk_radius is not None else p.with_(disk_radius=system.rotor.disk_at(p.node).radius)
-                   for p in contacts)
-    nodes = options.nodes or tuple(dict.fromkeys([u.node for u in loads.unbalances] + [p.node for p in plates]))
-    if not nodes:
-        checks.fail("options.nodes", (), "must name a node to record (there is no unbalance or plate to default to)")
-    for k, n in enumerate(nodes):
-        checks.node(f"options.nodes[{k}]", n, system.full_dofs.nodes)
-    scene = Scene(name=system.rotor.name or "rotor", description=f"run-up along {operating.describe()}",
-                  rotor=system.rotor, rotor_source="python",
-                  speeds={s: float(np.max(w)) for s, w in profile.speeds.items()},  # a scene's [speeds]: > 0
-                  unbalances=tuple(loads.unbalances), plates=plates,
-                  solver=SolverSpec(dt=options.dt, duration=profile.duration, record_start=0.0, start=options.start,
-                                    gravity=loads.gravity or 0.0),
-                  output=OutputSpec(nodes=nodes, table=(nodes[-1], "y")),
-                  runup=RunupSpec(profile, reference, options.orders, options.orbits_hz, options.record_dt,
+    plates = plates_on(contacts, system.rotor)
+    nodes = recorded_nodes(options.nodes, load_nodes(loads, plates), system)
+    scene = built_scene(system, f"run-up along {operating.describe()}",
+                        {s: float(np.max(w)) for s, w in profile.speeds.items()},  # a scene's [speeds]: > 0
+                        loads, plates,
+                        SolverSpec(dt=options.dt, duration=profile.duration, record_start=0.0, start=options.start,
+                                   gravity=loads.gravity or 0.0),
+                        OutputSpec(nodes=nodes, table=(nodes[-1], "y")),
+                        RunupSpec(profile, reference, options.orders, options.orbits_hz, options.record_dt,
                                   options.revs_per_block))
     return run_runup(scene, SceneModel(system, f"{system.n_dof}-DOF model", 0.0, ()), progress)
 
