@@ -244,6 +244,32 @@ def test_harmonic_balance_runs_at_the_operatings_spool_speeds(operating, expecte
     assert result.problem.f0 == pytest.approx(min(w for w in expected.values() if w > 0) / (2 * np.pi), rel=1e-12)
 
 
+@pytest.mark.parametrize("operating, expected, bases", [
+    # the reference c at rest, a and b given: the torus of a's and b's frequencies (20 Hz, 10 sqrt(2) Hz)
+    (Operating.point({"c": 0.0, "a": 2 * np.pi * 20.0, "b": 2 * np.pi * 10.0 * np.sqrt(2.0)}),
+     {"a": 2 * np.pi * 20.0, "b": 2 * np.pi * 10.0 * np.sqrt(2.0), "c": 0.0}, (20.0, 10.0 * np.sqrt(2.0))),
+    # every spool turning: c follows the reference b at its nominal ratio 1/3, the order (0, 1) of the bases
+    (Operating.point({"b": 2 * np.pi * 10.0 * np.sqrt(2.0), "a": 2 * np.pi * 20.0}),
+     {"a": 2 * np.pi * 20.0, "b": 2 * np.pi * 10.0 * np.sqrt(2.0), "c": 2 * np.pi * 10.0 * np.sqrt(2.0) / 3.0},
+     (20.0, 10.0 * np.sqrt(2.0) / 3.0)),
+])
+def test_torus_balance_runs_at_the_operatings_spool_speeds(operating, expected, bases):
+    """torus_balance (its start's transient and the balance on the torus) asks the three-spool model for its matrices
+    at the spool speeds the rule gives, written out here by hand, and at no other; each turning spool's frequency is
+    the order of the bases it must be (a (1, 0), b (0, 1) or (0, 3), c (0, 1)), and a spool at rest is order (0, 0)."""
+    model = _Recording.of(three_spools())
+    unbalances = [u for u in (Unbalance(2, 1e-4), Unbalance(12, 1e-4, 1.0), Unbalance(22, 1e-4, 2.0))
+                  if expected[model.spool_of[u.node]] > 0]
+    model.taken()
+    result = rr.torus_balance(model, operating, rr.Loads(unbalances), [rr.RubPlate(node=2, disk_radius=0.1)],
+                              rr.TorusOptions(bases=bases, orders=(2, 6), f_max=None, start_window=(1.0, 2.0),
+                                              start_orders=(1, 1), dt=1e-4))
+    assert {tuple(c.items()) for c in model.taken()} == {tuple({s: round(w, 9) for s, w in expected.items()}.items())}
+    assert result.speeds == pytest.approx(expected, rel=1e-15)
+    k_b = (0, 1) if expected["c"] == 0 else (0, 3)
+    assert result.problem.spool_orders == {"a": (1, 0), "b": k_b, "c": (0, 1) if expected["c"] > 0 else (0, 0)}
+
+
 def test_continue_balance_keeps_the_operatings_ratios_along_its_branch():
     """continue_balance along a's speed line (b, c at the nominal ratios 1.5 and 0.5) asks the three-spool model for
     its matrices only at speeds on the line: b = 1.5 a and c = 0.5 a at every call (to the 1e-9 rad/s the recording

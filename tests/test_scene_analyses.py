@@ -167,3 +167,59 @@ def test_a_map_along_a_speed_line_is_the_commands_map(tmp_path):
             compared += 1
     assert compared >= 15 and ours.n_run == 2
     assert rr.envelope_map(*args, tmp_path / "python").n_resumed == 2
+
+
+@pytest.fixture(scope="module")
+def torus(rig):
+    """paper-rub at outer 91.37 Hz (inner 70 Hz), rubbing: torus_balance on the coarse set of
+    tests/test_nonlinear_torus.py (|k1| <= 6, |k2| <= 30, grid 32 x 256), the torus found by the line fit of its
+    start's transient (2-3 s)."""
+    scene, sm = rig
+    op = rr.Operating.point({"outer": 2 * np.pi * 91.37, "inner": 2 * np.pi * 70.0})
+    return op, rr.torus_balance(sm.model, op, rr.Loads(scene.unbalances), scene.plates,
+                                rr.TorusOptions(orders=(6, 30), f_max=None, outputs=[(14, "y"), (18, "x")]))
+
+
+def test_the_torus_is_the_transients_lines(rig, torus):
+    """The torus the start's line fit finds is (f_L, f_H/3); Newton converges from the record's least squares (measured
+    7 iterations, residual 9e-15), and the three largest lines at node 14 Y equal those of an independent 3 s transient
+    (rr.simulate, fitted on 2-3 s; measured f_H -0.15 %, 4f_H/3 -0.35 %, f_L -0.017 %, asserted as
+    tests/test_nonlinear_torus.py)."""
+    scene, sm = rig
+    op, result = torus
+    assert result.bases_hz == pytest.approx((70.0, 91.37 / 3), rel=1e-12)
+    assert result.problem.spool_orders == {"inner": (1, 0), "outer": (0, 3)}
+    assert result.start == "the transient's record (least squares)"
+    assert result.solution.iterations <= 10 and result.solution.residual < 1e-10
+    res = rr.simulate(sm.model, op, 3.0, scene.solver.dt, loads=rr.Loads(scene.unbalances), contacts=scene.plates,
+                      recording=rr.Recording([(14, "y")], start=2.0), control=rr.StepControl(progress=False))
+    fit = rr.fit_lines(res.t, res.outputs[(14, "y")], 70.0, 91.37)
+    lines = {ln.label: ln for ln in fit.lines}
+    for label, tol in (("f_H", 1.5e-2), ("4f_H/3", 3.5e-2), ("f_L", 2e-3)):
+        k = int(np.argmin(np.abs(result.frequencies - lines[label].frequency_hz)))
+        assert result.frequencies[k] == pytest.approx(lines[label].frequency_hz, rel=1e-9)
+        assert result.amplitudes[k, 0] == pytest.approx(lines[label].amplitude, rel=tol), label
+
+
+def test_the_torus_shows_itself(torus, tmp_path):
+    assert_shows_itself(torus[1], tmp_path, of=rr.RubTorus)
+    assert "bases f_1 = 70 Hz, f_2 = 30.4567 Hz; spool orders inner (1, 0), outer (0, 3)" in repr(torus[1])
+
+
+def test_torus_bad_input_is_refused_before_computing(rig):
+    scene, sm = rig
+    op = rr.Operating.point({"outer": 2 * np.pi * 91.37, "inner": 2 * np.pi * 70.0})
+    loads = rr.Loads(scene.unbalances)
+    with pytest.raises(rr.InputError, match=r"^loads.gravity = 9.81: must be None"):
+        rr.torus_balance(sm.model, op, rr.Loads(scene.unbalances, gravity=9.81), scene.plates)
+    with pytest.raises(rr.InputError, match=r"^operating = 'line of 2 speeds"):
+        rr.torus_balance(sm.model, rr.Operating.line([1.0, 2.0]), loads, scene.plates)
+    with pytest.raises(rr.InputError, match=r"^options.bases = \(60.0, 30.45.*\): must hold each spool frequency as one "
+                       r"order k1 f1 \+ k2 f2; 70 Hz is no order of the bases"):
+        rr.torus_balance(sm.model, op, loads, scene.plates, rr.TorusOptions(bases=(60.0, 91.37 / 3)))
+    with pytest.raises(rr.InputError, match=r"70 Hz is several orders: the bases are commensurate"):
+        rr.torus_balance(sm.model, op, loads, scene.plates, rr.TorusOptions(bases=(70.0, 35.0)))
+    with pytest.raises(rr.InputError, match=r"^options.bases = None: must be given where they cannot be found"):
+        rr.torus_balance(sm.model, op, loads, scene.plates, rr.TorusOptions(start_window=None))
+    with pytest.raises(rr.InputError, match=r"^options.grid\[1\] = 60: must be even and > 2 \* orders\[1\] = 60"):
+        rr.TorusOptions(orders=(6, 30), grid=(32, 60))

@@ -31,7 +31,7 @@ from rotorred.nonlinear.hb import coefficient_variables
 from rotorred.results import Result, dof_coordinates
 from rotorred.scenes.balance_harmonics import cold_solution, samples_for
 from rotorred.scenes.branch import BranchOptions, SceneBranch, check_key, continue_scene
-from rotorred.scenes.built import built_scene, checked_loads, plates_on, recorded_nodes, rotor_model
+from rotorred.scenes.built import balance_loads, built_scene, plates_on, recorded_nodes, rotor_model
 from rotorred.scenes.harmonic_balance import RubProblem, rub_problem
 from rotorred.scenes.run import start_record
 from rotorred.scenes.schema import OutputSpec, SolverSpec
@@ -235,7 +235,7 @@ def harmonic_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     operating = checked_operating(operating)
     speeds = operating.single(system)
     plates = plates_on(contacts, system.rotor, min_len=1)
-    scene = built_scene(system, f"harmonic balance at {operating.describe()}", speeds, _unbalances(loads), plates,
+    scene = built_scene(system, f"harmonic balance at {operating.describe()}", speeds, balance_loads(loads), plates,
                         SolverSpec(dt=options.dt, method="harmonic-balance"), OutputSpec())
     outputs = options.outputs or tuple((p.node, d) for p in plates for d in ("x", "y"))
     for k, dof in enumerate(outputs):
@@ -297,7 +297,7 @@ def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     reference = operating.reference_of(system)
     plates = plates_on(contacts, system.rotor, min_len=1)
     nodes = recorded_nodes(nodes, [p.node for p in plates], system, "nodes")
-    scene = built_scene(system, f"branch along {operating.describe()}", operating.at(system, 0), _unbalances(loads),
+    scene = built_scene(system, f"branch along {operating.describe()}", operating.at(system, 0), balance_loads(loads),
                         plates, SolverSpec(method="harmonic-balance", harmonics=options.harmonics,
                                            samples=options.samples), OutputSpec(nodes=nodes, table=(nodes[0], "y")))
     key = f"speeds.{reference}"
@@ -305,9 +305,3 @@ def continue_balance(model, operating: Operating, loads: Loads, contacts: Sequen
     check_key(scene, key, start, end)
     return continue_scene(scene, system, key, start, end, options, progress=progress)
 
-
-def _unbalances(loads: Loads) -> Loads:
-    """``loads`` without gravity: a static load has no periodic balance here."""
-    if checked_loads(loads).gravity:
-        checks.fail("loads.gravity", loads.gravity, "must be None: harmonic balance here has no static load", "m/s^2")
-    return loads

@@ -17,7 +17,7 @@ from rotorred.transient.contact import RubPlate
 from rotorred.transient.matrices import disk_radii
 from rotorred.transient.options import Loads
 
-__all__ = ["rotor_model", "checked_loads", "plates_on", "load_nodes", "recorded_nodes", "built_scene"]
+__all__ = ["rotor_model", "checked_loads", "balance_loads", "plates_on", "load_nodes", "recorded_nodes", "built_scene"]
 
 
 def rotor_model(model):
@@ -34,6 +34,14 @@ def checked_loads(loads) -> Loads:
     """``loads``, a :class:`rotorred.transient.options.Loads`."""
     if not isinstance(loads, Loads):
         checks.fail("loads", type(loads).__name__, "must be a Loads")
+    return loads
+
+
+def balance_loads(loads) -> Loads:
+    """``loads``, a :class:`rotorred.transient.options.Loads` without gravity: a static load has no harmonic balance
+    here (periodic or on a torus)."""
+    if checked_loads(loads).gravity:
+        checks.fail("loads.gravity", loads.gravity, "must be None: harmonic balance here has no static load", "m/s^2")
     return loads
 
 

@@ -45,7 +45,7 @@ def _spool_order(h: TorusHarmonics, bases: tuple[float, float], f_s: float) -> t
     hits = np.flatnonzero(np.abs(np.abs(f) - f_s) <= ORDER_RTOL * f_s)
     if hits.size != 1:
         why = "is no order of the bases in the truncated set" if hits.size == 0 else \
-            "is several orders: the bases are commensurate (use the periodic rub_problem)"
+            "is several orders: the bases are commensurate (a periodic harmonic balance)"
         checks.fail("torus", bases, f"must hold each spool frequency as one order k1 f1 + k2 f2; {f_s:.9g} Hz {why}",
                     "Hz")
     return tuple(int(k) for k in h.orders[hits[0]])

@@ -1,0 +1,339 @@
+"""The quasi-periodic rub response of a rotor by harmonic balance on a torus, from Python:
+``torus_balance(model, operating, loads, contacts, options)`` (docs/model.md §15).
+
+At spool speeds that are not commensurate the steady response lies on a two-dimensional torus of two base frequencies:
+the spools' own or their sub-harmonics (near 88-95 Hz on the outer spool of ``paper-rub`` the impacts lock to
+``f_H / 3``). The operating point is read by the one rule of :class:`rotorred.model.operating.Operating`, the model
+through :func:`rotorred.model.assembly.system_of`. The steps:
+
+1. a transient from the settled linear state over the options' start window, recording the rub disks and plates;
+2. the bases: the options' own, or the torus the signal layer's line fit finds in that record
+   (:func:`rotorred.signals.linefit.fit_lines`, bases ``f_L / j`` and ``f_H / k``);
+3. the torus problem of :func:`rotorred.scenes.torus_balance.torus_rub_problem`, started from the record fitted by
+   least squares on a small box of orders, and solved by Newton (:func:`rotorred.nonlinear.torus.solve_torus`).
+
+With no start window the solution starts from the linear response (enough where the rub is light or absent).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.checks import InputError
+from rotorred.model.operating import Operating, checked as checked_operating
+from rotorred.nonlinear.hb import coefficient_variables
+from rotorred.nonlinear.torus import TorusSolution, solve_torus
+from rotorred.results import Result, dof_coordinates
+from rotorred.scenes.built import balance_loads, built_scene, plates_on, rotor_model
+from rotorred.scenes.harmonic_balance import unknown_records
+from rotorred.scenes.run import settled_state
+from rotorred.scenes.schema import OutputSpec, SolverSpec
+from rotorred.scenes.torus_balance import TorusRubProblem, torus_bases, torus_rub_problem
+from rotorred.signals.linefit import fit_lines
+from rotorred.transient.contact import RubPlate
+from rotorred.transient.options import Initial, Loads, Recording, StepControl
+
+__all__ = ["TorusOptions", "RubTorus", "torus_balance", "default_grid"]
+
+#: how the solution was started
+FROM_RECORD, FROM_LINEAR = "the transient's record (least squares)", "the linear response"
+
+
+def default_grid(H1: int, H2: int) -> tuple[int, int]:
+    """The AFT grid ``(N_1, N_2)`` for the box ``|k_1| <= H1``, ``|k_2| <= H2``: the powers of two at or above
+    ``4 H1`` and ``8 H2``, the grids ``validation/hb_torus.py`` converges on for the rig's rub ((16, 70) -> (64, 1024))
+    and ``tests/test_nonlinear_torus.py`` uses ((6, 30) -> (32, 256))."""
+    return 1 << max(3, math.ceil(math.log2(4 * H1))), 1 << max(3, math.ceil(math.log2(8 * H2)))
+
+
+@dataclass(frozen=True)
+class TorusOptions:
+    """The torus, its truncation and its start for :func:`torus_balance`.
+
+    Parameters
+    ----------
+    bases : (float, float), optional
+        Base frequencies ``(f_1, f_2)`` (Hz); every turning spool's frequency must be an order ``k_1 f_1 + k_2 f_2``
+        of them. Default: the torus the line fit finds in the start's transient (two turning spools).
+    orders : (int, int)
+        The box of orders ``|k_1| <= H1``, ``|k_2| <= H2`` (default (16, 70): 1.27 % on the rig's ten largest lines,
+        ``validation/hb_torus.py``).
+    grid : (int, int), optional
+        The AFT grid ``(N_1, N_2)``, each even and > 2 H_i; default :func:`default_grid`.
+    f_max : float, optional
+        Keep only the orders whose line is at most ``f_max`` (Hz); default 1500 Hz, None for the whole box.
+    start_window : (float, float), optional
+        The transient's recorded window ``(t_0, t_1)`` (s): it runs to ``t_1`` from the settled linear state and the
+        start is fitted on ``[t_0, t_1]``; default (2, 3) s. None: start from the linear response, no transient.
+    start_orders : (int, int)
+        The box of orders fitted to the record (default (4, 30)); its lines must be at least 2 / (t_1 - t_0) apart.
+    dt : float
+        Time step of the start's transient (s), > 0.
+    tol : float
+        Relative residual Newton must reach (-).
+    outputs : sequence of (int, str)
+        Model DOFs (node, direction) reported; default x and y of every rub node.
+    """
+
+    bases: tuple[float, float] | None = None
+    orders: tuple[int, int] = (16, 70)
+    grid: tuple[int, int] | None = None
+    f_max: float | None = 1500.0
+    start_window: tuple[float, float] | None = (2.0, 3.0)
+    start_orders: tuple[int, int] = (4, 30)
+    dt: float = 2e-5
+    tol: float = 1e-10
+    outputs: Sequence[tuple[int, str]] = ()
+
+    def __post_init__(self):
+        if self.bases is not None:
+            object.__setattr__(self, "bases", torus_bases(self.bases))
+        H = _pair("options.orders", self.orders, 1)
+        object.__setattr__(self, "orders", H)
+        if self.grid is not None:
+            grid = _pair("options.grid", self.grid, 4)
+            for i in range(2):
+                if grid[i] % 2 or grid[i] <= 2 * H[i]:
+                    checks.fail(f"options.grid[{i}]", grid[i], f"must be even and > 2 * orders[{i}] = {2 * H[i]}")
+            object.__setattr__(self, "grid", grid)
+        if self.f_max is not None:
+            checks.positive("options.f_max", self.f_max, "Hz")
+        if self.start_window is not None:
+            t = checks.sequence("options.start_window", list(self.start_window), min_len=2, max_len=2)
+            t0 = checks.non_negative("options.start_window[0]", t[0], "s")
+            t1 = checks.number("options.start_window[1]", t[1], "s", gt=t0)
+            object.__setattr__(self, "start_window", (t0, t1))
+        object.__setattr__(self, "start_orders", _pair("options.start_orders", self.start_orders, 0))
+        checks.positive("options.dt", self.dt, "s")
+        checks.number("options.tol", self.tol, gt=0.0, lt=1.0)
+        object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
+
+    @property
+    def n_grid(self) -> tuple[int, int]:
+        """``(N_1, N_2)``: the grid given, or :func:`default_grid` of the orders."""
+        return self.grid if self.grid is not None else default_grid(*self.orders)
+
+
+def _pair(field: str, value, low: int) -> tuple[int, int]:
+    pair = checks.sequence(field, list(np.ravel(value)), min_len=2, max_len=2)
+    return tuple(checks.integer(f"{field}[{i}]", v, ge=low) for i, v in enumerate(pair))
+
+
+@dataclass(frozen=True, repr=False)
+class RubTorus(Result):
+    """The quasi-periodic rub response of a rotor at an operating point (:func:`torus_balance`).
+
+    Attributes
+    ----------
+    problem : TorusRubProblem
+        The problem solved (its model, bases and orders).
+    solution : TorusSolution
+        Newton's solution: the coefficients of the unknowns, iterations and residual.
+    start : str
+        How the solution was started (:data:`FROM_RECORD` or :data:`FROM_LINEAR`).
+    outputs : tuple of (int, str)
+        The model DOFs reported.
+    operating : Operating
+        The operating point.
+    speeds : dict of str to float
+        Speed of every spool there (rad/s).
+    solve_time : float
+        Wall time of the start's transient and Newton's solve (s).
+    """
+
+    problem: TorusRubProblem
+    solution: TorusSolution
+    start: str
+    outputs: tuple
+    operating: Operating
+    speeds: Mapping[str, float]
+    solve_time: float
+
+    @property
+    def bases_hz(self) -> tuple[float, float]:
+        """The base frequencies ``(f_1, f_2)`` (Hz)."""
+        return self.problem.bases_hz
+
+    @property
+    def orders(self) -> np.ndarray:
+        """The order ``(k_1, k_2)`` of each line, shape (K, 2)."""
+        return self.problem.problem.harmonics.orders
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The frequency ``|k_1 f_1 + k_2 f_2|`` of each order's line, shape (K,) (Hz)."""
+        return np.abs(self.problem.problem.harmonics.frequencies(self.bases_hz))
+
+    @property
+    def phasors(self) -> np.ndarray:
+        """Complex amplitude ``Q_k = a_k - i b_k`` of each order and output, shape (K, n_outputs) (m or rad): the line
+        of order k is ``Re(Q_k exp(i (k_1 theta_1 + k_2 theta_2)))`` with ``theta_i = 2 pi f_i t``."""
+        Q = self.problem.problem.recover(self.solution.z)[:, :self.problem.n_model]
+        return Q @ self.problem.model.output_rows(list(self.outputs)).T
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        """Amplitude of each order's line and output, shape (K, n_outputs) (m or rad)."""
+        return np.abs(self.phasors)
+
+    def summary(self) -> list[str]:
+        """The operating point, the torus, the truncation, the convergence and each output's strongest lines."""
+        h, s = self.problem.problem.harmonics, self.solution
+        f1, f2 = self.bases_hz
+        lines = [f"harmonic balance on a torus of {self.problem.model.name or 'the rotor'} at "
+                 f"{self.operating.describe()}",
+                 f"bases f_1 = {f1:.6g} Hz, f_2 = {f2:.6g} Hz; spool orders "
+                 + ", ".join(f"{sp} {k}" for sp, k in self.problem.spool_orders.items()),
+                 f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}), grid {h.N1} x {h.N2}; "
+                 f"{len(self.problem.problem.dofs)} unknowns",
+                 f"{s.iterations} Newton iterations, relative residual {s.residual:.3g}; started from {self.start}; "
+                 f"{self.solve_time:.3g} s"]
+        A, f = self.amplitudes, self.frequencies
+        for j, dof in enumerate(self.outputs[:8]):
+            top = np.argsort(-A[:, j])[:3]
+            lines.append(f"node {dof[0]} {dof[1]}: " + ", ".join(
+                f"{1e6 * A[k, j]:.4g} µm at {f[k]:.6g} Hz {tuple(int(v) for v in self.orders[k])}" for k in top
+                if A[k, j] > 0))
+        if len(self.outputs) > 8:
+            lines.append(f"... {len(self.outputs) - 8} more outputs")
+        return lines
+
+    def plot(self, ax=None, *, title: str | None = None):
+        """The amplitude of each order's line of each output at its frequency (µm, log scale).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Where to draw (default: a new figure).
+        title : str, optional
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from rotorred.plots.branch import plot_harmonics
+
+        return plot_harmonics(self.frequencies, self.amplitudes, [f"node {n} {d}" for n, d in self.outputs], ax,
+                              title=title)
+
+    def to_xarray(self):
+        """Dims order, output: ``cos`` a_k, ``sin`` b_k and ``amplitude`` (m); the orders' ``k1``, ``k2`` and
+        ``frequency`` (Hz); the bases (Hz) on dim base, the spool speeds (rad/s) on dim spool; the start, the Newton
+        iterations and the residual as attributes."""
+        import xarray as xr
+
+        spools = list(self.speeds)
+        return xr.Dataset(
+            {**coefficient_variables(self.phasors, ("order", "output")),
+             "base_frequency": ("base", np.array(self.bases_hz), {"units": "Hz", "long_name": "base frequencies"}),
+             "spool_speed": ("spool", np.array([self.speeds[s] for s in spools]),
+                             {"units": "rad/s", "long_name": "spool speed"})},
+            coords={"k1": ("order", self.orders[:, 0], {"units": "1", "long_name": "order of f_1"}),
+                    "k2": ("order", self.orders[:, 1], {"units": "1", "long_name": "order of f_2"}),
+                    "frequency": ("order", self.frequencies, {"units": "Hz", "long_name": "|k1 f_1 + k2 f_2|"}),
+                    "spool": ("spool", np.array(spools, dtype=object), {"units": "1", "long_name": "spool"}),
+                    **dof_coordinates("output", self.outputs, "reported DOF")},
+            attrs={"start": self.start, "iterations": self.solution.iterations,
+                   "residual": self.solution.residual})
+
+
+def torus_balance(model, operating: Operating, loads: Loads, contacts: Sequence[RubPlate],
+                  options: TorusOptions = TorusOptions()) -> RubTorus:
+    """The quasi-periodic rub response of ``model`` at the ``operating`` point by harmonic balance on a torus
+    (docs/model.md §15).
+
+    Parameters
+    ----------
+    model : Rotor, SystemMatrices or ReducedSystem
+        Built from a rotor (:func:`rotorred.model.assembly.system_of`); each rub node's x and y must be its own
+        coordinates (a boundary node of a reduced model: ``reduce_rotor(rotor, extra_nodes=[node])``).
+    operating : Operating
+        One point; every turning spool's frequency must be one order of the torus's bases.
+    loads : Loads
+        The unbalances; no gravity.
+    contacts : sequence of RubPlate
+        At least one plate; a plate without ``disk_radius`` takes its disk's from the rotor.
+    options : TorusOptions
+        The bases (default: found in the start's transient), the orders, the grid, the start and the DOFs reported.
+
+    Returns
+    -------
+    RubTorus
+
+    Raises
+    ------
+    rotorred.checks.InputError
+        For a bad input, before the transient: not one point, no plate, gravity, a rub node that is not a coordinate
+        of the model, a spool frequency that is no order of the bases; after the transient, if no bases were given and
+        its line fit finds no torus of two incommensurate bases.
+    rotorred.transient.results.SimulationDiverged
+        If the start's transient diverges (it carries what was computed).
+    rotorred.nonlinear.hb.NotConverged
+        If Newton does not reach ``options.tol``.
+    """
+    system = rotor_model(model)
+    operating = checked_operating(operating)
+    if not isinstance(options, TorusOptions):
+        checks.fail("options", type(options).__name__, "must be a TorusOptions")
+    speeds = operating.single(system)
+    plates = plates_on(contacts, system.rotor, min_len=1)
+    scene = built_scene(system, f"torus harmonic balance at {operating.describe()}", speeds, balance_loads(loads),
+                        plates, SolverSpec(dt=options.dt, method="harmonic-balance"), OutputSpec())
+    outputs = options.outputs or tuple((p.node, d) for p in plates for d in ("x", "y"))
+    for k, dof in enumerate(outputs):
+        system.full_dofs.checked_outputs([dof], f"options.outputs[{k}]")
+    turning = sorted(w / (2 * math.pi) for w in speeds.values() if w > 0)
+    if options.bases is not None:
+        try:  # every check of the problem before the transient runs
+            torus_rub_problem(scene, system, options.bases, *options.orders, *options.n_grid, options.f_max)
+        except InputError as exc:
+            if exc.field != "torus":
+                raise
+            checks.fail("options.bases", options.bases, exc.requirement, exc.unit)
+    elif options.start_window is None or len(turning) != 2:
+        checks.fail("options.bases", None, "must be given where they cannot be found in a transient (a start window "
+                    f"and exactly two turning spools; here {len(turning)} turning"
+                    + (", no start window)" if options.start_window is None else ")"), "Hz")
+    t0 = time.perf_counter()
+    record = None if options.start_window is None else _start_record(scene, system, operating, options)
+    bases = options.bases or _found_bases(record, plates[0].node, turning)
+    rp = torus_rub_problem(scene, system, bases, *options.orders, *options.n_grid, options.f_max)
+    if record is None:
+        z0, start = rp.problem.linear_response(), FROM_LINEAR
+    else:
+        try:
+            z0 = rp.start_from_record(record.t, unknown_records(plates, record), within=options.start_orders)
+        except InputError as exc:  # the start's lines closer than the record resolves
+            checks.fail("options.start_orders", options.start_orders, "must give lines the start window "
+                        f"{options.start_window} s resolves: their frequencies {exc.requirement}", exc.unit)
+        start = FROM_RECORD
+    solution = solve_torus(rp.problem, z0, tol=options.tol)
+    return RubTorus(rp, solution, start, outputs, operating, dict(speeds), time.perf_counter() - t0)
+
+
+def _start_record(scene, system, operating: Operating, options: TorusOptions):
+    """The transient from the settled linear state to ``t_1``, recording each plate node's x and y from ``t_0``."""
+    from rotorred.transient.newmark import simulate  # numba only when a transient runs
+
+    t0, t1 = options.start_window
+    nodes = [(p.node, d) for p in scene.plates for d in ("x", "y")]
+    return simulate(system, operating, t1, options.dt, loads=Loads(scene.unbalances), contacts=scene.plates,
+                    recording=Recording(nodes, start=t0), start=Initial(*settled_state(scene, system)),
+                    control=StepControl(progress=False))
+
+
+def _found_bases(record, node: int, turning: list[float]) -> tuple[float, float]:
+    """The torus the line fit finds in the record at ``node`` y, with the two turning spools' frequencies (Hz)."""
+    fit = fit_lines(record.t, record.outputs[(node, "y")], turning[0], turning[1])
+    torus = fit.torus
+    if torus is None or torus.ratio is not None:
+        found = "no torus" if torus is None else f"the commensurate torus ({torus.label})"
+        checks.fail("options.bases", None, f"must be given: the start's line fit at node {node} y found {found}, not "
+                    "two incommensurate bases (a periodic response: harmonic_balance)", "Hz")
+    return torus_bases(torus)
