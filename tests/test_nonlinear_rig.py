@@ -17,7 +17,6 @@ from rotorred.scenes.harmonic_balance import base_frequency, rub_problem, unknow
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
 from rotorred.transient.contact import disk_force, normal_force, sliding_velocity
-from rotorred.model.operating import Operating
 from rotorred.transient.newmark import Loads, Recording, simulate
 
 
@@ -115,7 +114,7 @@ def test_the_rigs_rub_response_equals_the_settled_transient(paper_rub):
     errors = [abs(lines[round(ln.frequency_hz, 6)] / ln.amplitude - 1) for ln in largest]
     assert iterations <= 5 and max(errors) < 1e-2, errors
     # the solution as a transient's start (RubProblem.final_state): 0.5 s later the transient is still on it
-    again = simulate(sm.model, Operating.point(scene.speeds), 0.5, scene.solver.dt, loads=Loads(scene.unbalances),
+    again = simulate(sm.model, scene.operating, 0.5, scene.solver.dt, loads=Loads(scene.unbalances),
                      contacts=scene.plates, recording=Recording([(18, "x"), (18, "y")], start=0.4),
                      start=rp.final_state(z))
     window = again.t >= again.t[-1] - period + 1e-9

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -285,3 +286,25 @@ def test_continue_balance_keeps_the_operatings_ratios_along_its_branch():
     for c in calls:
         assert c["b"] == pytest.approx(1.5 * c["a"], abs=2e-9) and c["c"] == pytest.approx(0.5 * c["a"], abs=2e-9)
         assert c["a"] >= 2 * np.pi * 20.0 * (1 - 1e-6)
+
+
+def test_a_scene_reads_its_speeds_by_the_rule(tmp_path):
+    """A scene's [speeds] is an Operating point: with the outer spool given alone, the inner follows it at the seed
+    rig's nominal ratio 70/90 (the rule of Operating.point, written out here by hand), and the scene's operating point
+    gives another analysis the same speeds; the outer spool given at rest stops the inner too, which is refused (no
+    spool turns)."""
+    text = (Path(rr.__file__).parent / "scenes" / "builtin" / "paper-normal.toml").read_text(encoding="utf-8")
+    assert "inner = 70.0\nouter = 90.0\n" in text
+    path = tmp_path / "one-spool.toml"
+    path.write_text(text.replace("inner = 70.0\nouter = 90.0\n", "outer = 100.0\n"), encoding="utf-8")
+    scene = rr.load_scene(path)
+    expected = {"inner": 2 * np.pi * 100.0 * 70.0 / 90.0, "outer": 2 * np.pi * 100.0}
+    assert scene.speeds == pytest.approx(expected, rel=1e-15) and list(scene.speeds) == ["inner", "outer"]
+    assert scene.operating.reference == "outer"
+    assert rr.campbell(scene.rotor, scene.operating, n_modes=2).operating is scene.operating
+    (tmp_path / "resolved.toml").write_text(rr.scene_toml(scene), encoding="utf-8")
+    assert rr.load_scene(tmp_path / "resolved.toml").speeds == scene.speeds  # to the bit, the reference first
+    path.write_text(text.replace("inner = 70.0\nouter = 90.0\n", "outer = 0.0\n"), encoding="utf-8")
+    with pytest.raises(InputError, match=r"speeds = \{'outer': 0.0\}: must give at least one spool of inner, outer a "
+                                         r"speed > 0"):
+        rr.load_scene(path)

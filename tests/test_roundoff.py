@@ -14,7 +14,6 @@ import pytest
 
 from rotorred.scenes.run import build_model, settled_response, settled_state
 from rotorred.scenes.schema import load_scene
-from rotorred.model.operating import Operating
 from rotorred.transient.newmark import Initial, Loads, Recording, simulate
 
 OUT = [(18, "y"), (14, "y")]
@@ -27,7 +26,7 @@ def error_against_settled(model_kind: str, dt: float) -> float:
     model = build_model(scene).model
     q0, v0 = settled_state(scene, model)
     plates = [p.with_(clearance=1e-3) for p in scene.plates]
-    res = simulate(model, Operating.point(scene.speeds), 0.004, dt, loads=Loads(scene.unbalances), contacts=plates,
+    res = simulate(model, scene.operating, 0.004, dt, loads=Loads(scene.unbalances), contacts=plates,
                    recording=Recording(OUT), start=Initial(q0=q0, v0=v0))
     assert res.contacts[0].fraction("open") == 1.0  # before (without) any contact
     ref = settled_response(scene, model, model.output_rows(OUT), res.t)

@@ -22,7 +22,7 @@ def rig():
 @pytest.fixture(scope="module")
 def balance(rig):
     scene, sm = rig
-    return rr.harmonic_balance(sm.model, rr.Operating.point(scene.speeds), rr.Loads(scene.unbalances), scene.plates,
+    return rr.harmonic_balance(sm.model, scene.operating, rr.Loads(scene.unbalances), scene.plates,
                                rr.BalanceOptions(H, N, outputs=[(14, "y"), (18, "x"), (18, "y")]))
 
 
@@ -59,7 +59,7 @@ def test_the_result_shows_itself(balance, tmp_path):
 
 def test_bad_input_is_refused_before_computing(rig):
     scene, sm = rig
-    op = rr.Operating.point(scene.speeds)
+    op = scene.operating
     with pytest.raises(rr.InputError, match=r"^loads.gravity = 9.81: must be None"):
         rr.harmonic_balance(sm.model, op, rr.Loads(scene.unbalances, gravity=9.81), scene.plates)
     with pytest.raises(rr.InputError, match=r"^contacts = \[\]: must hold at least 1"):
@@ -99,7 +99,7 @@ def test_a_speed_line_with_a_fixed_spool_is_refused(rig):
         rr.continue_balance(sm.model, rr.Operating.line([90.0, 91.0], "outer", fixed={"inner": 70.0}, unit="Hz"),
                             rr.Loads(scene.unbalances), scene.plates)
     with pytest.raises(rr.InputError, match=r"must be a speed line of at least two speeds"):
-        rr.continue_balance(sm.model, rr.Operating.point(scene.speeds), rr.Loads(scene.unbalances), scene.plates)
+        rr.continue_balance(sm.model, scene.operating, rr.Loads(scene.unbalances), scene.plates)
 
 
 def test_a_runup_from_python_is_the_scenes_runup(tmp_path):

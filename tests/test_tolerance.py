@@ -16,7 +16,6 @@ from rotorred.scenes.run import build_model, respond, spool_frequencies
 from rotorred.scenes.schema import load_scene
 from rotorred.scenes.tolerance import choose, run_to_tolerance
 from rotorred.signals.compare import outputs_error, record_error
-from rotorred.model.operating import Operating
 from rotorred.transient.newmark import Loads, Recording, simulate
 
 OUT = [(18, "x"), (18, "y"), (13, "x"), (14, "y")]
@@ -45,7 +44,7 @@ def test_the_average_acceleration_steady_state_is_the_receptance_at_the_warped_f
     omega_d = (2/dt) tan(omega dt/2), to the decay of the start (measured 2.4e-9), not with H(i omega) (5.2e-3)."""
     scene, model = normal
     dt = 2e-4
-    res = simulate(model, Operating.point(scene.speeds), 6.0, dt, loads=Loads(scene.unbalances),
+    res = simulate(model, scene.operating, 6.0, dt, loads=Loads(scene.unbalances),
                    recording=Recording(OUT, start=5.0))
     y = np.array([res.outputs[o] for o in OUT])
     scale = np.abs(y).max()

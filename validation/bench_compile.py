@@ -42,7 +42,7 @@ def worker(loop: str) -> float:
 
     scene = load_scene("paper-rub")
     model = build_model(scene).model
-    operating = Operating.point(scene.speeds)
+    operating = scene.operating
     if loop == "varying speed":
         operating = Operating.profile(SpeedProfile(t=np.array([0.0, 1.0]), speeds={k: np.array([v, 1.01 * v])
                                                                                    for k, v in scene.speeds.items()}))

@@ -19,7 +19,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
-from rotorred.model.operating import Operating
 from rotorred.transient.newmark import Loads, Recording, StepControl, simulate
 
 
@@ -27,7 +26,7 @@ def run(model_kind: str, rub: bool, ramp: bool, duration: float):
     scene = load_scene("runup-rub" if rub else "runup", {"solver.model": model_kind, "runup.duration": duration,
                                                          "runup.orbits_hz": []})
     model = build_model(scene).model
-    operating = Operating.profile(scene.runup.profile) if ramp else Operating.point(scene.speeds)
+    operating = scene.runup.operating if ramp else scene.operating
     res = simulate(model, operating, duration, scene.solver.dt, loads=Loads(scene.unbalances),
                    contacts=scene.plates, recording=Recording(scene.output.dofs, decimate=5),
                    control=StepControl(progress=False))

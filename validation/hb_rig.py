@@ -37,7 +37,6 @@ from rotorred.scenes.branch import STABILITY_SUBSTEPS, BranchOptions, cold_start
 from rotorred.scenes.harmonic_balance import rub_problem, unknown_records
 from rotorred.scenes.run import build_model, run_scene, start_record
 from rotorred.scenes.schema import load_scene
-from rotorred.model.operating import Operating
 from rotorred.transient.newmark import Loads, Recording, simulate
 
 OUTPUT = (14, "y")
@@ -159,7 +158,7 @@ def main() -> None:
 
 def settled_from(scene, sm, rp, z):
     """The coefficients of the last period of a 2 s transient started on the orbit ``z``."""
-    res = simulate(sm.model, Operating.point(scene.speeds), 2.0, scene.solver.dt, loads=Loads(scene.unbalances),
+    res = simulate(sm.model, scene.operating, 2.0, scene.solver.dt, loads=Loads(scene.unbalances),
                    contacts=scene.plates, recording=Recording([(18, "x"), (18, "y")], start=1.9),
                    start=rp.final_state(z))
     window = res.t >= res.t[-1] - 1.0 / rp.f0 + 1e-9

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rotorred import checks
+from rotorred.model.operating import SpoolLine
 from rotorred.scenes.schema import Scene, load_scene
 from rotorred.scenes.keys import key_unit
 
@@ -158,8 +159,8 @@ class MapSpec:
         out = dict(self.settings)
         for axis, i in zip(self.axes, index):
             out[axis.key] = axis.values[i]
-        for spool, r in self.ratios:
-            out[f"speeds.{spool}"] = r * self.axes[0].values[index[0]]
+        for spool, r in self.ratios:  # a spool at ratio r of the varied speed, by the speed line's rule
+            out[f"speeds.{spool}"] = float(SpoolLine(r, 0.0, "ratio").at(self.axes[0].values[index[0]]))
         return out
 
     def scene_at(self, index: tuple[int, ...]) -> Scene:

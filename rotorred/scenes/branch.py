@@ -41,6 +41,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
+from rotorred.model.operating import Operating
 from rotorred.nonlinear.condensed import ClearanceFamily
 from rotorred.nonlinear.continuation import (INTERRUPTS, ContinuationOptions, continue_branch, interrupt_name,
                                              stability_variable)
@@ -531,15 +532,17 @@ def continue_scene(scene, model, key: str, start: float, end: float, options: Br
 
 
 def scene_at(scene, key: str, value: float):
-    """``scene`` with ``key`` at ``value``: a spool's speed with every spool scaled with it, or a number of the first
-    plate (``rub.clearance`` and :data:`PLATE_KEYS`); and the base frequency (Hz) to build it with (None: its speeds'
+    """``scene`` with ``key`` at ``value``: a spool's speed (Hz) with every other spool at its ratio to it in the scene
+    (a speed line, :meth:`rotorred.model.operating.Operating.line`), or a number of the first plate
+    (``rub.clearance`` and :data:`PLATE_KEYS`); and the base frequency (Hz) to build it with (None: its speeds'
     own)."""
     group, _, name = key.partition(".")
     if group == "speeds":
-        factor = value / scene.frequencies_hz[name]
-        speeds = {s: w * factor for s, w in scene.speeds.items()}
+        ratios = {s: w / scene.speeds[name] for s, w in scene.speeds.items() if s != name}
+        line = Operating.line([value], name, ratios=ratios, unit="Hz")
         f = scene.frequencies_hz
-        return dataclasses.replace(scene, speeds=speeds), value * base_frequency(tuple(f.values())) / f[name]
+        return (dataclasses.replace(scene, operating=Operating.point(line.at(scene.rotor))),
+                value * base_frequency(tuple(f.values())) / f[name])
     plates = (scene.plates[0].with_(**{name: value}),) + tuple(scene.plates[1:])
     return dataclasses.replace(scene, plates=plates), None
 

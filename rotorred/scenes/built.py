@@ -12,6 +12,7 @@ from collections.abc import Mapping, Sequence
 
 from rotorred import checks
 from rotorred.model.assembly import system_of
+from rotorred.model.operating import Operating
 from rotorred.scenes.schema import OutputSpec, RunupSpec, Scene, SolverSpec
 from rotorred.transient.contact import RubPlate
 from rotorred.transient.matrices import disk_radii
@@ -76,5 +77,5 @@ def built_scene(system, description: str, speeds: Mapping[str, float], loads: Lo
     """The scene of ``system``'s rotor at ``speeds`` (rad/s) with ``loads``' unbalances and ``plates``; its
     ``rotor_source`` is ``"python"`` (:func:`rotorred.scenes.resolved.scene_toml` writes the rotor inline)."""
     return Scene(name=system.rotor.name or "rotor", description=description, rotor=system.rotor,
-                 rotor_source="python", speeds=dict(speeds), unbalances=tuple(loads.unbalances), plates=plates,
+                 rotor_source="python", operating=Operating.point(dict(speeds)), unbalances=tuple(loads.unbalances), plates=plates,
                  solver=solver, output=output, runup=runup)

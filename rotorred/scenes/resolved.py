@@ -75,17 +75,18 @@ def _rotor(scene: Scene) -> dict:
 
 
 def _speeds(scene: Scene, written: dict, built: bool = False) -> dict:
-    """Every spool's speed (Hz): as written, else its Hz value when it reads back exactly; else left to the rotor's
-    nominal speed (the same default) in a scene read from a file, and written within 1 ulp in a scene ``built`` in
-    Python, whose speeds need not be the nominal ones."""
-    out = {}
-    for spool, w in scene.speeds.items():
-        hz = written[spool] if spool in written else _exact_hz(w)
-        if hz is None and built:
-            hz = w / (2 * math.pi)
-        if hz is not None:
-            out[spool] = hz
-    return out
+    """Every spool's speed (Hz), the spools the scene gave first in their order (the first is the reference of its
+    operating point): as written, else its Hz value when it reads back exactly, else left out, which the same rule
+    gives back (a spool the scene left out follows its reference at the nominal ratio; no ``[speeds]``: all the
+    rotor's nominal speeds, so none is written unless all read back). A scene ``built`` in Python writes every speed,
+    within 1 ulp where no Hz value reads back."""
+    if built:
+        return {s: _exact_hz(w) or w / (2 * math.pi) for s, w in scene.speeds.items()}
+    exact = {s: written[s] if s in written else _exact_hz(scene.speeds[s])
+             for s in [*written, *(s for s in scene.speeds if s not in written)]}
+    if not written and None in exact.values():
+        return {}
+    return {s: hz for s, hz in exact.items() if hz is not None}
 
 
 def _exact_hz(w: float) -> float | None:

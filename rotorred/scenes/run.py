@@ -47,7 +47,6 @@ from rotorred.model.assembly import assemble
 from rotorred.progress import stage
 from rotorred.results import Result
 from rotorred.linear.harmonic import SteadyState, steady_state
-from rotorred.model.operating import Operating
 from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
 from rotorred.signals.classify import Classification, classify
@@ -464,7 +463,7 @@ def scene_steady_state(scene: Scene, model) -> SteadyState | None:
     """Linear steady state of the scene's unbalances, per spool (None without unbalances)."""
     if not scene.unbalances:
         return None
-    return steady_state(model, Operating.point(scene.speeds), scene.unbalances)
+    return steady_state(model, scene.operating, scene.unbalances)
 
 
 def _static_deflection(scene: Scene, model) -> np.ndarray | None:
@@ -717,7 +716,7 @@ def start_record(scene: Scene, model) -> tuple[np.ndarray, dict] | None:
     dt = period / math.ceil(period / scene.solver.dt - 1e-9)
     outputs = [(p.node, d) for p in scene.plates for d in ("x", "y")]
     try:
-        res = simulate(model, Operating.point(scene.speeds), START_PERIODS * period, dt,
+        res = simulate(model, scene.operating, START_PERIODS * period, dt,
                        loads=Loads(scene.unbalances), contacts=scene.plates,
                        recording=Recording(outputs, start=(START_PERIODS - 1) * period),
                        start=Initial(*settled_state(scene, model)), control=StepControl(progress=False))
@@ -743,7 +742,7 @@ def _transient_response(scene: Scene, scene_model: SceneModel, progress: bool | 
     stage("stepping %s: %s, %d steps of %g s to %g s (record from %g s)", scene.name, s.method,
           round(s.duration / s.dt), s.dt, s.duration, s.record_start, logger=LOG)
     try:
-        res = simulate(model, Operating.point(scene.speeds), s.duration, s.dt,
+        res = simulate(model, scene.operating, s.duration, s.dt,
                        loads=Loads(scene.unbalances, s.gravity or None), contacts=scene.plates,
                        scheme=Scheme(s.method, alpha=s.alpha if s.method == "hht" else None),
                        recording=Recording(scene.output.dofs, start=s.record_start), start=initial,

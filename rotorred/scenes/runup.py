@@ -452,14 +452,14 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
         raise ValueError(f"scene {scene.name!r} has no [runup]")
     model = model or build_model(scene)
     s, profile = scene.solver, scene.runup.profile
-    at_t0 = dataclasses.replace(scene, speeds=profile.speeds_at(0.0))
+    at_t0 = dataclasses.replace(scene, operating=Operating.point(profile.speeds_at(0.0)))
     start = Initial(*settled_state(at_t0, model.model)) if s.start == "settled" else None
     t0 = time.perf_counter()
     incomplete = None
     stage("stepping %s through its speed profile: %d steps of %g s to %g s", scene.name, round(s.duration / s.dt),
           s.dt, s.duration)
     try:
-        res = simulate(model.model, Operating.profile(profile, scene.runup.reference), s.duration, s.dt,
+        res = simulate(model.model, scene.runup.operating, s.duration, s.dt,
                        loads=Loads(scene.unbalances, s.gravity or None), contacts=scene.plates,
                        recording=Recording(scene.output.dofs, decimate=int(round(scene.runup.record_dt / s.dt))),
                        start=start, control=StepControl(progress=progress))

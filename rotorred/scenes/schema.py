@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from importlib import resources
@@ -46,6 +47,7 @@ from rotorred import checks
 from rotorred.checks import InputError, fail
 from rotorred.model.dofs import DIRECTIONS, parse_dof
 from rotorred.model.loads import Unbalance, unbalance_from_table
+from rotorred.model.operating import Operating
 from rotorred.model.rotor import Rotor, node_ranges, plural, speed_text
 from rotorred.model.rotor_file import ROTOR_FILE_KEYS, presets, read_rotor, read_text_file, read_toml, rotor_from_dict
 from rotorred.model.speeds import SpeedProfile
@@ -237,6 +239,11 @@ class RunupSpec:
     record_dt: float = 1e-4
     revs_per_block: int = 8
 
+    @property
+    def operating(self) -> Operating:
+        """The run-up's operating condition: its profile, with its reference spool (:meth:`Operating.profile`)."""
+        return Operating.profile(self.profile, self.reference)
+
 
 @dataclass(frozen=True)
 class Scene:
@@ -249,14 +256,17 @@ class Scene:
         The rotor, with the scene's Rayleigh override applied.
     rotor_source : str
         Preset name or file path.
-    speeds : dict of str to float
-        Spool speeds (rad/s).
+    operating : Operating
+        The operating point (``[speeds]``, Hz, by the rule of :meth:`Operating.point`: the spools given at their
+        speeds, the first the reference, a spool left out following it at the rotor's nominal ratio; no ``[speeds]``:
+        the rotor's nominal speeds). Its spool speeds are :attr:`speeds`.
     unbalances : tuple of Unbalance
     plates : tuple of RubPlate
     solver : SolverSpec
     output : OutputSpec
     runup : RunupSpec or None
-        The speed profile of a run-up or coast-down; None for constant ``speeds``.
+        The speed profile of a run-up or coast-down (its operating condition: ``runup.operating``); None for
+        constant ``speeds``.
     source : str
         Where the scene came from (file, built-in name or "<string>").
     data : dict
@@ -270,7 +280,7 @@ class Scene:
     description: str
     rotor: Rotor
     rotor_source: str
-    speeds: dict
+    operating: Operating
     unbalances: tuple
     plates: tuple
     solver: SolverSpec
@@ -279,6 +289,11 @@ class Scene:
     source: str = "<string>"
     data: dict = field(default_factory=dict, repr=False, compare=False)
     rotor_data: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @functools.cached_property
+    def speeds(self) -> dict[str, float]:
+        """Every spool's speed (rad/s) at the operating point, in the rotor's spool order."""
+        return self.operating.single(self.rotor, "speeds")
 
     @property
     def frequencies_hz(self) -> dict[str, float]:
@@ -549,19 +564,25 @@ def _inline_rotor(tables: dict) -> Rotor:
         raise exc.within("rotor") from None
 
 
-def _speeds(value, rotor: Rotor) -> dict[str, float]:
-    """Spool speeds (rad/s): the rotor's nominal speeds, overridden by ``[speeds]`` (Hz); one must be > 0."""
-    speeds = dict(rotor.speeds)
-    if value is not None:
-        table = checks.table("speeds", value)
-        checks.keys("speeds", table, [s.name for s in rotor.spools])
-        for s, v in table.items():
-            speeds[s] = 2 * math.pi * checks.non_negative(f"speeds.{s}", v, "Hz")
+def _operating(value, rotor: Rotor) -> Operating:
+    """``[speeds]`` (Hz) as an operating point (:meth:`Operating.point`: the spools given at their speeds, the first
+    the reference, a spool left out following it at the rotor's nominal ratio); none given: the rotor's nominal
+    speeds. At least one spool must turn."""
+    spools = [s.name for s in rotor.spools]
+    table = {} if value is None else checks.table("speeds", value)
+    checks.keys("speeds", table, spools)
+    given = {s: checks.non_negative(f"speeds.{s}", v, "Hz") for s, v in table.items()}
+    operating = Operating.point(given, unit="Hz") if given else Operating.point(rotor.speeds)
+    try:
+        speeds = operating.single(rotor, "speeds")
+    except InputError as exc:  # a spool left out whose ratio to the reference does not follow from the rotor
+        fail("speeds", value, f"must give the speed of every spool whose nominal ratio to {next(iter(given))!r} is "
+             f"undefined ({exc.requirement})", "Hz")
     if not any(w > 0 for w in speeds.values()):
-        given = {s: w / (2 * math.pi) for s, w in speeds.items()} if value is None else value
-        fail("speeds", given, f"must give at least one spool of {', '.join(speeds)} a speed > 0"
+        shown = {s: w / (2 * math.pi) for s, w in speeds.items()} if value is None else value
+        fail("speeds", shown, f"must give at least one spool of {', '.join(speeds)} a speed > 0"
              + ("; the rotor's nominal speeds are all 0" if value is None else ""), "Hz")
-    return speeds
+    return operating
 
 
 def _runup(value, rotor: Rotor, speeds: dict[str, float]) -> RunupSpec | None:
@@ -813,7 +834,8 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     name = checks.string("name", data.get("name", Path(source).stem if base is not None else source))
     description = checks.string("description", data.get("description", ""))
     rotor, rotor_source, rotor_data = _rotor(data["rotor"], base, source)
-    speeds = _speeds(data.get("speeds"), rotor)
+    operating = _operating(data.get("speeds"), rotor)
+    speeds = operating.single(rotor, "speeds")
     unbalances = _unbalances(data.get("unbalance", []), rotor)
     plates = _plates(data.get("rub", []), rotor)
     runup = _runup(data.get("runup"), rotor, speeds)
@@ -827,8 +849,8 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     if not unbalances and solver.gravity == 0:
         fail("unbalance", data.get("unbalance", []), "must hold at least one entry unless solver.gravity is given: "
              "the scene has no load")
-    return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source, speeds=speeds,
-                 unbalances=unbalances, plates=plates, solver=solver, output=output, runup=runup, source=source,
+    return Scene(name=name, description=description, rotor=rotor, rotor_source=rotor_source,
+                 operating=operating, unbalances=unbalances, plates=plates, solver=solver, output=output, runup=runup, source=source,
                  data=data, rotor_data=rotor_data)
 
 
