@@ -183,3 +183,45 @@ def test_every_exported_result_type_shows_itself_and_is_checked():
         if not re.search(rf"assert_shows_itself\([^\n]*of=rr\.{cls.__name__}\b", shown):
             problems.append(f"{cls.__name__} is not checked by assert_shows_itself(..., of=rr.{cls.__name__})")
     assert not problems, "\n".join(problems)
+
+
+# --- the CLI keeps its units and names them in every option's help (issue 35, Build 1) ------------------------------
+#: options whose values carry no physical unit: counts, names, paths, DOFs, ratios, tolerances, choices
+UNITLESS = {"--out", "--ratio", "--reference", "--reference-spool", "--modes", "--harmonics", "--samples", "--tol",
+            "--model", "--boundary-nodes", "--outputs", "--frf", "--reduce", "--direction", "--workers",
+            "--scheduler"}
+#: a unit named in a help text: a parenthesised or spelled-out SI or CLI unit
+UNIT = re.compile(r"(?<![\w'])(rpm|Hz|rad/s|s|m|µm|kg m|N/m|degrees|deg)(?![\w'/])|scene units")
+
+
+def _value_options():
+    import argparse
+
+    from rotorred.cli import build_parser
+
+    for action in build_parser()._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for command, sub in action.choices.items():
+                for option in sub._actions:
+                    if option.option_strings and option.nargs != 0 and not isinstance(option, argparse._HelpAction):
+                        yield command, option
+
+
+def test_every_cli_option_with_a_physical_value_names_its_unit_in_its_help():
+    """Every option of every command that takes a value is either unitless (listed above) or names its unit in its
+    help (rpm, Hz, s, m, kg m, degrees, or the scene units of a scene key)."""
+    checked, missing = 0, []
+    for command, option in _value_options():
+        name = option.option_strings[-1]
+        if name in UNITLESS:
+            continue
+        checked += 1
+        if not UNIT.search(option.help or ""):
+            missing.append(f"{command} {name}: {option.help!r}")
+    assert checked >= 12 and not missing, missing
+
+
+def test_the_unit_check_can_fail():
+    """The unit pattern finds no unit in a help that names none, and finds the scene units and rpm."""
+    assert not UNIT.search("simulate a point that has not settled up to this time (default: the scene's duration)")
+    assert UNIT.search("reference-spool speeds in rpm") and UNIT.search("fix a scene key (scene units: Hz ...)")

@@ -21,7 +21,7 @@ import contextlib
 
 from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
-from rotorred.cli.options import out_dir, provenance
+from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance
 
 
 def add_parser(subparsers):
@@ -34,9 +34,8 @@ def add_parser(subparsers):
                     "point's stability; write the branch as CSV and NetCDF and plot it.")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file (with rub plates)")
     p.add_argument("--param", required=True, metavar="KEY=START:STOP",
-                   help="the key and its first and last value (scene units: m for rub.clearance, Hz for speeds, "
-                        "N/m for rub.k_n ...)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
+                   help=f"the key and its first and last value ({SCENE_UNITS})")
+    add_settings(p, "fix")
     p.add_argument("--harmonics", type=int, default=50, help="harmonics of the base frequency f_0 (default 50)")
     p.add_argument("--samples", type=int, default=1024, help="AFT samples a period, even (default 1024)")
     p.add_argument("--tol", type=float, default=1e-9, help="relative residual of every point (default 1e-9)")

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from rotorred import checks
 from rotorred.cli.feedback import error, report
-from rotorred.cli.options import out_dir, provenance, spool_ratios
+from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
 
 
 def add_parser(subparsers):
@@ -28,15 +28,15 @@ def add_parser(subparsers):
                     "and heat maps.")
     p.add_argument("scene", metavar="SCENE", help="built-in scene or scene TOML file")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=VALUES",
-                   help="KEY=START:STOP:N or KEY=v1,v2,... (scene units: speeds in Hz, clearance in m); repeat for "
-                        "a 2-D map; the first is the continuation axis")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fix a scene key (repeatable)")
+                   help=f"KEY=START:STOP:N or KEY=v1,v2,... ({SCENE_UNITS}); repeat for a 2-D map; the first is the "
+                        "continuation axis")
+    add_settings(p, "fix")
     p.add_argument("--ratio", action="append", default=[], metavar="SPOOL=R",
                    help="that spool turns at R times the varied speed, e.g. inner=0.7778 with --vary speeds.outer=...")
     p.add_argument("--direction", default="up", help="up, down or both (hysteresis, coexisting responses)")
     p.add_argument("--cold", action="store_true", help="start every point from the scene's start (no continuation)")
     p.add_argument("--limit", type=float, default=None, metavar="SECONDS",
-                   help="simulate a point that has not settled up to this time (default: the scene's duration)")
+                   help="simulate a point that has not settled up to this time (s; default: the scene's duration)")
     p.add_argument("--workers", type=int, default=None, help="local Dask workers (default one per core; 0: serial)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="an existing Dask scheduler, tcp://host:port")
     p.add_argument("--out", required=True, help="output directory (its points/ are kept: the same command resumes)")

@@ -14,10 +14,19 @@ from rotorred import checks
 from rotorred import Operating, parse_dof
 
 __all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
-           "provenance", "stage_summary", "MAX_COUNT"]
+           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
+
+#: the units of a scene key's value on the command line: the scene file's (docs/scenes.md)
+SCENE_UNITS = "scene units: Hz for speeds.*, m for rub.clearance, N/m for rub.k_n, s for solver.dt"
+
+
+def add_settings(parser, verb: str = "fix") -> None:
+    """The ``--set KEY=VALUE`` option of the scene commands (``verb``: what it does to the key)."""
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help=f"{verb} a scene key, e.g. rub.clearance=20e-6 ({SCENE_UNITS}; repeatable)")
 
 
 def grid(option: str, text: str, unit: str, *, min_count: int = 1, ge: float | None = None,

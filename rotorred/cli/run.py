@@ -23,7 +23,7 @@ import time
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import error, report
-from rotorred.cli.options import out_dir, provenance
+from rotorred.cli.options import add_settings, out_dir, provenance
 
 DEFAULT_SCENE = "paper-rub"
 
@@ -40,9 +40,7 @@ def add_parser(subparsers):
                    help=f"built-in scene ({', '.join(builtin_scenes())}) or scene TOML file (default {DEFAULT_SCENE})")
     p.add_argument("--out", default=None, help="output directory (default ./rotorred-<scene name>); locked while "
                                                "a run writes it, its files replaced as a whole when the run ends")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene key before validation, e.g. rub.clearance=20e-6 or solver.model=full "
-                        "(repeatable)")
+    add_settings(p, "override (before validation)")
     p.add_argument("--no-normal", action="store_true", help="do not compute the scene without rub for comparison")
     p.add_argument("--force", action="store_true",
                    help="go on with a run beyond the size limits (steps, memory, model size; see the message)")
