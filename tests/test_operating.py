@@ -288,6 +288,35 @@ def test_continue_balance_keeps_the_operatings_ratios_along_its_branch():
         assert c["a"] >= 2 * np.pi * 20.0 * (1 - 1e-6)
 
 
+def test_runup_fills_the_spools_its_profile_leaves_out_by_the_rule():
+    """runup along a ramp of spool a from rest (a zero reference speed) to 100 rad/s: its scene's profile turns b and c
+    at the nominal ratios 1.5 and 0.5 to a at every breakpoint (written out here by hand), and the model is asked for
+    its matrices only at speeds on that line."""
+    model = _Recording.of(three_spools())
+    model.taken()
+    result = rr.runup(model, Operating.ramp({"a": 0.0}, {"a": 100.0}, 0.05), rr.Loads([Unbalance(2, 1e-4)]), (),
+                      rr.RunupOptions(dt=1e-4, record_dt=1e-4, nodes=(2,), orbits_hz=()), progress=False)
+    p = result.scene.runup.profile
+    np.testing.assert_array_equal(p.speeds["a"], [0.0, 100.0])
+    np.testing.assert_allclose(p.speeds["b"], 1.5 * p.speeds["a"], rtol=1e-15)
+    np.testing.assert_allclose(p.speeds["c"], 0.5 * p.speeds["a"], rtol=1e-15)
+    for c in model.taken():
+        assert c["b"] == pytest.approx(1.5 * c["a"], abs=1e-9) and c["c"] == pytest.approx(0.5 * c["a"], abs=1e-9)
+
+
+def test_envelope_map_runs_each_point_at_the_rules_speeds(tmp_path):
+    """envelope_map along spool a's line from rest (a zero reference speed) with b at the stated ratio 2 and c fixed at
+    30 rad/s: the scene of each point (as its worker reads it) turns the spools at the speeds written out here by hand
+    (to the 1e-12 a speed's round trip through Hz allows), and both points run."""
+    run = rr.envelope_map(three_spools(), Operating.line([0.0, 50.0], "a", ratios={"b": 2.0}, fixed={"c": 30.0}),
+                          rr.Loads([Unbalance(12, 1e-4), Unbalance(22, 1e-4)]), (),
+                          rr.MapOptions(dt=1e-4, duration=0.05, record_start=0.03, nodes=(12, 22), table=(22, "y"),
+                                        workers=0, figures=False), tmp_path / "map")
+    assert run.n_run == 2 and run.n_failed == 0
+    for i, W in enumerate((0.0, 50.0)):
+        assert run.spec.scene_at((i,)).speeds == pytest.approx({"a": W, "b": 2.0 * W, "c": 30.0}, rel=1e-12, abs=1e-12)
+
+
 def test_a_scene_reads_its_speeds_by_the_rule(tmp_path):
     """A scene's [speeds] is an Operating point: with the outer spool given alone, the inner follows it at the seed
     rig's nominal ratio 70/90 (the rule of Operating.point, written out here by hand), and the scene's operating point

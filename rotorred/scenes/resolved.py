@@ -75,18 +75,16 @@ def _rotor(scene: Scene) -> dict:
 
 
 def _speeds(scene: Scene, written: dict, built: bool = False) -> dict:
-    """Every spool's speed (Hz), the spools the scene gave first in their order (the first is the reference of its
-    operating point): as written, else its Hz value when it reads back exactly, else left out, which the same rule
-    gives back (a spool the scene left out follows its reference at the nominal ratio; no ``[speeds]``: all the
-    rotor's nominal speeds, so none is written unless all read back). A scene ``built`` in Python writes every speed,
-    within 1 ulp where no Hz value reads back."""
+    """Every spool's speed (Hz) the scene's operating point needs: the spools the scene gave, as written and in their
+    order (the first is the reference; a spool left out follows it by the same rule on reading back); no ``[speeds]``:
+    the rotor's nominal speeds where every one reads back exactly from its Hz value, else none (the same default). A
+    scene ``built`` in Python writes every speed, within 1 ulp where no Hz value reads back."""
+    if written:
+        return dict(written)
+    exact = {s: _exact_hz(w) for s, w in scene.speeds.items()}
     if built:
-        return {s: _exact_hz(w) or w / (2 * math.pi) for s, w in scene.speeds.items()}
-    exact = {s: written[s] if s in written else _exact_hz(scene.speeds[s])
-             for s in [*written, *(s for s in scene.speeds if s not in written)]}
-    if not written and None in exact.values():
-        return {}
-    return {s: hz for s, hz in exact.items() if hz is not None}
+        return {s: hz if hz is not None else scene.speeds[s] / (2 * math.pi) for s, hz in exact.items()}
+    return exact if None not in exact.values() else {}
 
 
 def _exact_hz(w: float) -> float | None:

@@ -572,7 +572,8 @@ def _operating(value, rotor: Rotor) -> Operating:
     table = {} if value is None else checks.table("speeds", value)
     checks.keys("speeds", table, spools)
     given = {s: checks.non_negative(f"speeds.{s}", v, "Hz") for s, v in table.items()}
-    operating = Operating.point(given, unit="Hz") if given else Operating.point(rotor.speeds)
+    operating = Operating.point(given, unit="Hz") if given else dataclasses.replace(Operating.point(rotor.speeds),
+                                                                                    unit="Hz")
     try:
         speeds = operating.single(rotor, "speeds")
     except InputError as exc:  # a spool left out whose ratio to the reference does not follow from the rotor
