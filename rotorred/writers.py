@@ -10,6 +10,11 @@ integers and strings as they are. Units belong in the header (``"amplitude (um)"
 TOML (rotor files written by ``rotorred convert``, resolved scenes and rotors): floats with ``repr``, so a file read
 back holds the same numbers to the last bit.
 
+Faults of the machine (a full disk or quota, a file-size limit, a folder removed while the command runs, memory
+that runs out while a file is built) are raised as one :class:`ResourceFault` naming the file, the earlier file left
+as it was; an existing path that is a symlink, a FIFO, a device or any other non-regular file is refused
+(:func:`check_target`), never replaced.
+
 NPZ, .mat and NetCDF take an optional mapping of string attributes (the provenance of
 :mod:`rotorred.provenance`): NPZ entries, .mat variables, NetCDF global attributes. NetCDF files follow the CF
 conventions: :func:`write_netcdf` refuses a dataset without units on a variable or coordinate, or with a name CF
@@ -36,7 +41,8 @@ import numpy as np
 
 __all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", "write_toml", "toml_text",
            "exact_in_unit", "atomic_path", "render_table", "OutputFolder", "CF_CONVENTIONS", "read_netcdf", "LABELS_OF",
-           "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK"]
+           "FolderBusy", "INCOMPLETE", "MANIFEST", "LOCK", "ResourceFault", "as_fault", "check_target",
+           "non_regular"]
 
 
 def _umask() -> int:
@@ -48,21 +54,132 @@ def _umask() -> int:
 _UMASK = _umask()
 
 
+class ResourceFault(OSError):
+    """A file that could not be written for a reason of the machine, not of the input: a full disk or quota
+    (``ENOSPC``, ``EDQUOT``), the file-size limit (``EFBIG``, ``ulimit -f``), a folder removed while the command ran
+    (``ENOENT``), memory that ran out (``ENOMEM``, :class:`MemoryError`), or an existing non-regular file or symlink
+    at the path. ``str()`` is the whole message, naming the file or the size; the command line exits 4 with it."""
+
+    def __str__(self) -> str:
+        return self.strerror or super().__str__()
+
+
+#: errno of a fault of the machine (full disk, quota, file-size limit, memory, read-only or failing medium), whatever
+#: raised it
+_MACHINE = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is used up",
+            errno.EFBIG: "the file would exceed the file-size limit (ulimit -f) or the file system's largest file",
+            errno.ENOMEM: "out of memory", errno.EROFS: "the file system is read-only",
+            errno.EIO: "an input/output error of the disk"}
+
+
+def as_fault(exc: BaseException, file: str | Path | None = None) -> BaseException:
+    """``exc`` as a :class:`ResourceFault` when it is a fault of the machine, else ``exc`` itself.
+
+    Parameters
+    ----------
+    exc : BaseException
+        A :class:`MemoryError`, or an :class:`OSError` whose errno is a full disk, a quota, the file-size limit,
+        memory, a read-only file system or an I/O error (any other exception is returned as it is).
+    file : str or Path, optional
+        The file being written, named in the message instead of the exception's own file name (which may be a
+        temporary one).
+
+    Returns
+    -------
+    BaseException
+    """
+    if isinstance(exc, ResourceFault):
+        return exc
+    if isinstance(exc, MemoryError):
+        size = str(exc).strip()
+        what = f" while writing {str(file)!r}" if file is not None else ""
+        return ResourceFault(errno.ENOMEM, f"out of memory{what}" + (f": {size}" if size else "")
+                             + "; a smaller model, fewer points or a shorter record needs less", None)
+    if isinstance(exc, OSError) and exc.errno in _MACHINE:
+        name = file if file is not None else exc.filename
+        return ResourceFault(exc.errno, (f"could not write {str(name)!r}: " if name else "")
+                             + f"{_MACHINE[exc.errno]} ({exc.strerror or exc})", None if name is None else str(name))
+    return exc
+
+
+def non_regular(path: str | Path) -> str | None:
+    """What is at ``path`` when it is not a regular file (``"a symbolic link"``, ``"a FIFO (named pipe)"``, ``"a
+    character device"``, ...); None for a regular file or nothing. A symlink is one even when it points to a regular
+    file: replacing it would cut the link."""
+    import stat
+
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return None
+    if stat.S_ISREG(mode):
+        return None
+    kinds = ((stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+             (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"),
+             (stat.S_ISDIR, "a folder"))
+    return next((kind for test, kind in kinds if test(mode)), "not a regular file")
+
+
+def check_target(path: str | Path, option: str = "") -> Path:
+    """``path``, refused (:class:`ResourceFault`) when something other than a regular file is there
+    (:func:`non_regular`). A missing path or a regular file is fine (the file is replaced as a whole).
+
+    Parameters
+    ----------
+    path : str or Path
+    option : str
+        The option that named it (``"OUT"``, ``"--out"``), for the message.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    try:
+        kind = non_regular(path)
+    except OSError as exc:
+        raise as_fault(exc, path) from exc
+    if kind is None:
+        return path
+    named = f"{option} = {str(path)!r}" if option else repr(str(path))
+    raise ResourceFault(errno.EEXIST, f"{named} is {kind}: rotorred writes only regular files and does not replace "
+                                      "it; remove it or choose another path", str(path))
+
+
 @contextmanager
 def atomic_path(path: str | Path, suffix: str = ""):
-    """Yield a temporary path in ``path``'s folder; on success it replaces ``path``, on error it is removed."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{suffix}", dir=path.parent)
+    """Yield a temporary path in ``path``'s folder; on success it replaces ``path``, on error it is removed.
+
+    ``path`` must be missing or a regular file (:func:`check_target`). A fault of the machine while writing or
+    renaming, or the folder gone, is raised as a :class:`ResourceFault` naming ``path``.
+    """
+    path = check_target(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{suffix}", dir=path.parent)
+    except OSError as exc:
+        raise _write_fault(exc, path) from exc
     if hasattr(os, "fchmod"):  # POSIX: mkstemp's 0600 -> what open() would give; Windows has only a read-only flag
         os.fchmod(fd, 0o666 & ~_UMASK)
     os.close(fd)
     try:
         yield Path(tmp)
+        check_target(path)  # nothing put there meanwhile
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
-        raise
+        fault = _write_fault(exc, path)
+        if fault is exc:
+            raise
+        raise fault from exc
+
+
+def _write_fault(exc: BaseException, path: Path) -> BaseException:
+    """A fault while writing ``path``: :func:`as_fault`, and its folder gone (``ENOENT``) as one too."""
+    if isinstance(exc, FileNotFoundError) and not path.parent.is_dir():
+        return ResourceFault(errno.ENOENT, f"could not write {str(path)!r}: its folder {str(path.parent)!r} no longer "
+                                           "exists (removed while the command ran?)", str(path))
+    return as_fault(exc, path)
 
 
 def _cell(value, digits: int) -> str:
@@ -190,8 +307,19 @@ def write_netcdf(path: str | Path, dataset, attributes: Mapping[str, str] | None
     cf = _labels_apart(dataset).assign_attrs(attrs)
     encoding = {name: {"_FillValue": None} for name in cf.coords}
     path = Path(path)
+    # built in memory, then written by Python: HDF5 writing the file itself on a full disk (or at the file-size limit)
+    # raised a RuntimeError and crashed (SIGSEGV) at exit. xarray before 2025 builds NetCDF-4 in memory with no engine
+    try:
+        data = cf.to_netcdf(engine="h5netcdf", encoding=encoding)
+    except MemoryError as exc:
+        raise as_fault(exc, path) from exc
+    except ValueError:  # an older xarray: HDF5 writes the file
+        data = None
     with atomic_path(path, ".nc") as tmp:
-        cf.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
+        if data is None:
+            cf.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
+        else:
+            tmp.write_bytes(data)
     return path
 
 
@@ -509,6 +637,11 @@ class OutputFolder:
     Use as a context manager: the lock is taken on entry (:class:`FolderBusy` if another run holds
     it), and on exit the staging folder and the lock are removed, and the folder too if this run
     created it and committed nothing.
+
+    Faults of the machine within the block (a full disk, the file-size limit, memory, the folder removed meanwhile)
+    leave it as one :class:`ResourceFault` naming the file of the folder being written (not its staged name) or the
+    size that could not be allocated; a symlink or another non-regular file where a file of the result goes is
+    refused, not replaced (:func:`check_target`).
     """
 
     def __init__(self, folder: str | Path):
@@ -516,6 +649,7 @@ class OutputFolder:
         self.staging: Path | None = None
         self._created = False
         self._lock = None
+        self._writing: Path | None = None  # the file of the folder staged last: the one a fault names
         self.committed = False
 
     def __enter__(self) -> OutputFolder:
@@ -529,9 +663,10 @@ class OutputFolder:
             raise
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type=None, exc=None, tb=None) -> None:
         import shutil
 
+        fault = None if exc is None else self._fault(exc)
         if self.staging is not None:
             shutil.rmtree(self.staging, ignore_errors=True)
         if self._lock is not None:
@@ -542,10 +677,41 @@ class OutputFolder:
                 self.folder.rmdir()
             except OSError:
                 pass
+        if fault is not None and fault is not exc:
+            raise fault from exc
+
+    def _fault(self, exc: BaseException) -> BaseException:
+        """``exc`` as a :class:`ResourceFault` naming the folder's file (:func:`as_fault`), the folder gone as one."""
+        if isinstance(exc, ResourceFault):  # a writer's, naming the staged file: the folder's is meant
+            staging = str(self.staging)
+            if staging in str(exc) or staging in str(exc.filename):
+                return ResourceFault(exc.errno, str(exc).replace(staging, str(self.folder)),
+                                     exc.filename and exc.filename.replace(staging, str(self.folder)))
+            return exc
+        if isinstance(exc, FileNotFoundError) and not (self.staging or self.folder).is_dir():
+            return self._vanished()
+        if isinstance(exc, MemoryError):
+            return as_fault(exc)
+        name = Path(exc.filename).name if isinstance(exc, OSError) and exc.filename else None
+        return as_fault(exc, self.folder / name if name else self._writing)
+
+    def _vanished(self) -> ResourceFault:
+        return ResourceFault(errno.ENOENT, f"the output folder {str(self.folder)!r} no longer exists (removed while "
+                                           f"the command ran?); nothing of this result was kept", str(self.folder))
 
     def staged(self, path: Path) -> Path:
-        """Where a file of the result goes before the commit (its name in the staging folder)."""
-        return self.staging / Path(path).name
+        """Where a file of the result goes before the commit (its name in the staging folder).
+
+        Raises
+        ------
+        ResourceFault
+            The folder was removed meanwhile, or a symlink or another non-regular file is where the file goes.
+        """
+        name = Path(path).name
+        if self.staging is None or not self.staging.is_dir():
+            raise self._vanished()
+        self._writing = check_target(self.folder / name, "--out")
+        return self.staging / name
 
     def commit(self, incomplete: str | None = None) -> list[Path]:
         """Move the staged files into the folder; ``incomplete``: the reason written to :data:`INCOMPLETE`.
@@ -556,19 +722,26 @@ class OutputFolder:
             The files of the result in the folder.
         """
         with signals_held():
+            if not self.staging.is_dir():
+                raise self._vanished()
+            new = sorted(p.name for p in self.staging.iterdir() if not p.name.startswith("."))
+            for name in new:  # refused before anything moves: the earlier result stays whole
+                check_target(self.folder / name, "--out")
             marker = self.folder / INCOMPLETE
             write_text(marker, (incomplete or "a rotorred run was writing this folder and did not finish") + "\n")
-            new = sorted(p.name for p in self.staging.iterdir() if not p.name.startswith("."))
             for name in _manifest(self.folder):
-                if name not in new and name != INCOMPLETE:
+                if name not in new and name != INCOMPLETE and (self.folder / name).is_file():
                     (self.folder / name).unlink(missing_ok=True)
             for name in new:
+                self._writing = self.folder / name
                 os.replace(self.staging / name, self.folder / name)
             names = new + ([INCOMPLETE] if incomplete else [])
             write_text(self.folder / MANIFEST, "".join(f"{n}\n" for n in names))
             if not incomplete:
                 marker.unlink()
             self.committed = True
+        if not all((self.folder / n).is_file() for n in names):  # removed as it was committed: never listed as written
+            raise self._vanished()
         return [self.folder / n for n in names]
 
 

@@ -231,7 +231,7 @@ def _report(args, exc: BaseException) -> int:
     if _is_diverged(exc):
         _error(args, str(exc))
         return EXIT_DIVERGED
-    if isinstance(exc, writers.FolderBusy):
+    if isinstance(exc := writers.as_fault(exc), (writers.FolderBusy, writers.ResourceFault)):  # exit 4, one line
         _error(args, str(exc))
         return EXIT_ENVIRONMENT
     if isinstance(exc, OSError):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rotorred import checks
+from rotorred import checks, writers
 from rotorred.cli.feedback import report
 
 
@@ -50,6 +50,10 @@ def _target(text: str, source: str) -> Path:
     path = Path(text).expanduser()
     if path.is_dir():
         checks.fail("OUT", text, "must be a file path; this is a folder")
+    kind = writers.non_regular(path)
+    if kind is not None:  # replaced by a regular file, a FIFO, a device or a link's target would be lost
+        checks.fail("OUT", text, f"must be a new path or a regular file; this is {kind}, which rotorred does not "
+                                 "replace")
     if path.exists() and path.resolve() == Path(source).expanduser().resolve():
         checks.fail("OUT", text, "must differ from ROSS_FILE: the ROSS file is kept")
     if not path.parent.exists():
