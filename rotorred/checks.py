@@ -15,19 +15,26 @@ raw file values before converting rpm or Hz to rad/s).
 
 The checks return the converted value (``float``, ``int``, ``str``, tuple), so a loader reads as
 a list of named fields.
+
+Physical bounds (:data:`BOUNDS`, :func:`bounded`): a value may be a finite number of the right sign and still mean
+nothing (a speed of 1e300 rpm, an unbalance of 1e300 kg m): its result overflows to inf or NaN, or is an artefact
+of round-off. Such magnitudes are refused before computing, with the bound and why it holds (docs/model.md, "Physical
+bounds of command inputs"). After computing, :func:`finite_result` refuses a result that holds NaN or inf before it is
+written, naming where it appeared.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Collection, Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any, NoReturn
 
 import numpy as np
 
 __all__ = ["InputError", "MISSING", "fail", "join", "number", "positive", "non_negative", "integer", "choice",
            "string", "boolean", "table", "tables", "sequence", "array", "vector", "node", "keys", "ranges_text",
-           "fmt_value"]
+           "fmt_value", "Bound", "BOUNDS", "bounded", "bound_text", "NonFiniteResult", "finite_result"]
 
 
 class _Missing:
@@ -315,3 +322,108 @@ def keys(field: str, data: Mapping, allowed: Iterable[str], required: Iterable[s
         if k not in data:
             raise InputError(join(field, k), MISSING, "required")
 
+
+
+# --------------------------------------------------------------------------- physical bounds
+@dataclass(frozen=True)
+class Bound:
+    """The largest magnitude an input may have, in the unit the user gives it, and why (docs/model.md).
+
+    Attributes
+    ----------
+    limit : float
+        The largest magnitude allowed (in ``unit``).
+    unit : str
+    why : str
+        What the bound stands for, for the message.
+    """
+
+    limit: float
+    unit: str
+    why: str
+
+
+#: the physical bounds of command inputs, each in the unit the user types (docs/model.md, "Physical bounds of command
+#: inputs", where each is argued); a spool speed in rad/s or Hz is bounded by the same speed as in rpm
+BOUNDS = {
+    "speed": Bound(1e6, "rpm", "twice the fastest machine rotors: micro gas turbines and dental air turbines stay "
+                               "below 500 000 rpm"),
+    "ratio": Bound(100.0, "", "the spools of one machine turn within a factor 100 of each other: dual-rotor "
+                              "engines 1-3, geared fans about 3"),
+    "unbalance": Bound(1e3, "kg m", "26 x the 38 kg m the coarsest ISO 21940-11 grade, G 4000, allows a 100 t "
+                                    "rotor at 100 rpm"),
+    "harmonic": Bound(1e3, "", "excitation orders stay below 1000: the highest, blade-passing orders, are blade "
+                               "counts"),
+    "frequency": Bound(1e6, "Hz", "far beyond the bending modes a beam model describes"),
+}
+
+_PER_RPM = {"rpm": 1.0, "Hz": 60.0, "rad/s": 30.0 / math.pi}
+
+
+def bounded(field: str, value, values, kind: str, unit: str = "") -> np.ndarray:
+    """``values`` (a number or an array), refused when not finite or when a magnitude exceeds :data:`BOUNDS` ``[kind]``.
+
+    Parameters
+    ----------
+    field : str
+        The option or key that gave them (``"--speeds"``).
+    value : object
+        The value as the user gave it (its text), shown in the message.
+    values : float or array_like
+        The values, in ``unit``.
+    kind : str
+        A key of :data:`BOUNDS`: ``"speed"``, ``"ratio"``, ``"unbalance"``, ``"harmonic"``, ``"frequency"``.
+    unit : str
+        The unit of ``values`` (default the bound's; a speed may be in ``"rpm"``, ``"Hz"`` or ``"rad/s"``).
+
+    Returns
+    -------
+    ndarray
+        ``values`` as floats.
+    """
+    bound = BOUNDS[kind]
+    unit = unit or bound.unit
+    arr = np.asarray(values, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        fail(field, value, "must be finite", unit)
+    limit = bound.limit / _PER_RPM[unit] if kind == "speed" else bound.limit
+    if arr.size and float(np.max(np.abs(arr))) > limit:
+        fail(field, value, f"must be at most {bound_text(kind, unit)}")
+    return arr
+
+
+def bound_text(kind: str, unit: str = "") -> str:
+    """``"1e+06 rpm (twice the fastest machine rotors: ...)"``: the bound of :data:`BOUNDS` ``[kind]`` in ``unit``
+    (default the bound's) and why."""
+    bound = BOUNDS[kind]
+    unit = unit or bound.unit
+    limit = bound.limit / _PER_RPM[unit] if kind == "speed" else bound.limit
+    shown = f"{limit:.6g}" + (f" {unit}" if unit else "") + (f" = {bound.limit:g} {bound.unit}" if unit != bound.unit
+                                                             else "")
+    return f"{shown} ({bound.why})"
+
+
+class NonFiniteResult(ValueError):
+    """A computed result that holds NaN or inf, refused before it is written: the message names the quantity and
+    where (the speed, the frequency) it first appeared."""
+
+
+def finite_result(what: str, values, where) -> None:
+    """Refuse (:class:`NonFiniteResult`) ``values`` holding NaN or inf.
+
+    Parameters
+    ----------
+    what : str
+        The quantity, as the message names it (``"the response at node 13 x"``).
+    values : array_like
+        The values, of any shape.
+    where : callable
+        ``where(index)`` -> text naming the place of a value (``"at 1500 rpm"``), from its index tuple.
+    """
+    arr = np.asarray(values)
+    bad = ~np.isfinite(arr)
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        shown = "nan" if np.isnan(arr[index]) else "inf"
+        raise NonFiniteResult(f"{what} is {shown} {where(index)} ({int(bad.sum())} of {arr.size} values not "
+                              "finite): nothing written; check the inputs' magnitudes and the model's damping")

@@ -13,14 +13,15 @@ import numpy as np
 
 from rotorred import checks, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (grid, number_list, out_dir, provenance, ratio_number, speed_line, spool_ratios,
-                                  stage_summary)
+from rotorred.cli.options import (bounded_line, grid, number_list, out_dir, provenance, ratio_number, speed_line,
+                                  spool_ratios, stage_summary)
 
 
 def parse_speeds(text: str) -> np.ndarray:
     """``"0:12000:61"``, ``"0,1000,2500"`` or ``"3000"`` (rpm, >= 0, increasing) -> speeds (rpm)."""
     single = ":" not in text and "," not in text  # one speed; a range or a list holds at least two
-    return grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True)
+    speeds = grid("--speeds", text, "rpm", min_count=1 if single else 2, ge=0.0, increasing=True)
+    return checks.bounded("--speeds", text, speeds, "speed")
 
 
 def parse_ratio(items: list[str]):
@@ -28,8 +29,10 @@ def parse_ratio(items: list[str]):
     if not items:
         return None
     if len(items) == 1 and "=" not in items[0]:
-        return checks.number("--ratio", ratio_number("--ratio", items[0]), ge=0.0)
-    return {spool: checks.number(f"--ratio {spool}", r, ge=0.0) for spool, r in spool_ratios("--ratio", items).items()}
+        ratio = checks.number("--ratio", ratio_number("--ratio", items[0]), ge=0.0)
+        return float(checks.bounded("--ratio", items[0], ratio, "ratio"))
+    return {spool: float(checks.bounded(f"--ratio {spool}", r, checks.number(f"--ratio {spool}", r, ge=0.0), "ratio"))
+            for spool, r in spool_ratios("--ratio", items).items()}
 
 
 def ratios_to_reference(ratio, rotor, reference: str | None) -> dict[str, float] | None:
@@ -51,8 +54,10 @@ def ratios_to_reference(ratio, rotor, reference: str | None) -> dict[str, float]
 
 
 def parse_harmonics(text: str) -> tuple[float, ...]:
-    """``"1,2"`` -> (1.0, 2.0); each > 0."""
-    return number_list("--harmonics", text, gt=0.0)
+    """``"1,2"`` -> (1.0, 2.0); each > 0 and within :data:`rotorred.checks.BOUNDS` ``["harmonic"]``."""
+    harmonics = number_list("--harmonics", text, gt=0.0)
+    checks.bounded("--harmonics", text, harmonics, "harmonic")
+    return harmonics
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -103,9 +108,11 @@ def run(args) -> int:
     record = provenance(args, "rotor", writers.toml_text(document))
     check_model_size(rotor, args.force)
     operating = speed_line(rotor, speeds, args.reference, ratios_to_reference(ratio, rotor, args.reference), "rpm")
+    bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds, ",".join(args.ratio) or "default"))
     with writers.OutputFolder(out) as folder:
         model = rotor if args.reduce is None else _reduced(rotor, args.reduce)
         result = campbell(model, operating, n_modes=args.modes, harmonics=harmonics)
+        check_finite(result)
         # the full model tracks as many modes as the reduced one, whose frequencies it is compared with
         comparison = None if args.reduce is None else format_reduction_error(
             result, campbell(rotor, operating, n_modes=result.n_modes, harmonics=harmonics))
@@ -122,6 +129,18 @@ def run(args) -> int:
     report(text)
     report("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
+
+
+def check_finite(result) -> None:
+    """Refuse whirl frequencies or log decrements holding NaN or inf (a rigid-body mode's log decrement, over a zero
+    frequency, excepted) before anything is written, naming the mode and speed."""
+    def where(k):
+        return f"for mode {k[1]} at {result.speeds_rpm[k[0]]:.6g} rpm of {result.reference}"
+
+    checks.finite_result("the whirl frequency (Hz)", result.frequencies_hz, where)
+    elastic = [j for j in range(result.n_modes) if j not in set(result.rigid_modes)]
+    checks.finite_result("the log decrement", result.log_dec[:, elastic],
+                         lambda k: where((k[0], elastic[k[1]])))
 
 
 def format_mode_count(result) -> str:

@@ -30,8 +30,8 @@ import numpy as np
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (dof_list, grid, node_list, out_dir, provenance, ratio_number, speed_line,
-                                  spool_ratios, stage_summary)
+from rotorred.cli.options import (bounded_line, dof_list, grid, node_list, out_dir, provenance, ratio_number,
+                                  speed_line, spool_ratios, stage_summary)
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
 #: file's ``[defaults]`` gives one
@@ -94,6 +94,7 @@ def _unbalance(text: str, nodes):
         checks.fail("--unbalance", text, "must be NODE:ME[:PHASE_DEG] (e.g. 11:1e-5:90)")
     checks.node("--unbalance", node, nodes)
     checks.non_negative("--unbalance", m_e, "kg m")
+    checks.bounded("--unbalance", text, m_e, "unbalance")
     return Unbalance(node, m_e, math.radians(checks.number("--unbalance", phase, "deg")))
 
 
@@ -107,8 +108,10 @@ def _ratios(text: str | None, rotor, reference: str) -> dict[str, float] | None:
         others = [s for s in names if s != reference]
         if len(others) != 1:
             checks.fail("--ratio", text, f"a bare number needs a two-spool rotor; spools are {names}: write SPOOL=R,...")
-        return {others[0]: checks.number("--ratio", ratio_number("--ratio", text), gt=0.0)}
-    return {spool: checks.number("--ratio", r, ge=0.0) for spool, r in spool_ratios("--ratio", [text]).items()}
+        ratio = checks.number("--ratio", ratio_number("--ratio", text), gt=0.0)
+        return {others[0]: float(checks.bounded("--ratio", text, ratio, "ratio"))}
+    return {spool: float(checks.bounded("--ratio", text, checks.number("--ratio", r, ge=0.0), "ratio"))
+            for spool, r in spool_ratios("--ratio", [text]).items()}
 
 
 def _load(spec: str):
@@ -137,7 +140,7 @@ def _is_scene_file(spec: str) -> bool:
 def _speeds(args, rotor, reference: str) -> np.ndarray:
     """Reference-spool speeds of the sweep (rad/s)."""
     if args.speeds is not None:
-        return grid("--speeds", args.speeds, "rpm", ge=0.0) / _RPM
+        return checks.bounded("--speeds", args.speeds, grid("--speeds", args.speeds, "rpm", ge=0.0), "speed") / _RPM
     nominal = rotor.speeds[reference]
     if nominal <= 0:
         checks.fail("--speeds", None, f"must be given: rotor {args.rotor!r} has no nominal speed for spool "
@@ -146,16 +149,22 @@ def _speeds(args, rotor, reference: str) -> np.ndarray:
 
 
 def _unbalances(args, rotor, scene) -> list:
-    """--unbalance, else the scene's, else the rotor file's [defaults], else 1e-5 kg m on each spool's first disk."""
+    """--unbalance, else the scene's, else the rotor file's [defaults], else 1e-5 kg m on each spool's first disk;
+    each within :data:`rotorred.checks.BOUNDS` ``["unbalance"]``."""
     from rotorred import Unbalance
 
     nodes = rotor.spool_of
     if args.unbalance:
         return [_unbalance(u, nodes) for u in args.unbalance]
-    if scene is not None:
-        return list(scene.unbalances)
-    if rotor.defaults.unbalances:
-        return list(rotor.defaults.unbalances)
+    given, field, source = ((list(scene.unbalances), "unbalance", str(scene.source)) if scene is not None
+                            else (list(rotor.defaults.unbalances), "defaults.unbalance", str(args.rotor)))
+    for i, u in enumerate(given):
+        try:
+            checks.bounded(f"{field}[{i}].m_e", u.m_e, u.m_e, "unbalance")
+        except checks.InputError as exc:
+            raise exc.from_source(source) from None
+    if scene is not None or given:
+        return given
     out = []
     for s in rotor.spools:
         disks = [d for d in rotor.disks if d.node in set(s.nodes)]
@@ -230,8 +239,9 @@ def run(args) -> int:
     outputs = _outputs(args, rotor, scene, unbalances)
     operating = speed_line(rotor, speeds, reference, _ratios(args.ratio, rotor, reference), "rad/s",
                            ("--reference-spool", "--ratio"))
+    bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds or "default", args.ratio or "default"))
     frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
-    frf_freqs = 2 * math.pi * grid("--frequencies", args.frequencies, "Hz", ge=0.0) if args.frf else None
+    frf_freqs = 2 * math.pi * _frequencies(args.frequencies) if args.frf else None
     _check_model_options(args)
 
     with writers.OutputFolder(out) as folder:
@@ -239,6 +249,7 @@ def run(args) -> int:
         model, label, kind = _model(args, rotor, scene, operating)  # checks the model's options against the rotor
         progress.stage(f"unbalance response of {args.rotor} at {len(speeds)} speeds ({kind} model)")
         result = unbalance_response(model, operating, unbalances, outputs)
+        _check_finite(result)
         elapsed = time.perf_counter() - t0
         title = f"{rotor.name or args.rotor}: unbalance response ({kind} model)"
         names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
@@ -256,7 +267,21 @@ def _check_model_options(args) -> None:
     if args.modes is not None:
         checks.integer("--modes", args.modes, ge=0)
     if args.cutoff is not None:
-        checks.positive("--cutoff", args.cutoff, "Hz")
+        checks.bounded("--cutoff", args.cutoff, checks.positive("--cutoff", args.cutoff, "Hz"), "frequency")
+
+
+def _frequencies(text: str) -> np.ndarray:
+    """--frequencies (Hz), each within :data:`rotorred.checks.BOUNDS` ``["frequency"]``."""
+    return checks.bounded("--frequencies", text, grid("--frequencies", text, "Hz", ge=0.0), "frequency")
+
+
+def _check_finite(result) -> None:
+    """Refuse a response holding NaN or inf before anything is written, naming the output, spool and speeds."""
+    for spool, phasors in result.phasors.items():
+        for output, values in phasors.items():
+            checks.finite_result(f"the response at node {output[0]} {output[1]} to the {spool} unbalances", values,
+                                 lambda k: "at " + ", ".join(f"{s} {w[k[0]] * _RPM:.6g} rpm"
+                                                             for s, w in result.spool_speeds.items()))
 
 
 def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[str]:
@@ -271,6 +296,8 @@ def _write(folder, result, title, model, rotor, frf_pairs, frf_freqs) -> list[st
         inputs = list(dict.fromkeys(p[0] for p in frf_pairs))
         frf = frequency_response(model, Operating.point(rotor.speeds), inputs,
                                  list(dict.fromkeys(p[1] for p in frf_pairs)), frf_freqs)
+        checks.finite_result("the receptance (FRF)", frf.H, lambda k: f"at {frf.frequencies[k[0]] / (2 * math.pi):.6g} "
+                             f"Hz from {frf.inputs[k[2]]} to {frf.outputs[k[1]]}")
         frf.write_csv(folder.staged("frf.csv"))
         save_figure(frf.plot(), folder.staged("frf.png"))
         names += ["frf.csv", "frf.png"]

@@ -14,7 +14,7 @@ from rotorred import checks
 from rotorred import Operating, parse_dof
 
 __all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
-           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings"]
+           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings", "bounded_line"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -58,6 +58,8 @@ def grid(option: str, text: str, unit: str, *, min_count: int = 1, ge: float | N
         if ":" in text:
             a, b, n = text.split(":")
             count = int(n)
+            if not (math.isfinite(float(a)) and math.isfinite(float(b))):
+                raise ValueError
             if count > MAX_COUNT:
                 checks.fail(option, text, f"must have COUNT <= {MAX_COUNT} (each value is a solve)", unit)
             values = np.linspace(float(a), float(b), count) if count >= 1 else np.zeros(0)
@@ -151,6 +153,29 @@ def speed_line(rotor, speeds, reference: str | None, ratios: Mapping[str, float]
     except checks.InputError as exc:  # a spool whose ratio the rotor does not give
         raise checks.InputError(ratio_option, dict(ratios) if ratios else None, exc.requirement) from None
     return operating
+
+
+def bounded_line(rotor, operating: Operating, options: tuple[str, str], texts: tuple) -> None:
+    """Refuse a speed line on which a spool turns beyond :data:`rotorred.checks.BOUNDS` ``["speed"]``: a ratio within
+    its bound times a speed within its bound may still exceed it.
+
+    Parameters
+    ----------
+    rotor : Rotor
+    operating : Operating
+        The line of :func:`speed_line`.
+    options : (str, str)
+        The names of the speed and the ratio options.
+    texts : (str, str)
+        Their values as typed.
+    """
+    limit = checks.BOUNDS["speed"].limit
+    for spool, speeds in operating.speeds(rotor).items():
+        top = float(np.max(np.abs(speeds), initial=0.0)) * 30.0 / math.pi  # rpm
+        if not top <= limit:
+            checks.fail(f"{options[0]} and {options[1]}", f"{texts[0]} and {texts[1]}",
+                        f"put spool {spool!r} at {top:.6g} rpm; a spool must turn at most "
+                        + checks.bound_text("speed"))
 
 
 def dof_list(option: str, text: str, nodes=None) -> list[tuple[int, str]]:

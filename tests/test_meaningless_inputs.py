@@ -1,0 +1,140 @@
+"""Inputs whose results would be meaningless, refused before computing, and results that are not finite, refused
+before writing (issue 41, Build 4 for `harmonic` and `campbell`; docs/model.md, "Physical bounds of command inputs").
+
+On the issue's main, `harmonic` with an absurd unbalance, speed or ratio wrote a response.csv of NaN/inf with exit 0,
+and `campbell --ratio 1e300` printed UNSTABLE lines at frequencies of 1e76 Hz and more.
+
+Bad-input kinds tested here (counted in the README): 11 absurd or non-finite magnitudes (harmonic: unbalance, speed,
+ratio, a spool's speed on the line, FRF frequencies, cutoff, a non-finite speed; campbell: ratio, a spool's ratio,
+harmonic order, speed) and 2 non-finite results (harmonic response, campbell whirl frequency).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rotorred
+from rotorred import checks
+from rotorred.cli import main
+
+_HARMONIC = [  # (arguments, the option the one error line names)
+    (["--speeds", "0:6000:5", "--unbalance", "11:1e300"], "--unbalance = '11:1e300': must be at most 1000 kg m"),
+    (["--speeds", "0:1e300:5"], "--speeds = '0:1e300:5': must be at most 1e+06 rpm"),
+    (["--speeds", "0:6000:5", "--ratio", "1e300"], "--ratio = '1e300': must be at most 100 "),
+    (["--speeds", "0:600000:5", "--ratio", "50"],
+     "--speeds and --ratio = '0:600000:5 and 50': put spool 'outer' at 3e+07 rpm; a spool must turn at most 1e+06"),
+    (["--speeds", "0:6000:5", "--frf", "18:x>13:x", "--frequencies", "0:1e9:3"],
+     "--frequencies = '0:1e9:3': must be at most 1e+06 Hz"),
+    (["--speeds", "0:6000:5", "--reduced", "--cutoff", "1e300"], "--cutoff = 1e+300: must be at most 1e+06 Hz"),
+    (["--speeds", "0:inf:5"], "--speeds = '0:inf:5': must be START:STOP:COUNT"),
+]
+
+_CAMPBELL = [
+    (["--speeds", "0:6000:5", "--ratio", "1e300", "--modes", "6"], "--ratio = '1e300': must be at most 100 "),
+    (["--speeds", "0:6000:5", "--ratio", "outer=1e300"], "--ratio outer = 1e+300: must be at most 100 "),
+    (["--speeds", "0:6000:5", "--harmonics", "1e9"], "--harmonics = '1e9': must be at most 1000 "),
+    (["--speeds", "0:1e9:5"], "--speeds = '0:1e9:5': must be at most 1e+06 rpm"),
+]
+
+
+def _refused(command, args, expected, tmp_path, capsys) -> None:
+    """Exit 2, one line on stderr naming the option and its bound, nothing computed (no stage line), no --out."""
+    out = tmp_path / "out"
+    assert main([command, "seed-rig", *args, "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert lines == [lines[0]] and lines[0].startswith(f"rotorred {command}: error: {expected}"), captured.err
+    assert "UNSTABLE" not in captured.out and captured.out == "" and not out.exists()
+
+
+@pytest.mark.parametrize("args, expected", _HARMONIC, ids=[a[-1] for a, _ in _HARMONIC])
+def test_harmonic_refuses_meaningless_magnitudes_before_computing(tmp_path, capsys, args, expected):
+    _refused("harmonic", args, expected, tmp_path, capsys)
+
+
+@pytest.mark.parametrize("args, expected", _CAMPBELL, ids=[" ".join(a) for a, _ in _CAMPBELL])
+def test_campbell_refuses_meaningless_magnitudes_before_computing(tmp_path, capsys, args, expected):
+    _refused("campbell", args, expected, tmp_path, capsys)
+
+
+def test_a_message_gives_the_bound_and_why(tmp_path, capsys):
+    assert main(["campbell", "seed-rig", "--speeds", "0:6000:5", "--ratio", "1e300", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"must be at most 100 ({checks.BOUNDS['ratio'].why})")
+
+
+def test_the_bounds_hold_at_the_bound_and_convert_units():
+    """At the bound accepted, just beyond refused; a speed in rad/s or Hz is bounded by the same speed."""
+    for kind, bound in checks.BOUNDS.items():
+        unit = bound.unit
+        assert checks.bounded("x", bound.limit, bound.limit, kind)[()] == bound.limit
+        with pytest.raises(checks.InputError, match=re.escape(f"x = {bound.limit * 1.000001!r}: must be at most")):
+            checks.bounded("x", bound.limit * 1.000001, bound.limit * 1.000001, kind, unit)
+    checks.bounded("x", 0, 1e6 * np.pi / 30, "speed", "rad/s")
+    checks.bounded("x", 0, 1e6 / 60, "speed", "Hz")
+    for unit, value in (("rad/s", 1e6 * np.pi / 30 * 1.000001), ("Hz", 1e6 / 60 * 1.000001)):
+        with pytest.raises(checks.InputError, match=re.escape(f"{1e6 / (60 if unit == 'Hz' else 30 / np.pi):.6g} "
+                                                              f"{unit} = 1e+06 rpm")):
+            checks.bounded("x", value, value, "speed", unit)
+    with pytest.raises(checks.InputError, match="must be finite"):
+        checks.bounded("x", "nan", [1.0, np.nan], "ratio")
+
+
+def test_the_bounds_are_the_documented_ones():
+    """Each bound of checks.BOUNDS is in the table of docs/model.md with its value."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "model.md").read_text(encoding="utf-8")
+    section = text[text.index("## Physical bounds of command inputs"):]
+    rows = {"speed": "| 1e6 rpm", "ratio": "| 100 |", "unbalance": "| 1000 kg m |", "harmonic": "| 1000 |",
+            "frequency": "| 1e6 Hz |"}
+    assert set(rows) == set(checks.BOUNDS)
+    for kind, cell in rows.items():
+        assert cell in section, kind
+        assert float(cell.strip("| ").split()[0]) == checks.BOUNDS[kind].limit
+
+
+def test_a_non_finite_response_is_refused_before_writing(tmp_path, capsys, monkeypatch):
+    """A response holding NaN (as an absurd input gave on main): exit 2 naming the output, the spool and the speeds;
+    no response.csv of NaN, no --out."""
+    real = rotorred.unbalance_response
+
+    def with_nan(*args, **kwargs):
+        result = real(*args, **kwargs)
+        result.phasors["outer"][(14, "y")][3] = np.nan
+        return result
+
+    monkeypatch.setattr(rotorred, "unbalance_response", with_nan)
+    out = tmp_path / "out"
+    assert main(["harmonic", "seed-rig", "--speeds", "0:6000:5", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("rotorred harmonic: error: the response at node 14 y to the outer unbalances is nan at "
+                          "inner 4500 rpm, outer 5785.71 rpm (1 of 5 values not finite): nothing written"), err
+    assert not out.exists()
+
+
+def test_a_non_finite_whirl_frequency_is_refused_before_writing(tmp_path, capsys, monkeypatch):
+    real = rotorred.campbell
+
+    def with_inf(*args, **kwargs):
+        result = real(*args, **kwargs)
+        frequencies = result.frequencies.copy()
+        frequencies[2, 1] = np.inf
+        return dataclasses.replace(result, frequencies=frequencies)
+
+    monkeypatch.setattr(rotorred, "campbell", with_inf)
+    out = tmp_path / "out"
+    assert main(["campbell", "seed-rig", "--speeds", "0:6000:5", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("rotorred campbell: error: the whirl frequency (Hz) is inf for mode 1 at 3000 rpm of inner"), err
+    assert not out.exists()
+
+
+def test_bounded_values_still_run(tmp_path, capsys):
+    """Within the bounds the commands run as before (a ratio of 2, an unbalance of 1 kg m)."""
+    out = tmp_path / "out"
+    assert main(["harmonic", "seed-rig", "--speeds", "0:6000:5", "--ratio", "2", "--unbalance", "11:1", "--out",
+                 str(out), "-q"]) == 0
+    assert (out / "response.csv").is_file() and "nan" not in (out / "response.csv").read_text()
