@@ -13,15 +13,23 @@ Whether they show is the logger's decision: the command line sets its level from
 default level, WARNING), unless it asks with ``logging.basicConfig(level=logging.INFO)`` or passes
 ``progress=True`` where a function offers it. A bar is drawn on a terminal only: in a log file or a pipe
 (CI, a batch job) its stage line says what runs, without a screenful of carriage returns.
+
+A terminal (or pipe) whose encoding cannot show a character rotorred prints (µ, ×, °, Ω, ... with
+``PYTHONIOENCODING=ascii``, or a Latin-1 console that lacks Ω) gets its ASCII form instead (µm -> um, × -> x):
+:func:`ascii_fallback` sets that on a stream, and the command line sets it on stdout and stderr, so that a command
+never fails, after computing, on printing its report.
 """
 
 from __future__ import annotations
 
+import codecs
+import io
 import logging
 import sys
+import unicodedata
 from contextlib import contextmanager
 
-__all__ = ["LOG", "stage", "bar", "shown", "muted"]
+__all__ = ["LOG", "stage", "bar", "shown", "muted", "ascii_text", "ascii_fallback", "ASCII_FORMS"]
 
 #: the package's logger: the parent of every module's logger
 LOG = logging.getLogger("rotorred")
@@ -90,3 +98,62 @@ def _terminal() -> bool:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):
         return False
+
+
+#: the ASCII form of a character rotorred prints where the stream's encoding cannot show it (:func:`ascii_text`); a
+#: character not listed takes the ASCII letters of its compatibility decomposition (é -> e, ₕ -> h), else ``?``
+ASCII_FORMS = {"µ": "u", "μ": "u", "×": "x", "°": "deg", "±": "+/-", "−": "-", "–": "-", "—": "--", "≤": "<=",
+               "≥": ">=", "≈": "~", "→": "->", "·": "*", "…": "...", "§": "section ", "²": "^2", "³": "^3",
+               "Ω": "Omega", "ω": "omega", "φ": "phi", "κ": "kappa", "λ": "lambda", "Δ": "Delta", "δ": "delta",
+               "θ": "theta", "ζ": "zeta", "π": "pi", "σ": "sigma", "ν": "nu", "ρ": "rho",
+               "‘": "'", "’": "'", "“": '"', "”": '"'}
+
+#: the codec error handler of :func:`ascii_fallback`
+ERRORS = "rotorred-ascii"
+
+
+def ascii_text(text: str) -> str:
+    """``text`` with each character outside ASCII in its ASCII form (:data:`ASCII_FORMS`): ``"4.2 µm, 1× outer"``
+    -> ``"4.2 um, 1x outer"``."""
+    return "".join(c if c.isascii() else _ascii_char(c) for c in text)
+
+
+def _ascii_char(char: str) -> str:
+    if char in ASCII_FORMS:
+        return ASCII_FORMS[char]
+    decomposed = "".join(c for c in unicodedata.normalize("NFKD", char) if c.isascii())
+    return decomposed or "?"
+
+
+def _fallback(error: UnicodeError):
+    """The codec error handler: what the encoding cannot write, in ASCII (a lone surrogate, a byte that was not
+    decodable, written back as that byte, as ``surrogateescape`` does)."""
+    if not isinstance(error, UnicodeEncodeError):
+        raise error
+    part = error.object[error.start:error.end]
+    if all("\udc80" <= c <= "\udcff" for c in part):
+        return bytes(ord(c) - 0xDC00 for c in part), error.end
+    return ascii_text(part), error.end
+
+
+def ascii_fallback(stream) -> None:
+    """Let the text ``stream`` write what its encoding cannot as ASCII (:func:`ascii_text`) instead of raising
+    :class:`UnicodeEncodeError`. Characters the encoding has are written as they are (UTF-8 writes everything). A
+    stream that cannot be reconfigured (not an :class:`io.TextIOWrapper`) is left as it is.
+
+    Parameters
+    ----------
+    stream : io.TextIOWrapper
+        E.g. ``sys.stdout``.
+    """
+    try:
+        codecs.lookup_error(ERRORS)
+    except LookupError:
+        codecs.register_error(ERRORS, _fallback)
+    reconfigure = getattr(stream, "reconfigure", None)
+    if reconfigure is None:
+        return
+    try:
+        reconfigure(errors=ERRORS)
+    except (ValueError, io.UnsupportedOperation, AttributeError):  # closed, or not a text wrapper after all
+        pass

@@ -7,6 +7,9 @@ Two streams, both through :mod:`logging`:
   a line never cuts a progress bar in half.
 * **the report** (:data:`REPORT`): the command's result on stdout: summaries, tables, the files written.
 
+Both streams write what their encoding cannot show in ASCII (µm -> um, × -> x: :func:`rotorred.progress.ascii_fallback`),
+so that a terminal with ``PYTHONIOENCODING=ascii`` or an ASCII locale never fails a command after it computed.
+
 The level: INFO by default (stage lines, bars on a terminal, the report); ``-v`` adds DEBUG (timings and choices,
 each line with the seconds since the start); ``-q`` leaves errors only (nothing on stdout). Errors themselves are
 printed by :func:`rotorred.cli.main`'s one error path, whatever the level.
@@ -92,7 +95,10 @@ class _Format(logging.Formatter):
 
 def configure(command: str | None, lvl: int) -> None:
     """Set the loggers for one command: stage lines and warnings on the current stderr, the report on the current
-    stdout, both at ``lvl`` (replacing the handlers of an earlier call in this process)."""
+    stdout, both at ``lvl`` (replacing the handlers of an earlier call in this process). What the streams' encoding
+    cannot show is written in ASCII (:func:`rotorred.progress.ascii_fallback`: µm -> um, × -> x)."""
+    for stream in (sys.stdout, sys.stderr):
+        progress.ascii_fallback(stream)
     for logger, stream, fmt in ((LOG, sys.stderr, _Format(command or "", lvl <= logging.DEBUG)),
                                 (REPORT, sys.stdout, logging.Formatter("%(message)s"))):
         for old in list(logger.handlers):
