@@ -6,7 +6,8 @@ and `campbell --ratio 1e300` printed UNSTABLE lines at frequencies of 1e76 Hz an
 
 Bad-input kinds tested here (counted in the README): 11 absurd or non-finite magnitudes (harmonic: unbalance, speed,
 ratio, a spool's speed on the line, FRF frequencies, cutoff, a non-finite speed; campbell: ratio, a spool's ratio,
-harmonic order, speed) and 2 non-finite results (harmonic response, campbell whirl frequency).
+harmonic order, speed), 2 non-finite results (harmonic response, campbell whirl frequency) and 4 conflicting options
+(harmonic: --modes, --cutoff, --boundary-nodes without --reduced, --frequencies without --frf).
 """
 
 from __future__ import annotations
@@ -128,7 +129,8 @@ def test_a_non_finite_whirl_frequency_is_refused_before_writing(tmp_path, capsys
     out = tmp_path / "out"
     assert main(["campbell", "seed-rig", "--speeds", "0:6000:5", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert err.startswith("rotorred campbell: error: the whirl frequency (Hz) is inf for mode 1 at 3000 rpm of inner"), err
+    assert err.startswith("rotorred campbell: error: the whirl frequency (Hz) is inf for mode 1 at 3000 rpm of "
+                          "inner"), err
     assert not out.exists()
 
 
@@ -138,3 +140,17 @@ def test_bounded_values_still_run(tmp_path, capsys):
     assert main(["harmonic", "seed-rig", "--speeds", "0:6000:5", "--ratio", "2", "--unbalance", "11:1", "--out",
                  str(out), "-q"]) == 0
     assert (out / "response.csv").is_file() and "nan" not in (out / "response.csv").read_text()
+
+
+_CONFLICTS = [  # options the command would ignore: refused, naming the option and what it needs
+    (["--modes", "8"], "--modes = 8: applies to the reduced model only: add --reduced"),
+    (["--cutoff", "300"], "--cutoff = 300.0: applies to the reduced model only: add --reduced"),
+    (["--boundary-nodes", "18"], "--boundary-nodes = '18': applies to the reduced model only: add --reduced"),
+    (["--frequencies", "0:100:11"], "--frequencies = '0:100:11': applies with --frf only"),
+]
+
+
+@pytest.mark.parametrize("args, expected", _CONFLICTS, ids=[a[0] for a, _ in _CONFLICTS])
+def test_harmonic_refuses_options_it_would_ignore(tmp_path, capsys, args, expected):
+    """On main each was silently ignored (the full model solved, no FRF), exit 0."""
+    _refused("harmonic", ["--speeds", "0:6000:5", *args], expected, tmp_path, capsys)

@@ -7,8 +7,9 @@ Two streams, both through :mod:`logging`:
   a line never cuts a progress bar in half.
 * **the report** (:data:`REPORT`): the command's result on stdout: summaries, tables, the files written.
 
-Both streams write what their encoding cannot show in ASCII (µm -> um, × -> x: :func:`rotorred.progress.ascii_fallback`),
-so that a terminal with ``PYTHONIOENCODING=ascii`` or an ASCII locale never fails a command after it computed.
+Both streams write what their encoding cannot show in ASCII (µm -> um, × -> x:
+:func:`rotorred.progress.ascii_fallback`), so that a terminal with ``PYTHONIOENCODING=ascii`` or an ASCII locale
+never fails a command after it computed.
 
 The level: INFO by default (stage lines, bars on a terminal, the report); ``-v`` adds DEBUG (timings and choices,
 each line with the seconds since the start); ``-q`` leaves errors only (nothing on stdout). Errors themselves are

@@ -37,6 +37,8 @@ from rotorred.cli.options import (bounded_line, dof_list, grid, node_list, out_d
 #: file's ``[defaults]`` gives one
 DEFAULT_M_E = 1e-5
 _RPM = 60.0 / (2.0 * math.pi)
+#: the FRF frequencies (Hz) when --frf is given without --frequencies
+FRF_FREQUENCIES = "0:500:1001"
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -75,7 +77,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--boundary-nodes", default="", help="extra boundary nodes N,N,... (with --reduced)")
     p.add_argument("--frf", default=None,
                    help="FRF pairs IN>OUT,... e.g. 18:x>13:x, at the nominal speeds (writes frf.csv, frf.png)")
-    p.add_argument("--frequencies", default="0:500:1001", help="FRF frequencies in Hz START:STOP:N (default 0:500:1001)")
+    p.add_argument("--frequencies", default=None,
+                   help=f"FRF frequencies in Hz START:STOP:N (with --frf; default {FRF_FREQUENCIES})")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
@@ -241,8 +244,8 @@ def run(args) -> int:
                            ("--reference-spool", "--ratio"))
     bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds or "default", args.ratio or "default"))
     frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
-    frf_freqs = 2 * math.pi * _frequencies(args.frequencies) if args.frf else None
-    _check_model_options(args)
+    frf_freqs = 2 * math.pi * _frequencies(args.frequencies or FRF_FREQUENCIES) if args.frf else None
+    _check_model_options(args, scene)
 
     with writers.OutputFolder(out) as folder:
         t0 = time.perf_counter()
@@ -262,8 +265,20 @@ def run(args) -> int:
     return 0
 
 
-def _check_model_options(args) -> None:
-    """--modes and --cutoff, in the units the user typed, before any model is built."""
+def _check_model_options(args, scene) -> None:
+    """--modes and --cutoff, in the units the user typed, before any model is built; options that would be ignored
+    (the reduced model's with the full model, --frequencies without --frf) refused as conflicting."""
+    full = (args.model or (scene.solver.model if scene is not None else "full")) != "reduced"
+    reduced_only = {"--modes": args.modes, "--cutoff": args.cutoff,
+                    "--boundary-nodes": args.boundary_nodes.strip() or None}
+    for option, value in reduced_only.items():
+        if full and value is not None:
+            checks.fail(option, value, "applies to the reduced model only: add --reduced (the model is the full one"
+                                       + (f", as scene {scene.name!r} says" if scene is not None and not args.model
+                                          else "") + ")")
+    if args.frequencies is not None and not args.frf:
+        checks.fail("--frequencies", args.frequencies, "applies with --frf only (the FRF's frequencies): add --frf "
+                                                       "IN>OUT or leave --frequencies out")
     if args.modes is not None:
         checks.integer("--modes", args.modes, ge=0)
     if args.cutoff is not None:
