@@ -2,13 +2,15 @@
 limit, ``RLIMIT_FSIZE``), a folder removed mid-run, memory that runs out, and a symlink, FIFO or device node where a
 file goes. Each ends in one exit-4 line naming the file or the size, no traceback, no crash, the earlier result kept.
 
-Fault kinds tested here (counted in the README): full disk in each of 7 writers (CSV, NPZ, MAT, NetCDF, text, TOML,
-PNG figure), full disk in 5 commands (harmonic, campbell, run, map, convert), output folder removed mid-run, allocation
-failure, and 4 non-regular targets (FIFO, symlink, device node, symlink inside --out).
+Fault kinds tested here (counted in the README), 21: the file-size limit in each of 7 writers (CSV, NPZ, MAT, NetCDF,
+text, TOML, PNG figure) and in 5 commands (harmonic, campbell, run, map, convert); a full disk and a used-up quota
+(ENOSPC, EDQUOT); the output folder removed mid-run; an allocation failure; 5 non-regular targets (a FIFO, a symlink,
+a device node at convert's OUT; a symlink inside --out; a FIFO put at the path while the file is written).
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 import subprocess
@@ -223,3 +225,25 @@ def test_atomic_path_refuses_a_target_replaced_meanwhile(tmp_path):
             tmp.write_text("x")
             os.mkfifo(path)
     assert stat.S_ISFIFO(os.lstat(path).st_mode) and sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+
+
+@pytest.mark.parametrize("code, says", [(errno.ENOSPC, "the disk is full"),
+                                        (errno.EDQUOT, "the disk quota is used up")], ids=["ENOSPC", "EDQUOT"])
+def test_a_full_disk_or_quota_says_disk_and_names_the_file(tmp_path, monkeypatch, capsys, code, says):
+    """ENOSPC and EDQUOT (no file-size limit can make them) from the writes of the staging folder: exit 4, one line
+    saying disk and naming the file of --out."""
+    real = Path.write_text
+
+    def full(self, *args, **kwargs):
+        if ".rotorred-staging-" in str(self):
+            raise OSError(code, os.strerror(code))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", full)
+    out = tmp_path / "out"
+    assert main(["harmonic", "seed-rig", "--speeds", "0:6000:5", "--out", str(out)]) == 4
+    err = capsys.readouterr().err
+    errors = [line for line in err.splitlines() if ": error: " in line]
+    assert errors == [f"rotorred harmonic: error: could not write {str(out / 'response.csv')!r}: {says} "
+                      f"({os.strerror(code)})"], err
+    assert not out.exists()
