@@ -692,8 +692,12 @@ class OutputFolder:
             return self._vanished()
         if isinstance(exc, MemoryError):
             return as_fault(exc)
-        name = Path(exc.filename).name if isinstance(exc, OSError) and exc.filename else None
-        return as_fault(exc, self.folder / name if name else self._writing)
+        if not isinstance(exc, OSError):
+            return exc
+        if exc.filename is None:  # (matplotlib's PNG writer names none): the file being staged
+            return as_fault(exc, self._writing)
+        inside = Path(exc.filename).parent in (self.staging, self.folder)
+        return as_fault(exc, self.folder / Path(exc.filename).name if inside else exc.filename)
 
     def _vanished(self) -> ResourceFault:
         return ResourceFault(errno.ENOENT, f"the output folder {str(self.folder)!r} no longer exists (removed while "

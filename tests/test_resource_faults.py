@@ -247,3 +247,21 @@ def test_a_full_disk_or_quota_says_disk_and_names_the_file(tmp_path, monkeypatch
     assert errors == [f"rotorred harmonic: error: could not write {str(out / 'response.csv')!r}: {says} "
                       f"({os.strerror(code)})"], err
     assert not out.exists()
+
+
+def test_a_fault_within_the_folder_block_names_the_right_file(tmp_path):
+    """A fault of a file outside the folder (a cache) keeps its own name; one without a name (matplotlib's PNG
+    writer) names the file being staged; one naming a staged file names the folder's."""
+    out = tmp_path / "out"
+    for raised, named in ((OSError(errno.ENOSPC, "No space left on device", "/elsewhere/cache.bin"),
+                           "/elsewhere/cache.bin"),
+                          (OSError(errno.EFBIG, "File too large"), str(out / "a.png")),
+                          (OSError(errno.EDQUOT, "Disk quota exceeded", "STAGED/b.csv"), str(out / "b.csv"))):
+        with pytest.raises(writers.ResourceFault) as caught:
+            with writers.OutputFolder(out) as folder:
+                folder.staged("a.png")
+                if raised.filename == "STAGED/b.csv":
+                    raised.filename = str(folder.staged("b.csv"))
+                raise raised
+        assert str(caught.value).startswith(f"could not write {named!r}: "), str(caught.value)
+    assert not out.exists()
