@@ -45,6 +45,10 @@ __all__ = ["write_csv", "write_npz", "write_mat", "write_netcdf", "write_text", 
            "non_regular"]
 
 
+#: the name of an output folder's staging folder starts so (:class:`OutputFolder`)
+_STAGING = ".rotorred-staging-"
+
+
 def _umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
@@ -155,7 +159,8 @@ def atomic_path(path: str | Path, suffix: str = ""):
     """
     path = check_target(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        if not path.parent.name.startswith(_STAGING):  # an output folder's staging folder is never made again here
+            path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{suffix}", dir=path.parent)
     except OSError as exc:
         raise _write_fault(exc, path) from exc
@@ -650,6 +655,7 @@ class OutputFolder:
         self._created = False
         self._lock = None
         self._writing: Path | None = None  # the file of the folder staged last: the one a fault names
+        self._identity: tuple[int, int] | None = None  # (device, inode) of the staging folder
         self.committed = False
 
     def __enter__(self) -> OutputFolder:
@@ -657,7 +663,8 @@ class OutputFolder:
         self.folder.mkdir(parents=True, exist_ok=True)
         try:
             self._lock = _acquire_lock(self.folder)
-            self.staging = Path(tempfile.mkdtemp(prefix=".rotorred-staging-", dir=self.folder))
+            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
+            self._identity = _identity(self.staging)
         except BaseException:  # the lock released, and the folder removed if this run created it
             self.__exit__()
             raise
@@ -672,7 +679,7 @@ class OutputFolder:
         if self._lock is not None:
             _release_lock(self.folder / LOCK, self._lock)
             self._lock = None
-        if self._created and not self.committed:
+        if (self._created and not self.committed) or isinstance(fault, _Vanished):  # (recreated by a writer: empty)
             try:
                 self.folder.rmdir()
             except OSError:
@@ -688,7 +695,7 @@ class OutputFolder:
                 return ResourceFault(exc.errno, str(exc).replace(staging, str(self.folder)),
                                      exc.filename and exc.filename.replace(staging, str(self.folder)))
             return exc
-        if isinstance(exc, FileNotFoundError) and not (self.staging or self.folder).is_dir():
+        if isinstance(exc, FileNotFoundError) and not self._still_there():
             return self._vanished()
         if isinstance(exc, MemoryError):
             return as_fault(exc)
@@ -699,8 +706,13 @@ class OutputFolder:
         inside = Path(exc.filename).parent in (self.staging, self.folder)
         return as_fault(exc, self.folder / Path(exc.filename).name if inside else exc.filename)
 
+    def _still_there(self) -> bool:
+        """Whether the staging folder made on entry is still there (not removed, nor removed and made again by a
+        writer's ``mkdir``)."""
+        return self.staging is not None and _identity(self.staging) == self._identity
+
     def _vanished(self) -> ResourceFault:
-        return ResourceFault(errno.ENOENT, f"the output folder {str(self.folder)!r} no longer exists (removed while "
+        return _Vanished(errno.ENOENT, f"the output folder {str(self.folder)!r} no longer exists (removed while "
                                            f"the command ran?); nothing of this result was kept", str(self.folder))
 
     def staged(self, path: Path) -> Path:
@@ -712,7 +724,7 @@ class OutputFolder:
             The folder was removed meanwhile, or a symlink or another non-regular file is where the file goes.
         """
         name = Path(path).name
-        if self.staging is None or not self.staging.is_dir():
+        if not self._still_there():
             raise self._vanished()
         self._writing = check_target(self.folder / name, "--out")
         return self.staging / name
@@ -726,7 +738,7 @@ class OutputFolder:
             The files of the result in the folder.
         """
         with signals_held():
-            if not self.staging.is_dir():
+            if not self._still_there():
                 raise self._vanished()
             new = sorted(p.name for p in self.staging.iterdir() if not p.name.startswith("."))
             for name in new:  # refused before anything moves: the earlier result stays whole
@@ -747,6 +759,19 @@ class OutputFolder:
         if not all((self.folder / n).is_file() for n in names):  # removed as it was committed: never listed as written
             raise self._vanished()
         return [self.folder / n for n in names]
+
+
+class _Vanished(ResourceFault):
+    """The output folder was removed while the command ran."""
+
+
+def _identity(folder: Path) -> tuple[int, int] | None:
+    """(device, inode) of ``folder``; None when it is not there."""
+    try:
+        st = os.stat(folder)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
 
 
 def _manifest(folder: Path) -> list[str]:

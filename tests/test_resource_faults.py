@@ -2,9 +2,10 @@
 limit, ``RLIMIT_FSIZE``), a folder removed mid-run, memory that runs out, and a symlink, FIFO or device node where a
 file goes. Each ends in one exit-4 line naming the file or the size, no traceback, no crash, the earlier result kept.
 
-Fault kinds tested here (counted in the README), 21: the file-size limit in each of 7 writers (CSV, NPZ, MAT, NetCDF,
+Fault kinds tested here (counted in the README), 23: the file-size limit in each of 7 writers (CSV, NPZ, MAT, NetCDF,
 text, TOML, PNG figure) and in 5 commands (harmonic, campbell, run, map, convert); a full disk and a used-up quota
-(ENOSPC, EDQUOT); the output folder removed mid-run; an allocation failure; 5 non-regular targets (a FIFO, a symlink,
+(ENOSPC, EDQUOT); the output folder removed mid-run (seen when staging, when a writer writes into the staging
+folder, and removed and made again before the commit: 3); an allocation failure; 5 non-regular targets (a FIFO, a symlink,
 a device node at convert's OUT; a symlink inside --out; a FIFO put at the path while the file is written).
 """
 
@@ -265,3 +266,35 @@ def test_a_fault_within_the_folder_block_names_the_right_file(tmp_path):
                 raise raised
         assert str(caught.value).startswith(f"could not write {named!r}: "), str(caught.value)
     assert not out.exists()
+
+
+def test_a_folder_removed_before_a_writer_writes_into_its_staging_is_not_made_again(tmp_path):
+    """A command that writes into ``folder.staging`` itself (map does) after --out's parent was removed: the writer's
+    mkdir made the staging folder and --out again, and the commit listed the files as written; now one fault naming
+    the folder's file, and nothing made again."""
+    import shutil
+
+    parent = tmp_path / "parent"
+    with pytest.raises(writers.ResourceFault) as caught:
+        with writers.OutputFolder(parent / "out") as folder:
+            shutil.rmtree(parent)
+            writers.write_text(folder.staging / "map.txt", "x\n")
+            folder.commit()
+    assert str(caught.value).startswith(f"could not write {str(parent / 'out' / 'map.txt')!r}: its folder "), caught.value
+    assert "no longer exists" in str(caught.value) and not parent.exists()
+
+
+def test_a_folder_removed_and_made_again_is_not_committed_into(tmp_path):
+    """--out removed and made again (empty) while the command ran: the commit refuses (the staging folder it made is
+    gone), and leaves the new folder as it found it."""
+    import shutil
+
+    out = tmp_path / "out"
+    with pytest.raises(writers.ResourceFault, match="no longer exists"):
+        with writers.OutputFolder(out) as folder:
+            writers.write_text(folder.staged("a.txt"), "x\n")
+            shutil.rmtree(out)
+            out.mkdir()
+            (out / "theirs.txt").write_text("theirs\n")
+            folder.commit()
+    assert sorted(p.name for p in out.iterdir()) == ["theirs.txt"]
