@@ -5,8 +5,8 @@ file goes. Each ends in one exit-4 line naming the file or the size, no tracebac
 Fault kinds tested here (counted in the README), 23: the file-size limit in each of 7 writers (CSV, NPZ, MAT, NetCDF,
 text, TOML, PNG figure) and in 5 commands (harmonic, campbell, run, map, convert); a full disk and a used-up quota
 (ENOSPC, EDQUOT); the output folder removed mid-run (seen when staging, when a writer writes into the staging
-folder, and removed and made again before the commit: 3); an allocation failure; 5 non-regular targets (a FIFO, a symlink,
-a device node at convert's OUT; a symlink inside --out; a FIFO put at the path while the file is written).
+folder, and removed and made again before the commit: 3); an allocation failure; 5 non-regular targets (a FIFO, a
+symlink, a device node at convert's OUT; a symlink inside --out; a FIFO put at the path while the file is written).
 """
 
 from __future__ import annotations
@@ -280,7 +280,8 @@ def test_a_folder_removed_before_a_writer_writes_into_its_staging_is_not_made_ag
             shutil.rmtree(parent)
             writers.write_text(folder.staging / "map.txt", "x\n")
             folder.commit()
-    assert str(caught.value).startswith(f"could not write {str(parent / 'out' / 'map.txt')!r}: its folder "), caught.value
+    assert str(caught.value).startswith(f"could not write {str(parent / 'out' / 'map.txt')!r}: its folder "), \
+        caught.value
     assert "no longer exists" in str(caught.value) and not parent.exists()
 
 
