@@ -6,8 +6,9 @@ and `campbell --ratio 1e300` printed UNSTABLE lines at frequencies of 1e76 Hz an
 
 Bad-input kinds tested here (counted in the README): 11 absurd or non-finite magnitudes (harmonic: unbalance, speed,
 ratio, a spool's speed on the line, FRF frequencies, cutoff, a non-finite speed; campbell: ratio, a spool's ratio,
-harmonic order, speed), 2 non-finite results (harmonic response, campbell whirl frequency) and 4 conflicting options
-(harmonic: --modes, --cutoff, --boundary-nodes without --reduced, --frequencies without --frf).
+harmonic order, speed), 2 non-finite results (harmonic response, campbell whirl frequency), 4 conflicting options
+(harmonic: --modes, --cutoff, --boundary-nodes without --reduced, --frequencies without --frf), and 3 mode counts
+beyond the model named by their option (campbell --reduce, --modes; harmonic --modes): 20 kinds.
 """
 
 from __future__ import annotations
@@ -154,3 +155,17 @@ _CONFLICTS = [  # options the command would ignore: refused, naming the option a
 def test_harmonic_refuses_options_it_would_ignore(tmp_path, capsys, args, expected):
     """On main each was silently ignored (the full model solved, no FRF), exit 0."""
     _refused("harmonic", ["--speeds", "0:6000:5", *args], expected, tmp_path, capsys)
+
+
+@pytest.mark.parametrize("command, args, expected", [
+    ("campbell", ["--reduce", "1000000"], "--reduce = 1000000: must be <= 60"),
+    ("campbell", ["--modes", "1000000"], "--modes = 1000000: must be <= 80"),
+    ("harmonic", ["--reduced", "--modes", "100000"], "--modes = 100000: must be <= 56"),
+], ids=["campbell --reduce", "campbell --modes", "harmonic --modes"])
+def test_a_mode_count_beyond_the_model_names_the_option(tmp_path, capsys, command, args, expected):
+    """On main the message named the function's parameter (`n_modes = 1000000: ...`), not the option typed."""
+    out = tmp_path / "out"
+    assert main([command, "seed-rig", "--speeds", "0:6000:5", *args, "--out", str(out)]) == 2
+    errors = [line for line in capsys.readouterr().err.splitlines() if ": error: " in line]
+    assert len(errors) == 1 and errors[0].startswith(f"rotorred {command}: error: {expected}"), errors
+    assert not out.exists()

@@ -13,8 +13,8 @@ import numpy as np
 
 from rotorred import checks, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (bounded_line, grid, number_list, out_dir, provenance, ratio_number, speed_line,
-                                  spool_ratios, stage_summary)
+from rotorred.cli.options import (bounded_line, grid, number_list, options_named, out_dir, provenance, ratio_number,
+                                  speed_line, spool_ratios, stage_summary)
 
 
 def parse_speeds(text: str) -> np.ndarray:
@@ -110,8 +110,10 @@ def run(args) -> int:
     operating = speed_line(rotor, speeds, args.reference, ratios_to_reference(ratio, rotor, args.reference), "rpm")
     bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds, ",".join(args.ratio) or "default"))
     with writers.OutputFolder(out) as folder:
-        model = rotor if args.reduce is None else _reduced(rotor, args.reduce)
-        result = campbell(model, operating, n_modes=args.modes, harmonics=harmonics)
+        with options_named({"n_modes": "--reduce"}):
+            model = rotor if args.reduce is None else _reduced(rotor, args.reduce)
+        with options_named({"n_modes": "--modes"}):
+            result = campbell(model, operating, n_modes=args.modes, harmonics=harmonics)
         check_finite(result)
         # the full model tracks as many modes as the reduced one, whose frequencies it is compared with
         comparison = None if args.reduce is None else format_reduction_error(

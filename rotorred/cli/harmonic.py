@@ -30,8 +30,8 @@ import numpy as np
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (bounded_line, dof_list, grid, node_list, out_dir, provenance, ratio_number,
-                                  speed_line, spool_ratios, stage_summary)
+from rotorred.cli.options import (bounded_line, dof_list, grid, node_list, options_named, out_dir, provenance,
+                                  ratio_number, speed_line, spool_ratios, stage_summary)
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
 #: file's ``[defaults]`` gives one
@@ -210,7 +210,8 @@ def _model(args, rotor, scene, operating):
     cutoff = None if cutoff_hz is None else 2 * math.pi * checks.positive("--cutoff", cutoff_hz, "Hz")
     # the band a cutoff must cover: every excitation frequency of the sweep
     band = None if cutoff is None else (0.0, max(float(np.max(w)) for w in operating.speeds(rotor).values()))
-    model = reduce_rotor(rotor, extra, n_modes=modes, cutoff=cutoff, band=band, system=system)
+    with options_named({"n_modes": "--modes" if args.modes is not None else "solver.modes"}):
+        model = reduce_rotor(rotor, extra, n_modes=modes, cutoff=cutoff, band=band, system=system)
     label = (f"Craig-Bampton model, {model.n_dof} DOFs ({model.n_boundary_dofs} boundary DOFs at nodes "
              f"{list(default_boundary_nodes(rotor, extra))} + {model.n_modes} modes); {model.selection.describe()}")
     return model, label, kind

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,8 @@ from rotorred import checks
 from rotorred import Operating, parse_dof
 
 __all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
-           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings", "bounded_line"]
+           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings", "bounded_line",
+           "options_named"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -176,6 +178,18 @@ def bounded_line(rotor, operating: Operating, options: tuple[str, str], texts: t
             checks.fail(f"{options[0]} and {options[1]}", f"{texts[0]} and {texts[1]}",
                         f"put spool {spool!r} at {top:.6g} rpm; a spool must turn at most "
                         + checks.bound_text("speed"))
+
+
+@contextmanager
+def options_named(names: Mapping[str, str]):
+    """Within the block, an :class:`rotorred.checks.InputError` of a function's parameter named in ``names``
+    (``{"n_modes": "--modes"}``) names the option the user typed instead, with the same value and requirement."""
+    try:
+        yield
+    except checks.InputError as exc:
+        if exc.field not in names:
+            raise
+        raise checks.InputError(names[exc.field], exc.value, exc.requirement, exc.unit, exc.source) from None
 
 
 def dof_list(option: str, text: str, nodes=None) -> list[tuple[int, str]]:
