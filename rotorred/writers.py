@@ -70,10 +70,11 @@ class ResourceFault(OSError):
 
 #: errno of a fault of the machine (full disk, quota, file-size limit, memory, read-only or failing medium), whatever
 #: raised it
-_MACHINE = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is used up",
-            errno.EFBIG: "the file would exceed the file-size limit (ulimit -f) or the file system's largest file",
-            errno.ENOMEM: "out of memory", errno.EROFS: "the file system is read-only",
-            errno.EIO: "an input/output error of the disk"}
+_MACHINE = {code: text for name, text in (
+    ("ENOSPC", "the disk is full"), ("EDQUOT", "the disk quota is used up"),
+    ("EFBIG", "the file would exceed the file-size limit (ulimit -f) or the file system's largest file"),
+    ("ENOMEM", "out of memory"), ("EROFS", "the file system is read-only"), ("EIO", "an input/output error of the disk"))
+    if (code := getattr(errno, name, None)) is not None}  # (Windows has no EDQUOT)
 
 
 def as_fault(exc: BaseException, file: str | Path | None = None) -> BaseException:
