@@ -316,7 +316,8 @@ def write_netcdf(path: str | Path, dataset, attributes: Mapping[str, str] | None
     # built in memory, then written by Python: HDF5 writing the file itself on a full disk (or at the file-size limit)
     # raised a RuntimeError and crashed (SIGSEGV) at exit. xarray before 2025 builds NetCDF-4 in memory with no engine
     try:
-        data = cf.to_netcdf(engine="h5netcdf", encoding=encoding)
+        with _local_locks():
+            data = cf.to_netcdf(engine="h5netcdf", encoding=encoding)
     except MemoryError as exc:
         raise as_fault(exc, path) from exc
     except ValueError:  # an older xarray: HDF5 writes the file
@@ -327,6 +328,19 @@ def write_netcdf(path: str | Path, dataset, attributes: Mapping[str, str] | None
         else:
             tmp.write_bytes(data)
     return path
+
+
+@contextmanager
+def _local_locks():
+    """xarray's write locks of this process, not a Dask cluster's: with a distributed client about (a map's), xarray
+    takes a cluster lock named by the target, which for a file built in memory is no name the cluster knows."""
+    try:
+        import dask
+    except ImportError:
+        yield
+        return
+    with dask.config.set(scheduler="synchronous"):
+        yield
 
 
 #: the attribute of a label variable ``<dim>_label`` that names the dimension it labels (:func:`write_netcdf`)
