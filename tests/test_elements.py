@@ -191,7 +191,7 @@ def test_hutchinson_against_cowper(nu, ratio):
         (dict(D_i=0.05), "D_i = 0.05: must be < D_o = 0.05 (m)"),
         (dict(D_i=0.06), "D_i = 0.06: must be < D_o = 0.05 (m)"),
         (dict(D_o=float("nan")), "D_o = nan: must be a finite number > 0 (m)"),
-        (dict(shear="reissner"), "shear = 'reissner': must be one of 'cowper', 'hutchinson', 'none'"),
+        (dict(shear="reissner"), "shear = 'reissner': must be one of 'cowper', 'hutchinson', 'ross-hutchinson', 'none'"),
         (dict(right=1), "right = 1: must differ from left = 1"),
         (dict(element="p5"), "element = 'p5': must be one of 'nelson', 'hierarchical'"),
         (dict(element="hierarchical", shear="none"), "element = 'hierarchical': must be 'nelson' with shear = 'none'"),

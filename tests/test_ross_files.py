@@ -9,6 +9,7 @@ kinetic energy in x, y, alpha, beta) are compared with rotorred's.
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import re
@@ -23,7 +24,7 @@ from rotorred.linear.campbell import campbell
 from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.assembly import assemble
-from rotorred.model.rotor_file import RotorFileError, load_rotor, rotor_from_toml
+from rotorred.model.rotor_file import RotorFileError, load_rotor, read_rotor, rotor_from_dict, rotor_from_toml
 
 ROSS3 = Path(__file__).resolve().parents[1] / "validation" / "reference" / "ross3"
 EXTRA = ROSS3 / "extra"  # a tapered rotor, a rotor on pedestals, a lightly damped rotor: extra/make_extra.py
@@ -301,3 +302,48 @@ def test_a_frequency_table_converts_to_frequency_rpm_and_reads_back_the_same(tmp
     assert target.read_text().count("frequency_rpm = [4000.0") == 2
     assert "14 bearings and seals (12 tabulated against speed, 2 against whirl frequency)" in capsys.readouterr().out
     assert load_rotor(target) == load_rotor(EXTRA / "frequency_rotor.toml")
+
+
+HUTCHINSON = json.loads((EXTRA / "hutchinson_reference.json").read_text())  # extra/make_hutchinson.py
+
+
+def test_rosss_hutchinson_coefficient_is_flagged_at_load_with_the_size_of_the_difference(caplog):
+    """A short hollow shaft (D_i/D_o = 0.4) whose elements use ROSS's Hutchinson coefficient (ROSS 3.1.0,
+    extra/make_hutchinson.py). ``shear = "ross-hutchinson"`` is ROSS's kappa to the last bits (each element's kappa as
+    ROSS stored it, 2.2e-16) and gives ROSS's whirl frequencies at 0, 500 and 1000 rad/s (matched as sets, 9.0e-14
+    measured; the published coefficient is up to 9.5 % off in the higher modes); the file is read with the published coefficient, 1 + nu = 1.2993 times ROSS's, and the load says so
+    once, with kappa -23 % and the first natural frequency -0.391 %, the difference ROSS's own first frequency at rest
+    (1245.696 rad/s) shows against rotorred's published-coefficient reading (measured the same to 4 digits)."""
+    path = EXTRA / "hutchinson_rotor.toml"
+    with caplog.at_level("WARNING", logger="rotorred.model.ross_file"):
+        published, document = read_rotor(path)
+    notes = [r.getMessage() for r in caplog.records if r.name == "rotorred.model.ross_file"]
+    assert len(notes) == 1 and "6 shaft elements use ROSS's Hutchinson shear coefficient" in notes[0]
+    assert "kappa differs by -23 % and the first natural frequency at standstill by -0.391 %" in notes[0]
+    as_ross = copy.deepcopy(document)
+    for e in as_ross["spool"][0]["elements"]:
+        e["shear"] = "ross-hutchinson"
+    as_ross = rotor_from_dict(as_ross)
+    for e, ross in zip(as_ross.spools[0].elements, HUTCHINSON["shaft_elements"]):
+        assert e.kappa == pytest.approx(ross["kappa"], rel=2e-15)
+        assert e.material.nu == pytest.approx(ross["Poisson"], rel=1e-15)
+    nu = HUTCHINSON["shaft_elements"][0]["Poisson"]
+    assert published.spools[0].elements[0].kappa / as_ross.spools[0].elements[0].kappa == pytest.approx(1 + nu, rel=1e-15)
+    for rotor, tolerance in ((as_ross, 9e-13), (published, None)):
+        model = assemble(rotor)
+        for block in HUTCHINSON["modal"]:
+            speeds = {"rotor": block["speed_rad_s"]}
+            reference = ross_roots(block)
+            ours = matched(reference, eigen(model.M, model.damping(speeds), model.stiffness(speeds)).eigenvalues)
+            error = np.max(np.abs(ours.imag / reference.imag - 1))
+            if tolerance is not None:
+                assert error < tolerance
+            else:
+                assert error > 0.09  # the published coefficient is not ROSS's
+    first = HUTCHINSON["modal"][0]["lateral_wd"][0]
+    assert first / _lowest_whirl(published) - 1 == pytest.approx(-0.00391, abs=5e-6)
+
+
+def _lowest_whirl(rotor) -> float:
+    model = assemble(rotor)
+    return float(np.min(eigen(model.M, model.damping({"rotor": 0.0}), model.K).eigenvalues.imag))

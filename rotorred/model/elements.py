@@ -23,7 +23,7 @@ from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_transl
 from rotorred._generated.tapered import tapered_spin_acceleration, tapered_stiffness
 from rotorred._generated import timoshenko as _gen
 
-SHEAR_METHODS = ("cowper", "hutchinson", "none")
+SHEAR_METHODS = ("cowper", "hutchinson", "ross-hutchinson", "none")
 FORMULATIONS = ("nelson", "hierarchical")
 
 
@@ -103,14 +103,17 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
         Outer and inner diameter (m), 0 <= D_i < D_o.
     nu : float
         Poisson's ratio (-).
-    method : {"cowper", "hutchinson"}
+    method : {"cowper", "hutchinson", "ross-hutchinson"}
         ``"cowper"``: Cowper (1966), J. Appl. Mech. 33, Table 1, hollow circle,
         kappa = 6 (1+nu)(1+m^2)^2 / ((7+6nu)(1+m^2)^2 + (20+12nu) m^2), m = D_i/D_o.
         ``"hutchinson"``: Hutchinson (2001), J. Appl. Mech. 68, Eq. (52), hollow circle
         (a = outer, b = inner radius),
         kappa = 6 (a^2+b^2)^2 (1+nu)^2 / (7a^4 + 34a^2b^2 + 7b^4
         + nu (12a^4 + 48a^2b^2 + 12b^4) + nu^2 (4a^4 + 16a^2b^2 + 4b^4)).
-        The (1+nu)^2 factor is part of the published formula (ROSS's line omits it).
+        The (1+nu)^2 factor is part of the published formula.
+        ``"ross-hutchinson"``: ROSS's line for Hutchinson's coefficient (``ShaftElement(shear_method_calc=
+        "hutchinson")``), which has (1+nu) where the published formula has (1+nu)^2: the published value / (1+nu),
+        to reproduce a ROSS rotor (docs/model.md §20).
 
     Returns
     -------
@@ -125,7 +128,9 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
         den = (7 * a2**2 + 34 * a2 * b2 + 7 * b2**2 + nu * (12 * a2**2 + 48 * a2 * b2 + 12 * b2**2)
                + nu**2 * (4 * a2**2 + 16 * a2 * b2 + 4 * b2**2))
         return num / den
-    checks.choice("method", method, ("cowper", "hutchinson"))
+    if method == "ross-hutchinson":
+        return shear_coefficient(D_o, D_i, nu, "hutchinson") / (1 + nu)
+    checks.choice("method", method, ("cowper", "hutchinson", "ross-hutchinson"))
 
 
 @dataclass(frozen=True)
@@ -143,8 +148,8 @@ class ShaftElement:
     D_i : float
         Inner diameter (m), 0 <= D_i < D_o.
     material : Material
-    shear : {"cowper", "hutchinson", "none"}
-        Shear coefficient formula; ``"none"`` gives the Euler-Bernoulli element (phi = 0)
+    shear : {"cowper", "hutchinson", "ross-hutchinson", "none"}
+        Shear coefficient formula (:func:`shear_coefficient`); ``"none"`` gives the Euler-Bernoulli element (phi = 0)
         with rotary inertia (Rayleigh beam).
     element : {"nelson", "hierarchical"}
         ``"nelson"`` (default): interdependent interpolation (Nelson 1980), 4 DOFs per node,

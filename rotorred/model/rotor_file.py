@@ -41,6 +41,7 @@ key path, the value and what is allowed, e.g.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -48,12 +49,16 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rotorred import checks
 from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
                                      IntershaftBearingTable, Material, Pedestal, ShaftElement, Support)
 from rotorred.model.loads import unbalance_from_table
+from rotorred.model import ross_file
+from rotorred.model.assembly import assemble
 from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 from rotorred.model.rotor_writer import rpm_to_rad_s
@@ -222,10 +227,53 @@ def rotor_document(data: dict[str, Any], source: str = "<string>", name: str = "
     RotorFileError
         For a ROSS rotor rotorred cannot represent, naming ``source`` and the key.
     """
+    if not is_ross_document(data):
+        return data
     try:
-        return ross_document(data, name) if is_ross_document(data) else data
+        document = ross_document(data, name)
     except InputError as exc:
         raise RotorFileError(exc.field, exc.value, exc.requirement, exc.unit).from_source(source) from None
+    _note_ross_hutchinson(document)
+    return document
+
+
+def _note_ross_hutchinson(document: dict[str, Any]) -> None:
+    """Say at load how much a ROSS rotor read with Hutchinson's published shear coefficient differs from ROSS's own
+    (which omits a factor 1 + nu, :func:`rotorred.model.elements.shear_coefficient`): the relative change of kappa and
+    of the rotor's first natural frequency at standstill (undamped), as a warning of ``rotorred.model.ross_file``."""
+    as_ross = copy.deepcopy(document)
+    entries = [e for s in as_ross["spool"] for e in (*s["elements"], *s.get("sleeves", ()))
+               if e.get("shear") == "hutchinson"]
+    if not entries:
+        return
+    for e in entries:
+        e["shear"] = "ross-hutchinson"
+    try:
+        published, as_ross = rotor_from_dict(document), rotor_from_dict(as_ross)
+    except InputError:
+        return  # the load itself says what is wrong
+    pairs = [(a, b) for s, t in zip(published.spools, as_ross.spools) for a, b in zip(s.all_elements, t.all_elements)
+             if a.shear == "hutchinson"]
+    kappa = [b.kappa / a.kappa - 1.0 for a, b in pairs]
+    w_published, w_ross = (_first_frequency(r) for r in (published, as_ross))
+    ross_file.LOG.warning(
+        "%d shaft elements use ROSS's Hutchinson shear coefficient (shear_method_calc = 'hutchinson'), which omits a "
+        "factor 1 + nu of the published formula (Hutchinson 2001, Eq. 52) that rotorred uses: ROSS's kappa differs "
+        "by %s and the first natural frequency at standstill by %+.3g %% (ROSS %.6g rad/s, rotorred %.6g rad/s). "
+        "shear = 'ross-hutchinson' on these elements reproduces ROSS (docs/model.md §20)",
+        len(pairs), " to ".join(dict.fromkeys(f"{100 * k:+.3g} %" for k in (min(kappa), max(kappa)))),
+        100 * (w_ross / w_published - 1.0), w_ross, w_published)
+
+
+def _first_frequency(rotor: Rotor) -> float:
+    """The lowest undamped natural frequency (rad/s) of ``rotor`` at its nominal speeds, gyroscopic terms left out:
+    sqrt of the least eigenvalue of (K, M) above 1e-10 of the largest (rigid-body motions and negative ones left
+    out)."""
+    from scipy.linalg import eigh
+
+    model = assemble(rotor)
+    w2 = eigh(model.K, model.M, eigvals_only=True)
+    return float(np.sqrt(w2[w2 > 1e-10 * np.max(w2)][0]))
 
 
 def read_text_file(path: Path, error: type[InputError] = InputError) -> str:
