@@ -13,11 +13,12 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from rotorred.checks import InputError
-from rotorred.linear.campbell import campbell, rigid_body_motions
+from rotorred.linear.campbell import campbell
 from rotorred.linear.harmonic import steady_state
 from rotorred.model.operating import Operating
 from rotorred.linear.reduction import reduce_rotor
 from rotorred.model.assembly import assemble
+from rotorred.model.rigid import rigid_body_motions
 from rotorred.model.elements import Bearing, Disk, Material, ShaftElement, Support
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import Rotor, Spool

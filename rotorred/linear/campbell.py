@@ -58,6 +58,7 @@ from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, system_of
 from rotorred.model.operating import Operating, SpoolLine
 from rotorred.model.operating import checked as checked_operating
+from rotorred.model.rigid import rigid_body_motions
 from rotorred.progress import stage
 from rotorred.results import Result
 
@@ -936,69 +937,6 @@ def _beyond_tables(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray) -> tup
 NEUTRAL_LOG_DEC = 1e-6
 #: a tracked mode with more than this share of its kinetic energy in the null space of K is a rigid-body mode
 RIGID_SHARE = 0.5
-#: generalised eigenvalues w^2 of (K, M) below this fraction of the spool's own first elastic w^2 (its shaft and
-#: disks free-free, no bearing; :func:`own_elastic_w2`) span the null space of K: w below 1e-4 of that frequency
-RIGID_RTOL = 1e-8
-#: ... or below this fraction of the largest w^2 of the model: the round-off of the eigen-solve (about 45 eps),
-#: under which no w^2 is distinguishable from zero; alone, it is the rule of a model built by hand (no rotor)
-_NULL_RTOL = 1e-14
-
-
-def rigid_body_motions(model) -> np.ndarray:
-    """The rigid-body motions of a model, M-orthonormal, shape (n, r): the eigenvectors of K phi = w^2 M phi whose w^2
-    is negligible against the own frequencies of the spools they move (a free spool's translations and tilts; r = 0
-    when every spool is held).
-
-    A vector is rigid when w^2 <= max(RIGID_RTOL sum_s e_s w2_s, _NULL_RTOL max|w^2|): e_s is the share of its
-    squared displacement on spool s's nodes, w2_s the spool's own first elastic w^2 (:func:`own_elastic_w2`). The
-    threshold follows each spool, not the stiffest bearing of the model: bearings of 1e15 N/m put the largest w^2
-    1e10 times above a shaft's bending w^2, which a threshold relative to the largest w^2 took for rigid-body modes
-    (docs/model.md §20).
-
-    Parameters
-    ----------
-    model : SystemMatrices or ReducedSystem
-        The model (its ``rotor`` gives the spools; a model built by hand uses the round-off rule alone).
-
-    Returns
-    -------
-    ndarray, shape (n, r)
-    """
-    w2, phi = sla.eigh(model.K, model.M)
-    limit = np.full(len(w2), _NULL_RTOL * max(float(np.max(np.abs(w2))), 1e-300))
-    own = own_elastic_w2(model.rotor) if model.rotor is not None else {}
-    if own:
-        candidates = np.flatnonzero(w2 <= RIGID_RTOL * max(own.values()))
-        shares = _spool_shares(model, phi[:, candidates])  # (n_spools, candidates)
-        scale = np.array([own[s] for s in model.spools]) @ shares
-        limit[candidates] = np.maximum(limit[candidates], RIGID_RTOL * scale)
-    return phi[:, w2 <= limit]
-
-
-def own_elastic_w2(rotor) -> dict[str, float]:
-    """Each spool's own first elastic w^2 (rad^2/s^2): the fifth eigenvalue of its shaft elements, sleeves and disks,
-    free-free and without bearings (the first four are its rigid translations and tilts)."""
-    from rotorred.model.assembly import assemble
-    from rotorred.model.rotor import Rotor
-
-    out = {}
-    for s in rotor.spools:
-        alone = assemble(Rotor((s,), disks=tuple(d for d in rotor.disks if d.node in set(s.nodes))))
-        w2 = sla.eigh(alone.K, alone.M, eigvals_only=True, subset_by_index=(0, min(4, alone.n_dof - 1)))
-        out[s.name] = float(w2[-1])
-    return out
-
-
-def _spool_shares(model, vectors: np.ndarray) -> np.ndarray:
-    """Share of each vector's squared physical displacement on each spool's nodes, shape (n_spools, n_vectors),
-    columns summing to 1 (a pedestal's share is left out). ``vectors`` on the model's coordinates (recovered by
-    ``T`` for a reduced model)."""
-    full = vectors if isinstance(model, SystemMatrices) else model.T @ vectors
-    dofs, spool_of = model.full_dofs, model.spool_of
-    squares = np.abs(full) ** 2
-    out = np.array([sum((squares[dofs.node_dofs(n)].sum(axis=0) for n in dofs.nodes if spool_of.get(n) == s),
-                        np.zeros(vectors.shape[1])) for s in model.spools])
-    return out / np.maximum(out.sum(axis=0), 1e-300)
 
 
 def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.ndarray:

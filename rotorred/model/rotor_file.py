@@ -59,6 +59,7 @@ from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, Beari
 from rotorred.model.loads import unbalance_from_table
 from rotorred.model import ross_file
 from rotorred.model.assembly import assemble
+from rotorred.model.rigid import null_space
 from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 from rotorred.model.rotor_writer import rpm_to_rad_s
@@ -267,13 +268,10 @@ def _note_ross_hutchinson(document: dict[str, Any]) -> None:
 
 def _first_frequency(rotor: Rotor) -> float:
     """The lowest undamped natural frequency (rad/s) of ``rotor`` at its nominal speeds, gyroscopic terms left out:
-    sqrt of the least eigenvalue of (K, M) above 1e-10 of the largest (rigid-body motions and negative ones left
-    out)."""
-    from scipy.linalg import eigh
-
-    model = assemble(rotor)
-    w2 = eigh(model.K, model.M, eigvals_only=True)
-    return float(np.sqrt(w2[w2 > 1e-10 * np.max(w2)][0]))
+    sqrt of the least positive eigenvalue of (K, M) that is no rigid-body motion (:func:`rotorred.model.rigid.
+    null_space`)."""
+    w2, _, rigid = null_space(assemble(rotor))
+    return float(np.sqrt(w2[~rigid & (w2 > 0.0)][0]))
 
 
 def read_text_file(path: Path, error: type[InputError] = InputError) -> str:
