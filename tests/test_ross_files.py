@@ -311,9 +311,10 @@ def test_rosss_hutchinson_coefficient_is_flagged_at_load_with_the_size_of_the_di
     """A short hollow shaft (D_i/D_o = 0.4) whose elements use ROSS's Hutchinson coefficient (ROSS 3.1.0,
     extra/make_hutchinson.py). ``shear = "ross-hutchinson"`` is ROSS's kappa to the last bits (each element's kappa as
     ROSS stored it, 2.2e-16) and gives ROSS's whirl frequencies at 0, 500 and 1000 rad/s (matched as sets, 9.0e-14
-    measured; the published coefficient is up to 9.5 % off in the higher modes); the file is read with the published coefficient, 1 + nu = 1.2993 times ROSS's, and the load says so
-    once, with kappa -23 % and the first natural frequency -0.391 %, the difference ROSS's own first frequency at rest
-    (1245.696 rad/s) shows against rotorred's published-coefficient reading (measured the same to 4 digits)."""
+    measured; the published coefficient is up to 9.5 % off in the higher modes). The file is read with the published
+    coefficient, 1 + nu = 1.2993 times ROSS's, and the load says so once, with kappa -23 % and the first natural
+    frequency -0.391 %, the difference ROSS's own first frequency at rest (1245.696 rad/s) shows against rotorred's
+    published-coefficient reading (measured the same to 4 digits)."""
     path = EXTRA / "hutchinson_rotor.toml"
     with caplog.at_level("WARNING", logger="rotorred.model.ross_file"):
         published, document = read_rotor(path)
@@ -328,7 +329,8 @@ def test_rosss_hutchinson_coefficient_is_flagged_at_load_with_the_size_of_the_di
         assert e.kappa == pytest.approx(ross["kappa"], rel=2e-15)
         assert e.material.nu == pytest.approx(ross["Poisson"], rel=1e-15)
     nu = HUTCHINSON["shaft_elements"][0]["Poisson"]
-    assert published.spools[0].elements[0].kappa / as_ross.spools[0].elements[0].kappa == pytest.approx(1 + nu, rel=1e-15)
+    ratio = published.spools[0].elements[0].kappa / as_ross.spools[0].elements[0].kappa
+    assert ratio == pytest.approx(1 + nu, rel=1e-15)
     for rotor, tolerance in ((as_ross, 9e-13), (published, None)):
         model = assemble(rotor)
         for block in HUTCHINSON["modal"]:

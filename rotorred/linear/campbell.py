@@ -50,7 +50,6 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers

@@ -762,7 +762,8 @@ class IntershaftBearing(_Support):
         Damping (N s/m).
     name : str
     k_txtx, k_tyty, k_txty, k_tytx, c_txtx, c_tyty, c_txty, c_tytx : float
-        Tilt stiffness (N m/rad) and damping (N m s/rad) on the relative tilt (theta_a - theta_b), as :class:`Bearing`'s.
+        Tilt stiffness (N m/rad) and damping (N m s/rad) on the relative tilt (theta_a - theta_b), as
+        :class:`Bearing`'s.
     """
 
     node_a: int = field(default=-1, kw_only=True)
