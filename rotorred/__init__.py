@@ -44,6 +44,7 @@ _EXPORTS = {
     "Bearing": "rotorred.model.elements",
     "IntershaftBearing": "rotorred.model.elements",
     "BearingTable": "rotorred.model.elements",
+    "IntershaftBearingTable": "rotorred.model.elements",
     "Pedestal": "rotorred.model.elements",
     "Support": "rotorred.model.elements",
     "Spool": "rotorred.model.rotor",

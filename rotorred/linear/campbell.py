@@ -50,7 +50,6 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
@@ -58,6 +57,7 @@ from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, system_of
 from rotorred.model.operating import Operating, SpoolLine
 from rotorred.model.operating import checked as checked_operating
+from rotorred.model.rigid import rigid_body_motions
 from rotorred.progress import stage
 from rotorred.results import Result
 
@@ -790,7 +790,7 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
     log_dec = -2.0 * np.pi * lam_all.real / freq
     whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
 
-    null = rigid_body_motions(sm.M, sm.K)
+    null = rigid_body_motions(sm)
     is_rigid = np.array([rigid_body_share(sm.M, null, v) > RIGID_SHARE for v in shapes])  # (n_s, n_modes)
     crit = []
     for spool, hh, slope, offset, same in _distinct_lines(lines, h):
@@ -936,16 +936,6 @@ def _beyond_tables(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray) -> tup
 NEUTRAL_LOG_DEC = 1e-6
 #: a tracked mode with more than this share of its kinetic energy in the null space of K is a rigid-body mode
 RIGID_SHARE = 0.5
-#: generalised eigenvalues w^2 of (K, M) below this fraction of the largest span the null space of K
-_NULL_RTOL = 1e-10
-
-
-def rigid_body_motions(M: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """The rigid-body motions of a structure, M-orthonormal, shape (n, r): the eigenvectors of
-    K phi = w^2 M phi with w^2 <= 1e-10 max(w^2) (a free spool's translations and tilts; r = 0 when
-    every spool is held)."""
-    w2, phi = sla.eigh(K, M)
-    return phi[:, w2 <= _NULL_RTOL * max(float(np.max(np.abs(w2))), 1e-300)]
 
 
 def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from scipy.sparse import coo_matrix
 
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
-from rotorred.model.elements import Bearing, BearingTable
+from rotorred.model.elements import Bearing, BearingTable, IntershaftBearingTable
 from rotorred.model.rotor import Rotor, node_ranges, plural, speed_text
 from rotorred.results import Result
 
@@ -35,20 +35,21 @@ __all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", 
 
 @dataclass(frozen=True)
 class TabulatedSupport:
-    """A bearing whose coefficients depend on speed (:class:`~rotorred.model.elements.BearingTable`), in a model.
+    """A bearing whose coefficients depend on speed (:class:`~rotorred.model.elements.BearingTable`,
+    :class:`~rotorred.model.elements.IntershaftBearingTable`), in a model.
 
     Attributes
     ----------
-    table : BearingTable
+    table : BearingTable or IntershaftBearingTable
     spool : str
-        The spool whose speed the table follows (the spool of the bearing's node).
-    rows : ndarray, shape (2, n)
-        The bearing node's x and y displacements as rows on the model's coordinates.
-    nominal : Bearing
+        The spool whose speed the table follows (the spool of the bearing's node; an inter-shaft table's ``speed_of``).
+    rows : ndarray, shape (4, n)
+        The bearing's deflection (x, y, theta_x, theta_y) as rows on the model's coordinates (:func:`_deflection_rows`).
+    nominal : Bearing or IntershaftBearing
         The coefficients the model's ``K`` and ``C`` hold: the table at the rotor's speed of ``spool``.
     """
 
-    table: BearingTable
+    table: BearingTable | IntershaftBearingTable
     spool: str
     rows: np.ndarray
     nominal: Bearing
@@ -62,7 +63,7 @@ class TabulatedSupport:
         """The bearing's ``matrix`` (``"K"``: stiffness, ``"C"``: damping) at ``speeds`` (rad/s; a spool left out stands
         still, as in ``gyroscopic``) minus the nominal one, on the model's coordinates, shape (n, n)."""
         b = self.table.at(speeds.get(self.spool, 0.0))
-        delta = getattr(b, matrix) - getattr(self.nominal, matrix)
+        delta = b.block(matrix) - self.nominal.block(matrix)
         return self.rows.T @ delta @ self.rows
 
 
@@ -337,26 +338,16 @@ def assemble(rotor: Rotor) -> SystemMatrices:
         K_G[spool_of[d.node]].add(idx, d.K_G())
     for p in rotor.pedestals:
         M.add(dofs.node_dofs(p.node), p.M())
-    coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
     tables = []
-    for b in rotor.bearings:
-        idx = dofs.node_dofs(b.node)[:2]
-        if isinstance(b, BearingTable):
-            spool = spool_of[b.node]
-            tables.append(TabulatedSupport(b, spool, _deflection_rows(dofs, b), b.at(rotor.speeds[spool])))
+    for b in (*rotor.bearings, *rotor.intershaft_bearings):
+        rows = _deflection_rows(dofs, b)
+        if isinstance(b, (BearingTable, IntershaftBearingTable)):
+            spool = _table_spool(b, spool_of)
+            tables.append(TabulatedSupport(b, spool, rows, b.at(rotor.speeds[spool])))
             b = tables[-1].nominal
-        if b.link is None:
-            K.add(idx, b.K)
-            C.add(idx, b.C)
-        else:
-            both = np.concatenate([idx, dofs.node_dofs(b.link)])
-            K.add(both, np.kron(coupling, b.K))
-            C.add(both, np.kron(coupling, b.C))
-    for b in rotor.intershaft_bearings:
-        a, c = dofs.node_dofs(b.node_a)[:2], dofs.node_dofs(b.node_b)[:2]
-        idx = np.concatenate([a, c])
-        K.add(idx, np.kron(coupling, b.K))
-        C.add(idx, np.kron(coupling, b.C))
+        idx = np.flatnonzero(np.any(rows != 0.0, axis=0))  # the DOFs the bearing's deflection reads
+        K.add(idx, rows[:, idx].T @ b.block("K") @ rows[:, idx])
+        C.add(idx, rows[:, idx].T @ b.block("C") @ rows[:, idx])
     Cm = C.dense(n)
     alpha, beta = rotor.rayleigh
     if alpha or beta:
@@ -367,12 +358,21 @@ def assemble(rotor: Rotor) -> SystemMatrices:
 
 
 def _deflection_rows(dofs: DofMap, b) -> np.ndarray:
-    """A bearing's deflection, its node's x, y (less its pedestal's), as rows on the DOFs, shape (2, n)."""
-    rows = np.zeros((2, dofs.n_dof))
-    rows[[0, 1], dofs.node_dofs(b.node)[:2]] = 1.0
-    if b.link is not None:
-        rows[[0, 1], dofs.node_dofs(b.link)] = -1.0
+    """A bearing's deflection (x, y, theta_x, theta_y) as rows on the DOFs, shape (4, n): its node's motion, less
+    its pedestal's x, y (a pedestal does not tilt) or the other spool's node's motion (an inter-shaft bearing). The
+    tilt rows are zero at a pedestal node, which has no rotations (docs/model.md §20)."""
+    rows = np.zeros((4, dofs.n_dof))
+    for node, sign in ((b.node_a, 1.0), (b.node_b, -1.0)) if hasattr(b, "node_b") else ((b.node, 1.0), (b.link, -1.0)):
+        if node is not None:
+            idx = dofs.node_dofs(node)
+            rows[np.arange(len(idx)), idx] = sign
     return rows
+
+
+def _table_spool(b, spool_of: Mapping[int, str]) -> str:
+    """The spool whose speed a bearing table follows: an inter-shaft table's ``speed_of`` (default its node_a's), else
+    its node's."""
+    return getattr(b, "speed_of", None) or spool_of[b.node]
 
 
 def _supported(system: SystemMatrices, supports) -> SystemMatrices:

@@ -21,8 +21,8 @@ from typing import Mapping
 
 from rotorred import checks
 from rotorred.model.dofs import checked_dof
-from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Pedestal, ShaftElement,
-                                     Support)
+from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, IntershaftBearingTable, Pedestal,
+                                     ShaftElement, Support)
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor_writer import rotor_table
 from rotorred.results import Result
@@ -201,8 +201,9 @@ class Rotor:
     disks : tuple of Disk
     bearings : tuple of Bearing or BearingTable
         Node-to-ground bearings; a :class:`BearingTable`'s coefficients follow the speed of its node's spool.
-    intershaft_bearings : tuple of IntershaftBearing
-        Bearings between nodes of two different spools.
+    intershaft_bearings : tuple of IntershaftBearing or IntershaftBearingTable
+        Bearings between nodes of two different spools; an :class:`IntershaftBearingTable`'s coefficients follow the
+        speed of its ``speed_of`` spool.
     rayleigh : tuple of float, optional
         (alpha (1/s), beta (s)) of the shafts' Rayleigh damping C = alpha M_shaft + beta K_shaft;
         disks and bearings are not included.
@@ -220,7 +221,7 @@ class Rotor:
     spools: tuple[Spool, ...]
     disks: tuple[Disk, ...] = ()
     bearings: tuple[Bearing | BearingTable, ...] = ()
-    intershaft_bearings: tuple[IntershaftBearing, ...] = ()
+    intershaft_bearings: tuple[IntershaftBearing | IntershaftBearingTable, ...] = ()
     rayleigh: tuple[float, float] = (0.0, 0.0)
     name: str = ""
     defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
@@ -229,7 +230,8 @@ class Rotor:
 
     def __post_init__(self):
         for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", (Bearing, BearingTable)),
-                          ("intershaft_bearings", IntershaftBearing), ("supports", Support), ("pedestals", Pedestal)):
+                          ("intershaft_bearings", (IntershaftBearing, IntershaftBearingTable)), ("supports", Support),
+                          ("pedestals", Pedestal)):
             object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
             checks.fail("spools", self.spools, "must hold at least one spool")
@@ -255,6 +257,9 @@ class Rotor:
             if isinstance(b, BearingTable) and b.node in pedestals:
                 checks.fail(f"bearings[{i}].node", b.node, "must be a shaft node for a bearing tabulated against "
                             "speed (its spool's speed); node {} is a pedestal".format(b.node))
+            if b.node in pedestals and b.tilts:
+                checks.fail(f"bearings[{i}].node", b.node, "must be a shaft node for a bearing with tilt coefficients; "
+                            f"node {b.node} is a pedestal, which has no rotations (x and y only)")
         self._check_supports(owner)
         for i, b in enumerate(self.intershaft_bearings):
             checks.node(f"intershaft_bearings[{i}].node_a", b.node_a, owner)
@@ -263,6 +268,9 @@ class Rotor:
                 checks.fail(f"intershaft_bearings[{i}].node_b", b.node_b,
                             f"must be on another spool than node_a = {b.node_a} (both are on spool "
                             f"{owner[b.node_a]!r}); an inter-shaft bearing joins two different spools")
+            if getattr(b, "speed_of", None) is not None and b.speed_of not in owner.values():
+                checks.fail(f"intershaft_bearings[{i}].speed_of", b.speed_of, "must name a spool of the rotor ("
+                            f"{', '.join(repr(s.name) for s in self.spools)})")
         try:
             self.defaults.check_nodes(owner)
         except checks.InputError as exc:
