@@ -66,6 +66,8 @@ _EXPORTS = {
     "MIN_DEFAULT_MODES": "rotorred.linear.campbell",
     "CampbellResult": "rotorred.linear.campbell",
     "CriticalSpeed": "rotorred.linear.campbell",
+    "mode_shapes": "rotorred.linear.modes",
+    "ModeShapes": "rotorred.linear.modes",
     "unbalance_response": "rotorred.linear.harmonic",
     "UnbalanceResponse": "rotorred.linear.harmonic",
     "frequency_response": "rotorred.linear.harmonic",

@@ -163,7 +163,7 @@ def format_reduction_error(reduced, full) -> str:
     """The reduced model's largest whirl-frequency and critical-speed differences against the full model."""
     rel = np.abs(reduced.frequencies / full.frequencies - 1.0)
     i, j = np.unravel_index(int(np.argmax(rel)), rel.shape)
-    text = (f"reduced model against the full one: whirl frequencies within {100 * rel[i, j]:.3g} % (largest: mode {j} "
+    text = (f"reduced model against the full one: whirl frequencies within {100 * rel[i, j]:.3g} % (largest: mode {j + 1} "
             f"at {full.speeds_rpm[i]:.6g} rpm)")
     pairs = list(zip(reduced.critical_speeds, full.critical_speeds))
     if pairs and len(reduced.critical_speeds) == len(full.critical_speeds):
@@ -191,7 +191,7 @@ def format_whirl_table(result, i: int = 0) -> str:
              f"{result.reference}" + (f" ({others})" if others else ""),
              f"{'mode':>5} {'freq Hz':>12} {'whirl':>9} {'damping ratio':>14} {'log dec':>10}"]
     for j in range(result.n_modes):
-        lines.append(f"{j:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
+        lines.append(f"{j + 1:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
                      f"{result.damping_ratio[i, j]:14.6f} {result.log_dec[i, j]:10.5f}")
     return "\n".join(lines + _beyond_tables(result))
 
@@ -206,15 +206,15 @@ def format_critical_speeds(result) -> str:
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")
     for c in result.stability_changes:
-        lines.append(f"UNSTABLE: mode {c.mode} ({c.whirl}, {c.frequency_hz:.2f} Hz) "
+        lines.append(f"UNSTABLE: mode {c.mode + 1} ({c.whirl}, {c.frequency_hz:.2f} Hz) "
                      + (f"becomes unstable above {c.speed_rpm:.1f} rpm (log dec < 0)" if c.onset
                         else f"is unstable below {c.speed_rpm:.1f} rpm (log dec < 0), stable above"))
     if result.rigid_modes:
         f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
         lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "
-                     f"{', '.join(str(j) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
+                     f"{', '.join(str(j + 1) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
     for c in result.critical_speeds:
-        lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
+        lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode + 1:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")
     return "\n".join(lines + _beyond_tables(result))
 
