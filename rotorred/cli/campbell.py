@@ -81,15 +81,41 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--reduce", type=int, default=None, metavar="MODES",
                    help="solve the Craig-Bampton model with MODES fixed-interface modes (0: chosen to the default "
                         "target) and print its largest difference against the full model")
+    p.add_argument("--operating-range", default=None, metavar="MIN:MAX",
+                   help="minimum and maximum continuous speed of the reference spool (rpm) for the API 617 "
+                        "separation margins of critical_speeds.csv (default: the rotor file's [defaults] "
+                        "operating_range_rpm of that spool; without either, amplification factors only)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
 
 
+def parse_operating_range(text: str | None) -> tuple[float, float] | None:
+    """``"3000:4500"`` (rpm, 0 <= MIN <= MAX) -> (3000.0, 4500.0); None -> None."""
+    if text is None:
+        return None
+    values = number_list("--operating-range", text.replace(":", ","), "rpm")
+    if len(values) != 2 or not 0.0 <= values[0] <= values[1]:
+        checks.fail("--operating-range", text, "must be MIN:MAX, the minimum and maximum continuous speed with "
+                    "0 <= MIN <= MAX", "rpm")
+    return values
+
+
+def operating_range(given: tuple[float, float] | None, rotor, reference: str):
+    """The :class:`rotorred.OperatingRange` of the reference spool: ``--operating-range`` (rpm), else the rotor's
+    ``[defaults]``, else None."""
+    from rotorred import OperatingRange
+
+    if given is not None:
+        return OperatingRange(*(w * math.pi / 30.0 for w in given))
+    default = rotor.defaults.operating_range(reference)
+    return None if default is None else OperatingRange(*default)
+
+
 def run(args) -> int:
     import matplotlib  # noqa: F401 - a missing matplotlib fails before any work
 
-    from rotorred import campbell, read_rotor, save_figure
+    from rotorred import campbell, read_rotor, save_figure, separation_margins
 
     out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
@@ -99,6 +125,7 @@ def run(args) -> int:
     ratio = parse_ratio(args.ratio)
     if args.reduce is not None:
         checks.integer("--reduce", args.reduce, ge=0)
+    given_range = parse_operating_range(args.operating_range)
     rotor, document = read_rotor(args.rotor)
     record = provenance(args, "rotor", writers.toml_text(document))
     check_model_size(rotor, args.force)
@@ -111,17 +138,40 @@ def run(args) -> int:
             result, campbell(rotor, operating, n_modes=result.n_modes, harmonics=harmonics))
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
+        api = []
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
             operating_speed = ref_nominal if ref_nominal > 0 else None
             files.append(save_figure(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
-            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed))
+            rng = operating_range(given_range, rotor, result.reference)
+            margins = separation_margins(model, result, rng)
+            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed, margins))
+            api = [format_margins(result, margins, rng)]
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
-                          format_mode_count(result)] + ([comparison] if comparison else []))
+                          format_mode_count(result)] + api + ([comparison] if comparison else []))
         files += stage_summary(folder, "campbell.txt", text, record)
         folder.commit()
     report(text)
     report("wrote " + " and ".join(str(out / f.name) for f in files))
     return 0
+
+
+def format_margins(result, margins, rng) -> str:
+    """The API 617 amplification factor and separation margin of each critical speed (docs/model.md §21)."""
+    rpm = 30.0 / math.pi
+    head = (f"API 617 separation margins from the operating range {rng.minimum * rpm:.6g}-{rng.maximum * rpm:.6g} rpm "
+            f"of {result.reference}" if rng is not None else
+            f"amplification factors (no operating range of {result.reference}: give --operating-range MIN:MAX or "
+            "[defaults] operating_range_rpm for the separation margins)")
+    lines = [head, f"{result.reference + ' rpm':>14} {'mode':>5} {'AF':>8} {'required %':>11} {'actual %':>9}  verdict"]
+    for m in margins:
+        c = m.critical
+        verdict = "" if m.meets is None else "meets API" if m.meets else "FAILS API"
+        af = "-" if math.isnan(m.amplification_factor) else f"{m.amplification_factor:.3g}"
+        req = "-" if math.isnan(m.required) else f"{100 * m.required:.3g}"
+        act = "-" if math.isnan(m.actual) else f"{100 * m.actual:.3g}"
+        lines.append(f"{c.speed_rpm:14.1f} {c.mode + 1:5d} {af:>8} {req:>11} {act:>9}  {verdict}"
+                     + (f" ({m.note})" if m.note else ""))
+    return "\n".join(lines)
 
 
 def format_mode_count(result) -> str:

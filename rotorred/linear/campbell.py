@@ -363,11 +363,14 @@ class CampbellResult(Result):
         return tuple((s, h, h * r, h * self.fixed_speeds.get(s, 0.0)) for s, r in self.speed_ratios.items()
                      if r > 0 or self.fixed_speeds.get(s, 0.0) > 0 for h in self.harmonics)
 
-    def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None) -> Path:
+    def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None,
+                               margins: Sequence | None = None) -> Path:
         """Write the critical speeds, one row each: the reference spool's speed (rpm), the excitation line,
         the excited spool's speed (rpm), the mode, its frequency (Hz), whirl, log dec and damping ratio at
         the crossing, and the margin to ``operating_speed`` (rad/s of the reference spool), in % of it
-        (positive: the critical speed lies above the operating point; empty without one).
+        (positive: the critical speed lies above the operating point; empty without one); then the API 617
+        columns ``amplification_factor``, ``required_margin_pct``, ``actual_margin_pct``, ``meets_api`` (yes/no)
+        of ``margins`` (empty where a margin has none, and without ``margins``).
 
         Parameters
         ----------
@@ -375,6 +378,8 @@ class CampbellResult(Result):
             The CSV file to write.
         operating_speed : float, optional
             Operating speed of the reference spool (rad/s), > 0 for a margin; None or 0: no margin.
+        margins : sequence of SeparationMargin, optional
+            One per critical speed (:func:`rotorred.separation_margins`).
 
         Returns
         -------
@@ -391,6 +396,10 @@ class CampbellResult(Result):
                    np.array([c.spool_speed * 30.0 / math.pi for c in cs]), np.array([c.mode + 1 for c in cs], int),
                    np.array([c.frequency_hz for c in cs]), [c.whirl for c in cs], np.array([c.log_dec for c in cs]),
                    np.array([c.damping_ratio for c in cs]), [margin(c) for c in cs]]
+        api = [(_cell(m.amplification_factor), _cell(100 * m.required), _cell(100 * m.actual),
+                "" if m.meets is None else "yes" if m.meets else "no") for m in margins or ()] or [("",) * 4] * len(cs)
+        header += ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
+        columns += [list(col) for col in zip(*api)] if cs else [[], [], [], []]
         return writers.write_csv(path, header, columns)
 
     @property
@@ -527,6 +536,11 @@ class CampbellResult(Result):
         stable = ["no" if v < -NEUTRAL_LOG_DEC else "yes" for v in self.log_dec.ravel()]
         return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"],
                                  [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec, stable], digits=10)
+
+
+def _cell(value: float) -> str:
+    """A number of the API 617 columns (6 significant digits), empty for NaN (none defined)."""
+    return "" if math.isnan(value) else f"{value:.6g}"
 
 
 #: attributes of a whirl-direction variable: CF flags, the codes' meanings in :data:`WHIRL_LABELS` order

@@ -265,7 +265,7 @@ def mode_shapes(model, operating: Operating, *, n_modes: int | None = None) -> M
     table = campbell(sm, operating, n_modes=n_modes)
     lines = operating.lines(sm)
     _, shapes = modes_at(sm, lines, float(operating.Omega[0]), table.n_modes)
-    nodes, node_spools, z, X, Y = _node_motion(sm, shapes)
+    nodes, node_spools, z, X, Y = node_motion(sm, shapes)
     X, Y = _scaled(X, Y)
     return ModeShapes(speeds={s: float(line.at(operating.Omega[0])) for s, line in lines.items()},
                       reference=table.reference, frequencies=table.frequencies[0], log_dec=table.log_dec[0],
@@ -274,10 +274,28 @@ def mode_shapes(model, operating: Operating, *, n_modes: int | None = None) -> M
                       operating=operating)
 
 
-def _node_motion(sm, shapes: np.ndarray):
-    """(nodes, their spools, z (m), X, Y (n_modes, n_nodes)) of every shaft node from the modes ``shapes`` (model
-    coordinates, columns): the rows of x and y (:meth:`output_rows`, a reduced model's rows of T); 0 at a node a
-    support holds."""
+def node_motion(sm, shapes: np.ndarray):
+    """The motion of every shaft node in the modes ``shapes``.
+
+    Parameters
+    ----------
+    sm : SystemMatrices or ReducedSystem
+        A model with its rotor.
+    shapes : ndarray, shape (n, n_modes), complex
+        Modes in the model's coordinates (columns).
+
+    Returns
+    -------
+    nodes : ndarray of int, shape (n_nodes,)
+        Shaft nodes, spool by spool, axially.
+    spools : tuple of str
+        Spool of each node.
+    z : ndarray, shape (n_nodes,)
+        Axial positions (m).
+    X, Y : ndarray, shape (n_modes, n_nodes), complex
+        x and y of each node (the rows of :meth:`output_rows`, a reduced model's rows of T); 0 where a support
+        holds the node.
+    """
     rotor, dofs = sm.rotor, sm.full_dofs
     positions = rotor.positions
     nodes = [n for s in rotor.spools for n in s.nodes]
