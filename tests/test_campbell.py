@@ -484,12 +484,14 @@ def test_critical_speeds_csv_and_a_shared_line_listed_once(tmp_path):
     result = campbell(rig, Operating.line(speeds), n_modes=6)
     op = rig.speeds["inner"]
     rows = list(csv.reader(result.critical_speeds_to_csv(tmp_path / "c.csv", op).open()))
-    assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][-1] == "margin to operating point (%)"
+    assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][8] == "margin to operating point (%)"
+    assert rows[0][9:] == ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
     assert len(rows) == 1 + len(result.critical_speeds) >= 10
     for row, c in zip(rows[1:], result.critical_speeds):
         assert float(row[0]) == pytest.approx(c.speed_rpm, rel=1e-8) and row[1] == c.line
-        assert float(row[-1]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
-        assert float(row[-2]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|
+        assert float(row[8]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
+        assert float(row[7]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|
+        assert row[9:] == [""] * 4  # no margins given (tests/test_margins.py)
 
 
 def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():

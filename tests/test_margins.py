@@ -114,6 +114,7 @@ def ross_required_margin(AF, below):
     (5.0, 17 * (1 - 1 / 3.5), 10 + 17 * (1 - 1 / 3.5)),      # 12.1429 %, 22.1429 %
     (18.5, 16.0, 26.0),                                # 17 (1 - 1/17) = 16: both caps are reached at AF = 18.5
     (107.0, 16.0, 26.0),
+    (math.inf, 16.0, 26.0),                            # an undamped mode: the half-power points coincide
 ])
 def test_the_margin_rule(af, below, above):
     """API 617 (7th ed., 2.6.2.10; API 684 2nd ed. SP6.8.2.10): below the minimum speed SM = min(17 (1 - 1/(AF -

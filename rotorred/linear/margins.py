@@ -138,8 +138,9 @@ class HalfPower:
 
     @property
     def amplification_factor(self) -> float:
-        """AF = N_c / (N_2 - N_1) (-)."""
-        return self.peak_speed / (self.upper - self.lower)
+        """AF = N_c / (N_2 - N_1) (-); infinite where the half-power points coincide (an undamped mode)."""
+        width = self.upper - self.lower
+        return self.peak_speed / width if width > 0 else math.inf
 
 
 @dataclass(frozen=True)
@@ -188,7 +189,7 @@ def required_margin(amplification_factor: float, side: str) -> float:
     Parameters
     ----------
     amplification_factor : float
-        AF (-), > 0.
+        AF (-), > 0; infinite for an undamped mode.
     side : {"below", "above"}
         Below the minimum speed, or above the maximum continuous speed.
 
@@ -198,7 +199,10 @@ def required_margin(amplification_factor: float, side: str) -> float:
         0 if AF < 2.5; else min(0.17 (1 - 1/(AF - 1.5)), 0.16) below, min(0.10 + 0.17 (1 - 1/(AF - 1.5)), 0.26)
         above.
     """
-    af = checks.number("amplification_factor", amplification_factor, gt=0.0)
+    af = amplification_factor
+    if math.isinf(af) and af > 0:  # undamped: the rule's limit, 17 (1 - 1/(AF - 1.5)) -> 17
+        af = 1e300
+    af = checks.number("amplification_factor", af, gt=0.0)
     side = checks.choice("side", side, ("below", "above"))
     if af < AF_CRITICALLY_DAMPED:
         return 0.0
