@@ -72,8 +72,9 @@ def test_amplification_factor_of_a_rotor_that_behaves_as_one_dof(zeta):
     (a) the closed form AF = 1/(2 zeta) of API 684, within 1 %: measured -0.039 %, -0.16 %, -0.64 % (the half-power
     method's own bias on an unbalance response, -4 zeta^2: (b)); (b) the half-power AF of the single-DOF unbalance
     response r^2 / |1 - r^2 + 2 i zeta r| on its closed form, within 5e-5: measured 5.5e-6, 5.2e-6, 5.4e-6 (the
-    shaft is stiff, not rigid; the crossing and the peak are 1.8e-6 below the closed forms'; asserted 2e-5). The backward translation (the same frequency: no gyroscopic effect on it) shares
-    the peak; the backward conical mode, which a forward unbalance does not excite, gets no AF and needs no margin."""
+    shaft is stiff, not rigid; the crossing and the peak are 1.8e-6 below the closed forms'; asserted 2e-5). The
+    backward translation (the same frequency: no gyroscopic effect on it) shares the peak; the backward conical
+    mode, which a forward unbalance does not excite, gets no AF and needs no margin."""
     rotor, m = disk_rotor(zeta)
     wn = math.sqrt(2 * K_BEARING / m)
     diagram = rr.campbell(rotor, rr.Operating.line(np.linspace(0.0, 2.0 * wn, 41)))

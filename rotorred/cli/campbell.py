@@ -1,6 +1,7 @@
 """``rotorred campbell ROTOR --speeds START:STOP:COUNT --out DIR``: Campbell diagram and critical speeds.
 
-Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv``, ``campbell.txt`` (what it prints, under the
+Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv`` (with the API 684 / 617 amplification factors and
+separation margins, :mod:`rotorred.linear.margins`), ``campbell.txt`` (what it prints, under the
 rotorred version, command line and date) and ``rotor.toml`` (the rotor as read, a rotor file that gives it again).
 """
 
@@ -61,8 +62,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Whirl frequencies against the speed of a reference spool (other spools at a fixed speed "
                     "ratio), forward/backward whirl, modes tracked by MAC, and the critical speeds where a "
                     "whirl curve crosses an excitation line h x (spool speed). Writes campbell.csv and "
-                    "campbell.png and critical_speeds.csv (excitation, mode, whirl, damping and margin to the "
-                    "operating point) to --out and prints the critical speeds.")
+                    "campbell.png and critical_speeds.csv (excitation, mode, whirl, damping, margin to the "
+                    "operating point, and the API 684 amplification factor and API 617 separation margin from "
+                    "--operating-range) to --out and prints the critical speeds. Modes are numbered from 1.")
     p.add_argument("rotor", metavar="ROTOR", help="preset name (e.g. seed-rig) or rotor TOML file")
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
                    help="reference-spool speeds in rpm, e.g. 0:12000:61, a comma list (increasing, >= 0), or one "

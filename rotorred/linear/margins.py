@@ -11,7 +11,8 @@ The one place of the standard's rule. For each critical speed of a Campbell diag
 2. **The amplification factor by the half-power method** (:func:`half_power`) on that unbalance response
    (:func:`rotorred.unbalance_response`) along the diagram's speed line: the response peak N_c, the speeds
    N_1 < N_c < N_2 where the amplitude is the peak's over sqrt(2), ``AF = N_c / (N_2 - N_1)``: the same in the
-   reference spool's speed and the excited one's, which turns at a ratio to it (``Omega_s = a_s Omega``). The peak is refined by a bounded scalar search and N_1, N_2 by Brent's method, not read off a grid.
+   reference spool's speed and the excited one's, which turns at a ratio to it (``Omega_s = a_s Omega``). The
+   peak is refined by a bounded scalar search and N_1, N_2 by Brent's method, not read off a grid.
 3. **The required separation margin** (:func:`required_margin`), from AF and the side of the operating range
    (minimum to maximum continuous speed of the reference spool, :class:`OperatingRange`) the peak lies on:
 
@@ -308,7 +309,7 @@ def _margin(sm, result: CampbellResult, c: CriticalSpeed, rng: OperatingRange | 
         band *= 2.0
     if hp is not None and 0.0 < zeta and (hp.upper - hp.lower) / hp.peak_speed > OWN_BANDWIDTH * 2.0 * zeta:
         hp = None  # a peak this broad is a better damped mode's, not this one's
-    why = "" if hp is not None else "no peak of the unbalance response of its own (not excited, or overdamped)"
+    why = "" if hp is not None else "no response peak of its own: not excited, or overdamped"
     return _verdict(c, hp, node, rng, why, verdict=True)
 
 
