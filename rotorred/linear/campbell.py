@@ -453,7 +453,8 @@ class CampbellResult(Result):
                 f"mode {c.mode + 1} {'unstable above' if c.onset else 'stable above'} {c.speed_rpm:.6g} rpm"
                 for c in self.stability_changes[:3]) + ("; ..." if len(self.stability_changes) > 3 else "")
         if np.any(self.unstable):
-            return f"UNSTABLE: modes {', '.join(map(str, np.flatnonzero(self.unstable.any(axis=0))))} (log dec < 0)"
+            unstable = ", ".join(str(j + 1) for j in np.flatnonzero(self.unstable.any(axis=0)))
+            return f"UNSTABLE: modes {unstable} (log dec < 0)"
         return "stable over the sweep (no log dec < 0)"
 
     def plot(self, ax=None, **options):
