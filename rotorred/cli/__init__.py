@@ -30,6 +30,7 @@ COMMANDS = [
     "convert",
     "harmonic",
     "map",
+    "modes",
     "run",
 ]
 
@@ -77,6 +78,8 @@ EXAMPLES = {
     "campbell": ["rotorred campbell seed-rig --speeds 0:12000:61 --out campbell",
                  "rotorred campbell seed-rig --speeds 3000 --out whirl     # whirl frequencies at one speed",
                  "rotorred campbell my_rotor.toml --speeds 0:20000:81 --ratio 1.4 --harmonics 1,2 --out cd"],
+    "modes": ["rotorred modes seed-rig --speed 3000 --out modes",
+              "rotorred modes my_rotor.toml --speed 9000 --ratio outer=1.3 --modes 8 --out modes"],
     "convert": ["rotorred convert rotor_saved_by_ross.toml rotor.toml"],
     "harmonic": ["rotorred harmonic seed-rig --speeds 0:12000:241 --out bode"],
     "map": ["rotorred map paper-rub --vary rub.clearance=10e-6:60e-6:11 --out clearance",

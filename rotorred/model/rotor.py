@@ -41,21 +41,44 @@ class AnalysisDefaults:
         Default response DOFs (node, direction).
     boundary_nodes : tuple of int
         Extra boundary nodes of a Craig-Bampton reduced model (e.g. the rub node).
+    operating_ranges : tuple of (str, float, float)
+        (spool, minimum speed, maximum continuous speed) (rad/s): the operating range of a spool, which the API 617
+        separation margins of its critical speeds are measured from (``rotorred campbell``, docs/model.md §21).
 
-    All are empty by default; :class:`Rotor` checks that their nodes exist.
+    All are empty by default; :class:`Rotor` checks that their nodes and spools exist.
     """
 
     unbalances: tuple[Unbalance, ...] = ()
     outputs: tuple[tuple[int, str], ...] = ()
     boundary_nodes: tuple[int, ...] = ()
+    operating_ranges: tuple[tuple[str, float, float], ...] = ()
 
     def __post_init__(self):
         unbalances = checks.sequence("unbalances", _tuple(self.unbalances), _unbalance)
         outputs = checks.sequence("outputs", _tuple(self.outputs), checked_dof, unique=True)
         boundary = checks.sequence("boundary_nodes", _tuple(self.boundary_nodes), _node_number, unique=True)
+        ranges = checks.sequence("operating_ranges", _tuple(self.operating_ranges), _operating_range)
         object.__setattr__(self, "unbalances", unbalances)
         object.__setattr__(self, "outputs", outputs)
         object.__setattr__(self, "boundary_nodes", boundary)
+        object.__setattr__(self, "operating_ranges", ranges)
+        if len({r[0] for r in ranges}) < len(ranges):
+            checks.fail("operating_ranges", ranges, "must give each spool's range once")
+
+    def operating_range(self, spool: str) -> tuple[float, float] | None:
+        """(minimum, maximum continuous) speed of ``spool`` (rad/s), or None if not given.
+
+        Parameters
+        ----------
+        spool : str
+            A spool's name.
+        """
+        return next(((lo, hi) for s, lo, hi in self.operating_ranges if s == spool), None)
+
+    def check_spools(self, spools: Collection[str]) -> None:
+        """InputError naming the entry if an operating range's spool is not one of ``spools``."""
+        for i, (s, _, _) in enumerate(self.operating_ranges):
+            checks.choice(f"operating_ranges[{i}].spool", s, sorted(spools))
 
     def check_nodes(self, nodes: Collection[int]) -> None:
         """InputError naming the entry if a node is not one of ``nodes``."""
@@ -66,11 +89,12 @@ class AnalysisDefaults:
         for i, n in enumerate(self.boundary_nodes):
             checks.node(f"boundary_nodes[{i}]", n, nodes)
 
-    def restricted(self, nodes: Collection[int]) -> AnalysisDefaults:
-        """The defaults whose nodes are among ``nodes`` (e.g. of one spool)."""
+    def restricted(self, nodes: Collection[int], spools: Collection[str] = ()) -> AnalysisDefaults:
+        """The defaults whose nodes are among ``nodes`` and operating ranges of ``spools`` (e.g. of one spool)."""
         return AnalysisDefaults(tuple(u for u in self.unbalances if u.node in nodes),
                                 tuple(o for o in self.outputs if o[0] in nodes),
-                                tuple(n for n in self.boundary_nodes if n in nodes))
+                                tuple(n for n in self.boundary_nodes if n in nodes),
+                                tuple(r for r in self.operating_ranges if r[0] in spools))
 
 
 def _tuple(value):
@@ -88,6 +112,15 @@ def _unbalance(field_: str, value) -> Unbalance:
 
 def _node_number(field_: str, value) -> int:
     return checks.integer(field_, value, ge=0)
+
+
+def _operating_range(field_: str, value) -> tuple[str, float, float]:
+    """(spool, minimum, maximum) with 0 <= minimum <= maximum (rad/s)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+        checks.fail(field_, value, "must be (spool, minimum, maximum continuous speed) (rad/s)")
+    lo = checks.non_negative(f"{field_}.minimum", value[1], "rad/s")
+    return (checks.string(f"{field_}.spool", value[0], empty=False), lo,
+            checks.number(f"{field_}.maximum", value[2], "rad/s", ge=lo))
 
 
 @dataclass(frozen=True)
@@ -273,6 +306,7 @@ class Rotor:
                             f"{', '.join(repr(s.name) for s in self.spools)})")
         try:
             self.defaults.check_nodes(owner)
+            self.defaults.check_spools(set(owner.values()))
         except checks.InputError as exc:
             raise exc.within("defaults") from None
 
@@ -505,7 +539,7 @@ class Rotor:
             bearings=tuple(b for b in self.bearings if b.node in nodes or b.node in linked), intershaft_bearings=(),
             supports=tuple(sp for sp in self.supports if sp.node in nodes),
             pedestals=tuple(p for p in self.pedestals if p.node in linked),
-            name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes))
+            name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes, {name}))
 
 
 

@@ -29,6 +29,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     unbalance = [ { node = 11, m_e = 1e-5, phase_deg = 0.0 } ]   # kg m, deg
     outputs = ["13:x", "13:y"]         # NODE:DIRECTION, DIRECTION x, y, theta_x (tx), theta_y (ty)
     boundary_nodes = [18]              # extra boundary nodes of a reduced model
+    operating_range_rpm = { inner = [3000.0, 4500.0] }   # a spool's minimum and maximum continuous speed (API 617)
 
 Speeds and phases may also be given in SI (``speed_rad_s``, ``phase_rad``), as :meth:`Rotor.to_toml` writes those
 that no rpm or degree number reads back to exactly (docs/model.md §18).
@@ -93,7 +94,7 @@ _AXIS_KEYS = {"speed": ("speed_rpm", "speed_rad_s"), "frequency": ("frequency_rp
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
 _SUPPORT_NODE_KEYS = {"node", "kind", "name"}
 _TABLE_KEYS = {"extrapolate", "interpolation"}  # a bearing table's rules, with speed_rpm only
-_DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
+_DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes", "operating_range_rpm", "operating_range_rad_s"}
 #: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
 _FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing",
               "supports": "support", "pedestals": "pedestal"}
@@ -345,7 +346,7 @@ def _rotor(data: dict) -> Rotor:
     pedestals = tuple(_pedestal(f"pedestal[{i}]", p)
                       for i, p in enumerate(checks.tables("pedestal", data.get("pedestal", []))))
     rayleigh = _damping(data.get("damping", {}))
-    defaults = _defaults(data.get("defaults", {}), nodes)
+    defaults = _defaults(data.get("defaults", {}), nodes, [s.name for s in spools])
     try:
         return Rotor(spools=spools, disks=disks, bearings=bearings, intershaft_bearings=inter, rayleigh=rayleigh,
                      name=name, defaults=defaults, supports=supports, pedestals=pedestals)
@@ -632,7 +633,7 @@ def _damping(value) -> tuple[float, float]:
             checks.non_negative("damping.rayleigh_beta", table.get("rayleigh_beta", 0.0), "s"))
 
 
-def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
+def _defaults(value, nodes: set[int], spools: list[str]) -> AnalysisDefaults:
     table = checks.table("defaults", value)
     checks.keys("defaults", table, _DEFAULTS_KEYS)
     unbalances = tuple(unbalance_from_table(f"defaults.unbalance[{i}]", u, nodes)
@@ -641,4 +642,23 @@ def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
                               unique=True)
     boundary = checks.sequence("defaults.boundary_nodes", table.get("boundary_nodes", []),
                                lambda f, v: checks.node(f, v, nodes), unique=True)
-    return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary)
+    return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary,
+                            operating_ranges=_operating_ranges(table, spools))
+
+
+def _operating_ranges(table: dict, spools: list[str]) -> tuple[tuple[str, float, float], ...]:
+    """``operating_range_rpm = { inner = [3000.0, 4500.0] }`` (or ``operating_range_rad_s``, what a written rotor
+    holds where no rpm number reads back exactly): each spool's minimum and maximum continuous speed, in rad/s."""
+    out = []
+    for key, to_rad_s in (("operating_range_rpm", rpm_to_rad_s), ("operating_range_rad_s", float)):
+        unit = "rpm" if key.endswith("rpm") else "rad/s"
+        for spool, pair in checks.table(f"defaults.{key}", table.get(key, {})).items():
+            where = f"defaults.{key}.{spool}"
+            checks.choice(f"defaults.{key}", spool, spools)
+            lo, hi = checks.sequence(where, pair, lambda f, v: checks.non_negative(f, v, unit), min_len=2, max_len=2)
+            if hi < lo:
+                checks.fail(where, pair, "must be [minimum, maximum continuous speed] with minimum <= maximum", unit)
+            if spool in {s for s, _, _ in out}:
+                checks.fail(where, pair, "must be given once: in operating_range_rpm or operating_range_rad_s")
+            out.append((spool, to_rad_s(lo), to_rad_s(hi)))
+    return tuple(out)

@@ -214,6 +214,10 @@ def _defaults_table(d) -> dict[str, Any]:
         out["outputs"] = [f"{node}:{direction}" for node, direction in d.outputs]
     if d.boundary_nodes:
         out["boundary_nodes"] = list(d.boundary_nodes)
+    for spool, lo, hi in d.operating_ranges:  # in rpm where both read back exactly, else in rad/s
+        rpm = [exact_in_unit(w, rpm_to_rad_s, w * 30.0 / math.pi) for w in (lo, hi)]
+        key, pair = ("operating_range_rpm", rpm) if None not in rpm else ("operating_range_rad_s", [lo, hi])
+        out.setdefault(key, {})[spool] = pair
     return out
 
 
