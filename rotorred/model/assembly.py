@@ -147,9 +147,10 @@ class SpoolSpeedMixin:
                 out += Omega * self.G[name]
         return out
 
-    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C(Omega) + sum_s Omega_s G_s`` (N s/m), shape (n, n), at spool speeds ``speeds`` (rad/s)."""
-        return self.dissipation(speeds) + self.gyroscopic(speeds)
+    def damping(self, speeds: Mapping[str, float], frequency: float | None = None) -> np.ndarray:
+        """``C(Omega) + sum_s Omega_s G_s`` (N s/m), shape (n, n), at spool speeds ``speeds`` (rad/s) (a loss factor
+        at whirl ``frequency``, rad/s: :meth:`rotating_damping`)."""
+        return self.dissipation(speeds, frequency) + self.gyroscopic(speeds)
 
     def dissipation(self, speeds: Mapping[str, float], frequency: float | None = None) -> np.ndarray:
         """``C(Omega)`` (N s/m), shape (n, n): ``C`` with the speed-dependent bearings' damping at ``speeds`` (rad/s)
@@ -186,6 +187,12 @@ class SpoolSpeedMixin:
             C += C_s
             N -= speeds.get(s, 0.0) * N_s
         return C, N
+
+    @property
+    def frequency_dependent(self) -> bool:
+        """Whether the model's damping and stiffness depend on the whirl frequency: an internal loss factor (taken at
+        the excitation frequency in a harmonic response, docs/model.md §19)."""
+        return any(np.any(r.C_h) for r in self.rotating.values())
 
     @property
     def speed_dependent(self) -> bool:
