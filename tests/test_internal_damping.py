@@ -223,3 +223,108 @@ def test_energy_balance_with_internal_damping_closes(operating):
     scale = max(np.abs(balance.drive).max(), balance.damping.max(), np.abs(balance.energy).max())
     assert np.abs(balance.circulatory).max() > 0.1 * scale
     assert "W_circulatory" in repr(balance) and float(balance.to_xarray()["internal"][-1]) == balance.internal[-1]
+
+
+def test_harmonic_balance_linear_part_with_the_spin_following_omega():
+    """Harmonic balance's linear part with the spin following omega (``D1`` = G, ``K1`` = -N: the circulatory
+    stiffness grows with omega): the full and the condensed problem's linear response equal the unbalance response,
+    and dR/domega the central difference of R. A rotor whose internal damping makes ``K`` depend on omega, which
+    the unbalance response evaluates at each speed."""
+    from rotorred.nonlinear.condensed import CondensedProblem
+
+    rotor, omega_n, onset = jeffcott()
+    rotor = dataclasses.replace(rotor, bearings=(rr.Bearing(node=2, k_xx=2e5, k_yy=3e5, c_xx=40.0, c_yy=40.0),))
+    model = assemble(rotor)  # anisotropic bearing: the response has a backward part the internal damping acts on
+    C_r, _ = model.rotating_damping({})
+    N = model.rotating["shaft"].N_v
+    f = 1e-5 * (model.output_rows([(2, "x")])[0] - 1j * model.output_rows([(2, "y")])[0])
+    h = rr.Harmonics(1, 8)
+    n = model.n_dof
+
+    def forcing(omega):
+        F, dF = np.zeros((3, n)), np.zeros((3, n))
+        F[1], F[2], dF[1], dF[2] = omega**2 * f.real, -omega**2 * f.imag, 2 * omega * f.real, -2 * omega * f.imag
+        return F.reshape(-1), dF.reshape(-1)
+
+    common = dict(M=model.M, D=model.C + C_r, K=model.K, harmonics=h, forcing=forcing, D1=model.G["shaft"], K1=-N)
+    full = rr.PeriodicProblem(**common)
+    condensed = CondensedProblem(**common, dofs=tuple(int(model.dofs.index(2, d)) for d in ("x", "y")))
+    omegas = np.array([0.5, 1.0, 1.3]) * onset
+    ub = rr.unbalance_response(model, rr.Operating.line(omegas), [rr.Unbalance(2, 1e-5)], [(2, "x"), (2, "y")])
+    for k, omega in enumerate(omegas):
+        z = full.linear_response(omega).reshape(3, n)
+        zc = condensed.linear_response(omega).reshape(3, 2)
+        for j, d in enumerate(("x", "y")):
+            expected = ub.phasors["shaft"][(2, d)][k]
+            i = model.dofs.index(2, d)
+            assert abs(z[1, i] - 1j * z[2, i] - expected) <= 1e-9 * abs(expected)
+            assert abs(zc[1, j] - 1j * zc[2, j] - expected) <= 1e-9 * abs(expected)
+        z = full.linear_response(omega)
+        step = 1e-6 * omega
+        numeric = (full.evaluate(z, omega + step).R - full.evaluate(z, omega - step).R) / (2 * step)
+        assert np.abs(full.evaluate(z, omega).dR_domega - numeric).max() <= 1e-6 * np.abs(numeric).max()
+
+
+def test_unbalance_response_of_an_isotropic_rotor_does_not_see_internal_damping():
+    """On isotropic supports the unbalance whirl is forward, circular and synchronous: the rotating frame sees a
+    static deflection, so internal damping (viscous or hysteretic) changes nothing (to round-off)."""
+    rotor, omega_n, onset = jeffcott()
+    bare = dataclasses.replace(rotor, spools=(dataclasses.replace(rotor.spools[0], internal_damping_beta=0.0),))
+    lossy = dataclasses.replace(rotor, spools=(dataclasses.replace(rotor.spools[0], internal_damping_beta=0.0,
+                                                                   internal_loss_factor=0.02),))
+    op = rr.Operating.line(np.linspace(0.2, 2.0, 10) * omega_n)
+    args = ([rr.Unbalance(2, 1e-5)], [(2, "x"), (2, "y")])
+    reference = rr.unbalance_response(bare, op, *args)
+    for other in (rotor, lossy):
+        assert rr.linear.harmonic.response_error(reference, rr.unbalance_response(other, op, *args)) < 1e-9
+
+
+def test_loss_factor_in_a_frequency_response_is_taken_at_the_excitation_frequency():
+    """A loss factor eta is the viscous eta / |w| at the excitation frequency w: the receptance x/F_x of the
+    Jeffcott rotor (pinned ends, disk in the middle) at spin Omega against the two-DOF closed form
+    m s^2 + c_e s + k + eta k (s - i Omega) / |w| for the forward (+) and backward (-) parts of a force in x,
+    x = F/2 (1/Z(w) + 1/conj(Z(-w))), with s = i w (measured: 1.8e-6 at w = omega_n, the shaft's mass, 2e-8 of the
+    disk's, amplified by the resonance's 1 / eta)."""
+    rotor, omega_n, onset = jeffcott(beta=0.0)
+    eta = 0.02
+    rotor = dataclasses.replace(rotor, spools=(dataclasses.replace(rotor.spools[0], internal_loss_factor=eta),))
+    model = assemble(rotor)
+    c_e, k = rotor.bearings[0].c_xx, M_DISK * omega_n**2
+    Omega = 1.3 * omega_n
+    w = np.array([0.5, 0.9, 1.0, 1.1, 2.0]) * omega_n
+    H = rr.frequency_response(model, rr.Operating.point({"shaft": Omega}), [(2, "x")], [(2, "x")], w).H[:, 0, 0]
+
+    def Z(w_signed):  # z = x + i y ~ e^{i w t}: m z'' + c_e z' + k z + eta k / |w| (z' - i Omega z)
+        s = 1j * w_signed
+        return M_DISK * s**2 + c_e * s + k + eta * k * (s - 1j * Omega) / abs(w_signed)
+
+    expected = 0.5 * (1.0 / Z(w) + 1.0 / np.conj(Z(-w)))
+    print("loss factor error", np.abs(H / expected - 1).max())
+    assert np.abs(H / expected - 1).max() < 2e-5
+    # the first natural frequency at rest (3.7e-7 off: the light shaft's near-singular mass conditions eigh)
+    assert model.loss_frequency == pytest.approx(omega_n, rel=4e-6)
+
+
+def test_a_reduced_model_keeps_the_internal_damping():
+    """Craig-Bampton (VM261, bearing nodes as the boundary): the projected rotating damping is T^T X T, each
+    reduced onset speed is the reduced model's own forward critical speed (to 1e-9), and they approach the full
+    model's as modes are added (measured 1.2e-2 with 2 fixed-interface modes, 2.7e-5 with 8; an odd count splits a
+    pair of the isotropic shaft's x and y modes and makes the reduced rotor anisotropic)."""
+    rotor = rr.load_rotor(VM261)
+    full = assemble(rotor)
+    op = rr.Operating.line(np.linspace(0.0, 16000.0, 17), unit="rpm")
+    onsets = sorted(rr.campbell(full, op, n_modes=4).onset_speeds.values())
+    errors = []
+    for n_modes in (2, 8):
+        red = rr.reduce_rotor(rotor, n_modes=n_modes)
+        T = red.T
+        assert np.allclose(red.rotating["shaft"].N_v, T.T @ full.rotating["shaft"].N_v @ T, rtol=0,
+                           atol=1e-12 * np.abs(full.rotating["shaft"].N_v).max())
+        cd = rr.campbell(red, op, n_modes=4)
+        reduced = sorted(cd.onset_speeds.values())
+        assert len(reduced) == len(onsets) == 2
+        forward = [c.speed for c in cd.critical_speeds if c.whirl == "forward"]
+        assert np.allclose(reduced, forward, rtol=1e-9, atol=0)
+        errors.append(max(abs(a / b - 1) for a, b in zip(reduced, onsets)))
+    print("reduced onset errors", errors)
+    assert errors[1] < errors[0] / 100 and errors[1] < 3e-4
