@@ -131,7 +131,8 @@ def test_rotating_damping_matrices():
     model = assemble(rotor)
     r = model.rotating["shaft"]
     assert np.abs(r.N_v + r.N_v.T).max() <= 1e-12 * np.abs(r.N_v).max()
-    bare = assemble(dataclasses.replace(rotor, spools=(dataclasses.replace(rotor.spools[0], internal_damping_beta=0.0),)))
+    spool = dataclasses.replace(rotor.spools[0], internal_damping_beta=0.0)
+    bare = assemble(dataclasses.replace(rotor, spools=(spool,)))
     bearings = np.zeros_like(bare.K)
     for b in rotor.bearings:
         i = model.dofs.node_dofs(b.node)[:2]

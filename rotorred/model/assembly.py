@@ -8,7 +8,8 @@ where ``M = M_T + M_R`` (translational and rotary), ``K`` includes bearing stiff
 ``C`` bearing and (optional) Rayleigh shaft damping, ``G_s`` collects the shaft and disk
 gyroscopic matrices of spool ``s`` per unit spin speed (1 rad/s), and ``K_G,s`` their
 spin-acceleration matrices per unit angular acceleration (1 rad/s^2; zero at constant speed,
-docs/model.md, Eq. R2).
+docs/model.md, Eq. R2). A spool's internal (rotating) damping adds ``C_r,s`` to the damping and
+``-Omega_s N_s`` to the stiffness (:class:`RotatingDamping`, docs/model.md §19).
 
 Matrices are dense ndarrays: rotorred's models have at most a few thousand DOFs, where
 dense LAPACK beats sparse solvers and keeps eigen-analysis simple. They are built from COO

@@ -70,7 +70,7 @@ _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "int
 #: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
 ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
-#: internal (rotating) damping: on a spool (its elements' default) or on an element, sleeve or station (docs/model.md §19)
+#: internal (rotating) damping: on a spool (its elements' default) or an element, sleeve or station (docs/model.md §19)
 _INTERNAL_KEYS = {"internal_damping_beta", "internal_loss_factor"}
 _SPOOL_KEYS = {"name", "first_node", "nodes", "z0", "speed_rpm", "speed_rad_s", "shear", "element", "rotary_inertia",
                "elements", "stations", "material", "sleeves"} | _INTERNAL_KEYS

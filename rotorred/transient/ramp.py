@@ -135,9 +135,9 @@ class Operators:
         return K if self.N is None else K - np.tensordot(speeds, self.N, axes=1)
 
     def speed_blocks(self) -> np.ndarray:
-        """``[G_0, K_G,0, (-N_0,) G_1, K_G,1, (-N_1,) ...]``, shape (n, blocks n_s n)."""
-        return np.hstack([m for s in range(len(self.G))
-                          for m in ((self.G[s], self.K_G[s]) if self.N is None else (self.G[s], self.K_G[s], -self.N[s]))])
+        """``[G_0, K_G,0, G_1, K_G,1, ..., (-N_0, -N_1, ...)]``, shape (n, blocks n_s n)."""
+        blocks = [m for s in range(len(self.G)) for m in (self.G[s], self.K_G[s])]
+        return np.hstack(blocks + ([] if self.N is None else [-N_s for N_s in self.N]))
 
 
 def operators(model, K_G: dict) -> Operators:
@@ -156,7 +156,7 @@ def operators(model, K_G: dict) -> Operators:
 
 def _pass_operators(ops: Operators, ref: np.ndarray, dt: float, n_levels: int) -> tuple[np.ndarray, np.ndarray]:
     """``R`` per level (shape (L, n, b n_s n)) and the infinity norms of its blocks (shape (L, n_s, b)), b =
-    ``ops.blocks``."""
+    ``ops.blocks``: for spool s its G and K_G blocks, then its -N block among the last n_s."""
     D, K, blocks = ops.D(ref[:, 0]), ops.K_of(ref[:, 0], ref[:, 1]), ops.speed_blocks()
     n, n_s, b = len(D), len(ops.G), ops.blocks
     R, norms = [], []
@@ -164,8 +164,8 @@ def _pass_operators(ops: Operators, ref: np.ndarray, dt: float, n_levels: int) -
         c = newmark_coefficients(dt / 2**level, 0.5, 0.25)
         Rl = sla.lu_solve(sla.lu_factor(c[0] * ops.M + c[3] * D + K, check_finite=False), blocks, check_finite=False)
         R.append(Rl)
-        norms.append([[np.abs(Rl[:, (b * s + j) * n:(b * s + j + 1) * n]).sum(axis=1).max() for j in range(b)]
-                      for s in range(n_s)])
+        columns = [[2 * s + j for j in (0, 1)] + ([2 * n_s + s] if b == 3 else []) for s in range(n_s)]
+        norms.append([[np.abs(Rl[:, k * n:(k + 1) * n]).sum(axis=1).max() for k in blocks_of] for blocks_of in columns])
     return np.ascontiguousarray(np.array(R)), np.array(norms)
 
 
