@@ -56,7 +56,6 @@ def test_jeffcott_onset_speed_is_the_closed_form(beta, ratio, grid):
     cd = rr.campbell(rotor, rr.Operating.line(np.linspace(0.0, 2.0 * omega_n, grid)), n_modes=2)
     changes = cd.stability_changes
     assert len(changes) == 1 and changes[0].onset and changes[0].whirl == "forward"
-    print("onset error", changes[0].speed / onset - 1.0, "frequency error", changes[0].frequency / omega_n - 1.0)
     assert abs(changes[0].speed / onset - 1.0) < 1e-7
     assert abs(changes[0].frequency / omega_n - 1.0) < 1e-7  # at the onset the forward whirl is at omega_n
     assert cd.onset_speeds == {changes[0].mode: changes[0].speed}
@@ -91,7 +90,6 @@ def test_jeffcott_transient_grows_above_the_onset_and_decays_below(factor):
                       recording=rr.Recording([(2, "x"), (2, "y")]))
     r = np.hypot(res.outputs[(2, "x")], res.outputs[(2, "y")])
     measured = float(np.polyfit(res.t, np.log(r), 1)[0])
-    print("growth rate", measured, "Re(lambda)", lam.real, measured / lam.real - 1)
     assert (measured > 0) == (factor > 1) and abs(lam.real) > 1.0
     assert abs(measured / lam.real - 1.0) < 1e-3
 
@@ -201,7 +199,6 @@ def test_jeffcott_run_up_through_the_onset_matches_solve_ivp():
     assert ref.success
     for j, d in enumerate(("x", "y")):
         coarse, fine = (np.max(np.abs(r.outputs[(2, d)] - ref.y[j])) / np.max(np.abs(ref.y[j])) for r in runs)
-        print("run-up error", d, coarse, fine)
         assert fine < 1e-4 and abs(math.log2(coarse / fine) - 2.0) < 0.1
 
 
@@ -217,7 +214,6 @@ def test_energy_balance_with_internal_damping_closes(operating):
     loads = rr.Loads([rr.Unbalance(2, 1e-5)])
     run = rr.simulate(rotor, op, 0.5, 2e-5, loads=loads, recording=rr.Recording([(2, "x")], states=True))
     balance = rr.energy_balance(rotor, run, op, loads)
-    print("energy residual", balance.relative_residual, balance.internal[-1], balance.circulatory[-1],
           balance.damping[-1], balance.drive[-1])
     assert balance.relative_residual < 1e-11
     assert np.all(np.diff(balance.internal) >= 0) and balance.internal[-1] > 0
@@ -300,7 +296,6 @@ def test_loss_factor_in_a_frequency_response_is_taken_at_the_excitation_frequenc
         return M_DISK * s**2 + c_e * s + k + eta * k * (s - 1j * Omega) / abs(w_signed)
 
     expected = 0.5 * (1.0 / Z(w) + 1.0 / np.conj(Z(-w)))
-    print("loss factor error", np.abs(H / expected - 1).max())
     assert np.abs(H / expected - 1).max() < 2e-5
     # the first natural frequency at rest (3.7e-7 off: the light shaft's near-singular mass conditions eigh)
     assert model.loss_frequency == pytest.approx(omega_n, rel=4e-6)
@@ -327,5 +322,4 @@ def test_a_reduced_model_keeps_the_internal_damping():
         forward = [c.speed for c in cd.critical_speeds if c.whirl == "forward"]
         assert np.allclose(reduced, forward, rtol=1e-9, atol=0)
         errors.append(max(abs(a / b - 1) for a, b in zip(reduced, onsets)))
-    print("reduced onset errors", errors)
     assert errors[1] < errors[0] / 100 and errors[1] < 3e-4
