@@ -214,7 +214,6 @@ def test_energy_balance_with_internal_damping_closes(operating):
     loads = rr.Loads([rr.Unbalance(2, 1e-5)])
     run = rr.simulate(rotor, op, 0.5, 2e-5, loads=loads, recording=rr.Recording([(2, "x")], states=True))
     balance = rr.energy_balance(rotor, run, op, loads)
-          balance.damping[-1], balance.drive[-1])
     assert balance.relative_residual < 1e-11
     assert np.all(np.diff(balance.internal) >= 0) and balance.internal[-1] > 0
     scale = max(np.abs(balance.drive).max(), balance.damping.max(), np.abs(balance.energy).max())
