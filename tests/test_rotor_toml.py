@@ -43,19 +43,23 @@ def python_rotor() -> Rotor:
     number reads back to, materials by nu and by G, tapered, hierarchical, Euler-Bernoulli and Rayleigh elements,
     sleeves, tables against speed (linear and pchip) and against whirl frequency, tilt coefficients (isotropic, cross
     and tabulated; on a pedestal link), a pedestal, a support, inter-shaft bearings (one tabulated against another
-    spool's speed), defaults."""
+    spool's speed), defaults, internal damping (viscous and hysteretic, on spools and overridden on elements and a
+    sleeve)."""
     steel = Material("steel", E=2.07e11, rho=7833.4, nu=0.29)
     titanium = Material("Ti-6Al-4V", E=1.138e11, G=4.4e10, rho=4430.0)
     low = Spool("low", (ShaftElement(1, 2, 0.071, 0.031, 0.0, steel),
-                        ShaftElement(2, 5, 0.071, 0.031, 0.0, steel, D_o_right=0.027),
+                        ShaftElement(2, 5, 0.071, 0.031, 0.0, steel, D_o_right=0.027, internal_loss_factor=0.013),
                         ShaftElement(5, 9, 0.09, 0.027, 0.011, titanium, shear="hutchinson"),
-                        ShaftElement(9, 4, 0.09, 0.027, 0.011, titanium, element="hierarchical"),
+                        ShaftElement(9, 4, 0.09, 0.027, 0.011, titanium, element="hierarchical",
+                                     internal_damping_beta=0.0),
                         ShaftElement(4, 40, 0.11, 0.025, 0.0, steel, shear="none", rotary_inertia=False)),
                 speed=inexact(2 * math.pi * 73.3, rpm_to_rad_s, lambda w: w * 30 / math.pi), z0=-0.013,
-                sleeves=(ShaftElement(5, 9, 0.09, 0.045, 0.027, steel), ShaftElement(9, 4, 0.09, 0.045, 0.027, steel),
+                internal_damping_beta=2.1e-5,
+                sleeves=(ShaftElement(5, 9, 0.09, 0.045, 0.027, steel, internal_damping_beta=3e-5),
+                         ShaftElement(9, 4, 0.09, 0.045, 0.027, steel),
                          ShaftElement(1, 2, 0.071, 0.05, 0.031, titanium, D_i_right=0.033)))
     high = Spool("high", tuple(ShaftElement(n, n + 1, 0.05, 0.06, 0.045, titanium) for n in range(20, 25)),
-                 speed=1234.5678, z0=0.1)
+                 speed=1234.5678, z0=0.1, internal_loss_factor=2e-3)
     fan = Spool("fan", (ShaftElement(60, 58, 0.2, 0.04, 0.0, steel), ShaftElement(58, 56, 0.2, 0.04, 0.0, steel)),
                 z0=0.5)
     speeds = (0.0, 157.3, 1e3 / 3, 2 * math.pi * 97.1)

@@ -408,6 +408,17 @@ class CampbellResult(Result):
         return self.log_dec < -NEUTRAL_LOG_DEC
 
     @property
+    def onset_speeds(self) -> dict[int, float]:
+        """Onset speed of each mode that becomes unstable along the sweep: the reference spool's speed (rad/s) of its
+        first :class:`StabilityChange` with ``onset`` (the root of Re(lambda) = 0, e.g. from internal damping,
+        docs/model.md §19), by mode."""
+        out: dict[int, float] = {}
+        for c in self.stability_changes:
+            if c.onset:
+                out.setdefault(c.mode, c.speed)
+        return out
+
+    @property
     def damping_ratio(self) -> np.ndarray:
         """Damping ratio zeta = -Re(lambda) / |lambda| = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
         return self.log_dec / np.sqrt(self.log_dec ** 2 + 4.0 * np.pi ** 2)
@@ -1056,15 +1067,22 @@ def _root(solver: _Solver, Omega, lam_grid, shapes, i: int, j: int, f):
 
 
 def _stability_changes(solver: _Solver, Omega, lam_grid, shapes, whirl, log_dec, is_rigid):
-    """Where each tracked mode's log dec changes sign between grid speeds: the root of Re(lambda) (:func:`_root`)."""
+    """Where each tracked mode's log dec changes sign between grid speeds: the root of Re(lambda) (:func:`_root`).
+
+    A change is between two grid speeds where the log dec is beyond round-off (|log dec| > ``NEUTRAL_LOG_DEC``) with
+    opposite signs, not round-off about an undamped mode's zero; grid speeds between them within round-off of zero
+    (a root on the grid itself) are crossed: the root is refined in the first interval where Re(lambda) changes sign.
+    """
     out = []
     for j in range(log_dec.shape[1]):
-        for i in range(len(Omega) - 1):
-            a, b = log_dec[i, j], log_dec[i + 1, j]
-            if is_rigid[i, j] or is_rigid[i + 1, j] or not (min(a, b) < -NEUTRAL_LOG_DEC < NEUTRAL_LOG_DEC < max(a, b)):
-                continue  # a change from stable to unstable, not round-off about an undamped mode's zero
-            root, lam, _ = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.real)
-            w = str(whirl[i, j]) if whirl[i, j] == whirl[i + 1, j] else "mixed"
+        clear = [i for i in range(len(Omega)) if abs(log_dec[i, j]) > NEUTRAL_LOG_DEC]
+        for i, k in zip(clear[:-1], clear[1:]):
+            if log_dec[i, j] * log_dec[k, j] > 0 or is_rigid[i:k + 1, j].any():
+                continue
+            at = next(m for m in range(i, k) if lam_grid[m + 1, j].real == 0.0
+                      or np.sign(lam_grid[m, j].real) != np.sign(lam_grid[m + 1, j].real))
+            root, lam, _ = _root(solver, Omega, lam_grid, shapes, at, j, lambda lam, W: lam.real)
+            w = str(whirl[i, j]) if len(set(whirl[i:k + 1, j])) == 1 else "mixed"
             out.append(StabilityChange(float(root), j, float(lam.imag), w, bool(log_dec[i, j] > 0)))
     return tuple(sorted(out, key=lambda c: (c.speed, c.mode)))
 

@@ -22,6 +22,7 @@ from rotorred import checks
 from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_translational
 from rotorred._generated.tapered import tapered_spin_acceleration, tapered_stiffness
 from rotorred._generated import timoshenko as _gen
+from rotorred._generated.internal_damping import hierarchical_spin_rotation, timoshenko_spin_rotation
 
 SHEAR_METHODS = ("cowper", "hutchinson", "ross-hutchinson", "none")
 FORMULATIONS = ("nelson", "hierarchical")
@@ -165,6 +166,13 @@ class ShaftElement:
         Diameters at the right node (m) of a tapered element, default ``D_o`` and ``D_i``: the
         diameters vary linearly from left to right and the element is the conical one of
         derivations/tapered.py (``element = "nelson"`` only). ``D_o``, ``D_i`` are then the left ones.
+    internal_damping_beta : float, optional
+        Internal (rotating) viscous damping (s): the damping ``beta K`` acting in the frame that turns with the
+        shaft (docs/model.md §19), >= 0. None (default): its spool's
+        (:attr:`rotorred.model.rotor.Spool.internal_damping_beta`).
+    internal_loss_factor : float, optional
+        Internal hysteretic damping: loss factor eta (-), >= 0, as the viscous ``beta = eta / |omega|`` at the whirl
+        frequency omega (docs/model.md §19). None (default): its spool's.
     """
 
     left: int
@@ -178,9 +186,14 @@ class ShaftElement:
     rotary_inertia: bool = True
     D_o_right: float | None = None
     D_i_right: float | None = None
+    internal_damping_beta: float | None = None
+    internal_loss_factor: float | None = None
 
     def __post_init__(self):
         _set(self, "left", checks.integer("left", self.left, ge=0))
+        for key, unit in (("internal_damping_beta", "s"), ("internal_loss_factor", "-")):
+            if getattr(self, key) is not None:
+                _set(self, key, checks.non_negative(key, getattr(self, key), unit))
         if not isinstance(self.rotary_inertia, (bool, np.bool_)):
             checks.fail("rotary_inertia", self.rotary_inertia, "must be true or false")
         _set(self, "right", checks.integer("right", self.right, ge=0))
@@ -310,6 +323,12 @@ class ShaftElement:
             return _gen.hierarchical_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
         return _gen.timoshenko_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
 
+    def spin_rotation(self) -> np.ndarray:
+        """Rotation generator ``J`` of the element's DOFs, ``q = exp(Omega t J) q_r`` from the rotating frame,
+        shape (8 + n_internal,) * 2 (-): the rotating damping ``beta K`` is the circulatory stiffness
+        ``-Omega beta K J`` in the fixed frame (derivations/internal_damping.py)."""
+        return hierarchical_spin_rotation() if self.element == "hierarchical" else timoshenko_spin_rotation()
+
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line.
 
@@ -329,7 +348,8 @@ class ShaftElement:
         return [ShaftElement(chain[i], chain[i + 1], self.L / n, along(self.D_o, self.D_o_right, i / n),
                              along(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
                              self.rotary_inertia, along(self.D_o, self.D_o_right, (i + 1) / n),
-                             along(self.D_i, self.D_i_right, (i + 1) / n)) for i in range(n)]
+                             along(self.D_i, self.D_i_right, (i + 1) / n), self.internal_damping_beta,
+                             self.internal_loss_factor) for i in range(n)]
 
 
 def along(left: float, right: float, xi: float) -> float:

@@ -141,6 +141,12 @@ class Spool:
         Concentric elements over spans of the chain (a sleeve shrunk on the shaft, ROSS's layered
         elements): each joins the two nodes of an element of the chain, has its length, and adds its
         matrices to that element's (the two act in parallel). They add no node.
+    internal_damping_beta : float
+        Internal (rotating) viscous damping of its elements (s), >= 0: ``beta K`` in the frame turning with the
+        spool (docs/model.md §19); an element's own value overrides it. Default 0.
+    internal_loss_factor : float
+        Internal hysteretic damping of its elements, loss factor (-), >= 0; an element's own value overrides it.
+        Default 0.
     """
 
     name: str
@@ -148,6 +154,8 @@ class Spool:
     speed: float = 0.0
     z0: float = 0.0
     sleeves: tuple[ShaftElement, ...] = ()
+    internal_damping_beta: float = 0.0
+    internal_loss_factor: float = 0.0
 
     def __post_init__(self):
         checks.string("name", self.name, empty=False)
@@ -166,6 +174,25 @@ class Spool:
         object.__setattr__(self, "z0", checks.number("z0", self.z0, "m"))
         object.__setattr__(self, "sleeves", checks.sequence("sleeves", _tuple(self.sleeves), _shaft_element))
         self._check_sleeves()
+        for key, unit in (("internal_damping_beta", "s"), ("internal_loss_factor", "-")):
+            object.__setattr__(self, key, checks.non_negative(key, getattr(self, key), unit))
+
+    def internal_damping(self, element: ShaftElement) -> tuple[float, float]:
+        """The internal damping of one of its elements: the element's own values, else the spool's.
+
+        Parameters
+        ----------
+        element : ShaftElement
+            An element (or sleeve) of the spool.
+
+        Returns
+        -------
+        (float, float)
+            beta (s) and the loss factor eta (-).
+        """
+        beta, eta = element.internal_damping_beta, element.internal_loss_factor
+        return (self.internal_damping_beta if beta is None else beta,
+                self.internal_loss_factor if eta is None else eta)
 
     def _check_sleeves(self) -> None:
         """Each sleeve lies on an element of the chain: the same two nodes and the same length."""
@@ -435,6 +462,9 @@ class Rotor:
                          f"{plural(len(self.pedestals), 'pedestal')}")
         if self.rayleigh != (0.0, 0.0):
             lines.append(f"shaft damping: Rayleigh alpha {self.rayleigh[0]:.4g} 1/s, beta {self.rayleigh[1]:.4g} s")
+        internal = [s.name for s in self.spools if any(any(s.internal_damping(e)) for e in s.all_elements)]
+        if internal:
+            lines.append(f"internal (rotating) damping on spool{'s' * (len(internal) > 1)} {', '.join(internal)}")
         d = self.defaults
         if d.unbalances or d.outputs or d.boundary_nodes:
             lines.append(f"defaults: {plural(len(d.unbalances), 'unbalance')}, {plural(len(d.outputs), 'output')}, "

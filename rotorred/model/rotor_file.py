@@ -8,6 +8,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
     [[spool]]                          # a chain of elements on consecutive node numbers (or nodes = [1, 2, 7, ...])
     name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
+    internal_damping_beta = 0.0        # rotating damping beta K (s), or internal_loss_factor (-); also per element
     elements = [ { L = 0.08, D_o = 0.02, D_i = 0.0, material = "steel", repeat = 12 } ]
     [[disk]]                           # either m, I_d, I_p (kg, kg m^2) or D_o, D_i, thickness, material
     node = 3; m = 5.7; I_d = 0.023; I_p = 0.045; radius = 0.125
@@ -78,11 +79,16 @@ _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "int
 #: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
 ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
+#: internal (rotating) damping: on a spool (its elements' default) or an element, sleeve or station (docs/model.md §19)
+_INTERNAL_KEYS = {"internal_damping_beta", "internal_loss_factor"}
 _SPOOL_KEYS = {"name", "first_node", "nodes", "z0", "speed_rpm", "speed_rad_s", "shear", "element", "rotary_inertia",
-               "elements", "stations", "material", "sleeves"}
-_SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
-_STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
-_ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
+               "elements", "stations", "material", "sleeves"} | _INTERNAL_KEYS
+_SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element",
+                "rotary_inertia"} | _INTERNAL_KEYS
+_STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element",
+                 "rotary_inertia"} | _INTERNAL_KEYS
+_ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element",
+                 "rotary_inertia"} | _INTERNAL_KEYS
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
 _SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx", "k_tt", "c_tt",
                  "k_txtx", "k_tyty", "k_txty", "k_tytx", "c_txtx", "c_tyty", "c_txty", "c_tytx"}
@@ -426,7 +432,8 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
     else:
         speed = rpm_to_rad_s(checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm"))
     sleeves = _sleeves(where, s, elements, defaults, materials)
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves)
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves,
+                  **{k: s[k] for k in _INTERNAL_KEYS if k in s})
 
 
 def _one_of(where: str, table: dict, names: tuple[str, str], required: bool = True) -> None:
@@ -463,7 +470,7 @@ def _sleeves(where: str, s: dict, chain: list[ShaftElement], defaults: dict, mat
                         f"{entry['left']} to the spool's end")
         section = {"D_i": 0.0, **{k: entry[k] for k in ("D_o", "D_i", "D_o_right", "D_i_right") if k in entry}}
         material = _section_material(sw, entry, s, where, materials)
-        options = {k: entry.get(k, v) for k, v in defaults.items()}
+        options = {k: entry.get(k, v) for k, v in defaults.items()} | {k: entry[k] for k in _INTERNAL_KEYS & set(entry)}
         out.extend(_build(sw, ShaftElement, left=e.left, right=e.right, L=e.L, material=material,
                           **section, **options) for e in chain[first:first + repeat])
     return tuple(out)
@@ -475,8 +482,8 @@ def _sections_of_elements(where: str, s: dict, materials: dict[str, Material]) -
     for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
         ew = f"{where}.elements[{j}]"
         checks.keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o"})
-        section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia")
-                   if k in e}
+        section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia",
+                                     *sorted(_INTERNAL_KEYS)) if k in e}
         out.append(dict(section, where=ew, D_i=e.get("D_i", 0.0), material=_section_material(ew, e, s, where, materials),
                         count=checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1), split=1))
     return out
@@ -507,7 +514,8 @@ def _sections_of_stations(where: str, s: dict, materials: dict[str, Material]) -
         D_i_end = checks.non_negative(f"{sw}.D_i_end", st.get("D_i_end", D_i), "m")
         section = dict(where=sw, z=z[k], L=z[k + 1] - z[k], D_o=D_o, D_i=D_i, D_o_right=D_o_end, D_i_right=D_i_end,
                        count=1, split=n, material=_section_material(sw, st, s, where, materials))
-        out.append(dict(section, **{k2: st[k2] for k2 in ("shear", "element", "rotary_inertia") if k2 in st}))
+        out.append(dict(section, **{k2: st[k2] for k2 in ("shear", "element", "rotary_inertia", *sorted(_INTERNAL_KEYS))
+                                    if k2 in st}))
     return out
 
 

@@ -18,6 +18,9 @@ from rotorred.writers import exact_in_unit
 
 __all__ = ["rotor_table", "rpm_to_rad_s"]
 
+#: the internal-damping keys of a spool (its elements' default) and of an element (None: the spool's)
+_INTERNAL = ("internal_damping_beta", "internal_loss_factor")
+
 
 def rpm_to_rad_s(rpm):
     """A speed in rpm in rad/s, ``rpm * pi / 30`` (a float or an array): the one conversion of a rotor file's speeds
@@ -90,6 +93,7 @@ def _spool_table(s, names: dict[Material, str]) -> dict[str, Any]:
                              "z0": s.z0}
     if s.speed != 0.0:
         table.update(_speeds_in_rpm("speed", [s.speed], single=True))
+    table.update({k: getattr(s, k) for k in _INTERNAL if getattr(s, k) != 0.0})
     materials = {names[e.material] for e in s.all_elements}
     common = materials.pop() if len(materials) == 1 else None
     if common is not None:
@@ -114,6 +118,7 @@ def _section(e: ShaftElement, names: dict[Material, str], common: str | None) ->
     for key, default in (("shear", "cowper"), ("element", "nelson"), ("rotary_inertia", True)):
         if getattr(e, key) != default:
             out[key] = getattr(e, key)
+    out.update({k: getattr(e, k) for k in _INTERNAL if getattr(e, k) is not None})
     return out
 
 
