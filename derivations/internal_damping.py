@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from derivations.shape_functions import L, hierarchical_shape_functions, spatial_shape_functions, z
+from derivations.shape_functions import hierarchical_shape_functions, spatial_shape_functions, z
 
 phi_r, Omega, t = sp.symbols("phi Omega t", real=True)
 

@@ -25,7 +25,7 @@ from typing import Mapping
 import numpy as np
 
 from rotorred import checks, writers
-from rotorred.linear.campbell import WHIRL_LABELS, ModeCount, campbell, modes_at
+from rotorred.linear.campbell import ModeCount, campbell, modes_at
 from rotorred.model.assembly import system_of
 from rotorred.model.operating import Operating
 from rotorred.model.operating import checked as checked_operating
@@ -204,7 +204,7 @@ class ModeShapes(Result):
 
     def to_xarray(self):
         """The modes as an :class:`xarray.Dataset`: dimensions ``mode`` (numbers from 1) and ``node``; variables
-        ``frequency`` (Hz), ``log_dec``, ``whirl`` (flags of :data:`WHIRL_LABELS`), and the amplitude (-) and phase
+        ``frequency`` (Hz), ``log_dec``, ``whirl`` (flags of :data:`rotorred.linear.campbell.WHIRL_LABELS`), and the amplitude (-) and phase
         (rad) of x and y; coordinates ``z`` (m) and ``spool`` of each node."""
         import xarray as xr
 
