@@ -204,3 +204,27 @@ def test_operating_range_input_is_refused_before_any_computation(tmp_path, capsy
     from rotorred.model.rotor_writer import rotor_table
 
     assert rotor_from_dict(rotor_table(rotor)) == rotor  # written back in rpm, read to the bit
+
+
+def test_an_undamped_rotor_has_infinite_amplification_factors_and_the_capped_margins(tmp_path):
+    """Nelson-McVaugh's rotor has no damping (log dec 0 to round-off): each 1x critical speed has AF infinite (1/(2
+    zeta) with zeta below 1e-8) without a singular response solve, and requires the rule's limits, 16 % below the
+    minimum and 26 % above the maximum continuous speed; a mode 2 % of the speed below the minimum fails."""
+    import warnings
+
+    from scipy.linalg import LinAlgWarning
+
+    rotor = rr.load_rotor("nelson-mcvaugh")
+    result = rr.campbell(rotor, rr.Operating.line(np.linspace(0.0, 40000.0, 41), unit="rpm"))
+    forward = [c for c in result.critical_speeds if c.harmonic == 1.0 and c.whirl == "forward"][0]
+    W = forward.speed
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LinAlgWarning)
+        below = rr.separation_margins(rotor, result, rr.OperatingRange(1.02 * W, 1.5 * W))
+        above = rr.separation_margins(rotor, result, rr.OperatingRange(0.1 * W, 0.5 * W))
+    for margins, side, required in ((below, "below", 16.0), (above, "above", 26.0)):
+        m = margins[result.critical_speeds.index(forward)]
+        assert m.amplification_factor == np.inf and m.side == side
+        assert m.required == pytest.approx(required / 100.0, rel=1e-12)
+    assert below[result.critical_speeds.index(forward)].meets is False
+    assert above[result.critical_speeds.index(forward)].meets is True

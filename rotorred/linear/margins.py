@@ -73,6 +73,9 @@ PEAK_ZETAS, MIN_PEAK = 2.0, 0.02
 OWN_BANDWIDTH = 3.0
 #: samples of the response over the band (the peak and the half-power points are then refined)
 BAND_SAMPLES = 41
+#: a mode whose damping ratio at the crossing is below this is undamped: its AF, 1 / (2 zeta) > 5e7, is taken as
+#: infinite (the rule's limit), as no sampled response resolves a peak that sharp (its solves are singular)
+UNDAMPED_ZETA = 1e-8
 
 
 @dataclass(frozen=True)
@@ -152,7 +155,8 @@ class SeparationMargin:
     ----------
     critical : CriticalSpeed
     amplification_factor : float
-        AF by the half-power method (-); NaN where none is defined (``note`` says why).
+        AF by the half-power method (-); infinite for an undamped mode; NaN where none is defined (``note`` says
+        why).
     half_power : HalfPower or None
         The peak and half-power points of the unbalance response, in speeds of the reference spool (rad/s).
     unbalance_node : int or None
@@ -302,6 +306,9 @@ def _margin(sm, result: CampbellResult, c: CriticalSpeed, rng: OperatingRange | 
     node = _antinode(sm, result, c)
     hp = None
     zeta = abs(c.damping_ratio)
+    if zeta < UNDAMPED_ZETA:
+        return _verdict(c, None, node, rng, f"undamped (damping ratio {c.damping_ratio:.2g}): AF infinite",
+                        verdict=True, af=math.inf)
     band, near = max(BAND_ZETAS * zeta, MIN_BAND), max(PEAK_ZETAS * zeta, MIN_PEAK)
     while hp is None and band <= MAX_BAND:  # the peak near the crossing; its half-power points maybe farther
         W = np.linspace(c.speed * (1.0 - band), c.speed * (1.0 + band), BAND_SAMPLES)
@@ -313,15 +320,17 @@ def _margin(sm, result: CampbellResult, c: CriticalSpeed, rng: OperatingRange | 
     return _verdict(c, hp, node, rng, why, verdict=True)
 
 
-def _verdict(c, hp: HalfPower | None, node, rng: OperatingRange | None, note: str, verdict: bool) -> SeparationMargin:
-    """The margin of ``c`` from its half-power points (speeds of the reference spool) and the range."""
-    af = math.nan if hp is None else hp.amplification_factor
+def _verdict(c, hp: HalfPower | None, node, rng: OperatingRange | None, note: str, verdict: bool,
+             af: float | None = None) -> SeparationMargin:
+    """The margin of ``c`` from its half-power points (speeds of the reference spool), or the ``af`` given, and the
+    range."""
+    af = af if af is not None else math.nan if hp is None else hp.amplification_factor
     if rng is None:
         return SeparationMargin(c, af, hp, node, note=note)
     side, actual = rng.side_and_margin(c.speed if hp is None else hp.peak_speed)
     if not verdict:
         return SeparationMargin(c, af, hp, node, side, math.nan, actual, None, note)
-    required = 0.0 if hp is None else required_margin(af, side)
+    required = 0.0 if math.isnan(af) else required_margin(af, side)
     # no margin required (AF < 2.5, or no peak): met wherever the critical speed lies, even inside the range
     return SeparationMargin(c, af, hp, node, side, required, actual, bool(required == 0.0 or actual >= required),
                             note)
