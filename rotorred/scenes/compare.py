@@ -36,7 +36,8 @@ from rotorred.scenes.run import build_model, respond, spool_frequencies
 from rotorred.scenes.schema import Scene, is_whole_steps
 from rotorred.signals.compare import N_LINES, MeasureErrors, measure_errors, response_measures
 
-__all__ = ["CompareOptions", "ModelRun", "ModelComparison", "compare_models", "check_options", "DEFAULT_MODES"]
+__all__ = ["CompareOptions", "ModelRun", "ModelComparison", "compare_models", "check_comparison", "DEFAULT_MODES",
+           "format_comparison", "write_comparison"]
 
 LOG = logging.getLogger(__name__)
 
@@ -202,8 +203,8 @@ class ModelComparison(Result):
     def columns(self) -> tuple[list[str], list]:
         """The CSV's header and columns: one row a run, each DOF's spectral error in its own column (%)."""
         runs = self.runs
-        header = ["model", "n_modes", "n_dof", "dt_s", "n_steps", "wall_s", "cpu_s", "build_s", "spectral_error_pct",
-                  "orbit_error_pct", "contact_error_pct", "worst_line", "peak_orbit_radius_um", "contact_fraction"]
+        header = ["model", "modes", "DOFs", "dt (s)", "steps", "wall (s)", "CPU (s)", "build (s)", "spectral error (%)",
+                  "orbit error (%)", "contact error (%)", "worst line", "peak orbit radius (um)", "contact fraction (-)"]
         columns = [[r.model for r in runs], np.array([r.n_modes for r in runs]), np.array([r.n_dof for r in runs]),
                    [r.dt for r in runs], np.array([r.n_steps for r in runs]), [r.wall for r in runs],
                    [r.cpu for r in runs], [r.build_time for r in runs], [100 * r.errors.spectral for r in runs],
@@ -211,7 +212,7 @@ class ModelComparison(Result):
                    [r.errors.worst_line for r in runs], [1e6 * r.peak_radius for r in runs],
                    [r.contact_fraction for r in runs]]
         for d in self.dofs:
-            header.append(f"spectral_error_{d[0]}{d[1]}_pct")
+            header.append(f"spectral error {d[0]}{d[1]} (%)")
             columns.append([100 * r.errors.per_dof.get(d, (0.0, 0.0))[0] for r in runs])
         return header, columns
 
@@ -278,7 +279,7 @@ def _percent(x: float) -> str:
 
 
 # --------------------------------------------------------------------------- checks
-def check_options(scene: Scene, options: CompareOptions) -> Scene:
+def check_comparison(scene: Scene, options: CompareOptions) -> Scene:
     """Refuse what cannot be compared, before any run: the scene as compared (rotor refined).
 
     Parameters
@@ -347,14 +348,14 @@ def _check_dts(scene: Scene, dts: tuple[float, ...]) -> None:
     s = scene.solver
     for dt in dts:
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            checks.fail("dt", list(dts), "must be numbers > 0", "s")
+            checks.fail("dts", list(dts), "must be numbers > 0", "s")
         for name, t in (("solver.duration", s.duration), ("solver.record_start", s.record_start),
                         ("the coarsest dt", dts[0])):
             if not is_whole_steps(t, dt):
-                checks.fail("dt", dt, f"must be a whole fraction of {name} = {t:g} s (the comparison steps to it "
+                checks.fail("dts", dt, f"must be a whole fraction of {name} = {t:g} s (the comparison steps to it "
                             f"and resamples every record to the coarsest dt, {dts[0]:g} s)", "s")
     if len(set(dts)) != len(dts):
-        checks.fail("dt", list(dts), "must give each step once", "s")
+        checks.fail("dts", list(dts), "must give each step once", "s")
 
 
 # --------------------------------------------------------------------------- runs
@@ -380,11 +381,11 @@ def compare_models(scene: Scene, options: CompareOptions = CompareOptions(),
     Raises
     ------
     InputError
-        Before any run (:func:`check_options`).
+        Before any run (:func:`check_comparison`).
     SceneDiverged
         If a run diverges.
     """
-    scene = check_options(scene, options)
+    scene = check_comparison(scene, options)
     dts = _dts(scene, options)
     plan = [(None, dt) for dt in reversed(dts)] + [(k, dt) for k in options.modes for dt in reversed(dts)]
     recorded = _recording_scene(scene)
@@ -427,7 +428,8 @@ def _warm_up(scene: Scene, dt: float) -> float:
     t0 = time.perf_counter()
     short = replace(scene.solver, model="full", dt=dt, duration=WARM_UP_STEPS * dt, record_start=0.0)
     case = replace(scene, solver=short)
-    respond(case, build_model(case), progress=False)
+    with progress.muted():
+        respond(case, build_model(case), progress=False)
     return time.perf_counter() - t0
 
 
@@ -439,9 +441,10 @@ def _run(scene: Scene, n_modes: int | None, dt: float, kernel: list) -> tuple:
     name = "full" if n_modes is None else f"CB {n_modes}"
     progress.stage("running %s on %s at dt = %g s", scene.name, name, dt, logger=LOG)
     t0, c0 = time.perf_counter(), time.process_time()
-    model = build_model(case)
-    c_build = time.process_time() - c0
-    response = respond(case, model, progress=False)
+    with progress.muted():  # this run's own line above says it
+        model = build_model(case)
+        c_build = time.process_time() - c0
+        response = respond(case, model, progress=False)
     load = float(response.counters.get("kernel_load_time", 0.0))
     wall, cpu = time.perf_counter() - t0 - load, time.process_time() - c0 - load
     kernel[0] += load
@@ -472,3 +475,64 @@ def _measured(scene: Scene, runs: list, orbit_node, sample_dt: float, n_lines: i
                    contact_fraction=m.contact_fraction) for (run, _), m in zip(runs, measures)]
     return ModelComparison(scene=scene, runs=tuple(out), dofs=tuple(dofs), orbit_node=orbit_node,
                            sample_dt=sample_dt, n_lines=n_lines, kernel_time=kernel_time, interrupted=interrupted)
+
+
+# --------------------------------------------------------------------------- files
+def format_comparison(comparison: ModelComparison) -> str:
+    """The printed report: what was compared and against what, the table of every run (units in its header), each
+    reduced model's floor, and the time left out.
+
+    Parameters
+    ----------
+    comparison : ModelComparison
+
+    Returns
+    -------
+    str
+    """
+    ref, c = comparison.reference, comparison
+    head = [f"INCOMPLETE: interrupted ({c.interrupted}) after {len(c.runs)} runs"] if c.interrupted else []
+    dofs = ", ".join(f"{n}{d}" for n, d in c.dofs)
+    head += [f"scene {c.scene.name} ({c.scene.rotor_source}): reference the full model, {ref.n_dof} DOFs, "
+             f"{c.scene.solver.method} dt = {ref.dt:g} s, record {c.scene.solver.record_start:g}-"
+             f"{c.scene.solver.duration:g} s compared at {c.sample_dt:g} s",
+             f"spectral: worst relative error of the {c.n_lines} largest lines (0 Hz excluded) of {dofs}; orbit: peak "
+             f"orbit radius at node {c.orbit_node} (reference {1e6 * ref.peak_radius:.4g} um); contact: fraction "
+             f"in contact (reference {100 * ref.contact_fraction:.3g} %)"]
+    floors = [f"{name} {_percent(r.errors.spectral)} %" for name, r in c.floors().items() if name != "full"]
+    tail = [f"at dt = {ref.dt:g} s (the reduction's floor), spectral error: {', '.join(floors)}"] if floors else []
+    tail.append(f"times: wall and CPU of each run, its model's build included; warm-up and step-kernel loads "
+                f"({c.kernel_time:.2f} s) left out")
+    return "\n".join(head + [c.table()] + tail)
+
+
+def write_comparison(comparison: ModelComparison, folder, provenance=None) -> list:
+    """Stage ``compare.csv`` (a row a run, :meth:`ModelComparison.columns`), ``compare.png``
+    (:meth:`ModelComparison.plot`) and ``compare.txt`` (:func:`format_comparison`) in ``folder``
+    (:class:`rotorred.writers.OutputFolder`); a ``provenance`` (:class:`rotorred.provenance.Provenance`, with the
+    scene) goes on top of ``compare.txt`` and is written as ``scene.toml``.
+
+    Parameters
+    ----------
+    comparison : ModelComparison
+    folder : rotorred.writers.OutputFolder
+        The open output folder; the files are staged, and written when it commits.
+    provenance : Provenance, optional
+
+    Returns
+    -------
+    list of Path
+        The staged files.
+    """
+    from rotorred.plots.axes import save_figure  # matplotlib only when figures are written
+    from rotorred.writers import write_csv, write_text
+
+    header, columns = comparison.columns()
+    files = [write_csv(folder.staged("compare.csv"), header, columns),
+             save_figure(comparison.plot(), folder.staged("compare.png"))]
+    text = format_comparison(comparison)
+    files.append(write_text(folder.staged("compare.txt"), (text if provenance is None else provenance.on_top(text))
+                            + "\n"))
+    if provenance is not None:
+        files.append(write_text(folder.staged(provenance.file_name), provenance.file_text()))
+    return files
