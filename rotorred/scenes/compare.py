@@ -396,7 +396,7 @@ def compare_models(scene: Scene, options: CompareOptions = CompareOptions(),
     with progress.bar(len(plan), "compare", "run", progress=options.progress) as bar:
         try:
             for n_modes, dt in plan:
-                runs.append(_run(recorded, n_modes, dt, kernel))
+                runs.append(_run(recorded, n_modes, dt, kernel, options.progress))
                 bar.update(1)
         except tuple(interrupts) as exc:
             if not runs:
@@ -433,18 +433,19 @@ def _warm_up(scene: Scene, dt: float) -> float:
     return time.perf_counter() - t0
 
 
-def _run(scene: Scene, n_modes: int | None, dt: float, kernel: list) -> tuple:
-    """One run: (ModelRun without errors, its Response); ``kernel[0]`` gathers the kernel load time."""
+def _run(scene: Scene, n_modes: int | None, dt: float, kernel: list, shown: bool | None = False) -> tuple:
+    """One run: (ModelRun without errors, its Response); ``kernel[0]`` gathers the kernel load time; ``shown``: the
+    transient's own stage line and step bar (:func:`rotorred.scenes.run.respond`)."""
     solver = replace(scene.solver, dt=dt, model="full" if n_modes is None else "reduced", modes=n_modes,
                      cutoff_hz=None)
     case = replace(scene, solver=solver)
     name = "full" if n_modes is None else f"CB {n_modes}"
-    progress.stage("running %s on %s at dt = %g s", scene.name, name, dt, logger=LOG)
+    progress.stage("%s on %s at dt = %g s", scene.name, name, dt, logger=LOG)
     t0, c0 = time.perf_counter(), time.process_time()
-    with progress.muted():  # this run's own line above says it
+    with progress.muted():  # the line above says it
         model = build_model(case)
-        c_build = time.process_time() - c0
-        response = respond(case, model, progress=False)
+    c_build = time.process_time() - c0
+    response = respond(case, model, progress=shown)  # its steps and time left on a terminal, when long
     load = float(response.counters.get("kernel_load_time", 0.0))
     wall, cpu = time.perf_counter() - t0 - load, time.process_time() - c0 - load
     kernel[0] += load
