@@ -101,6 +101,19 @@ def test_the_command_and_bench_pareto_measure_alike():
     assert got.errors.worst_line == row.errors.worst_line
 
 
+def test_a_linear_scene_compares_its_two_lines_not_its_round_off():
+    """paper-normal (no rub, started settled: the harmonic response, no steps): only the 70 and 90 Hz lines are
+    above the scene's line threshold, so the worst line is one of them; CB 24 against full measured 4.31e-5, CB 8
+    2.30e-3 (asserted within 10x); no plate, so no contact error."""
+    cmp = rr.compare_models(rr.load_scene("paper-normal"), rr.CompareOptions(modes=(8, 24), progress=False))
+    floors = cmp.floors()
+    for name, measured in (("CB 8", 2.30e-3), ("CB 24", 4.31e-5)):
+        e = floors[name].errors
+        assert measured / 10 < e.spectral < 10 * measured and e.worst_line.endswith((" 70 Hz", " 90 Hz")), e
+        assert np.isnan(e.contact)
+    assert cmp.reference.n_steps == 0 and cmp.orbit_node == 18  # the largest recorded orbit
+
+
 # --------------------------------------------------------------------------- bad input, before any run
 @pytest.fixture
 def no_runs(monkeypatch):

@@ -7,7 +7,8 @@ step. The measures are :mod:`rotorred.signals.compare`'s (the same as ``validati
 §22):
 
 * spectral: the worst relative error of the reference's :data:`~rotorred.signals.compare.N_LINES` largest lines of
-  every recorded DOF (records resampled to the coarsest step, rectangular window on whole common periods);
+  every recorded DOF, those above the scene's ``output.line_threshold`` of the DOF's largest (records resampled to the
+  coarsest step, rectangular window on whole common periods);
 * orbit: the peak orbit radius at the rub node (its x and y are recorded for this), else at the recorded node with
   the largest orbit of the reference;
 * contact: the fraction of the record the (first) rub plate touches.
@@ -330,7 +331,7 @@ def _check_modes(scene: Scene, modes) -> None:
     if not modes:
         checks.fail("modes", list(modes), allowed)
     for k in modes:
-        if isinstance(k, bool) or not float(k).is_integer() or not 1 <= k <= n_interior:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= n_interior:
             checks.fail("modes", list(modes), allowed)
     if len(set(modes)) != len(modes):
         checks.fail("modes", list(modes), "must give each count once")
@@ -472,7 +473,8 @@ def _measured(scene: Scene, runs: list, orbit_node, sample_dt: float, n_lines: i
     measures = [response_measures(resp.outputs, run.dt, sample_dt, speeds, dofs, orbit_node,
                                   1.0 - resp.contacts[0].fraction("open") if resp.contacts else None)
                 for run, resp in runs]
-    out = [replace(run, errors=measure_errors(m, measures[0], n_lines), peak_radius=m.peak_radius,
+    threshold = scene.output.line_threshold
+    out = [replace(run, errors=measure_errors(m, measures[0], n_lines, threshold), peak_radius=m.peak_radius,
                    contact_fraction=m.contact_fraction) for (run, _), m in zip(runs, measures)]
     return ModelComparison(scene=scene, runs=tuple(out), dofs=tuple(dofs), orbit_node=orbit_node,
                            sample_dt=sample_dt, n_lines=n_lines, kernel_time=kernel_time, interrupted=interrupted)

@@ -16,7 +16,8 @@ other interpolated onto them when the bins differ, e.g. a windowed, non-commensu
 against a reference by the quantities an engineer reads off a rub response, each a relative error:
 
 * ``spectral``: the ``n_lines`` largest spectral amplitudes of the reference (0 Hz excluded) of each DOF compared,
-  the worst relative error over them all (the largest errors sit on small combination lines, not on the 1x lines);
+  those of at least ``threshold`` times the DOF's largest (a line, not round-off), the worst relative error over them
+  all (the largest errors sit on small combination lines, not on the 1x lines);
   spectra by :func:`rotorred.signals.spectra.settled_spectrum` of the records resampled to a common interval
   (:func:`response_measures`);
 * ``orbit``: the peak orbit radius ``max sqrt(x^2 + y^2)`` at one node;
@@ -32,8 +33,8 @@ import numpy as np
 
 from rotorred.signals.spectra import settled_spectrum
 
-__all__ = ["RecordError", "record_error", "outputs_error", "N_LINES", "ResponseMeasures", "response_measures",
-           "MeasureErrors", "measure_errors", "resample"]
+__all__ = ["RecordError", "record_error", "outputs_error", "N_LINES", "LINE_THRESHOLD", "ResponseMeasures",
+           "response_measures", "MeasureErrors", "measure_errors", "resample"]
 
 
 @dataclass(frozen=True)
@@ -100,6 +101,8 @@ def outputs_error(outputs: dict, dt: float, reference: dict, dt_ref: float, f_L:
 # --------------------------------------------------------------------------- reduced against full
 #: spectral amplitudes compared per DOF (the reference's largest, 0 Hz excluded)
 N_LINES = 10
+#: smallest line compared, relative to the DOF's largest (a scene's default ``output.line_threshold``)
+LINE_THRESHOLD = 0.005
 
 
 @dataclass(frozen=True)
@@ -211,7 +214,8 @@ class MeasureErrors:
     per_dof: dict = field(default_factory=dict)
 
 
-def measure_errors(m: ResponseMeasures, ref: ResponseMeasures, n_lines: int = N_LINES) -> MeasureErrors:
+def measure_errors(m: ResponseMeasures, ref: ResponseMeasures, n_lines: int = N_LINES,
+                   threshold: float = LINE_THRESHOLD) -> MeasureErrors:
     """Relative errors of ``m`` against ``ref``: the worst of the ``n_lines`` largest lines of each DOF, orbit, contact.
 
     Parameters
@@ -220,6 +224,10 @@ def measure_errors(m: ResponseMeasures, ref: ResponseMeasures, n_lines: int = N_
         The run and the reference, on the same bins (same window and sample interval).
     n_lines : int
         Largest lines of the reference compared per DOF (0 Hz excluded).
+    threshold : float
+        Of those, only the bins of at least ``threshold`` times the DOF's largest are lines (-): a linear response's
+        two lines are compared, not its round-off (a scene's ``output.line_threshold``). A DOF whose reference
+        spectrum is 0 is not compared.
 
     Returns
     -------
@@ -228,6 +236,9 @@ def measure_errors(m: ResponseMeasures, ref: ResponseMeasures, n_lines: int = N_
     worst, where, per_dof = 0.0, "", {}
     for o, A_ref in ref.spectra.items():
         order = np.argsort(A_ref[1:])[::-1][:n_lines] + 1      # bin 0 (the mean) excluded
+        if not A_ref[order[0]] > 0:
+            continue
+        order = order[A_ref[order] >= threshold * A_ref[order[0]]]
         rel = np.abs(m.spectra[o][order] - A_ref[order]) / A_ref[order]
         k = int(np.argmax(rel))
         per_dof[o] = (float(rel[k]), float(ref.frequencies[order[k]]))
