@@ -49,7 +49,8 @@ EXIT_STATUSES = {
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
                       "an optional library is missing (the message gives its install command)",
     EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
-                 "marked INCOMPLETE; `map`: the points done, resumed by the same command)",
+                 "marked INCOMPLETE; `compare`: the runs done, marked INCOMPLETE; `map`: the points done, resumed by "
+                 "the same command)",
     EXIT_SIGTERM: "terminated (SIGTERM): as 130",
 }
 
