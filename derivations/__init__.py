@@ -24,9 +24,16 @@ def _contact() -> str:
     return module_text()
 
 
+def _internal_damping() -> str:
+    from derivations.internal_damping import module_text
+
+    return module_text()
+
+
 #: (path relative to the project root, function returning the module text)
 TARGETS: list[tuple[str, object]] = [
     ("rotorred/_generated/timoshenko.py", _timoshenko),
     ("rotorred/_generated/contact.py", _contact),
     ("rotorred/_generated/tapered.py", _tapered),
+    ("rotorred/_generated/internal_damping.py", _internal_damping),
 ]

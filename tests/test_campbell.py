@@ -484,12 +484,14 @@ def test_critical_speeds_csv_and_a_shared_line_listed_once(tmp_path):
     result = campbell(rig, Operating.line(speeds), n_modes=6)
     op = rig.speeds["inner"]
     rows = list(csv.reader(result.critical_speeds_to_csv(tmp_path / "c.csv", op).open()))
-    assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][-1] == "margin to operating point (%)"
+    assert rows[0][:2] == ["inner speed (rpm)", "excitation"] and rows[0][8] == "margin to operating point (%)"
+    assert rows[0][9:] == ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
     assert len(rows) == 1 + len(result.critical_speeds) >= 10
     for row, c in zip(rows[1:], result.critical_speeds):
         assert float(row[0]) == pytest.approx(c.speed_rpm, rel=1e-8) and row[1] == c.line
-        assert float(row[-1]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
-        assert float(row[-2]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|
+        assert float(row[8]) == pytest.approx(100 * (c.speed - op) / op, abs=1e-4)
+        assert float(row[7]) == pytest.approx(-math.cos(math.atan2(2 * math.pi, -c.log_dec)), rel=1e-8)  # -Re/|lambda|
+        assert row[9:] == [""] * 4  # no margins given (tests/test_margins.py)
 
 
 def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():
@@ -506,7 +508,7 @@ def test_a_free_free_spool_lists_no_rigid_body_critical_speeds():
     assert result.rigid_modes and all(result.frequencies_hz[0, j] < 1e-2 for j in result.rigid_modes)
     assert result.critical_speeds and all(c.frequency_hz > 100.0 for c in result.critical_speeds)
     from rotorred.cli.campbell import format_critical_speeds
-    assert "rigid-body modes (a free or singly supported spool; not critical speeds): modes 0, 1" in \
+    assert "rigid-body modes (a free or singly supported spool; not critical speeds): modes 1, 2" in \
         format_critical_speeds(result)
     assert campbell(rigid_rotor(2.1e11), Operating.line(SPEEDS_RIGID), n_modes=4).rigid_modes == ()  # held by bearings
     bl = brentq(lambda x: math.cos(x) * math.cosh(x) - 1.0, 4.0, 5.0)
@@ -542,9 +544,9 @@ def test_unstable_mode_and_its_stability_limit_against_the_characteristic_polyno
     assert change.whirl == "forward" and not change.onset  # unstable below, stable above
     assert abs(change.speed / limit - 1) < 2e-5
     assert change.frequency == pytest.approx(kxy / c, rel=2e-5)  # neutral where c w = k_xy
-    assert "UNSTABLE: mode 0 (forward" in format_critical_speeds(result)
+    assert "UNSTABLE: mode 1 (forward" in format_critical_speeds(result)  # modes numbered from 1
     rows = list(csv.reader(result.to_csv(tmp_path / "c.csv").open()))
-    assert rows[1][:2] == ["0", "0"] and rows[1][-1] == "no"  # mode 0 at rest
+    assert rows[1][:2] == ["0", "1"] and rows[1][-1] == "no"  # mode 1 (column 0) at rest
     assert save_figure(result.plot(), tmp_path / "c.png").stat().st_size > 10_000
     stable = campbell(rigid_rotor(2.1e13), Operating.line(np.linspace(0.0, 1500.0, 31)), n_modes=4)
     assert stable.stability_changes == () and not np.any(stable.unstable)  # undamped: log dec 0 to round-off
@@ -844,7 +846,7 @@ def test_modes_option_overrides_the_default(tmp_path, capsys):
     assert main(["campbell", "seed-rig", "--speeds", "0:12000:13", "--modes", "3", "--out", str(tmp_path)]) == 0
     assert "tracked 3 modes (--modes)" in capsys.readouterr().out
     rows = list(csv.reader((tmp_path / "campbell.csv").open()))[1:]
-    assert {int(r[1]) for r in rows} == {0, 1, 2}
+    assert {int(r[1]) for r in rows} == {1, 2, 3}  # numbered from 1
 
 
 def test_default_mode_count_at_rest_and_bad_margin():

@@ -165,6 +165,9 @@ def test_shear_coefficients(nu):
     assert shear_coefficient(1.0, 0.0, nu, "cowper") == pytest.approx(6 * (1 + nu) / (7 + 6 * nu), rel=1e-15)
     assert shear_coefficient(1.0, 0.0, nu, "hutchinson") == pytest.approx(
         6 * (1 + nu) ** 2 / (7 + 12 * nu + 4 * nu**2), rel=1e-15)
+    # ROSS's line (ShaftElement, shear_method_calc="hutchinson") for a solid circle: 6(1+nu)/(7+12nu+4nu^2)
+    assert shear_coefficient(1.0, 0.0, nu, "ross-hutchinson") == pytest.approx(
+        6 * (1 + nu) / (7 + 12 * nu + 4 * nu**2), rel=1e-15)
     # Thin-walled tube limit (D_i -> D_o): Cowper 2(1+nu)/(4+3nu)
     assert shear_coefficient(1.0, 1.0 - 1e-9, nu, "cowper") == pytest.approx(2 * (1 + nu) / (4 + 3 * nu), rel=1e-8)
 
@@ -173,8 +176,8 @@ def test_shear_coefficients(nu):
 @pytest.mark.parametrize("ratio", [0.0, 0.4, 0.8, 0.99])
 def test_hutchinson_against_cowper(nu, ratio):
     """Both formulas coincide at nu = 0 (Hutchinson 2001, Sec. 5) and differ by under 10 % up to
-    nu = 0.45. ROSS's line drops the (1+nu)^2 factor, which would put it 1.69x lower at nu = 0.3
-    and fail this comparison."""
+    nu = 0.45. ROSS's line has (1+nu) where the published formula has (1+nu)^2 (shear =
+    "ross-hutchinson"), which puts it 1.3x lower at nu = 0.3 and fails this comparison."""
     k_h = shear_coefficient(1.0, ratio, nu, "hutchinson")
     k_c = shear_coefficient(1.0, ratio, nu, "cowper")
     if nu == 0.0:
@@ -191,7 +194,8 @@ def test_hutchinson_against_cowper(nu, ratio):
         (dict(D_i=0.05), "D_i = 0.05: must be < D_o = 0.05 (m)"),
         (dict(D_i=0.06), "D_i = 0.06: must be < D_o = 0.05 (m)"),
         (dict(D_o=float("nan")), "D_o = nan: must be a finite number > 0 (m)"),
-        (dict(shear="reissner"), "shear = 'reissner': must be one of 'cowper', 'hutchinson', 'none'"),
+        (dict(shear="reissner"),
+         "shear = 'reissner': must be one of 'cowper', 'hutchinson', 'ross-hutchinson', 'none'"),
         (dict(right=1), "right = 1: must differ from left = 1"),
         (dict(element="p5"), "element = 'p5': must be one of 'nelson', 'hierarchical'"),
         (dict(element="hierarchical", shear="none"), "element = 'hierarchical': must be 'nelson' with shear = 'none'"),

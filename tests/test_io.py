@@ -156,9 +156,16 @@ BAD = [
      "extrapolates"),
     ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nk = 1e7\ninterpolation = \"cubic\"",
      "bad.toml: bearing[0].interpolation = 'cubic': must be one of 'linear', 'pchip'"),
-    ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_rpm = [0.0, 1.0]\nnode_a = 12",
-     "bad.toml: intershaft_bearing[0].speed_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_xx, c_xy, c_yx, "
-     "c_yy, k, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b"),
+    ("k = 1e7\nc = 100.0", "speed_rpm = [0.0, 3000.0]\nfrequency_rpm = [0.0, 3000.0]\nk = 1e7",
+     "bad.toml: bearing[0].frequency_rpm = [0.0, 3000.0]: must not be given with speed_rpm: a table has one axis"),
+    ("k = 1e7\nc = 100.0", "frequency_rpm = [0.0, 3000.0]\nk = 1e7\nk_tt = [1e3, -2.0]\nc_tt = [1.0, -2.0]",
+     "bad.toml: bearing[0].c_tt = [1.0, -2.0]: must hold values >= 0 only (N m s/rad)"),
+    ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nfrequency_rpm = [0.0, 1.0]\nnode_a = 12",
+     "bad.toml: intershaft_bearing[0].frequency_rpm = [0.0, 1.0]: unknown key; allowed keys are c, c_tt, c_txtx, "
+     "c_txty, c_tytx, c_tyty, c_xx, c_xy, c_yx, c_yy, extrapolate, interpolation, k, k_tt, k_txtx, k_txty, k_tytx, "
+     "k_tyty, k_xx, k_xy, k_yx, k_yy, name, node_a, node_b, speed_of, speed_rad_s, speed_rpm"),
+    ("[[intershaft_bearing]]\nnode_a = 12", "[[intershaft_bearing]]\nspeed_of = \"inner\"\nnode_a = 12",
+     "bad.toml: intershaft_bearing[0].speed_of = 'inner': needs speed_rpm: only a table follows a spool's speed"),
     ("first_node = 1\n", "first_node = 1\nnodes = [1, 2, 3, 4, 5]\n",
      "bad.toml: spool[0].nodes = [1, 2, 3, 4, 5]: must not be given with first_node: give one of the two"),
     ("first_node = 1\n", "", "bad.toml: spool[0].first_node: missing; required (or nodes)"),

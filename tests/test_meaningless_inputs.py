@@ -130,7 +130,7 @@ def test_a_non_finite_whirl_frequency_is_refused_before_writing(tmp_path, capsys
     out = tmp_path / "out"
     assert main(["campbell", "seed-rig", "--speeds", "0:6000:5", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert err.startswith("rotorred campbell: error: the whirl frequency (Hz) is inf for mode 1 at 3000 rpm of "
+    assert err.startswith("rotorred campbell: error: the whirl frequency (Hz) is inf for mode 2 at 3000 rpm of "
                           "inner"), err
     assert not out.exists()
 

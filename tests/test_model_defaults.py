@@ -92,7 +92,7 @@ BAD = [
      "defaults.boundary_nodes[1] = 42: must be a node of the rotor (1-5, 10-12)"),
     ("boundary_nodes = [3, 11]", "boundary_nodes = 3", "defaults.boundary_nodes = 3: must be a list"),
     ("boundary_nodes = [3, 11]", "boundary = [3]", "defaults.boundary = [3]: unknown key; allowed keys are "
-     "boundary_nodes, outputs, unbalance"),
+     "boundary_nodes, operating_range_rad_s, operating_range_rpm, outputs, unbalance"),
     ("unbalance = [", "unbalance = 3 #[", "defaults.unbalance = 3: must be an array of tables"),
 ]
 

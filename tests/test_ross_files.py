@@ -9,6 +9,7 @@ kinetic energy in x, y, alpha, beta) are compared with rotorred's.
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import re
@@ -23,7 +24,7 @@ from rotorred.linear.campbell import campbell
 from rotorred.model.operating import Operating
 from rotorred.linear.modal import eigen
 from rotorred.model.assembly import assemble
-from rotorred.model.rotor_file import RotorFileError, load_rotor, rotor_from_toml
+from rotorred.model.rotor_file import RotorFileError, load_rotor, read_rotor, rotor_from_dict, rotor_from_toml
 
 ROSS3 = Path(__file__).resolve().parents[1] / "validation" / "reference" / "ross3"
 EXTRA = ROSS3 / "extra"  # a tapered rotor, a rotor on pedestals, a lightly damped rotor: extra/make_extra.py
@@ -208,9 +209,11 @@ def test_files_ross_saved_with_unsupported_elements_are_refused_by_name():
     ('gyroscopic = true', 'gyroscopic = false',
      "bad.toml: ['ShaftElement_Shaft Element 0'].gyroscopic = False: must equal rotary_inertia = True: rotorred's "
      "shaft element spins its rotary inertia (the gyroscopic matrix is rho I, with it or without it)"),
-    ('interpolation = "pchip"\nkxx = [ 1000000.0,]', 'interpolation = "pchip"\nfrequency = [10.0]\nkxx = [ 1000000.0,]',
-     "bad.toml: ['BearingElement_Bearing 0'].frequency = [10.0]: must not be given: rotorred's bearing coefficients "
-     "depend on speed only, not on the whirl frequency"),
+    ('interpolation = "pchip"\nkxx = [ 1000000.0,]',
+     'interpolation = "pchip"\nfrequency = [10.0, 20.0]\nspeed = [1.0, 2.0]\nkxx = [ 1000000.0,]',
+     "bad.toml: ['BearingElement_Bearing 0'].frequency = [10.0, 20.0]: must not be given with speed: a table against "
+     "both speed and whirl frequency (ROSS's 2-D table) has no rotorred equivalent; rotorred's tables follow one axis, "
+     "evaluated at the spool speed (give the synchronous coefficients against speed)"),
 ])
 def test_what_rotorred_cannot_represent_is_refused_by_name(old, new, message):
     """An element kind, a key or a value of a ROSS file that rotorred's lateral model cannot represent is refused,
@@ -259,3 +262,90 @@ def test_convert_refuses_a_rotorred_file_and_its_own_source(tmp_path):
     source = tmp_path / "r.toml"
     source.write_text((ROSS3 / "rotor_example.toml").read_text())
     assert main(["convert", str(source), str(source)]) == 2
+
+
+FREQUENCY = json.loads((EXTRA / "frequency_reference.json").read_text())  # extra/make_frequency_tables.py
+
+
+def test_bearings_tabulated_against_whirl_frequency_give_rosss_whirl_frequencies(caplog):
+    """ROSS's compressor with its two fluid-film bearings tabulated against whirl ``frequency`` (the seals against
+    ``speed``; extra/make_frequency_tables.py, ROSS 3.1.0): ROSS's modal analysis evaluates such a table at frequency =
+    rotor speed, and so does rotorred, at the spool's speed. At 3000 rpm (every bearing table extrapolated), 5000 and
+    8500 rpm (pchip between tabulated points), 6000 and 10000 rpm (tabulated points) every lateral root ROSS reports
+    is one of rotorred's: damped frequencies within 2.3e-11 relative at worst (5000 rpm; 1.3e-12 to 6.6e-12 at the
+    other speeds), the roots within 7.2e-12 (measured; asserted 10x; the issue asks for 1 %). The load says once, as
+    a warning, which bearings are read so."""
+    with caplog.at_level("WARNING", logger="rotorred.model.ross_file"):
+        rotor = load_rotor(EXTRA / "frequency_rotor.toml")
+    notes = [r.getMessage() for r in caplog.records if r.name == "rotorred.model.ross_file"]
+    assert len(notes) == 1 and notes[0].startswith("bearings 'Bearing 0' (node 7), 'Bearing 13' (node 48) are "
+                                                   "tabulated against whirl frequency in the ROSS file")
+    assert [b.axis for b in rotor.bearings].count("frequency") == 2
+    model = assemble(rotor)
+    errors = {}
+    for block in FREQUENCY["modal"]:
+        speeds = {"rotor": block["speed_rad_s"]}
+        roots = eigen(model.M, model.damping(speeds), model.stiffness(speeds)).eigenvalues
+        reference = ross_roots(block)
+        ours = matched(reference, roots)
+        errors[block["speed_rpm"]] = (np.max(np.abs(ours.imag / reference.imag - 1)),
+                                      np.max(np.abs(ours - reference) / np.abs(reference)))
+    assert sorted(errors) == pytest.approx([3000.0, 5000.0, 6000.0, 8500.0, 10000.0])
+    assert max(e[0] for e in errors.values()) < 2.3e-10 and max(e[1] for e in errors.values()) < 7.2e-11
+
+
+def test_a_frequency_table_converts_to_frequency_rpm_and_reads_back_the_same(tmp_path, capsys):
+    """``rotorred convert`` keeps a table against whirl frequency as ``frequency_rpm`` (the axis it was made against)
+    and the file reads back to the same rotor, to the last bit."""
+    target = tmp_path / "frequency.toml"
+    assert main(["convert", str(EXTRA / "frequency_rotor.toml"), str(target)]) == 0
+    assert target.read_text().count("frequency_rpm = [4000.0") == 2
+    assert "14 bearings and seals (12 tabulated against speed, 2 against whirl frequency)" in capsys.readouterr().out
+    assert load_rotor(target) == load_rotor(EXTRA / "frequency_rotor.toml")
+
+
+HUTCHINSON = json.loads((EXTRA / "hutchinson_reference.json").read_text())  # extra/make_hutchinson.py
+
+
+def test_rosss_hutchinson_coefficient_is_flagged_at_load_with_the_size_of_the_difference(caplog):
+    """A short hollow shaft (D_i/D_o = 0.4) whose elements use ROSS's Hutchinson coefficient (ROSS 3.1.0,
+    extra/make_hutchinson.py). ``shear = "ross-hutchinson"`` is ROSS's kappa to the last bits (each element's kappa as
+    ROSS stored it, 2.2e-16) and gives ROSS's whirl frequencies at 0, 500 and 1000 rad/s (matched as sets, 9.0e-14
+    measured; the published coefficient is up to 9.5 % off in the higher modes). The file is read with the published
+    coefficient, 1 + nu = 1.2993 times ROSS's, and the load says so once, with kappa -23 % and the first natural
+    frequency -0.391 %, the difference ROSS's own first frequency at rest (1245.696 rad/s) shows against rotorred's
+    published-coefficient reading (measured the same to 4 digits)."""
+    path = EXTRA / "hutchinson_rotor.toml"
+    with caplog.at_level("WARNING", logger="rotorred.model.ross_file"):
+        published, document = read_rotor(path)
+    notes = [r.getMessage() for r in caplog.records if r.name == "rotorred.model.ross_file"]
+    assert len(notes) == 1 and "6 shaft elements use ROSS's Hutchinson shear coefficient" in notes[0]
+    assert "kappa differs by -23 % and the first natural frequency at standstill by -0.391 %" in notes[0]
+    as_ross = copy.deepcopy(document)
+    for e in as_ross["spool"][0]["elements"]:
+        e["shear"] = "ross-hutchinson"
+    as_ross = rotor_from_dict(as_ross)
+    for e, ross in zip(as_ross.spools[0].elements, HUTCHINSON["shaft_elements"]):
+        assert e.kappa == pytest.approx(ross["kappa"], rel=2e-15)
+        assert e.material.nu == pytest.approx(ross["Poisson"], rel=1e-15)
+    nu = HUTCHINSON["shaft_elements"][0]["Poisson"]
+    ratio = published.spools[0].elements[0].kappa / as_ross.spools[0].elements[0].kappa
+    assert ratio == pytest.approx(1 + nu, rel=1e-15)
+    for rotor, tolerance in ((as_ross, 9e-13), (published, None)):
+        model = assemble(rotor)
+        for block in HUTCHINSON["modal"]:
+            speeds = {"rotor": block["speed_rad_s"]}
+            reference = ross_roots(block)
+            ours = matched(reference, eigen(model.M, model.damping(speeds), model.stiffness(speeds)).eigenvalues)
+            error = np.max(np.abs(ours.imag / reference.imag - 1))
+            if tolerance is not None:
+                assert error < tolerance
+            else:
+                assert error > 0.09  # the published coefficient is not ROSS's
+    first = HUTCHINSON["modal"][0]["lateral_wd"][0]
+    assert first / _lowest_whirl(published) - 1 == pytest.approx(-0.00391, abs=5e-6)
+
+
+def _lowest_whirl(rotor) -> float:
+    model = assemble(rotor)
+    return float(np.min(eigen(model.M, model.damping({"rotor": 0.0}), model.K).eigenvalues.imag))

@@ -14,8 +14,8 @@ import pytest
 
 import rotorred
 from rotorred.model.assembly import assemble
-from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Material, Pedestal, ShaftElement,
-                                     Support)
+from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, IntershaftBearingTable, Material,
+                                     Pedestal, ShaftElement, Support)
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 from rotorred.model.rotor_file import load_rotor
@@ -25,7 +25,8 @@ from rotorred.writers import exact_in_unit
 ROSS3 = Path(__file__).resolve().parents[1] / "validation" / "reference" / "ross3"
 #: the rotors saved by ROSS 3 that rotorred reads (tests/test_ross_files.py)
 ROSS_FILES = [ROSS3 / "rotor_example.toml", ROSS3 / "compressor_example.toml",
-              *(ROSS3 / "extra" / f"{name}.toml" for name in ("tapered_rotor", "pedestal_rotor", "damped_rotor"))]
+              *(ROSS3 / "extra" / f"{name}.toml" for name in ("tapered_rotor", "pedestal_rotor", "damped_rotor",
+                                                              "frequency_rotor", "hutchinson_rotor"))]
 
 
 def inexact(start: float, to_si, from_si) -> float:
@@ -40,19 +41,25 @@ def inexact(start: float, to_si, from_si) -> float:
 def python_rotor() -> Rotor:
     """A rotor no file made: three spools, non-consecutive node numbers, speeds and a phase that no rpm or degree
     number reads back to, materials by nu and by G, tapered, hierarchical, Euler-Bernoulli and Rayleigh elements,
-    sleeves, tables against speed (linear and pchip), a pedestal, a support, an inter-shaft bearing, defaults."""
+    sleeves, tables against speed (linear and pchip) and against whirl frequency, tilt coefficients (isotropic, cross
+    and tabulated; on a pedestal link), a pedestal, a support, inter-shaft bearings (one tabulated against another
+    spool's speed), defaults, internal damping (viscous and hysteretic, on spools and overridden on elements and a
+    sleeve)."""
     steel = Material("steel", E=2.07e11, rho=7833.4, nu=0.29)
     titanium = Material("Ti-6Al-4V", E=1.138e11, G=4.4e10, rho=4430.0)
     low = Spool("low", (ShaftElement(1, 2, 0.071, 0.031, 0.0, steel),
-                        ShaftElement(2, 5, 0.071, 0.031, 0.0, steel, D_o_right=0.027),
+                        ShaftElement(2, 5, 0.071, 0.031, 0.0, steel, D_o_right=0.027, internal_loss_factor=0.013),
                         ShaftElement(5, 9, 0.09, 0.027, 0.011, titanium, shear="hutchinson"),
-                        ShaftElement(9, 4, 0.09, 0.027, 0.011, titanium, element="hierarchical"),
+                        ShaftElement(9, 4, 0.09, 0.027, 0.011, titanium, element="hierarchical",
+                                     internal_damping_beta=0.0),
                         ShaftElement(4, 40, 0.11, 0.025, 0.0, steel, shear="none", rotary_inertia=False)),
                 speed=inexact(2 * math.pi * 73.3, rpm_to_rad_s, lambda w: w * 30 / math.pi), z0=-0.013,
-                sleeves=(ShaftElement(5, 9, 0.09, 0.045, 0.027, steel), ShaftElement(9, 4, 0.09, 0.045, 0.027, steel),
+                internal_damping_beta=2.1e-5,
+                sleeves=(ShaftElement(5, 9, 0.09, 0.045, 0.027, steel, internal_damping_beta=3e-5),
+                         ShaftElement(9, 4, 0.09, 0.045, 0.027, steel),
                          ShaftElement(1, 2, 0.071, 0.05, 0.031, titanium, D_i_right=0.033)))
     high = Spool("high", tuple(ShaftElement(n, n + 1, 0.05, 0.06, 0.045, titanium) for n in range(20, 25)),
-                 speed=1234.5678, z0=0.1)
+                 speed=1234.5678, z0=0.1, internal_loss_factor=2e-3)
     fan = Spool("fan", (ShaftElement(60, 58, 0.2, 0.04, 0.0, steel), ShaftElement(58, 56, 0.2, 0.04, 0.0, steel)),
                 z0=0.5)
     speeds = (0.0, 157.3, 1e3 / 3, 2 * math.pi * 97.1)
@@ -64,10 +71,17 @@ def python_rotor() -> Rotor:
                   BearingTable(40, speeds, k_xx=(1e7, 2e7, 3e7, 3.5e7), k_yy=(1e7, 2e7, 3e7, 3.5e7), c_xx=300.0,
                                c_yy=(300.0, 280.0, 250.0, 240.0), k_yx=(0.0, 1e5, 4e5, 6e5), interpolation="pchip",
                                extrapolate="linear", name="fluid film"),
-                  BearingTable(25, (10.0, 600.0), k_xx=5e6, k_yy=6e6, c_xy=(1.0, 2.0), link=70),
-                  Bearing(k_xx=1e8, k_yy=1e8, node=70), Bearing(k_xx=2e7, k_yy=2e7, c_xx=50.0, c_yy=50.0, node=60)),
+                  BearingTable(25, (10.0, 600.0), k_xx=5e6, k_yy=6e6, c_xy=(1.0, 2.0), link=70, k_txtx=(3e4, 4e4),
+                               k_tyty=(3e4, 4e4), axis="frequency"),
+                  Bearing(k_xx=1e8, k_yy=1e8, node=70),
+                  Bearing(k_xx=2e7, k_yy=2e7, c_xx=50.0, c_yy=50.0, node=60, k_txtx=2e5, k_tyty=2e5, k_txty=-3e3,
+                          c_txtx=4.0, c_tyty=4.5, c_tytx=0.5)),
         intershaft_bearings=(IntershaftBearing(k_xx=1e7, k_yy=1.2e7, c_xx=300.0, c_yy=300.0, node_a=20, node_b=5,
-                                               name="inter-shaft"),),
+                                               name="inter-shaft", k_txtx=1e4, k_tyty=1e4),
+                             IntershaftBearingTable(24, 9, speeds, k_xx=(1e6, 2e6, 3e6, 4e6), k_yy=2e6, c_xx=20.0,
+                                                    c_yy=20.0, speed_of="low", interpolation="pchip",
+                                                    c_txtx=(0.5, 0.6, 0.7, 0.8), c_tyty=(0.5, 0.6, 0.7, 0.8)),
+                             IntershaftBearingTable(56, 2, (0.0, 600.0), k_xx=(1e5, 2e5), k_yy=(1e5, 2e5))),
         rayleigh=(3.0, 1.7e-6), name="built in Python",
         defaults=AnalysisDefaults(unbalances=(Unbalance(9, 2e-5, inexact(0.7, math.radians, math.degrees)),
                                               Unbalance(22, 1e-5, math.radians(30.0)), Unbalance(56, 3e-6)),
@@ -141,6 +155,8 @@ def test_the_python_rotor_is_written_in_the_files_units_where_exact_and_in_si_wh
     assert f"phase_rad = {rotor.defaults.unbalances[0].phase!r}\n" in text and "phase_deg = 30.0\n" in text
     assert "nodes = [1, 2, 5, 9, 4, 40]" in text and "nodes = [60, 58, 56]" in text and "first_node = 20" in text
     assert 'name = "Ti-6Al-4V"\nE = 113800000000.0\nrho = 4430.0\nG = 44000000000.0\n' in text
+    assert "k_tt = 200000.0\nk_txty = -3000.0\nc_txtx = 4.0\nc_tyty = 4.5\nc_tytx = 0.5\n" in text
+    assert 'speed_of = "low"\nspeed_rad_s = [0.0, 157.3, ' in text and "frequency_rpm = [" in text
 
 
 def test_a_material_read_from_g_keeps_g_and_a_preset_is_written_in_its_own_units(tmp_path):

@@ -72,7 +72,7 @@ def test_campbell_result_shows_itself(diagram, tmp_path):
     assert_shows_itself(diagram, tmp_path, of=rr.CampbellResult, operating_speed=440.0)
     text = repr(diagram)
     first = diagram.critical_speeds[0]
-    assert f"{first.speed_rpm:.6g} rpm: {first.line}, mode {first.mode}" in text
+    assert f"{first.speed_rpm:.6g} rpm: {first.line}, mode {first.mode + 1}" in text
     assert f"{len(diagram.critical_speeds)} critical speeds" in text
 
 

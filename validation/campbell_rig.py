@@ -168,7 +168,7 @@ def main(argv=None) -> int:
     print(f"{'inner rpm':>10} {'outer rpm':>10} {'line':>9} {'mode':>4} {'freq Hz':>8} {'whirl':>9} "
           f"{'log dec':>8} {'margin':>7}")
     for c, m in margins(result):
-        print(f"{c.speed_rpm:10.1f} {c.speed_rpm * RATIO:10.1f} {c.line:>9} {c.mode:4d} {c.frequency_hz:8.2f} "
+        print(f"{c.speed_rpm:10.1f} {c.speed_rpm * RATIO:10.1f} {c.line:>9} {c.mode + 1:4d} {c.frequency_hz:8.2f} "
               f"{c.whirl:>9} {c.log_dec:8.4f} {100 * m:6.1f}%")
     missing, shift = completeness(result)
     print(f"completeness: {missing} of the undamped rig's 1x critical speeds (Hermitian formulation, all modes) "

@@ -1,6 +1,7 @@
 """``rotorred campbell ROTOR --speeds START:STOP:COUNT --out DIR``: Campbell diagram and critical speeds.
 
-Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv``, ``campbell.txt`` (what it prints, under the
+Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv`` (with the API 684 / 617 amplification factors and
+separation margins, :mod:`rotorred.linear.margins`), ``campbell.txt`` (what it prints, under the
 rotorred version, command line and date) and ``rotor.toml`` (the rotor as read, a rotor file that gives it again).
 """
 
@@ -66,8 +67,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Whirl frequencies against the speed of a reference spool (other spools at a fixed speed "
                     "ratio), forward/backward whirl, modes tracked by MAC, and the critical speeds where a "
                     "whirl curve crosses an excitation line h x (spool speed). Writes campbell.csv and "
-                    "campbell.png and critical_speeds.csv (excitation, mode, whirl, damping and margin to the "
-                    "operating point) to --out and prints the critical speeds.")
+                    "campbell.png and critical_speeds.csv (excitation, mode, whirl, damping, margin to the "
+                    "operating point, and the API 684 amplification factor and API 617 separation margin from "
+                    "--operating-range) to --out and prints the critical speeds. Modes are numbered from 1.")
     p.add_argument("rotor", metavar="ROTOR", help="preset name (e.g. seed-rig) or rotor TOML file")
     p.add_argument("--speeds", required=True, metavar="START:STOP:COUNT",
                    help="reference-spool speeds in rpm, e.g. 0:12000:61, a comma list (increasing, >= 0), or one "
@@ -86,15 +88,42 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--reduce", type=int, default=None, metavar="MODES",
                    help="solve the Craig-Bampton model with MODES fixed-interface modes (0: chosen to the default "
                         "target) and print its largest difference against the full model")
+    p.add_argument("--operating-range", default=None, metavar="MIN:MAX",
+                   help="minimum and maximum continuous speed of the reference spool (rpm) for the API 617 "
+                        "separation margins of critical_speeds.csv (default: the rotor file's [defaults] "
+                        "operating_range_rpm of that spool; without either, amplification factors only)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
     return p
 
 
+def parse_operating_range(text: str | None) -> tuple[float, float] | None:
+    """``"3000:4500"`` (rpm, 0 <= MIN <= MAX) -> (3000.0, 4500.0); None -> None."""
+    if text is None:
+        return None
+    values = number_list("--operating-range", text.replace(":", ","), "rpm")
+    if len(values) != 2 or not 0.0 <= values[0] <= values[1]:
+        checks.fail("--operating-range", text, "must be MIN:MAX, the minimum and maximum continuous speed with "
+                    "0 <= MIN <= MAX", "rpm")
+    checks.bounded("--operating-range", text, values, "speed")
+    return values
+
+
+def operating_range(given: tuple[float, float] | None, rotor, reference: str):
+    """The :class:`rotorred.OperatingRange` of the reference spool: ``--operating-range`` (rpm), else the rotor's
+    ``[defaults]``, else None."""
+    from rotorred import OperatingRange
+
+    if given is not None:
+        return OperatingRange(*(w * math.pi / 30.0 for w in given))
+    default = rotor.defaults.operating_range(reference)
+    return None if default is None else OperatingRange(*default)
+
+
 def run(args) -> int:
     import matplotlib  # noqa: F401 - a missing matplotlib fails before any work
 
-    from rotorred import campbell, read_rotor, save_figure
+    from rotorred import campbell, read_rotor, save_figure, separation_margins
 
     out = out_dir("--out", args.out)
     speeds = parse_speeds(args.speeds)
@@ -104,6 +133,7 @@ def run(args) -> int:
     ratio = parse_ratio(args.ratio)
     if args.reduce is not None:
         checks.integer("--reduce", args.reduce, ge=0)
+    given_range = parse_operating_range(args.operating_range)
     rotor, document = read_rotor(args.rotor)
     record = provenance(args, "rotor", writers.toml_text(document))
     check_model_size(rotor, args.force)
@@ -120,12 +150,16 @@ def run(args) -> int:
             result, campbell(rotor, operating, n_modes=result.n_modes, harmonics=harmonics))
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
+        api = []
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
             operating_speed = ref_nominal if ref_nominal > 0 else None
             files.append(save_figure(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
-            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed))
+            rng = operating_range(given_range, rotor, result.reference)
+            margins = separation_margins(model, result, rng)
+            files.append(result.critical_speeds_to_csv(folder.staged("critical_speeds.csv"), operating_speed, margins))
+            api = [format_margins(result, margins, rng)]
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
-                          format_mode_count(result)] + ([comparison] if comparison else []))
+                          format_mode_count(result)] + api + ([comparison] if comparison else []))
         files += stage_summary(folder, "campbell.txt", text, record)
         folder.commit()
     report(text)
@@ -137,12 +171,31 @@ def check_finite(result) -> None:
     """Refuse whirl frequencies or log decrements holding NaN or inf (a rigid-body mode's log decrement, over a zero
     frequency, excepted) before anything is written, naming the mode and speed."""
     def where(k):
-        return f"for mode {k[1]} at {result.speeds_rpm[k[0]]:.6g} rpm of {result.reference}"
+        return f"for mode {k[1] + 1} at {result.speeds_rpm[k[0]]:.6g} rpm of {result.reference}"
 
     checks.finite_result("the whirl frequency (Hz)", result.frequencies_hz, where)
     elastic = [j for j in range(result.n_modes) if j not in set(result.rigid_modes)]
     checks.finite_result("the log decrement", result.log_dec[:, elastic],
                          lambda k: where((k[0], elastic[k[1]])))
+
+
+def format_margins(result, margins, rng) -> str:
+    """The API 617 amplification factor and separation margin of each critical speed (docs/model.md §21)."""
+    rpm = 30.0 / math.pi
+    head = (f"API 617 separation margins from the operating range {rng.minimum * rpm:.6g}-{rng.maximum * rpm:.6g} rpm "
+            f"of {result.reference}" if rng is not None else
+            f"amplification factors (no operating range of {result.reference}: give --operating-range MIN:MAX or "
+            "[defaults] operating_range_rpm for the separation margins)")
+    lines = [head, f"{result.reference + ' rpm':>14} {'mode':>5} {'AF':>8} {'required %':>11} {'actual %':>9}  verdict"]
+    for m in margins:
+        c = m.critical
+        verdict = "" if m.meets is None else "meets API" if m.meets else "FAILS API"
+        af = "-" if math.isnan(m.amplification_factor) else f"{m.amplification_factor:.3g}"
+        req = "-" if math.isnan(m.required) else f"{100 * m.required:.3g}"
+        act = "-" if math.isnan(m.actual) else f"{100 * m.actual:.3g}"
+        lines.append(f"{c.speed_rpm:14.1f} {c.mode + 1:5d} {af:>8} {req:>11} {act:>9}  {verdict}"
+                     + (f" ({m.note})" if m.note else ""))
+    return "\n".join(lines)
 
 
 def format_mode_count(result) -> str:
@@ -184,7 +237,7 @@ def format_reduction_error(reduced, full) -> str:
     """The reduced model's largest whirl-frequency and critical-speed differences against the full model."""
     rel = np.abs(reduced.frequencies / full.frequencies - 1.0)
     i, j = np.unravel_index(int(np.argmax(rel)), rel.shape)
-    text = (f"reduced model against the full one: whirl frequencies within {100 * rel[i, j]:.3g} % (largest: mode {j} "
+    text = (f"reduced model against the full one: whirl frequencies within {100 * rel[i, j]:.3g} % (largest: mode {j + 1} "
             f"at {full.speeds_rpm[i]:.6g} rpm)")
     pairs = list(zip(reduced.critical_speeds, full.critical_speeds))
     if pairs and len(reduced.critical_speeds) == len(full.critical_speeds):
@@ -212,7 +265,7 @@ def format_whirl_table(result, i: int = 0) -> str:
              f"{result.reference}" + (f" ({others})" if others else ""),
              f"{'mode':>5} {'freq Hz':>12} {'whirl':>9} {'damping ratio':>14} {'log dec':>10}"]
     for j in range(result.n_modes):
-        lines.append(f"{j:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
+        lines.append(f"{j + 1:5d} {result.frequencies_hz[i, j]:12.4f} {result.whirl[i, j]:>9} "
                      f"{result.damping_ratio[i, j]:14.6f} {result.log_dec[i, j]:10.5f}")
     return "\n".join(lines + _beyond_tables(result))
 
@@ -227,15 +280,15 @@ def format_critical_speeds(result) -> str:
     if not result.critical_speeds:
         lines.append("  (none in the speed range)")
     for c in result.stability_changes:
-        lines.append(f"UNSTABLE: mode {c.mode} ({c.whirl}, {c.frequency_hz:.2f} Hz) "
+        lines.append(f"UNSTABLE: mode {c.mode + 1} ({c.whirl}, {c.frequency_hz:.2f} Hz) "
                      + (f"becomes unstable above {c.speed_rpm:.1f} rpm (log dec < 0)" if c.onset
                         else f"is unstable below {c.speed_rpm:.1f} rpm (log dec < 0), stable above"))
     if result.rigid_modes:
         f0 = ", ".join(f"{result.frequencies_hz[0, j]:.3g}" for j in result.rigid_modes)
         lines.append(f"rigid-body modes (a free or singly supported spool; not critical speeds): modes "
-                     f"{', '.join(str(j) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
+                     f"{', '.join(str(j + 1) for j in result.rigid_modes)}, {f0} Hz at {result.speeds_rpm[0]:.6g} rpm")
     for c in result.critical_speeds:
-        lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
+        lines.append(f"{c.speed_rpm:14.1f} {c.line:>{w}} {c.mode + 1:5d} {c.frequency_hz:10.2f} {c.whirl:>9} "
                      f"{c.log_dec:9.4f}")
     return "\n".join(lines + _beyond_tables(result))
 

@@ -34,10 +34,12 @@ def run(args) -> int:
             raise
         checks.fail("ROSS_FILE", args.source, exc.requirement)
     spool = rotor.spools[0]
-    tables = sum(1 for b in rotor.bearings if isinstance(b, BearingTable))
+    tables = [b.axis for b in rotor.bearings if isinstance(b, BearingTable)]
+    against = f"{tables.count('speed')} tabulated against speed" + (
+        f", {tables.count('frequency')} against whirl frequency" if "frequency" in tables else "")
     report(f"read {source}: {len(spool.elements)} shaft elements, nodes {spool.nodes[0]}-{spool.nodes[-1]}"
            + (f", {len(spool.sleeves)} sleeves (ROSS layered elements)" if spool.sleeves else "")
-           + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({tables} tabulated against speed)"
+           + f", {len(rotor.disks)} disks, {len(rotor.bearings)} bearings and seals ({against})"
            + (f", {len(rotor.pedestals)} pedestals" if rotor.pedestals else ""))
     report(f"wrote {target}")
     return 0

@@ -50,7 +50,6 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
@@ -58,6 +57,7 @@ from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, system_of
 from rotorred.model.operating import Operating, SpoolLine
 from rotorred.model.operating import checked as checked_operating
+from rotorred.model.rigid import rigid_body_motions
 from rotorred.progress import stage
 from rotorred.results import Result
 
@@ -117,7 +117,8 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
     harmonic : float
         Multiple h of that spool's speed (-).
     mode : int
-        Column of :attr:`CampbellResult.frequencies` (0-based tracked mode).
+        Column of :attr:`CampbellResult.frequencies` (0-based tracked mode); the files and printouts number it
+        from 1 (``mode + 1``), as :func:`rotorred.mode_shapes` numbers the modes at the first speed.
     frequency : float
         Whirl frequency at the crossing (rad/s) = h x speed of ``spool``.
     whirl : str
@@ -157,7 +158,7 @@ class CriticalSpeed(_PointOnTheDiagram, Result):
         """Where the curve meets which line, and the mode there."""
         lines = [f"{self.speed_rpm:.6g} rpm of the reference spool on {self.line} "
                  f"({self.spool} at {self.spool_speed * 30.0 / math.pi:.6g} rpm)",
-                 f"mode {self.mode}, {self.whirl} whirl at {self.frequency_hz:.6g} Hz",
+                 f"mode {self.mode + 1}, {self.whirl} whirl at {self.frequency_hz:.6g} Hz",
                  f"log dec {self.log_dec:.4g}, damping ratio {self.damping_ratio:.4g}"]
         return lines
 
@@ -362,11 +363,14 @@ class CampbellResult(Result):
         return tuple((s, h, h * r, h * self.fixed_speeds.get(s, 0.0)) for s, r in self.speed_ratios.items()
                      if r > 0 or self.fixed_speeds.get(s, 0.0) > 0 for h in self.harmonics)
 
-    def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None) -> Path:
+    def critical_speeds_to_csv(self, path: str | Path, operating_speed: float | None = None,
+                               margins: Sequence | None = None) -> Path:
         """Write the critical speeds, one row each: the reference spool's speed (rpm), the excitation line,
         the excited spool's speed (rpm), the mode, its frequency (Hz), whirl, log dec and damping ratio at
         the crossing, and the margin to ``operating_speed`` (rad/s of the reference spool), in % of it
-        (positive: the critical speed lies above the operating point; empty without one).
+        (positive: the critical speed lies above the operating point; empty without one); then the API 617
+        columns ``amplification_factor``, ``required_margin_pct``, ``actual_margin_pct``, ``meets_api`` (yes/no)
+        of ``margins`` (empty where a margin has none, and without ``margins``).
 
         Parameters
         ----------
@@ -374,6 +378,8 @@ class CampbellResult(Result):
             The CSV file to write.
         operating_speed : float, optional
             Operating speed of the reference spool (rad/s), > 0 for a margin; None or 0: no margin.
+        margins : sequence of SeparationMargin, optional
+            One per critical speed (:func:`rotorred.separation_margins`).
 
         Returns
         -------
@@ -387,15 +393,30 @@ class CampbellResult(Result):
         header = [f"{self.reference} speed (rpm)", "excitation", "excited spool speed (rpm)", "mode",
                   "frequency (Hz)", "whirl", "log dec", "damping ratio", "margin to operating point (%)"]
         columns = [np.array([c.speed_rpm for c in cs]), [c.line for c in cs],
-                   np.array([c.spool_speed * 30.0 / math.pi for c in cs]), np.array([c.mode for c in cs]),
+                   np.array([c.spool_speed * 30.0 / math.pi for c in cs]), np.array([c.mode + 1 for c in cs], int),
                    np.array([c.frequency_hz for c in cs]), [c.whirl for c in cs], np.array([c.log_dec for c in cs]),
                    np.array([c.damping_ratio for c in cs]), [margin(c) for c in cs]]
+        api = [(_cell(m.amplification_factor), _cell(100 * m.required), _cell(100 * m.actual),
+                "" if m.meets is None else "yes" if m.meets else "no") for m in margins or ()] or [("",) * 4] * len(cs)
+        header += ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
+        columns += [list(col) for col in zip(*api)] if cs else [[], [], [], []]
         return writers.write_csv(path, header, columns)
 
     @property
     def unstable(self) -> np.ndarray:
         """Where a mode's log dec is negative beyond round-off (< -NEUTRAL_LOG_DEC), shape (n_speeds, n_modes)."""
         return self.log_dec < -NEUTRAL_LOG_DEC
+
+    @property
+    def onset_speeds(self) -> dict[int, float]:
+        """Onset speed of each mode that becomes unstable along the sweep: the reference spool's speed (rad/s) of its
+        first :class:`StabilityChange` with ``onset`` (the root of Re(lambda) = 0, e.g. from internal damping,
+        docs/model.md §19), by mode."""
+        out: dict[int, float] = {}
+        for c in self.stability_changes:
+            if c.onset:
+                out.setdefault(c.mode, c.speed)
+        return out
 
     @property
     def damping_ratio(self) -> np.ndarray:
@@ -421,7 +442,7 @@ class CampbellResult(Result):
         lines.append(f"whirl frequencies {f.min():.4g}-{f.max():.4g} Hz")
         lines += self._critical_lines(5) + [self._stability_line()]
         if self.rigid_modes:
-            lines.append("rigid-body modes (no critical speeds): " + ", ".join(map(str, self.rigid_modes)))
+            lines.append("rigid-body modes (no critical speeds): " + ", ".join(str(j + 1) for j in self.rigid_modes))
         if self.beyond_tables:
             lines.append(f"the speeds leave the table of {len(self.beyond_tables)} speed-dependent bearing(s)")
         return lines
@@ -430,7 +451,7 @@ class CampbellResult(Result):
         """The number of critical speeds and the first ``most`` of them, a line each."""
         cs = self.critical_speeds
         lines = [f"{len(cs)} critical speeds" + (":" if cs else " in the speed range")]
-        lines += [f"  {c.speed_rpm:.6g} rpm: {c.line}, mode {c.mode} {c.whirl} at {c.frequency_hz:.4g} Hz, "
+        lines += [f"  {c.speed_rpm:.6g} rpm: {c.line}, mode {c.mode + 1} {c.whirl} at {c.frequency_hz:.4g} Hz, "
                   f"log dec {c.log_dec:.3g}" for c in cs[:most]]
         if len(cs) > most:
             lines.append(f"  ... {len(cs) - most} more (critical_speeds)")
@@ -440,10 +461,11 @@ class CampbellResult(Result):
         """Stable over the sweep, or where which modes change stability."""
         if self.stability_changes:
             return "stability: " + "; ".join(
-                f"mode {c.mode} {'unstable above' if c.onset else 'stable above'} {c.speed_rpm:.6g} rpm"
+                f"mode {c.mode + 1} {'unstable above' if c.onset else 'stable above'} {c.speed_rpm:.6g} rpm"
                 for c in self.stability_changes[:3]) + ("; ..." if len(self.stability_changes) > 3 else "")
         if np.any(self.unstable):
-            return f"UNSTABLE: modes {', '.join(map(str, np.flatnonzero(self.unstable.any(axis=0))))} (log dec < 0)"
+            unstable = ", ".join(str(j + 1) for j in np.flatnonzero(self.unstable.any(axis=0)))
+            return f"UNSTABLE: modes {unstable} (log dec < 0)"
         return "stable over the sweep (no log dec < 0)"
 
     def plot(self, ax=None, **options):
@@ -501,7 +523,8 @@ class CampbellResult(Result):
 
     def to_csv(self, path: str | Path) -> Path:
         """Write one row per (speed, mode): ``speed_rpm,mode,frequency_hz,whirl,log_dec,stable``
-        (``stable``: ``no`` where the log dec is below ``-NEUTRAL_LOG_DEC``).
+        (``mode``: the tracked mode numbered from 1, in frequency order at the first speed, as
+        :func:`rotorred.mode_shapes` numbers them; ``stable``: ``no`` where the log dec is below ``-NEUTRAL_LOG_DEC``).
 
         Speeds with 10 significant digits, frequencies with 9, log decrements with 6. The
         diagram itself is drawn by :meth:`plot`.
@@ -518,13 +541,18 @@ class CampbellResult(Result):
         """
         n_s, n_m = self.frequencies.shape
         speed = np.repeat(self.speeds_rpm, n_m)
-        mode = np.tile(np.arange(n_m), n_s)
+        mode = np.tile(np.arange(1, n_m + 1), n_s)  # numbered from 1, as rotorred modes numbers them
         # mixed precision: frequency and log dec are formatted here, the speed by the writer (digits=10)
         freq = [f"{v:.9g}" for v in self.frequencies_hz.ravel()]
         log_dec = [f"{v:.6g}" for v in self.log_dec.ravel()]
         stable = ["no" if v < -NEUTRAL_LOG_DEC else "yes" for v in self.log_dec.ravel()]
         return writers.write_csv(path, ["speed_rpm", "mode", "frequency_hz", "whirl", "log_dec", "stable"],
                                  [speed, mode, freq, [str(w) for w in self.whirl.ravel()], log_dec, stable], digits=10)
+
+
+def _cell(value: float) -> str:
+    """A number of the API 617 columns (6 significant digits), empty for NaN (none defined)."""
+    return "" if math.isnan(value) else f"{value:.6g}"
 
 
 #: attributes of a whirl-direction variable: CF flags, the codes' meanings in :data:`WHIRL_LABELS` order
@@ -628,6 +656,32 @@ def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -
         else:
             out.append("mixed")
     return out
+
+
+def modes_at(sm, lines: Mapping[str, SpoolLine], Omega: float, n_modes: int):
+    """The lowest ``n_modes`` modes at reference speed ``Omega`` (rad/s) as :func:`campbell` numbers its columns
+    at its first speed (the same eigen-solve, the same forward/backward basis of a multiple eigenvalue).
+
+    Parameters
+    ----------
+    sm : SystemMatrices or ReducedSystem
+        The model (:func:`rotorred.model.assembly.system_of`).
+    lines : dict of str to SpoolLine
+        Each spool's speed line (:meth:`Operating.lines`).
+    Omega : float
+        Speed of the reference spool (rad/s).
+    n_modes : int
+        Number of modes (>= 1).
+
+    Returns
+    -------
+    eigenvalues : ndarray, shape (n_modes,), complex
+    shapes : ndarray, shape (n, n_modes), complex
+        In the model's coordinates (a reduced model's: recover with its ``T``).
+    """
+    solver = _Solver(sm, lines, min(sm.n_dof, 2 * n_modes + 4))
+    lam, shapes = solver.solve(Omega)
+    return lam[:n_modes], shapes[:, :n_modes]
 
 
 def _canonical_basis(lam: np.ndarray, modes: np.ndarray, x_rows, y_rows) -> np.ndarray:
@@ -790,7 +844,7 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
     log_dec = -2.0 * np.pi * lam_all.real / freq
     whirl = np.array([whirl_direction(s, solver.x_rows, solver.y_rows) for s in shapes], dtype="<U8")
 
-    null = rigid_body_motions(sm.M, sm.K)
+    null = rigid_body_motions(sm)
     is_rigid = np.array([rigid_body_share(sm.M, null, v) > RIGID_SHARE for v in shapes])  # (n_s, n_modes)
     crit = []
     for spool, hh, slope, offset, same in _distinct_lines(lines, h):
@@ -936,16 +990,6 @@ def _beyond_tables(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray) -> tup
 NEUTRAL_LOG_DEC = 1e-6
 #: a tracked mode with more than this share of its kinetic energy in the null space of K is a rigid-body mode
 RIGID_SHARE = 0.5
-#: generalised eigenvalues w^2 of (K, M) below this fraction of the largest span the null space of K
-_NULL_RTOL = 1e-10
-
-
-def rigid_body_motions(M: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """The rigid-body motions of a structure, M-orthonormal, shape (n, r): the eigenvectors of
-    K phi = w^2 M phi with w^2 <= 1e-10 max(w^2) (a free spool's translations and tilts; r = 0 when
-    every spool is held)."""
-    w2, phi = sla.eigh(K, M)
-    return phi[:, w2 <= _NULL_RTOL * max(float(np.max(np.abs(w2))), 1e-300)]
 
 
 def rigid_body_share(M: np.ndarray, null: np.ndarray, modes: np.ndarray) -> np.ndarray:
@@ -1023,15 +1067,22 @@ def _root(solver: _Solver, Omega, lam_grid, shapes, i: int, j: int, f):
 
 
 def _stability_changes(solver: _Solver, Omega, lam_grid, shapes, whirl, log_dec, is_rigid):
-    """Where each tracked mode's log dec changes sign between grid speeds: the root of Re(lambda) (:func:`_root`)."""
+    """Where each tracked mode's log dec changes sign between grid speeds: the root of Re(lambda) (:func:`_root`).
+
+    A change is between two grid speeds where the log dec is beyond round-off (|log dec| > ``NEUTRAL_LOG_DEC``) with
+    opposite signs, not round-off about an undamped mode's zero; grid speeds between them within round-off of zero
+    (a root on the grid itself) are crossed: the root is refined in the first interval where Re(lambda) changes sign.
+    """
     out = []
     for j in range(log_dec.shape[1]):
-        for i in range(len(Omega) - 1):
-            a, b = log_dec[i, j], log_dec[i + 1, j]
-            if is_rigid[i, j] or is_rigid[i + 1, j] or not (min(a, b) < -NEUTRAL_LOG_DEC < NEUTRAL_LOG_DEC < max(a, b)):
-                continue  # a change from stable to unstable, not round-off about an undamped mode's zero
-            root, lam, _ = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.real)
-            w = str(whirl[i, j]) if whirl[i, j] == whirl[i + 1, j] else "mixed"
+        clear = [i for i in range(len(Omega)) if abs(log_dec[i, j]) > NEUTRAL_LOG_DEC]
+        for i, k in zip(clear[:-1], clear[1:]):
+            if log_dec[i, j] * log_dec[k, j] > 0 or is_rigid[i:k + 1, j].any():
+                continue
+            at = next(m for m in range(i, k) if lam_grid[m + 1, j].real == 0.0
+                      or np.sign(lam_grid[m, j].real) != np.sign(lam_grid[m + 1, j].real))
+            root, lam, _ = _root(solver, Omega, lam_grid, shapes, at, j, lambda lam, W: lam.real)
+            w = str(whirl[i, j]) if len(set(whirl[i:k + 1, j])) == 1 else "mixed"
             out.append(StabilityChange(float(root), j, float(lam.imag), w, bool(log_dec[i, j] > 0)))
     return tuple(sorted(out, key=lambda c: (c.speed, c.mode)))
 

@@ -503,15 +503,35 @@ def steady_state(model, operating: Operating, unbalances: Sequence[Unbalance]) -
     model = system_of(model)
     speeds = checked_operating(operating).single(model)
     forces = unbalance_forces(model, unbalances)
-    D, K = model.damping(speeds), model.stiffness(speeds)
+    matrices = _Matrices(model, speeds)
     phasors = {}
     for s, f in forces.items():
         w = speeds[s]
         if w == 0.0:
             phasors[s] = np.zeros(model.n_dof, dtype=complex)
             continue
-        phasors[s] = sla.solve(K - w * w * model.M + 1j * w * D, w * w * f, check_finite=False)
+        phasors[s] = sla.solve(matrices.dynamic_stiffness(w), w * w * f, check_finite=False)
     return SteadyState(speeds=speeds, phasors=phasors, operating=operating)
+
+
+class _Matrices:
+    """A model's dynamic stiffness at spool speeds ``speeds`` (rad/s), ``K - w^2 M + i w D`` for an excitation
+    frequency ``w`` (rad/s): an internal loss factor eta is taken at ``w`` itself (viscous eta / |w|: the
+    hysteretic force i sign(w) eta K_shaft in the rotating frame's terms, docs/model.md §19), else D and K are
+    evaluated once."""
+
+    def __init__(self, model, speeds):
+        self.model, self.speeds = model, speeds
+        self.fixed = None if model.frequency_dependent else (model.damping(speeds), model.stiffness(speeds))
+
+    def dynamic_stiffness(self, w: float) -> np.ndarray:
+        if self.fixed is not None:
+            D, K = self.fixed
+        elif w == 0.0:  # eta / |w| K w: the hysteretic force stays finite; at w = 0 its viscous form is not needed
+            D, K = self.model.damping(self.speeds, np.inf), self.model.stiffness(self.speeds, np.inf)
+        else:
+            D, K = self.model.damping(self.speeds, w), self.model.stiffness(self.speeds, w)
+        return K - w * w * self.model.M + 1j * w * D
 
 
 def unbalance_forces(model, unbalances: Sequence[Unbalance]) -> dict[str, np.ndarray]:
@@ -580,16 +600,14 @@ def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalan
     per_spool = unbalance_forces(model, unbalances)
     R = model.output_rows(outputs)
     phasors = {s: np.zeros((len(speeds), len(outputs)), dtype=complex) for s in per_spool}
-    M = model.M
     for k in range(len(speeds)):
         at = {s: float(w[k]) for s, w in spool_speeds.items()}
-        D, K = model.damping(at), model.stiffness(at)
+        matrices = _Matrices(model, at)
         for s, f in per_spool.items():
             w = at[s]
             if w == 0.0:
                 continue  # no unbalance force at rest
-            Z = K - w * w * M + 1j * w * D
-            phasors[s][k] = R @ sla.solve(Z, w * w * f, check_finite=False)
+            phasors[s][k] = R @ sla.solve(matrices.dynamic_stiffness(w), w * w * f, check_finite=False)
     return UnbalanceResponse(
         speeds=speeds, reference_spool=operating.reference_of(model), spool_speeds=spool_speeds, outputs=outputs,
         phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors},
@@ -661,12 +679,11 @@ def frequency_response(model, operating: Operating, inputs: Sequence[Output], ou
             checks.fail(name, pairs, "must name at least one (node, direction) pair")
     w_all = checks.vector("frequencies", [frequencies] if np.ndim(frequencies) == 0 else frequencies, "rad/s",
                           ge=0.0)
-    D, K = model.damping(speeds), model.stiffness(speeds)
+    matrices = _Matrices(model, speeds)
     B = model.output_rows(inputs).T
     R = model.output_rows(outputs)
     H = np.empty((len(w_all), len(outputs), len(inputs)), dtype=complex)
     for k, w in enumerate(w_all):
-        Z = K - w * w * model.M + 1j * w * D
-        H[k] = R @ sla.solve(Z, B.astype(complex), check_finite=False)
+        H[k] = R @ sla.solve(matrices.dynamic_stiffness(w), B.astype(complex), check_finite=False)
     return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H,
                              operating=operating)

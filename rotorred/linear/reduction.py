@@ -39,7 +39,8 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
-from rotorred.model.assembly import SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble, model_summary
+from rotorred.model.assembly import (RotatingDamping, SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble,
+                                     model_summary)
 from rotorred.model.dofs import DofMap
 from rotorred.model.operating import Operating
 from rotorred.model.operating import checked as checked_operating
@@ -190,6 +191,10 @@ class ReducedSystem(SpoolSpeedMixin):
         ``T^T`` times the full model's ``supported_weight`` (a rotor with pinned or clamped supports).
     rotor : Rotor or None
         The rotor of the full model (:class:`rotorred.model.assembly.SpoolSpeedMixin`).
+    rotating : dict of str to RotatingDamping
+        The full model's internal (rotating) damping projected, ``T^T X T`` of each of its matrices.
+    loss_frequency : float
+        The full model's (rad/s; :class:`rotorred.model.assembly.SystemMatrices`).
     """
 
     M: np.ndarray
@@ -207,6 +212,8 @@ class ReducedSystem(SpoolSpeedMixin):
     tables: tuple[TabulatedSupport, ...] = ()
     supported_weight: np.ndarray | None = None
     rotor: Rotor | None = field(default=None, compare=False, repr=False)
+    rotating: Mapping[str, RotatingDamping] = field(default_factory=dict)
+    loss_frequency: float = 0.0
     _bpos: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -608,7 +615,8 @@ def _make(system, nodes, basis: _Basis, T, n_modes, selection) -> ReducedSystem:
                          interior_frequencies=basis.omega[:n_modes].copy(), selection=selection, K_G=KGr,
                          tables=tuple(t.on(T) for t in system.tables),
                          supported_weight=None if system.supported_weight is None else T.T @ system.supported_weight,
-                         rotor=system.rotor)
+                         rotor=system.rotor, rotating={s: r.on(T) for s, r in system.rotating.items()},
+                         loss_frequency=system.loss_frequency)
 
 
 def reduce_rotor(rotor: Rotor, extra_nodes: Sequence[int] = (), n_modes: int | None = None,

@@ -8,7 +8,8 @@ where ``M = M_T + M_R`` (translational and rotary), ``K`` includes bearing stiff
 ``C`` bearing and (optional) Rayleigh shaft damping, ``G_s`` collects the shaft and disk
 gyroscopic matrices of spool ``s`` per unit spin speed (1 rad/s), and ``K_G,s`` their
 spin-acceleration matrices per unit angular acceleration (1 rad/s^2; zero at constant speed,
-docs/model.md, Eq. R2).
+docs/model.md, Eq. R2). A spool's internal (rotating) damping adds ``C_r,s`` to the damping and
+``-Omega_s N_s`` to the stiffness (:class:`RotatingDamping`, docs/model.md §19).
 
 Matrices are dense ndarrays: rotorred's models have at most a few thousand DOFs, where
 dense LAPACK beats sparse solvers and keeps eigen-analysis simple. They are built from COO
@@ -22,33 +23,36 @@ from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
+from scipy.linalg import eigh
 from scipy.sparse import coo_matrix
 
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
-from rotorred.model.elements import Bearing, BearingTable
+from rotorred.model.elements import Bearing, BearingTable, IntershaftBearingTable
 from rotorred.model.rotor import Rotor, node_ranges, plural, speed_text
 from rotorred.results import Result
 
-__all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "assemble", "system_of", "DofMap", "DIRECTIONS"]
+__all__ = ["SystemMatrices", "SpoolSpeedMixin", "TabulatedSupport", "RotatingDamping", "assemble", "system_of",
+           "DofMap", "DIRECTIONS"]
 
 
 @dataclass(frozen=True)
 class TabulatedSupport:
-    """A bearing whose coefficients depend on speed (:class:`~rotorred.model.elements.BearingTable`), in a model.
+    """A bearing whose coefficients depend on speed (:class:`~rotorred.model.elements.BearingTable`,
+    :class:`~rotorred.model.elements.IntershaftBearingTable`), in a model.
 
     Attributes
     ----------
-    table : BearingTable
+    table : BearingTable or IntershaftBearingTable
     spool : str
-        The spool whose speed the table follows (the spool of the bearing's node).
-    rows : ndarray, shape (2, n)
-        The bearing node's x and y displacements as rows on the model's coordinates.
-    nominal : Bearing
+        The spool whose speed the table follows (the spool of the bearing's node; an inter-shaft table's ``speed_of``).
+    rows : ndarray, shape (4, n)
+        The bearing's deflection (x, y, theta_x, theta_y) as rows on the model's coordinates (:func:`_deflection_rows`).
+    nominal : Bearing or IntershaftBearing
         The coefficients the model's ``K`` and ``C`` hold: the table at the rotor's speed of ``spool``.
     """
 
-    table: BearingTable
+    table: BearingTable | IntershaftBearingTable
     spool: str
     rows: np.ndarray
     nominal: Bearing
@@ -62,8 +66,48 @@ class TabulatedSupport:
         """The bearing's ``matrix`` (``"K"``: stiffness, ``"C"``: damping) at ``speeds`` (rad/s; a spool left out stands
         still, as in ``gyroscopic``) minus the nominal one, on the model's coordinates, shape (n, n)."""
         b = self.table.at(speeds.get(self.spool, 0.0))
-        delta = getattr(b, matrix) - getattr(self.nominal, matrix)
+        delta = b.block(matrix) - self.nominal.block(matrix)
         return self.rows.T @ delta @ self.rows
+
+
+@dataclass(frozen=True)
+class RotatingDamping:
+    """A spool's internal (rotating) damping in a model (docs/model.md §19).
+
+    In the frame turning with the spool its shaft elements are damped by ``sum_e (beta_e + eta_e / |omega|) K_e``;
+    in the fixed frame that is the damping ``C(omega)`` and, at spool speed ``Omega``, the circulatory stiffness
+    ``-Omega N(omega)`` (skew), with (derivations/internal_damping.py, ``J_e`` the element's rotation generator)
+
+        C(omega) = C_v + C_h / |omega|,   N(omega) = N_v + N_h / |omega|.
+
+    Attributes
+    ----------
+    C_v : ndarray, shape (n, n)
+        ``sum_e beta_e K_e``, viscous (N s/m).
+    N_v : ndarray, shape (n, n)
+        ``sum_e beta_e K_e J_e`` (N s/m).
+    C_h : ndarray, shape (n, n)
+        ``sum_e eta_e K_e``, hysteretic (N/m).
+    N_h : ndarray, shape (n, n)
+        ``sum_e eta_e K_e J_e`` (N/m).
+    """
+
+    C_v: np.ndarray
+    N_v: np.ndarray
+    C_h: np.ndarray
+    N_h: np.ndarray
+
+    def on(self, T: np.ndarray) -> RotatingDamping:
+        """The same damping in the coordinates ``p`` of ``q = T p`` (``T^T X T``; a column selection for supports)."""
+        return RotatingDamping(*(T.T @ X @ T for X in (self.C_v, self.N_v, self.C_h, self.N_h)))
+
+    def at(self, frequency: float) -> tuple[np.ndarray, np.ndarray]:
+        """(C, N) of the viscous damping equivalent at whirl frequency ``frequency`` (rad/s, > 0 where a loss factor
+        is given): ``beta + eta / |frequency|`` for each element."""
+        if not np.any(self.C_h):
+            return self.C_v, self.N_v
+        w = abs(frequency)
+        return self.C_v + self.C_h / w, self.N_v + self.N_h / w
 
 
 class SpoolSpeedMixin:
@@ -105,34 +149,57 @@ class SpoolSpeedMixin:
                 out += Omega * self.G[name]
         return out
 
-    def damping(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C(Omega) + sum_s Omega_s G_s`` (N s/m), shape (n, n), at spool speeds ``speeds`` (rad/s)."""
-        return self.dissipation(speeds) + self.gyroscopic(speeds)
+    def damping(self, speeds: Mapping[str, float], frequency: float | None = None) -> np.ndarray:
+        """``C(Omega) + sum_s Omega_s G_s`` (N s/m), shape (n, n), at spool speeds ``speeds`` (rad/s) (a loss factor
+        at whirl ``frequency``, rad/s: :meth:`rotating_damping`)."""
+        return self.dissipation(speeds, frequency) + self.gyroscopic(speeds)
 
-    def dissipation(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``C(Omega)`` (N s/m), shape (n, n): ``C`` with the speed-dependent bearings' damping at ``speeds`` (rad/s),
-        without the gyroscopic terms (which do no work)."""
-        if not self.tables:
+    def dissipation(self, speeds: Mapping[str, float], frequency: float | None = None) -> np.ndarray:
+        """``C(Omega)`` (N s/m), shape (n, n): ``C`` with the speed-dependent bearings' damping at ``speeds`` (rad/s)
+        and the internal damping (:meth:`rotating_damping`, at whirl ``frequency``), without the gyroscopic terms
+        (which do no work)."""
+        if not self.tables and not self.rotating:
             return self.C
-        out = self.C.copy()
+        out = self.C + self.rotating_damping(speeds, frequency)[0]
         for t in self.tables:
             out += t.change(speeds, "C")
         return out
 
-    def stiffness(self, speeds: Mapping[str, float]) -> np.ndarray:
-        """``K(Omega)`` (N/m), shape (n, n): ``K`` with the speed-dependent bearings' stiffness at ``speeds`` (rad/s)."""
-        if not self.tables:
+    def stiffness(self, speeds: Mapping[str, float], frequency: float | None = None) -> np.ndarray:
+        """``K(Omega)`` (N/m), shape (n, n): ``K`` with the speed-dependent bearings' stiffness at ``speeds`` (rad/s)
+        and the circulatory stiffness of internal damping (:meth:`rotating_damping`, at whirl ``frequency``)."""
+        if not self.tables and not self.rotating:
             return self.K
         checks.keys("speeds", speeds, self.G)
-        out = self.K.copy()
+        out = self.K + self.rotating_damping(speeds, frequency)[1]
         for t in self.tables:
             out += t.change(speeds, "K")
         return out
 
+    def rotating_damping(self, speeds: Mapping[str, float],
+                         frequency: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The internal (rotating) damping in the fixed frame (docs/model.md §19): the damping ``sum_s C_s`` (N s/m)
+        and the circulatory stiffness ``-sum_s Omega_s N_s`` (N/m, skew), shape (n, n) each, at spool speeds
+        ``speeds`` (rad/s; a spool left out stands still). A loss factor eta enters as the viscous ``eta / |omega|``
+        at the whirl ``frequency`` omega (rad/s); None: at :attr:`loss_frequency`."""
+        C, N = np.zeros_like(self.M), np.zeros_like(self.M)
+        w = self.loss_frequency if frequency is None else frequency
+        for s, r in self.rotating.items():
+            C_s, N_s = r.at(w)
+            C += C_s
+            N -= speeds.get(s, 0.0) * N_s
+        return C, N
+
+    @property
+    def frequency_dependent(self) -> bool:
+        """Whether the model's damping and stiffness depend on the whirl frequency: an internal loss factor (taken at
+        the excitation frequency in a harmonic response, docs/model.md §19)."""
+        return any(np.any(r.C_h) for r in self.rotating.values())
+
     @property
     def speed_dependent(self) -> bool:
         """Whether the model's stiffness or damping depends on the speeds beyond the gyroscopic terms."""
-        return bool(self.tables)
+        return bool(self.tables) or bool(self.rotating)
 
 
 @dataclass(frozen=True)
@@ -164,6 +231,13 @@ class SystemMatrices(SpoolSpeedMixin):
     rotor : Rotor or None
         The rotor assembled (:func:`assemble`): its nominal speeds, spools and disks (:class:`SpoolSpeedMixin`);
         None for a model built by hand.
+    rotating : dict of str to RotatingDamping
+        Internal (rotating) damping of each spool that has some (empty: none); :meth:`dissipation` and
+        :meth:`stiffness` hold it at given speeds (docs/model.md §19).
+    loss_frequency : float
+        Whirl frequency (rad/s) at which a loss factor is taken where an analysis has none of its own (Campbell,
+        transients, harmonic balance): the model's first natural frequency at rest (docs/model.md §19); 0 without
+        a loss factor.
     """
 
     M: np.ndarray
@@ -175,6 +249,8 @@ class SystemMatrices(SpoolSpeedMixin):
     tables: tuple[TabulatedSupport, ...] = ()
     supported_weight: np.ndarray | None = None
     rotor: Rotor | None = field(default=None, compare=False, repr=False)
+    rotating: Mapping[str, RotatingDamping] = field(default_factory=dict)
+    loss_frequency: float = 0.0
 
     @property
     def n_dof(self) -> int:
@@ -242,6 +318,9 @@ def model_summary(model) -> list[str]:
              f"M, K, C of shape ({model.n_dof}, {model.n_dof}); a G{' and a K_G' if model.K_G else ''} per spool"]
     speeds = [f"spool {s!r}, nominal {speed_text(w)}" for s, w in model.nominal_speeds.items()]
     lines += speeds if len(speeds) <= 3 else speeds[:2] + [f"... and {len(speeds) - 2} more spools"]
+    if model.rotating:
+        lines.append(f"internal (rotating) damping on spool{'s' * (len(model.rotating) > 1)} "
+                     f"{', '.join(model.rotating)}")
     if model.tables:
         lines.append(f"{plural(len(model.tables), 'bearing')} tabulated against speed, at nodes "
                      f"{node_ranges(t.table.node for t in model.tables)}: K and C at the nominal speeds")
@@ -315,6 +394,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     n = dofs.n_dof
     next_internal = n - n_internal
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
+    parts = {s.name: [_Triplets() for _ in range(4)] for s in rotor.spools}  # C_v, N_v, C_h, N_h of RotatingDamping
     G = {s.name: _Triplets() for s in rotor.spools}
     K_G = {s.name: _Triplets() for s in rotor.spools}
     for s in rotor.spools:
@@ -329,6 +409,11 @@ def assemble(rotor: Rotor) -> SystemMatrices:
             K_shaft.add(idx, Ke)
             G[s.name].add(idx, e.G())
             K_G[s.name].add(idx, e.K_G())
+            beta, eta = s.internal_damping(e)
+            if beta or eta:
+                KJ = Ke @ e.spin_rotation()
+                for triplets, factor, X in zip(parts[s.name], (beta, beta, eta, eta), (Ke, KJ, Ke, KJ)):
+                    triplets.add(idx, factor * X)
     spool_of = rotor.spool_of
     for d in rotor.disks:
         idx = dofs.node_dofs(d.node)
@@ -337,42 +422,62 @@ def assemble(rotor: Rotor) -> SystemMatrices:
         K_G[spool_of[d.node]].add(idx, d.K_G())
     for p in rotor.pedestals:
         M.add(dofs.node_dofs(p.node), p.M())
-    coupling = np.array([[1.0, -1.0], [-1.0, 1.0]])
     tables = []
-    for b in rotor.bearings:
-        idx = dofs.node_dofs(b.node)[:2]
-        if isinstance(b, BearingTable):
-            spool = spool_of[b.node]
-            tables.append(TabulatedSupport(b, spool, _deflection_rows(dofs, b), b.at(rotor.speeds[spool])))
+    for b in (*rotor.bearings, *rotor.intershaft_bearings):
+        rows = _deflection_rows(dofs, b)
+        if isinstance(b, (BearingTable, IntershaftBearingTable)):
+            spool = _table_spool(b, spool_of)
+            tables.append(TabulatedSupport(b, spool, rows, b.at(rotor.speeds[spool])))
             b = tables[-1].nominal
-        if b.link is None:
-            K.add(idx, b.K)
-            C.add(idx, b.C)
-        else:
-            both = np.concatenate([idx, dofs.node_dofs(b.link)])
-            K.add(both, np.kron(coupling, b.K))
-            C.add(both, np.kron(coupling, b.C))
-    for b in rotor.intershaft_bearings:
-        a, c = dofs.node_dofs(b.node_a)[:2], dofs.node_dofs(b.node_b)[:2]
-        idx = np.concatenate([a, c])
-        K.add(idx, np.kron(coupling, b.K))
-        C.add(idx, np.kron(coupling, b.C))
+        idx = np.flatnonzero(np.any(rows != 0.0, axis=0))  # the DOFs the bearing's deflection reads
+        K.add(idx, rows[:, idx].T @ b.block("K") @ rows[:, idx])
+        C.add(idx, rows[:, idx].T @ b.block("C") @ rows[:, idx])
     Cm = C.dense(n)
     alpha, beta = rotor.rayleigh
     if alpha or beta:
         Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
+    rotating = {k: RotatingDamping(*(t.dense(n) for t in v)) for k, v in parts.items() if v[0].vals}
     free = SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
-                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor)
-    return _supported(free, rotor.supports)
+                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor,
+                          rotating=rotating)
+    supported = _supported(free, rotor.supports)
+    if any(np.any(r.C_h) for r in rotating.values()):
+        supported = dataclasses.replace(supported, loss_frequency=first_natural_frequency(supported.M, supported.K))
+    return supported
+
+
+#: generalised eigenvalues w^2 of (K, M) below this fraction of the largest are rigid-body motions (as in
+#: rotorred.linear.campbell's rigid-body test)
+_RIGID_RTOL = 1e-10
+
+
+def first_natural_frequency(M: np.ndarray, K: np.ndarray) -> float:
+    """The lowest natural frequency of the undamped model at rest, ``K phi = w^2 M phi`` (rad/s), rigid-body
+    motions (w^2 <= 1e-10 max w^2) left out: where a loss factor is taken when an analysis has no whirl frequency
+    of its own (docs/model.md §19)."""
+    w2 = eigh(0.5 * (K + K.T), M, eigvals_only=True)
+    w2 = np.sort(w2[w2 > _RIGID_RTOL * max(float(np.max(np.abs(w2))), 1e-300)])
+    if not len(w2):
+        checks.fail("internal_loss_factor", "given", "needs a rotor with an elastic mode (every mode is rigid)")
+    return float(np.sqrt(w2[0]))
 
 
 def _deflection_rows(dofs: DofMap, b) -> np.ndarray:
-    """A bearing's deflection, its node's x, y (less its pedestal's), as rows on the DOFs, shape (2, n)."""
-    rows = np.zeros((2, dofs.n_dof))
-    rows[[0, 1], dofs.node_dofs(b.node)[:2]] = 1.0
-    if b.link is not None:
-        rows[[0, 1], dofs.node_dofs(b.link)] = -1.0
+    """A bearing's deflection (x, y, theta_x, theta_y) as rows on the DOFs, shape (4, n): its node's motion, less
+    its pedestal's x, y (a pedestal does not tilt) or the other spool's node's motion (an inter-shaft bearing). The
+    tilt rows are zero at a pedestal node, which has no rotations (docs/model.md §20)."""
+    rows = np.zeros((4, dofs.n_dof))
+    for node, sign in ((b.node_a, 1.0), (b.node_b, -1.0)) if hasattr(b, "node_b") else ((b.node, 1.0), (b.link, -1.0)):
+        if node is not None:
+            idx = dofs.node_dofs(node)
+            rows[np.arange(len(idx)), idx] = sign
     return rows
+
+
+def _table_spool(b, spool_of: Mapping[int, str]) -> str:
+    """The spool whose speed a bearing table follows: an inter-shaft table's ``speed_of`` (default its node_a's), else
+    its node's."""
+    return getattr(b, "speed_of", None) or spool_of[b.node]
 
 
 def _supported(system: SystemMatrices, supports) -> SystemMatrices:
@@ -391,4 +496,6 @@ def _supported(system: SystemMatrices, supports) -> SystemMatrices:
     return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
                           dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
                           tables=tuple(dataclasses.replace(t, rows=t.rows[:, keep]) for t in system.tables),
-                          supported_weight=(system.M @ e_y)[keep], rotor=system.rotor)
+                          supported_weight=(system.M @ e_y)[keep], rotor=system.rotor,
+                          rotating={k: RotatingDamping(*(cut(X) for X in (r.C_v, r.N_v, r.C_h, r.N_h)))
+                                    for k, r in system.rotating.items()})

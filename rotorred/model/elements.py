@@ -22,8 +22,9 @@ from rotorred import checks
 from rotorred._generated.tapered import tapered_mass_rotary, tapered_mass_translational
 from rotorred._generated.tapered import tapered_spin_acceleration, tapered_stiffness
 from rotorred._generated import timoshenko as _gen
+from rotorred._generated.internal_damping import hierarchical_spin_rotation, timoshenko_spin_rotation
 
-SHEAR_METHODS = ("cowper", "hutchinson", "none")
+SHEAR_METHODS = ("cowper", "hutchinson", "ross-hutchinson", "none")
 FORMULATIONS = ("nelson", "hierarchical")
 
 
@@ -103,14 +104,17 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
         Outer and inner diameter (m), 0 <= D_i < D_o.
     nu : float
         Poisson's ratio (-).
-    method : {"cowper", "hutchinson"}
+    method : {"cowper", "hutchinson", "ross-hutchinson"}
         ``"cowper"``: Cowper (1966), J. Appl. Mech. 33, Table 1, hollow circle,
         kappa = 6 (1+nu)(1+m^2)^2 / ((7+6nu)(1+m^2)^2 + (20+12nu) m^2), m = D_i/D_o.
         ``"hutchinson"``: Hutchinson (2001), J. Appl. Mech. 68, Eq. (52), hollow circle
         (a = outer, b = inner radius),
         kappa = 6 (a^2+b^2)^2 (1+nu)^2 / (7a^4 + 34a^2b^2 + 7b^4
         + nu (12a^4 + 48a^2b^2 + 12b^4) + nu^2 (4a^4 + 16a^2b^2 + 4b^4)).
-        The (1+nu)^2 factor is part of the published formula (ROSS's line omits it).
+        The (1+nu)^2 factor is part of the published formula.
+        ``"ross-hutchinson"``: ROSS's line for Hutchinson's coefficient (``ShaftElement(shear_method_calc=
+        "hutchinson")``), which has (1+nu) where the published formula has (1+nu)^2: the published value / (1+nu),
+        to reproduce a ROSS rotor (docs/model.md §20).
 
     Returns
     -------
@@ -125,7 +129,9 @@ def shear_coefficient(D_o: float, D_i: float, nu: float, method: str = "cowper")
         den = (7 * a2**2 + 34 * a2 * b2 + 7 * b2**2 + nu * (12 * a2**2 + 48 * a2 * b2 + 12 * b2**2)
                + nu**2 * (4 * a2**2 + 16 * a2 * b2 + 4 * b2**2))
         return num / den
-    checks.choice("method", method, ("cowper", "hutchinson"))
+    if method == "ross-hutchinson":
+        return shear_coefficient(D_o, D_i, nu, "hutchinson") / (1 + nu)
+    checks.choice("method", method, ("cowper", "hutchinson", "ross-hutchinson"))
 
 
 @dataclass(frozen=True)
@@ -143,8 +149,8 @@ class ShaftElement:
     D_i : float
         Inner diameter (m), 0 <= D_i < D_o.
     material : Material
-    shear : {"cowper", "hutchinson", "none"}
-        Shear coefficient formula; ``"none"`` gives the Euler-Bernoulli element (phi = 0)
+    shear : {"cowper", "hutchinson", "ross-hutchinson", "none"}
+        Shear coefficient formula (:func:`shear_coefficient`); ``"none"`` gives the Euler-Bernoulli element (phi = 0)
         with rotary inertia (Rayleigh beam).
     element : {"nelson", "hierarchical"}
         ``"nelson"`` (default): interdependent interpolation (Nelson 1980), 4 DOFs per node,
@@ -160,6 +166,13 @@ class ShaftElement:
         Diameters at the right node (m) of a tapered element, default ``D_o`` and ``D_i``: the
         diameters vary linearly from left to right and the element is the conical one of
         derivations/tapered.py (``element = "nelson"`` only). ``D_o``, ``D_i`` are then the left ones.
+    internal_damping_beta : float, optional
+        Internal (rotating) viscous damping (s): the damping ``beta K`` acting in the frame that turns with the
+        shaft (docs/model.md §19), >= 0. None (default): its spool's
+        (:attr:`rotorred.model.rotor.Spool.internal_damping_beta`).
+    internal_loss_factor : float, optional
+        Internal hysteretic damping: loss factor eta (-), >= 0, as the viscous ``beta = eta / |omega|`` at the whirl
+        frequency omega (docs/model.md §19). None (default): its spool's.
     """
 
     left: int
@@ -173,9 +186,14 @@ class ShaftElement:
     rotary_inertia: bool = True
     D_o_right: float | None = None
     D_i_right: float | None = None
+    internal_damping_beta: float | None = None
+    internal_loss_factor: float | None = None
 
     def __post_init__(self):
         _set(self, "left", checks.integer("left", self.left, ge=0))
+        for key, unit in (("internal_damping_beta", "s"), ("internal_loss_factor", "-")):
+            if getattr(self, key) is not None:
+                _set(self, key, checks.non_negative(key, getattr(self, key), unit))
         if not isinstance(self.rotary_inertia, (bool, np.bool_)):
             checks.fail("rotary_inertia", self.rotary_inertia, "must be true or false")
         _set(self, "right", checks.integer("right", self.right, ge=0))
@@ -305,6 +323,12 @@ class ShaftElement:
             return _gen.hierarchical_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
         return _gen.timoshenko_spin_acceleration(self.L, self.material.rho, I_r, self.phi)
 
+    def spin_rotation(self) -> np.ndarray:
+        """Rotation generator ``J`` of the element's DOFs, ``q = exp(Omega t J) q_r`` from the rotating frame,
+        shape (8 + n_internal,) * 2 (-): the rotating damping ``beta K`` is the circulatory stiffness
+        ``-Omega beta K J`` in the fixed frame (derivations/internal_damping.py)."""
+        return hierarchical_spin_rotation() if self.element == "hierarchical" else timoshenko_spin_rotation()
+
     def split(self, n: int, new_nodes: list[int]) -> list[ShaftElement]:
         """Split into ``n`` equal elements through ``new_nodes`` (length n - 1); a taper is split along its line.
 
@@ -324,7 +348,8 @@ class ShaftElement:
         return [ShaftElement(chain[i], chain[i + 1], self.L / n, along(self.D_o, self.D_o_right, i / n),
                              along(self.D_i, self.D_i_right, i / n), self.material, self.shear, self.element,
                              self.rotary_inertia, along(self.D_o, self.D_o_right, (i + 1) / n),
-                             along(self.D_i, self.D_i_right, (i + 1) / n)) for i in range(n)]
+                             along(self.D_i, self.D_i_right, (i + 1) / n), self.internal_damping_beta,
+                             self.internal_loss_factor) for i in range(n)]
 
 
 def along(left: float, right: float, xi: float) -> float:
@@ -394,11 +419,18 @@ class _Support:
     c_xy: float = 0.0
     c_yx: float = 0.0
     name: str = ""
+    k_txtx: float = 0.0
+    k_tyty: float = 0.0
+    k_txty: float = 0.0
+    k_tytx: float = 0.0
+    c_txtx: float = 0.0
+    c_tyty: float = 0.0
+    c_txty: float = 0.0
+    c_tytx: float = 0.0
 
     def _validate(self):
         for c in COEFFICIENTS:
-            unit = "N/m" if c[0] == "k" else "N s/m"
-            _set(self, c, checks.number(c, getattr(self, c), unit, ge=_least(c)))
+            _set(self, c, checks.number(c, getattr(self, c), coefficient_unit(c), ge=_least(c)))
         _set(self, "name", checks.string("name", self.name))
 
     @property
@@ -410,6 +442,29 @@ class _Support:
     def C(self) -> np.ndarray:
         """Translational damping [[c_xx, c_xy], [c_yx, c_yy]], shape (2, 2) (N s/m)."""
         return np.array([[self.c_xx, self.c_xy], [self.c_yx, self.c_yy]])
+
+    @property
+    def K_tilt(self) -> np.ndarray:
+        """Tilt stiffness [[k_txtx, k_txty], [k_tytx, k_tyty]] on (theta_x, theta_y), shape (2, 2) (N m/rad)."""
+        return np.array([[self.k_txtx, self.k_txty], [self.k_tytx, self.k_tyty]])
+
+    @property
+    def C_tilt(self) -> np.ndarray:
+        """Tilt damping [[c_txtx, c_txty], [c_tytx, c_tyty]] on (theta_x, theta_y), shape (2, 2) (N m s/rad)."""
+        return np.array([[self.c_txtx, self.c_txty], [self.c_tytx, self.c_tyty]])
+
+    @property
+    def tilts(self) -> bool:
+        """Whether any tilt coefficient is non-zero."""
+        return any(getattr(self, c) != 0.0 for c in TILT_COEFFICIENTS)
+
+    def block(self, matrix: str) -> np.ndarray:
+        """The support's ``matrix`` (``"K"``: stiffness, ``"C"``: damping) on a node's (x, y, theta_x, theta_y), shape
+        (4, 4): the translational 2 x 2 and the tilt 2 x 2 on the diagonal (no translation-tilt coupling)."""
+        out = np.zeros((4, 4))
+        out[:2, :2] = getattr(self, matrix)
+        out[2:, 2:] = getattr(self, f"{matrix}_tilt")
+        return out
 
 
 @dataclass(frozen=True)
@@ -426,6 +481,11 @@ class Bearing(_Support):
     c_xx, c_yy, c_xy, c_yx : float
         Damping coefficients (N s/m); the direct ones (c_xx, c_yy) >= 0.
     name : str
+    k_txtx, k_tyty, k_txty, k_tytx : float
+        Tilt stiffness (N m/rad), any sign: the moment on the shaft is -K_tilt [theta_x, theta_y] (docs/model.md §20;
+        with a link too, as a pedestal does not tilt). Not at a pedestal node (it has no rotations).
+    c_txtx, c_tyty, c_txty, c_tytx : float
+        Tilt damping (N m s/rad); the direct ones >= 0.
     link : int or None
         The pedestal node (:class:`Pedestal`) the bearing joins ``node`` to; None: ground.
     """
@@ -514,11 +574,15 @@ EXTRAPOLATIONS = ("hold", "linear")
 #: how a :class:`BearingTable` interpolates between its speeds
 INTERPOLATIONS = ("linear", "pchip")
 
-#: the coefficients of a support, in the order of :class:`_Support`'s fields
-COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
+#: the translational coefficients of a support, in the order of :class:`_Support`'s fields
+TRANSLATIONAL_COEFFICIENTS = ("k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx")
+#: the tilt coefficients of a support (on theta_x, theta_y; docs/model.md §20)
+TILT_COEFFICIENTS = ("k_txtx", "k_tyty", "k_txty", "k_tytx", "c_txtx", "c_tyty", "c_txty", "c_tytx")
+#: every coefficient of a support
+COEFFICIENTS = TRANSLATIONAL_COEFFICIENTS + TILT_COEFFICIENTS
 #: the coefficients that must be >= 0: a passive support's direct damping. Direct stiffness may be negative (annular
 #: and labyrinth seals have it: Childs 1993, Turbomachinery Rotordynamics, ch. 4), cross-coupled terms have any sign.
-DIRECT_DAMPING = ("c_xx", "c_yy")
+DIRECT_DAMPING = ("c_xx", "c_yy", "c_txtx", "c_tyty")
 
 
 def _least(c: str) -> float | None:
@@ -526,8 +590,77 @@ def _least(c: str) -> float | None:
     return 0.0 if c in DIRECT_DAMPING else None
 
 
+def coefficient_unit(c: str) -> str:
+    """The SI unit of support coefficient ``c``: N/m, N s/m; N m/rad, N m s/rad for the tilt terms."""
+    tilt = c in TILT_COEFFICIENTS
+    return {("k", False): "N/m", ("c", False): "N s/m", ("k", True): "N m/rad", ("c", True): "N m s/rad"}[c[0], tilt]
+
+
+class _TableRules:
+    """What every bearing table does with its columns (:class:`BearingTable`, :class:`IntershaftBearingTable`): check
+    them against its speeds, interpolate and extrapolate them (docs/model.md §10). A class using it is a frozen
+    dataclass with ``speeds``, the :data:`COEFFICIENTS` columns, ``interpolation`` and ``extrapolate``."""
+
+    def _check_table(self) -> None:
+        _set(self, "extrapolate", checks.choice("extrapolate", self.extrapolate, EXTRAPOLATIONS))
+        _set(self, "interpolation", checks.choice("interpolation", self.interpolation, INTERPOLATIONS))
+        speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
+        _set(self, "speeds", tuple(float(v) for v in speeds))
+        for c in COEFFICIENTS:
+            unit, ge, value = coefficient_unit(c), _least(c), getattr(self, c)
+            if np.ndim(value) == 0:
+                value = [checks.number(c, value, unit, ge=ge)] * len(speeds)
+            column = checks.vector(c, value, unit, min_len=len(speeds), max_len=len(speeds), ge=ge)
+            _set(self, c, tuple(float(v) for v in column))
+        _set(self, "name", checks.string("name", self.name))
+        if self.interpolation == "pchip" and len(speeds) > 2:
+            _set(self, "_curves", {c: _pchip(speeds, getattr(self, c)) for c in COEFFICIENTS})
+
+    def _coefficients_at(self, Omega: float, where: str) -> dict[str, float]:
+        """Every coefficient at speed ``Omega`` (rad/s); a direct damping extrapolated below 0 is refused, naming
+        the bearing by ``where``."""
+        Omega = checks.non_negative("Omega", Omega, "rad/s")
+        values = {c: self._value(c, Omega) for c in COEFFICIENTS}
+        for c in DIRECT_DAMPING:
+            if values[c] < 0.0:
+                checks.fail("extrapolate", self.extrapolate, f"gives {c} = {values[c]:.6g} at {Omega:.6g} rad/s for "
+                            f"the bearing at {where}, below 0 (its table covers {self.speeds[0]:.6g}-"
+                            f"{self.speeds[-1]:.6g} rad/s); extend the table or hold its ends (extrapolate = 'hold')")
+        return values
+
+    def _value(self, c: str, Omega: float) -> float:
+        W, v = self.speeds, getattr(self, c)
+        curves = getattr(self, "_curves", None)
+        end = 0 if Omega < W[0] else -1  # the table's end on Omega's side, where it lies outside the table
+        if curves is None:  # straight segments
+            if self.extrapolate == "linear" and not self.covers(Omega):
+                i = 0 if end == 0 else len(W) - 2  # the end segment on that side
+                return float(v[i] + (v[i + 1] - v[i]) * (Omega - W[i]) / (W[i + 1] - W[i]))
+            return float(np.interp(Omega, W, v))
+        value, slope = curves[c]
+        if self.covers(Omega):
+            return float(value(Omega))
+        tangent = slope[end] if self.extrapolate == "linear" else 0.0
+        return float(v[end] + tangent * (Omega - W[end]))
+
+    def covers(self, Omega: float) -> bool:
+        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies).
+
+        Parameters
+        ----------
+        Omega : float
+            Spool speed (rad/s).
+        """
+        return self.speeds[0] <= Omega <= self.speeds[-1]
+
+
+#: what the axis of a :class:`BearingTable` is: the spool's speed, or the whirl frequency of a table made against it
+#: (ROSS's ``frequency``), evaluated at frequency = spool speed (docs/model.md §20)
+TABLE_AXES = ("speed", "frequency")
+
+
 @dataclass(frozen=True)
-class BearingTable:
+class BearingTable(_TableRules):
     """Bearing from a node to ground whose coefficients are tabulated against the speed of the node's spool
     (fluid-film bearings, seals).
 
@@ -558,6 +691,12 @@ class BearingTable:
     interpolation : {"linear", "pchip"}
         Between the table's speeds: straight segments, or scipy's ``PchipInterpolator`` (C1, monotone between
         monotone data; with 2 speeds it is the straight line).
+    k_txtx, k_tyty, k_txty, k_tytx, c_txtx, c_tyty, c_txty, c_tytx : float or sequence of float, shape (p,)
+        Tilt stiffness (N m/rad) and damping (N m s/rad), as :class:`Bearing`'s, the same way.
+    axis : {"speed", "frequency"}
+        What the table's ``speeds`` were computed against: the spool speed, or the whirl (excitation) frequency of a
+        synchronous analysis (ROSS's ``frequency`` tables). Both are evaluated at the spool's speed, which a
+        ``"frequency"`` table takes as its frequency (docs/model.md §20); the axis is kept for what a file writes back.
     """
 
     node: int
@@ -574,25 +713,26 @@ class BearingTable:
     link: int | None = None
     extrapolate: str = "hold"
     interpolation: str = "linear"
+    k_txtx: tuple[float, ...] | float = 0.0
+    k_tyty: tuple[float, ...] | float = 0.0
+    k_txty: tuple[float, ...] | float = 0.0
+    k_tytx: tuple[float, ...] | float = 0.0
+    c_txtx: tuple[float, ...] | float = 0.0
+    c_tyty: tuple[float, ...] | float = 0.0
+    c_txty: tuple[float, ...] | float = 0.0
+    c_tytx: tuple[float, ...] | float = 0.0
+    axis: str = "speed"
 
     def __post_init__(self):
         _set(self, "node", checks.integer("node", self.node, ge=0))
         _check_link(self)
-        _set(self, "extrapolate", checks.choice("extrapolate", self.extrapolate, EXTRAPOLATIONS))
-        _set(self, "interpolation", checks.choice("interpolation", self.interpolation, INTERPOLATIONS))
-        speeds = checks.vector("speeds", self.speeds, "rad/s", min_len=2, ge=0.0, increasing=True)
-        _set(self, "speeds", tuple(float(v) for v in speeds))
-        for c in COEFFICIENTS:
-            unit = "N/m" if c[0] == "k" else "N s/m"
-            ge = _least(c)
-            value = getattr(self, c)
-            if np.ndim(value) == 0:
-                value = [checks.number(c, value, unit, ge=ge)] * len(speeds)
-            column = checks.vector(c, value, unit, min_len=len(speeds), max_len=len(speeds), ge=ge)
-            _set(self, c, tuple(float(v) for v in column))
-        _set(self, "name", checks.string("name", self.name))
-        if self.interpolation == "pchip" and len(speeds) > 2:
-            _set(self, "_curves", {c: _pchip(speeds, getattr(self, c)) for c in COEFFICIENTS})
+        _set(self, "axis", checks.choice("axis", self.axis, TABLE_AXES))
+        self._check_table()
+
+    @property
+    def tilts(self) -> bool:
+        """Whether any tilt coefficient is non-zero at a tabulated speed."""
+        return any(v != 0.0 for c in TILT_COEFFICIENTS for v in getattr(self, c))
 
     def at(self, Omega: float) -> Bearing:
         """The bearing at spool speed ``Omega`` (rad/s): each coefficient interpolated in speed (:attr:`interpolation`);
@@ -613,39 +753,8 @@ class BearingTable:
         InputError
             If ``Omega`` < 0, or linear extrapolation gives a direct damping coefficient below 0.
         """
-        Omega = checks.non_negative("Omega", Omega, "rad/s")
-        values = {c: self._value(c, Omega) for c in COEFFICIENTS}
-        for c in DIRECT_DAMPING:
-            if values[c] < 0.0:
-                checks.fail("extrapolate", self.extrapolate, f"gives {c} = {values[c]:.6g} at {Omega:.6g} rad/s for "
-                            f"the bearing at node {self.node}, below 0 (its table covers {self.speeds[0]:.6g}-"
-                            f"{self.speeds[-1]:.6g} rad/s); extend the table or hold its ends (extrapolate = 'hold')")
-        return Bearing(node=self.node, name=self.name, link=self.link, **values)
-
-    def _value(self, c: str, Omega: float) -> float:
-        W, v = self.speeds, getattr(self, c)
-        curves = getattr(self, "_curves", None)
-        end = 0 if Omega < W[0] else -1  # the table's end on Omega's side, where it lies outside the table
-        if curves is None:  # straight segments
-            if self.extrapolate == "linear" and not self.covers(Omega):
-                i = 0 if end == 0 else len(W) - 2  # the end segment on that side
-                return float(v[i] + (v[i + 1] - v[i]) * (Omega - W[i]) / (W[i + 1] - W[i]))
-            return float(np.interp(Omega, W, v))
-        value, slope = curves[c]
-        if self.covers(Omega):
-            return float(value(Omega))
-        tangent = slope[end] if self.extrapolate == "linear" else 0.0
-        return float(v[end] + tangent * (Omega - W[end]))
-
-    def covers(self, Omega: float) -> bool:
-        """Whether ``Omega`` (rad/s) lies within the table's speeds (outside, :attr:`extrapolate` applies).
-
-        Parameters
-        ----------
-        Omega : float
-            Spool speed (rad/s).
-        """
-        return self.speeds[0] <= Omega <= self.speeds[-1]
+        return Bearing(node=self.node, name=self.name, link=self.link,
+                       **self._coefficients_at(Omega, f"node {self.node}"))
 
 
 def _pchip(speeds: np.ndarray, values: tuple[float, ...]):
@@ -672,14 +781,98 @@ class IntershaftBearing(_Support):
     c_xx, c_yy, c_xy, c_yx : float
         Damping (N s/m).
     name : str
+    k_txtx, k_tyty, k_txty, k_tytx, c_txtx, c_tyty, c_txty, c_tytx : float
+        Tilt stiffness (N m/rad) and damping (N m s/rad) on the relative tilt (theta_a - theta_b), as
+        :class:`Bearing`'s.
     """
 
     node_a: int = field(default=-1, kw_only=True)
     node_b: int = field(default=-1, kw_only=True)
 
     def __post_init__(self):
-        _set(self, "node_a", checks.integer("node_a", self.node_a, ge=0))
-        _set(self, "node_b", checks.integer("node_b", self.node_b, ge=0))
-        if self.node_a == self.node_b:
-            checks.fail("node_b", self.node_b, f"must differ from node_a = {self.node_a}")
+        _check_nodes_ab(self)
         self._validate()
+
+
+def _check_nodes_ab(bearing) -> None:
+    _set(bearing, "node_a", checks.integer("node_a", bearing.node_a, ge=0))
+    _set(bearing, "node_b", checks.integer("node_b", bearing.node_b, ge=0))
+    if bearing.node_a == bearing.node_b:
+        checks.fail("node_b", bearing.node_b, f"must differ from node_a = {bearing.node_a}")
+
+
+@dataclass(frozen=True)
+class IntershaftBearingTable(_TableRules):
+    """Inter-shaft bearing whose coefficients are tabulated against the speed of one named spool (docs/model.md §20).
+
+    The force on ``node_a`` is -K (u_a - u_b) - C (u_a' - u_b') with K, C at that spool's speed, on ``node_b`` its
+    opposite; interpolated and extrapolated as a :class:`BearingTable`. :meth:`at` gives the
+    :class:`IntershaftBearing` at one speed.
+
+    Parameters
+    ----------
+    node_a, node_b : int
+        The nodes joined, on two different spools.
+    speeds : sequence of float, shape (p,)
+        Speeds of spool ``speed_of`` (rad/s), >= 0 and strictly increasing, at least 2.
+    k_xx, k_yy, k_xy, k_yx, c_xx, c_yy, c_xy, c_yx : float or sequence of float, shape (p,)
+        Stiffness (N/m) and damping (N s/m) at each speed (a number: at every speed); the direct damping >= 0.
+    name : str
+    speed_of : str or None
+        The spool whose speed the table follows; None: the spool of ``node_a`` (the rotor checks the name).
+    extrapolate : {"hold", "linear"}
+    interpolation : {"linear", "pchip"}
+    k_txtx, k_tyty, k_txty, k_tytx, c_txtx, c_tyty, c_txty, c_tytx : float or sequence of float, shape (p,)
+        Tilt stiffness (N m/rad) and damping (N m s/rad) on the relative tilt, the same way.
+    """
+
+    node_a: int
+    node_b: int
+    speeds: tuple[float, ...]
+    k_xx: tuple[float, ...] | float = 0.0
+    k_yy: tuple[float, ...] | float = 0.0
+    k_xy: tuple[float, ...] | float = 0.0
+    k_yx: tuple[float, ...] | float = 0.0
+    c_xx: tuple[float, ...] | float = 0.0
+    c_yy: tuple[float, ...] | float = 0.0
+    c_xy: tuple[float, ...] | float = 0.0
+    c_yx: tuple[float, ...] | float = 0.0
+    name: str = ""
+    speed_of: str | None = None
+    extrapolate: str = "hold"
+    interpolation: str = "linear"
+    k_txtx: tuple[float, ...] | float = 0.0
+    k_tyty: tuple[float, ...] | float = 0.0
+    k_txty: tuple[float, ...] | float = 0.0
+    k_tytx: tuple[float, ...] | float = 0.0
+    c_txtx: tuple[float, ...] | float = 0.0
+    c_tyty: tuple[float, ...] | float = 0.0
+    c_txty: tuple[float, ...] | float = 0.0
+    c_tytx: tuple[float, ...] | float = 0.0
+
+    def __post_init__(self):
+        _check_nodes_ab(self)
+        if self.speed_of is not None:
+            _set(self, "speed_of", checks.string("speed_of", self.speed_of, empty=False))
+        self._check_table()
+
+    @property
+    def node(self) -> int:
+        """``node_a``: the node that names the bearing in messages."""
+        return self.node_a
+
+    def at(self, Omega: float) -> IntershaftBearing:
+        """The inter-shaft bearing at speed ``Omega`` (rad/s) of spool :attr:`speed_of`, as :meth:`BearingTable.at`.
+
+        Parameters
+        ----------
+        Omega : float
+            Speed of spool ``speed_of`` (rad/s), >= 0.
+
+        Returns
+        -------
+        IntershaftBearing
+            Stiffness (N/m, N m/rad) and damping (N s/m, N m s/rad) at ``Omega``.
+        """
+        return IntershaftBearing(node_a=self.node_a, node_b=self.node_b, name=self.name,
+                                 **self._coefficients_at(Omega, f"nodes {self.node_a}-{self.node_b}"))

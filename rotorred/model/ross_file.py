@@ -19,17 +19,20 @@ What maps to what (docs/model.md §14):
 - ``BearingElement``, ``SealElement``, ``BallBearingElement``, ``RollerBearingElement`` -> a
   ``[[bearing]]`` (``n_link``: ``link``); tables against ``speed`` (rad/s) -> ``speed_rpm`` lists with
   ROSS's interpolation (``"pchip"`` or ``"linear"``) and its extrapolation along the end tangents
-  (``extrapolate = "linear"``).
+  (``extrapolate = "linear"``); tables against whirl ``frequency`` -> ``frequency_rpm`` lists, evaluated as ROSS's
+  modal and unbalance analyses evaluate them, at frequency = the spool's speed (said once at load, as a warning of
+  the logger ``rotorred.model.ross_file``; docs/model.md §20).
 
 ROSS models have 6 DOFs a node; rotorred's are lateral (x, y, theta_x, theta_y). The axial and
 torsional coefficients (``kzz``, ``czz``, ``mzz``) do not couple to lateral motion in ROSS's linear
 model and are not read. Anything else rotorred cannot represent (another element kind, bearing
-mass coefficients, axial force or torque on a shaft, coefficients against whirl frequency, Rayleigh
+mass coefficients, axial force or torque on a shaft, a table against both speed and whirl frequency, Rayleigh
 or modal damping) is refused by name, never dropped.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 from collections import defaultdict
 from typing import Any
@@ -37,6 +40,9 @@ from typing import Any
 from rotorred import checks
 
 __all__ = ["READ_KINDS", "is_ross_document", "ross_document"]
+
+#: where the reader says what it read differently from ROSS's saved form (a warning each, once a file)
+LOG = logging.getLogger(__name__)
 
 #: the ROSS element classes rotorred reads, and what it makes of them
 READ_KINDS = {"ShaftElement": "shaft element", "DiskElement": "disk", "PointMass": "point mass",
@@ -101,6 +107,7 @@ def ross_document(data: dict[str, Any], name: str = "ross-rotor") -> dict[str, A
     bearings = [_bearing(table, kind, values) for kind in ("BearingElement", "SealElement", "BallBearingElement",
                                                            "RollerBearingElement")
                 for table, values in sections[kind]]
+    _note_frequency_tables(bearings)
     document = {"name": name, "description": f"read from a rotor saved by ROSS {data.get('ross_version')}",
                 "material": list(materials.values()), "spool": [spool], "disk": disks, "bearing": bearings}
     if pedestals:
@@ -245,9 +252,11 @@ def _masses(disks: list[tuple[str, dict]], points: list[tuple[str, dict]], shaft
 def _bearing(where: str, kind: str, t: dict) -> dict[str, Any]:
     """A rotorred ``[[bearing]]`` of a ROSS bearing or seal table: constant, or a table against speed."""
     checks.keys(where, t, _BEARING_KEYS | _ROLLING_KEYS.get(kind, set()), required={"n", "kxx", "kyy"})
-    if "frequency" in t:
-        checks.fail(f"{where}.frequency", t["frequency"], "must not be given: rotorred's bearing coefficients depend "
-                    "on speed only, not on the whirl frequency")
+    axis = "frequency" if t.get("frequency") is not None else "speed"
+    if axis == "frequency" and t.get("speed") is not None:
+        checks.fail(f"{where}.frequency", t["frequency"], "must not be given with speed: a table against both speed "
+                    "and whirl frequency (ROSS's 2-D table) has no rotorred equivalent; rotorred's tables follow one "
+                    "axis, evaluated at the spool speed (give the synchronous coefficients against speed)")
     columns = {c: _column(f"{where}.{c}", t.get(c, [0.0])) for c in _LATERAL + _BEARING_MASS}
     for c in _BEARING_MASS:
         if any(v != 0.0 for v in columns[c]):
@@ -256,19 +265,32 @@ def _bearing(where: str, kind: str, t: dict) -> dict[str, Any]:
     if t.get("n_link") is not None:
         out["link"] = t["n_link"]
     lengths = {len(v) for v in columns.values()}
-    if "speed" not in t or t["speed"] is None:
+    if t.get(axis) is None:
         if lengths != {1}:
             checks.fail(f"{where}.kxx", t["kxx"], "must hold one value a coefficient without a speed table")
         out.update({f"{c[0]}_{c[1:]}": v[0] for c, v in ((c, columns[c]) for c in _LATERAL)})
         return out
-    speeds = _column(f"{where}.speed", t["speed"])
+    speeds = _column(f"{where}.{axis}", t[axis])
     if lengths != {len(speeds)}:
-        checks.fail(f"{where}.kxx", t["kxx"], f"must hold one value per speed of {where}.speed ({len(speeds)})")
-    out["speed_rpm"] = [w * 30.0 / math.pi for w in speeds]
+        checks.fail(f"{where}.kxx", t["kxx"], f"must hold one value per entry of {where}.{axis} ({len(speeds)})")
+    out[f"{axis}_rpm"] = [w * 30.0 / math.pi for w in speeds]
     out.update({f"{c[0]}_{c[1:]}": columns[c] for c in _LATERAL})
     out["interpolation"] = checks.choice(f"{where}.interpolation", t.get("interpolation", "pchip"), ("pchip", "linear"))
     out["extrapolate"] = "linear"  # ROSS continues a table along its end tangents
     return out
+
+
+def _note_frequency_tables(bearings: list[dict[str, Any]]) -> None:
+    """Say once which bearings are tabulated against whirl frequency, and how they are read."""
+    named = [f"{b['name']!r} (node {b['node']})" if b["name"] else f"node {b['node']}" for b in bearings
+             if "frequency_rpm" in b]
+    if named:
+        LOG.warning("%s tabulated against whirl frequency in the ROSS file: read as ROSS's modal and unbalance "
+                    "analyses evaluate such tables, at frequency = the speed of the bearing's spool (synchronous); "
+                    "a mode whirling at another frequency sees the coefficients of the spool speed, not of its own "
+                    "frequency (docs/model.md §20)",
+                    ("bearing " if len(named) == 1 else "bearings ") + ", ".join(named)
+                    + (" is" if len(named) == 1 else " are"))
 
 
 def _column(where: str, value) -> list[float]:

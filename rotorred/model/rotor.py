@@ -21,8 +21,8 @@ from typing import Mapping
 
 from rotorred import checks
 from rotorred.model.dofs import checked_dof
-from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Pedestal, ShaftElement,
-                                     Support)
+from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, IntershaftBearingTable, Pedestal,
+                                     ShaftElement, Support)
 from rotorred.model.loads import Unbalance
 from rotorred.model.rotor_writer import rotor_table
 from rotorred.results import Result
@@ -41,21 +41,44 @@ class AnalysisDefaults:
         Default response DOFs (node, direction).
     boundary_nodes : tuple of int
         Extra boundary nodes of a Craig-Bampton reduced model (e.g. the rub node).
+    operating_ranges : tuple of (str, float, float)
+        (spool, minimum speed, maximum continuous speed) (rad/s): the operating range of a spool, which the API 617
+        separation margins of its critical speeds are measured from (``rotorred campbell``, docs/model.md §21).
 
-    All are empty by default; :class:`Rotor` checks that their nodes exist.
+    All are empty by default; :class:`Rotor` checks that their nodes and spools exist.
     """
 
     unbalances: tuple[Unbalance, ...] = ()
     outputs: tuple[tuple[int, str], ...] = ()
     boundary_nodes: tuple[int, ...] = ()
+    operating_ranges: tuple[tuple[str, float, float], ...] = ()
 
     def __post_init__(self):
         unbalances = checks.sequence("unbalances", _tuple(self.unbalances), _unbalance)
         outputs = checks.sequence("outputs", _tuple(self.outputs), checked_dof, unique=True)
         boundary = checks.sequence("boundary_nodes", _tuple(self.boundary_nodes), _node_number, unique=True)
+        ranges = checks.sequence("operating_ranges", _tuple(self.operating_ranges), _operating_range)
         object.__setattr__(self, "unbalances", unbalances)
         object.__setattr__(self, "outputs", outputs)
         object.__setattr__(self, "boundary_nodes", boundary)
+        object.__setattr__(self, "operating_ranges", ranges)
+        if len({r[0] for r in ranges}) < len(ranges):
+            checks.fail("operating_ranges", ranges, "must give each spool's range once")
+
+    def operating_range(self, spool: str) -> tuple[float, float] | None:
+        """(minimum, maximum continuous) speed of ``spool`` (rad/s), or None if not given.
+
+        Parameters
+        ----------
+        spool : str
+            A spool's name.
+        """
+        return next(((lo, hi) for s, lo, hi in self.operating_ranges if s == spool), None)
+
+    def check_spools(self, spools: Collection[str]) -> None:
+        """InputError naming the entry if an operating range's spool is not one of ``spools``."""
+        for i, (s, _, _) in enumerate(self.operating_ranges):
+            checks.choice(f"operating_ranges[{i}].spool", s, sorted(spools))
 
     def check_nodes(self, nodes: Collection[int]) -> None:
         """InputError naming the entry if a node is not one of ``nodes``."""
@@ -66,11 +89,12 @@ class AnalysisDefaults:
         for i, n in enumerate(self.boundary_nodes):
             checks.node(f"boundary_nodes[{i}]", n, nodes)
 
-    def restricted(self, nodes: Collection[int]) -> AnalysisDefaults:
-        """The defaults whose nodes are among ``nodes`` (e.g. of one spool)."""
+    def restricted(self, nodes: Collection[int], spools: Collection[str] = ()) -> AnalysisDefaults:
+        """The defaults whose nodes are among ``nodes`` and operating ranges of ``spools`` (e.g. of one spool)."""
         return AnalysisDefaults(tuple(u for u in self.unbalances if u.node in nodes),
                                 tuple(o for o in self.outputs if o[0] in nodes),
-                                tuple(n for n in self.boundary_nodes if n in nodes))
+                                tuple(n for n in self.boundary_nodes if n in nodes),
+                                tuple(r for r in self.operating_ranges if r[0] in spools))
 
 
 def _tuple(value):
@@ -88,6 +112,15 @@ def _unbalance(field_: str, value) -> Unbalance:
 
 def _node_number(field_: str, value) -> int:
     return checks.integer(field_, value, ge=0)
+
+
+def _operating_range(field_: str, value) -> tuple[str, float, float]:
+    """(spool, minimum, maximum) with 0 <= minimum <= maximum (rad/s)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+        checks.fail(field_, value, "must be (spool, minimum, maximum continuous speed) (rad/s)")
+    lo = checks.non_negative(f"{field_}.minimum", value[1], "rad/s")
+    return (checks.string(f"{field_}.spool", value[0], empty=False), lo,
+            checks.number(f"{field_}.maximum", value[2], "rad/s", ge=lo))
 
 
 @dataclass(frozen=True)
@@ -108,6 +141,12 @@ class Spool:
         Concentric elements over spans of the chain (a sleeve shrunk on the shaft, ROSS's layered
         elements): each joins the two nodes of an element of the chain, has its length, and adds its
         matrices to that element's (the two act in parallel). They add no node.
+    internal_damping_beta : float
+        Internal (rotating) viscous damping of its elements (s), >= 0: ``beta K`` in the frame turning with the
+        spool (docs/model.md §19); an element's own value overrides it. Default 0.
+    internal_loss_factor : float
+        Internal hysteretic damping of its elements, loss factor (-), >= 0; an element's own value overrides it.
+        Default 0.
     """
 
     name: str
@@ -115,6 +154,8 @@ class Spool:
     speed: float = 0.0
     z0: float = 0.0
     sleeves: tuple[ShaftElement, ...] = ()
+    internal_damping_beta: float = 0.0
+    internal_loss_factor: float = 0.0
 
     def __post_init__(self):
         checks.string("name", self.name, empty=False)
@@ -133,6 +174,25 @@ class Spool:
         object.__setattr__(self, "z0", checks.number("z0", self.z0, "m"))
         object.__setattr__(self, "sleeves", checks.sequence("sleeves", _tuple(self.sleeves), _shaft_element))
         self._check_sleeves()
+        for key, unit in (("internal_damping_beta", "s"), ("internal_loss_factor", "-")):
+            object.__setattr__(self, key, checks.non_negative(key, getattr(self, key), unit))
+
+    def internal_damping(self, element: ShaftElement) -> tuple[float, float]:
+        """The internal damping of one of its elements: the element's own values, else the spool's.
+
+        Parameters
+        ----------
+        element : ShaftElement
+            An element (or sleeve) of the spool.
+
+        Returns
+        -------
+        (float, float)
+            beta (s) and the loss factor eta (-).
+        """
+        beta, eta = element.internal_damping_beta, element.internal_loss_factor
+        return (self.internal_damping_beta if beta is None else beta,
+                self.internal_loss_factor if eta is None else eta)
 
     def _check_sleeves(self) -> None:
         """Each sleeve lies on an element of the chain: the same two nodes and the same length."""
@@ -201,8 +261,9 @@ class Rotor:
     disks : tuple of Disk
     bearings : tuple of Bearing or BearingTable
         Node-to-ground bearings; a :class:`BearingTable`'s coefficients follow the speed of its node's spool.
-    intershaft_bearings : tuple of IntershaftBearing
-        Bearings between nodes of two different spools.
+    intershaft_bearings : tuple of IntershaftBearing or IntershaftBearingTable
+        Bearings between nodes of two different spools; an :class:`IntershaftBearingTable`'s coefficients follow the
+        speed of its ``speed_of`` spool.
     rayleigh : tuple of float, optional
         (alpha (1/s), beta (s)) of the shafts' Rayleigh damping C = alpha M_shaft + beta K_shaft;
         disks and bearings are not included.
@@ -220,7 +281,7 @@ class Rotor:
     spools: tuple[Spool, ...]
     disks: tuple[Disk, ...] = ()
     bearings: tuple[Bearing | BearingTable, ...] = ()
-    intershaft_bearings: tuple[IntershaftBearing, ...] = ()
+    intershaft_bearings: tuple[IntershaftBearing | IntershaftBearingTable, ...] = ()
     rayleigh: tuple[float, float] = (0.0, 0.0)
     name: str = ""
     defaults: AnalysisDefaults = field(default_factory=AnalysisDefaults)
@@ -229,7 +290,8 @@ class Rotor:
 
     def __post_init__(self):
         for name, cls in (("spools", Spool), ("disks", Disk), ("bearings", (Bearing, BearingTable)),
-                          ("intershaft_bearings", IntershaftBearing), ("supports", Support), ("pedestals", Pedestal)):
+                          ("intershaft_bearings", (IntershaftBearing, IntershaftBearingTable)), ("supports", Support),
+                          ("pedestals", Pedestal)):
             object.__setattr__(self, name, checks.sequence(name, _tuple(getattr(self, name)), _instance(cls)))
         if not self.spools:
             checks.fail("spools", self.spools, "must hold at least one spool")
@@ -255,6 +317,9 @@ class Rotor:
             if isinstance(b, BearingTable) and b.node in pedestals:
                 checks.fail(f"bearings[{i}].node", b.node, "must be a shaft node for a bearing tabulated against "
                             "speed (its spool's speed); node {} is a pedestal".format(b.node))
+            if b.node in pedestals and b.tilts:
+                checks.fail(f"bearings[{i}].node", b.node, "must be a shaft node for a bearing with tilt coefficients; "
+                            f"node {b.node} is a pedestal, which has no rotations (x and y only)")
         self._check_supports(owner)
         for i, b in enumerate(self.intershaft_bearings):
             checks.node(f"intershaft_bearings[{i}].node_a", b.node_a, owner)
@@ -263,8 +328,12 @@ class Rotor:
                 checks.fail(f"intershaft_bearings[{i}].node_b", b.node_b,
                             f"must be on another spool than node_a = {b.node_a} (both are on spool "
                             f"{owner[b.node_a]!r}); an inter-shaft bearing joins two different spools")
+            if getattr(b, "speed_of", None) is not None and b.speed_of not in owner.values():
+                checks.fail(f"intershaft_bearings[{i}].speed_of", b.speed_of, "must name a spool of the rotor ("
+                            f"{', '.join(repr(s.name) for s in self.spools)})")
         try:
             self.defaults.check_nodes(owner)
+            self.defaults.check_spools(set(owner.values()))
         except checks.InputError as exc:
             raise exc.within("defaults") from None
 
@@ -393,6 +462,9 @@ class Rotor:
                          f"{plural(len(self.pedestals), 'pedestal')}")
         if self.rayleigh != (0.0, 0.0):
             lines.append(f"shaft damping: Rayleigh alpha {self.rayleigh[0]:.4g} 1/s, beta {self.rayleigh[1]:.4g} s")
+        internal = [s.name for s in self.spools if any(any(s.internal_damping(e)) for e in s.all_elements)]
+        if internal:
+            lines.append(f"internal (rotating) damping on spool{'s' * (len(internal) > 1)} {', '.join(internal)}")
         d = self.defaults
         if d.unbalances or d.outputs or d.boundary_nodes:
             lines.append(f"defaults: {plural(len(d.unbalances), 'unbalance')}, {plural(len(d.outputs), 'output')}, "
@@ -497,7 +569,7 @@ class Rotor:
             bearings=tuple(b for b in self.bearings if b.node in nodes or b.node in linked), intershaft_bearings=(),
             supports=tuple(sp for sp in self.supports if sp.node in nodes),
             pedestals=tuple(p for p in self.pedestals if p.node in linked),
-            name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes))
+            name=f"{self.name} [{name}]", defaults=self.defaults.restricted(nodes, {name}))
 
 
 

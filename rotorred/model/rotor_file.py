@@ -8,6 +8,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     name = "steel"; E = 2.1e11; rho = 7850.0; nu = 0.3
     [[spool]]                          # a chain of elements on consecutive node numbers (or nodes = [1, 2, 7, ...])
     name = "inner"; first_node = 1; z0 = 0.0; speed_rpm = 4200.0; shear = "cowper"; element = "nelson"
+    internal_damping_beta = 0.0        # rotating damping beta K (s), or internal_loss_factor (-); also per element
     elements = [ { L = 0.08, D_o = 0.02, D_i = 0.0, material = "steel", repeat = 12 } ]
     [[disk]]                           # either m, I_d, I_p (kg, kg m^2) or D_o, D_i, thickness, material
     node = 3; m = 5.7; I_d = 0.023; I_p = 0.045; radius = 0.125
@@ -15,7 +16,9 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     node = 1; k = 2e7; c = 300.0
     [[bearing]]                        # against speed: speed_rpm and, per coefficient, a number or a list
     node = 13; speed_rpm = [0.0, 3000.0, 6000.0]; k = [1e7, 2e7, 3e7]; c_xx = [400.0, 300.0, 250.0]
-    [[intershaft_bearing]]
+    [[bearing]]                        # tilt: k_tt / c_tt (N m/rad, N m s/rad) or k_txtx, k_tyty, k_txty, k_tytx, ...
+    node = 7; k = 1e8; k_tt = 2e5      # (frequency_rpm in place of speed_rpm: a table against whirl frequency)
+    [[intershaft_bearing]]             # a table too, against the speed of the spool speed_of (default node_a's)
     node_a = 20; node_b = 9; k = 1e7; c = 300.0
     [[support]]                        # a rigid support: "pinned" fixes x, y; "clamped" also theta_x, theta_y
     node = 1; kind = "pinned"
@@ -27,6 +30,7 @@ path to a TOML file. The format is documented in the README ("Rotor files"); in 
     unbalance = [ { node = 11, m_e = 1e-5, phase_deg = 0.0 } ]   # kg m, deg
     outputs = ["13:x", "13:y"]         # NODE:DIRECTION, DIRECTION x, y, theta_x (tx), theta_y (ty)
     boundary_nodes = [18]              # extra boundary nodes of a reduced model
+    operating_range_rpm = { inner = [3000.0, 4500.0] }   # a spool's minimum and maximum continuous speed (API 617)
 
 Speeds and phases may also be given in SI (``speed_rad_s``, ``phase_rad``), as :meth:`Rotor.to_toml` writes those
 that no rpm or degree number reads back to exactly (docs/model.md §18).
@@ -39,6 +43,7 @@ key path, the value and what is allowed, e.g.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -46,12 +51,17 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rotorred import checks
 from rotorred.checks import InputError
 from rotorred.model.dofs import parse_dof
 from rotorred.model.elements import (FORMULATIONS, SHEAR_METHODS, Bearing, BearingTable, Disk, IntershaftBearing,
-                                     Material, Pedestal, ShaftElement, Support)
+                                     IntershaftBearingTable, Material, Pedestal, ShaftElement, Support)
 from rotorred.model.loads import unbalance_from_table
+from rotorred.model import ross_file
+from rotorred.model.assembly import assemble
+from rotorred.model.rigid import null_space
 from rotorred.model.ross_file import is_ross_document, ross_document
 from rotorred.model.rotor import AnalysisDefaults, Rotor, Spool
 from rotorred.model.rotor_writer import rpm_to_rad_s
@@ -69,17 +79,28 @@ _TOP_KEYS = {"name", "description", "material", "spool", "disk", "bearing", "int
 #: the top-level keys of a rotor file (a scene's inline ``[rotor]`` holds them too)
 ROTOR_FILE_KEYS = frozenset(_TOP_KEYS)
 _MATERIAL_KEYS = {"name", "E", "rho", "nu", "G"}
+#: internal (rotating) damping: on a spool (its elements' default) or an element, sleeve or station (docs/model.md §19)
+_INTERNAL_KEYS = {"internal_damping_beta", "internal_loss_factor"}
 _SPOOL_KEYS = {"name", "first_node", "nodes", "z0", "speed_rpm", "speed_rad_s", "shear", "element", "rotary_inertia",
-               "elements", "stations", "material", "sleeves"}
-_SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
-_STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element", "rotary_inertia"}
-_ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element", "rotary_inertia"}
+               "elements", "stations", "material", "sleeves"} | _INTERNAL_KEYS
+_SLEEVE_KEYS = {"left", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element",
+                "rotary_inertia"} | _INTERNAL_KEYS
+_STATION_KEYS = {"z", "D_o", "D_i", "D_o_end", "D_i_end", "material", "n", "shear", "element",
+                 "rotary_inertia"} | _INTERNAL_KEYS
+_ELEMENT_KEYS = {"L", "D_o", "D_i", "D_o_right", "D_i_right", "material", "repeat", "shear", "element",
+                 "rotary_inertia"} | _INTERNAL_KEYS
 _DISK_KEYS = {"node", "name", "m", "I_d", "I_p", "radius", "D_o", "D_i", "thickness", "material"}
-_SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx"}
+_SUPPORT_KEYS = {"name", "k", "c", "k_xx", "k_yy", "k_xy", "k_yx", "c_xx", "c_yy", "c_xy", "c_yx", "k_tt", "c_tt",
+                 "k_txtx", "k_tyty", "k_txty", "k_tytx", "c_txtx", "c_tyty", "c_txty", "c_tytx"}
+#: a support's isotropic shorthands: each sets the two direct coefficients (docs/model.md §20)
+_SHORTHANDS = {"k": ("k_xx", "k_yy", "N/m"), "c": ("c_xx", "c_yy", "N s/m"), "k_tt": ("k_txtx", "k_tyty", "N m/rad"),
+               "c_tt": ("c_txtx", "c_tyty", "N m s/rad")}
+#: the keys of a bearing table's axis, in rpm or rad/s: spool speed, or whirl frequency (evaluated at the spool speed)
+_AXIS_KEYS = {"speed": ("speed_rpm", "speed_rad_s"), "frequency": ("frequency_rpm", "frequency_rad_s")}
 _DAMPING_KEYS = {"rayleigh_alpha", "rayleigh_beta"}
 _SUPPORT_NODE_KEYS = {"node", "kind", "name"}
 _TABLE_KEYS = {"extrapolate", "interpolation"}  # a bearing table's rules, with speed_rpm only
-_DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes"}
+_DEFAULTS_KEYS = {"unbalance", "outputs", "boundary_nodes", "operating_range_rpm", "operating_range_rad_s"}
 #: Rotor attribute -> rotor-file key, to name the file's key in an error from Rotor's own checks
 _FILE_KEYS = {"spools": "spool", "disks": "disk", "bearings": "bearing", "intershaft_bearings": "intershaft_bearing",
               "supports": "support", "pedestals": "pedestal"}
@@ -214,10 +235,50 @@ def rotor_document(data: dict[str, Any], source: str = "<string>", name: str = "
     RotorFileError
         For a ROSS rotor rotorred cannot represent, naming ``source`` and the key.
     """
+    if not is_ross_document(data):
+        return data
     try:
-        return ross_document(data, name) if is_ross_document(data) else data
+        document = ross_document(data, name)
     except InputError as exc:
         raise RotorFileError(exc.field, exc.value, exc.requirement, exc.unit).from_source(source) from None
+    _note_ross_hutchinson(document)
+    return document
+
+
+def _note_ross_hutchinson(document: dict[str, Any]) -> None:
+    """Say at load how much a ROSS rotor read with Hutchinson's published shear coefficient differs from ROSS's own
+    (which omits a factor 1 + nu, :func:`rotorred.model.elements.shear_coefficient`): the relative change of kappa and
+    of the rotor's first natural frequency at standstill (undamped), as a warning of ``rotorred.model.ross_file``."""
+    as_ross = copy.deepcopy(document)
+    entries = [e for s in as_ross["spool"] for e in (*s["elements"], *s.get("sleeves", ()))
+               if e.get("shear") == "hutchinson"]
+    if not entries:
+        return
+    for e in entries:
+        e["shear"] = "ross-hutchinson"
+    try:
+        published, as_ross = rotor_from_dict(document), rotor_from_dict(as_ross)
+    except InputError:
+        return  # the load itself says what is wrong
+    pairs = [(a, b) for s, t in zip(published.spools, as_ross.spools) for a, b in zip(s.all_elements, t.all_elements)
+             if a.shear == "hutchinson"]
+    kappa = [b.kappa / a.kappa - 1.0 for a, b in pairs]
+    w_published, w_ross = (_first_frequency(r) for r in (published, as_ross))
+    ross_file.LOG.warning(
+        "%d shaft elements use ROSS's Hutchinson shear coefficient (shear_method_calc = 'hutchinson'), which omits a "
+        "factor 1 + nu of the published formula (Hutchinson 2001, Eq. 52) that rotorred uses: ROSS's kappa differs "
+        "by %s and the first natural frequency at standstill by %+.3g %% (ROSS %.6g rad/s, rotorred %.6g rad/s). "
+        "shear = 'ross-hutchinson' on these elements reproduces ROSS (docs/model.md §20)",
+        len(pairs), " to ".join(dict.fromkeys(f"{100 * k:+.3g} %" for k in (min(kappa), max(kappa)))),
+        100 * (w_ross / w_published - 1.0), w_ross, w_published)
+
+
+def _first_frequency(rotor: Rotor) -> float:
+    """The lowest undamped natural frequency (rad/s) of ``rotor`` at its nominal speeds, gyroscopic terms left out:
+    sqrt of the least positive eigenvalue of (K, M) that is no rigid-body motion (:func:`rotorred.model.rigid.
+    null_space`)."""
+    w2, _, rigid = null_space(assemble(rotor))
+    return float(np.sqrt(w2[~rigid & (w2 > 0.0)][0]))
 
 
 def read_text_file(path: Path, error: type[InputError] = InputError) -> str:
@@ -291,7 +352,7 @@ def _rotor(data: dict) -> Rotor:
     pedestals = tuple(_pedestal(f"pedestal[{i}]", p)
                       for i, p in enumerate(checks.tables("pedestal", data.get("pedestal", []))))
     rayleigh = _damping(data.get("damping", {}))
-    defaults = _defaults(data.get("defaults", {}), nodes)
+    defaults = _defaults(data.get("defaults", {}), nodes, [s.name for s in spools])
     try:
         return Rotor(spools=spools, disks=disks, bearings=bearings, intershaft_bearings=inter, rayleigh=rayleigh,
                      name=name, defaults=defaults, supports=supports, pedestals=pedestals)
@@ -371,7 +432,8 @@ def _spool(where: str, s: dict, materials: dict[str, Material]) -> Spool:
     else:
         speed = rpm_to_rad_s(checks.non_negative(f"{where}.speed_rpm", s.get("speed_rpm", 0.0), "rpm"))
     sleeves = _sleeves(where, s, elements, defaults, materials)
-    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves)
+    return _build(where, Spool, name=name, elements=tuple(elements), speed=speed, z0=z0, sleeves=sleeves,
+                  **{k: s[k] for k in _INTERNAL_KEYS if k in s})
 
 
 def _one_of(where: str, table: dict, names: tuple[str, str], required: bool = True) -> None:
@@ -408,7 +470,7 @@ def _sleeves(where: str, s: dict, chain: list[ShaftElement], defaults: dict, mat
                         f"{entry['left']} to the spool's end")
         section = {"D_i": 0.0, **{k: entry[k] for k in ("D_o", "D_i", "D_o_right", "D_i_right") if k in entry}}
         material = _section_material(sw, entry, s, where, materials)
-        options = {k: entry.get(k, v) for k, v in defaults.items()}
+        options = {k: entry.get(k, v) for k, v in defaults.items()} | {k: entry[k] for k in _INTERNAL_KEYS & set(entry)}
         out.extend(_build(sw, ShaftElement, left=e.left, right=e.right, L=e.L, material=material,
                           **section, **options) for e in chain[first:first + repeat])
     return tuple(out)
@@ -420,8 +482,8 @@ def _sections_of_elements(where: str, s: dict, materials: dict[str, Material]) -
     for j, e in enumerate(checks.tables(f"{where}.elements", s["elements"], min_len=1)):
         ew = f"{where}.elements[{j}]"
         checks.keys(ew, e, _ELEMENT_KEYS, required={"L", "D_o"})
-        section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia")
-                   if k in e}
+        section = {k: e[k] for k in ("L", "D_o", "D_o_right", "D_i_right", "shear", "element", "rotary_inertia",
+                                     *sorted(_INTERNAL_KEYS)) if k in e}
         out.append(dict(section, where=ew, D_i=e.get("D_i", 0.0), material=_section_material(ew, e, s, where, materials),
                         count=checks.integer(f"{ew}.repeat", e.get("repeat", 1), ge=1), split=1))
     return out
@@ -452,7 +514,8 @@ def _sections_of_stations(where: str, s: dict, materials: dict[str, Material]) -
         D_i_end = checks.non_negative(f"{sw}.D_i_end", st.get("D_i_end", D_i), "m")
         section = dict(where=sw, z=z[k], L=z[k + 1] - z[k], D_o=D_o, D_i=D_i, D_o_right=D_o_end, D_i_right=D_i_end,
                        count=1, split=n, material=_section_material(sw, st, s, where, materials))
-        out.append(dict(section, **{k2: st[k2] for k2 in ("shear", "element", "rotary_inertia") if k2 in st}))
+        out.append(dict(section, **{k2: st[k2] for k2 in ("shear", "element", "rotary_inertia", *sorted(_INTERNAL_KEYS))
+                                    if k2 in st}))
     return out
 
 
@@ -491,22 +554,39 @@ def _disk(where: str, d: dict, materials: dict[str, Material]) -> Disk:
 
 
 def _bearing(where: str, b: dict) -> Bearing | BearingTable:
-    """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed."""
-    checks.keys(where, b, _SUPPORT_KEYS | {"node", "speed_rpm", "speed_rad_s", "link"} | _TABLE_KEYS,
-                required={"node"})
-    _one_of(where, b, ("speed_rpm", "speed_rad_s"), required=False)
-    if "speed_rpm" not in b and "speed_rad_s" not in b:
+    """A bearing; with ``speed_rpm`` (a list of speeds) its coefficients are numbers or lists, one value per speed;
+    ``frequency_rpm`` is the same for a table made against whirl frequency (docs/model.md §20)."""
+    axis_keys = {k for keys in _AXIS_KEYS.values() for k in keys}
+    checks.keys(where, b, _SUPPORT_KEYS | {"node", "link"} | axis_keys | _TABLE_KEYS, required={"node"})
+    axis = _table_axis(where, b)
+    if axis is None:
+        return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
+    speeds = _table_speeds(where, b, axis)
+    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=speeds, axis=axis,
+                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(speeds)))
+
+
+def _table_axis(where: str, b: dict, axes=tuple(_AXIS_KEYS)) -> str | None:
+    """The axis of a bearing table (``"speed"``, ``"frequency"``), None for constant coefficients; one axis key at
+    most, and interpolation keys with an axis only."""
+    given = [k for axis in axes for k in _AXIS_KEYS[axis] if k in b]
+    if len(given) > 1:
+        checks.fail(f"{where}.{given[1]}", b[given[1]], f"must not be given with {given[0]}: a table has one axis")
+    if not given:
         for key in sorted(_TABLE_KEYS & set(b)):
             checks.fail(f"{where}.{key}", b[key], "needs speed_rpm: only a table against speed interpolates and "
                         "extrapolates")
-        return _build(where, Bearing, node=b["node"], link=b.get("link"), **_coefficients(where, b))
-    if "speed_rad_s" in b:
-        speeds = checks.vector(f"{where}.speed_rad_s", b["speed_rad_s"], "rad/s", min_len=2, ge=0.0, increasing=True)
-    else:
-        speeds = rpm_to_rad_s(checks.vector(f"{where}.speed_rpm", b["speed_rpm"], "rpm", min_len=2, ge=0.0,
-                                            increasing=True))
-    return _build(where, BearingTable, node=b["node"], link=b.get("link"), speeds=tuple(speeds),
-                  **{k: b[k] for k in _TABLE_KEYS & set(b)}, **_coefficients(where, b, n_speeds=len(speeds)))
+        return None
+    return next(axis for axis, keys in _AXIS_KEYS.items() if given[0] in keys)
+
+
+def _table_speeds(where: str, b: dict, axis: str) -> tuple[float, ...]:
+    """A table's axis in rad/s, from its key in rpm or rad/s."""
+    rpm_key, si_key = _AXIS_KEYS[axis]
+    if si_key in b:
+        return tuple(checks.vector(f"{where}.{si_key}", b[si_key], "rad/s", min_len=2, ge=0.0, increasing=True))
+    return tuple(rpm_to_rad_s(checks.vector(f"{where}.{rpm_key}", b[rpm_key], "rpm", min_len=2, ge=0.0,
+                                            increasing=True)))
 
 
 def _pedestal(where: str, p: dict) -> Pedestal:
@@ -519,28 +599,38 @@ def _support(where: str, sp: dict) -> Support:
     return _build(where, Support, node=sp["node"], kind=sp["kind"], name=sp.get("name", ""))
 
 
-def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing:
-    checks.keys(where, b, _SUPPORT_KEYS | {"node_a", "node_b"}, required={"node_a", "node_b"})
-    return _build(where, IntershaftBearing, node_a=b["node_a"], node_b=b["node_b"], **_coefficients(where, b))
+def _intershaft_bearing(where: str, b: dict) -> IntershaftBearing | IntershaftBearingTable:
+    """An inter-shaft bearing; with ``speed_rpm`` a table against the speed of spool ``speed_of`` (default node_a's)."""
+    checks.keys(where, b, _SUPPORT_KEYS | {"node_a", "node_b", "speed_of", *_AXIS_KEYS["speed"]} | _TABLE_KEYS,
+                required={"node_a", "node_b"})
+    if _table_axis(where, b, ("speed",)) is None:
+        if "speed_of" in b:
+            checks.fail(f"{where}.speed_of", b["speed_of"], "needs speed_rpm: only a table follows a spool's speed")
+        return _build(where, IntershaftBearing, node_a=b["node_a"], node_b=b["node_b"], **_coefficients(where, b))
+    speeds = _table_speeds(where, b, "speed")
+    return _build(where, IntershaftBearingTable, node_a=b["node_a"], node_b=b["node_b"], speeds=speeds,
+                  speed_of=b.get("speed_of"), **{k: b[k] for k in _TABLE_KEYS & set(b)},
+                  **_coefficients(where, b, n_speeds=len(speeds)))
 
 
 def _coefficients(where: str, b: dict, n_speeds: int = 0) -> dict[str, Any]:
-    """The support coefficients as given; ``k`` / ``c`` (isotropic) set both direct terms. With ``n_speeds`` (a
-    table against speed) each may be a number or a list of ``n_speeds`` values."""
-    out: dict[str, Any] = {k: v for k, v in b.items() if k in _SUPPORT_KEYS - {"k", "c"}}
-    for kind, unit in (("k", "N/m"), ("c", "N s/m")):
+    """The support coefficients as given; ``k`` / ``c`` (isotropic) set both direct terms, ``k_tt`` / ``c_tt`` both
+    direct tilt terms. With ``n_speeds`` (a table against speed) each may be a number or a list of ``n_speeds``
+    values."""
+    out: dict[str, Any] = {k: v for k, v in b.items() if k in _SUPPORT_KEYS - set(_SHORTHANDS)}
+    for kind, (xx, yy, unit) in _SHORTHANDS.items():
         if kind in b:
-            for direct in (f"{kind}_xx", f"{kind}_yy"):
+            for direct in (xx, yy):
                 if direct in b:
                     checks.fail(f"{where}.{direct}", b[direct], f"must not be given with {kind}: "
-                                f"give {kind} (isotropic) or {kind}_xx, {kind}_yy")
-            ge = 0.0 if kind == "c" else None  # direct damping >= 0; direct stiffness any sign (seals)
+                                f"give {kind} (isotropic) or {xx}, {yy}")
+            ge = 0.0 if kind[0] == "c" else None  # direct damping >= 0; direct stiffness any sign (seals)
             if n_speeds and isinstance(b[kind], (list, tuple)):
                 value = tuple(checks.vector(f"{where}.{kind}", b[kind], unit, min_len=n_speeds, max_len=n_speeds,
                                             ge=ge))
             else:
                 value = checks.number(f"{where}.{kind}", b[kind], unit, ge=ge)
-            out[f"{kind}_xx"] = out[f"{kind}_yy"] = value
+            out[xx] = out[yy] = value
     return out
 
 
@@ -551,7 +641,7 @@ def _damping(value) -> tuple[float, float]:
             checks.non_negative("damping.rayleigh_beta", table.get("rayleigh_beta", 0.0), "s"))
 
 
-def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
+def _defaults(value, nodes: set[int], spools: list[str]) -> AnalysisDefaults:
     table = checks.table("defaults", value)
     checks.keys("defaults", table, _DEFAULTS_KEYS)
     unbalances = tuple(unbalance_from_table(f"defaults.unbalance[{i}]", u, nodes)
@@ -560,4 +650,23 @@ def _defaults(value, nodes: set[int]) -> AnalysisDefaults:
                               unique=True)
     boundary = checks.sequence("defaults.boundary_nodes", table.get("boundary_nodes", []),
                                lambda f, v: checks.node(f, v, nodes), unique=True)
-    return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary)
+    return AnalysisDefaults(unbalances=unbalances, outputs=outputs, boundary_nodes=boundary,
+                            operating_ranges=_operating_ranges(table, spools))
+
+
+def _operating_ranges(table: dict, spools: list[str]) -> tuple[tuple[str, float, float], ...]:
+    """``operating_range_rpm = { inner = [3000.0, 4500.0] }`` (or ``operating_range_rad_s``, what a written rotor
+    holds where no rpm number reads back exactly): each spool's minimum and maximum continuous speed, in rad/s."""
+    out = []
+    for key, to_rad_s in (("operating_range_rpm", rpm_to_rad_s), ("operating_range_rad_s", float)):
+        unit = "rpm" if key.endswith("rpm") else "rad/s"
+        for spool, pair in checks.table(f"defaults.{key}", table.get(key, {})).items():
+            where = f"defaults.{key}.{spool}"
+            checks.choice(f"defaults.{key}", spool, spools)
+            lo, hi = checks.sequence(where, pair, lambda f, v: checks.non_negative(f, v, unit), min_len=2, max_len=2)
+            if hi < lo:
+                checks.fail(where, pair, "must be [minimum, maximum continuous speed] with minimum <= maximum", unit)
+            if spool in {s for s, _, _ in out}:
+                checks.fail(where, pair, "must be given once: in operating_range_rpm or operating_range_rad_s")
+            out.append((spool, to_rad_s(lo), to_rad_s(hi)))
+    return tuple(out)

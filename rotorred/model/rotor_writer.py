@@ -11,12 +11,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, Material, Pedestal, ShaftElement,
-                                     Support)
+from rotorred.model.elements import (Bearing, BearingTable, Disk, IntershaftBearing, IntershaftBearingTable, Material,
+                                     Pedestal, ShaftElement, Support)
 from rotorred.model.loads import Unbalance
 from rotorred.writers import exact_in_unit
 
 __all__ = ["rotor_table", "rpm_to_rad_s"]
+
+#: the internal-damping keys of a spool (its elements' default) and of an element (None: the spool's)
+_INTERNAL = ("internal_damping_beta", "internal_loss_factor")
 
 
 def rpm_to_rad_s(rpm):
@@ -90,6 +93,7 @@ def _spool_table(s, names: dict[Material, str]) -> dict[str, Any]:
                              "z0": s.z0}
     if s.speed != 0.0:
         table.update(_speeds_in_rpm("speed", [s.speed], single=True))
+    table.update({k: getattr(s, k) for k in _INTERNAL if getattr(s, k) != 0.0})
     materials = {names[e.material] for e in s.all_elements}
     common = materials.pop() if len(materials) == 1 else None
     if common is not None:
@@ -114,6 +118,7 @@ def _section(e: ShaftElement, names: dict[Material, str], common: str | None) ->
     for key, default in (("shear", "cowper"), ("element", "nelson"), ("rotary_inertia", True)):
         if getattr(e, key) != default:
             out[key] = getattr(e, key)
+    out.update({k: getattr(e, k) for k in _INTERNAL if getattr(e, k) is not None})
     return out
 
 
@@ -155,24 +160,34 @@ def _named(item) -> dict[str, str]:
 def _bearing_table(b: Bearing | BearingTable) -> dict[str, Any]:
     table: dict[str, Any] = {"node": b.node, **_named(b), **({"link": b.link} if b.link is not None else {})}
     if isinstance(b, BearingTable):
-        table.update(_speeds_in_rpm("speed", b.speeds))
-        table.update({k: getattr(b, k) for k, default in (("interpolation", "linear"), ("extrapolate", "hold"))
-                      if getattr(b, k) != default})
+        table.update(_table_rules(b, b.axis))
     return table | _coefficient_entries(b)
 
 
-def _intershaft_table(b: IntershaftBearing) -> dict[str, Any]:
-    return {"node_a": b.node_a, "node_b": b.node_b, **_named(b), **_coefficient_entries(b)}
+def _table_rules(b: BearingTable | IntershaftBearingTable, axis: str = "speed") -> dict[str, Any]:
+    """A table's axis (``speed_rpm``, or ``frequency_rpm`` for a table against whirl frequency) and its rules where
+    they differ from the defaults."""
+    return {**_speeds_in_rpm(axis, b.speeds),
+            **{k: getattr(b, k) for k, default in (("interpolation", "linear"), ("extrapolate", "hold"))
+               if getattr(b, k) != default}}
+
+
+def _intershaft_table(b: IntershaftBearing | IntershaftBearingTable) -> dict[str, Any]:
+    table: dict[str, Any] = {"node_a": b.node_a, "node_b": b.node_b, **_named(b)}
+    if isinstance(b, IntershaftBearingTable):
+        table.update({**({"speed_of": b.speed_of} if b.speed_of is not None else {}), **_table_rules(b)})
+    return table | _coefficient_entries(b)
 
 
 def _coefficient_entries(b) -> dict[str, Any]:
-    """The non-zero coefficients: ``k`` / ``c`` for equal direct terms; a column of a table equal at every speed as
-    one number."""
+    """The non-zero coefficients: ``k`` / ``c`` (``k_tt`` / ``c_tt``) for equal direct (tilt) terms; a column of a
+    table equal at every speed as one number."""
     out: dict[str, Any] = {}
-    for kind in ("k", "c"):
-        xx, yy = getattr(b, f"{kind}_xx"), getattr(b, f"{kind}_yy")
-        pairs = [(kind, xx)] if xx == yy else [(f"{kind}_xx", xx), (f"{kind}_yy", yy)]
-        pairs += [(f"{kind}_{d}", getattr(b, f"{kind}_{d}")) for d in ("xy", "yx")]
+    for short, (x, y) in (("k", ("x", "y")), ("c", ("x", "y")), ("k_tt", ("tx", "ty")), ("c_tt", ("tx", "ty"))):
+        kind = short[0]
+        xx, yy = getattr(b, f"{kind}_{x}{x}"), getattr(b, f"{kind}_{y}{y}")
+        pairs = [(short, xx)] if xx == yy else [(f"{kind}_{x}{x}", xx), (f"{kind}_{y}{y}", yy)]
+        pairs += [(f"{kind}_{d}", getattr(b, f"{kind}_{d}")) for d in (x + y, y + x)]
         out.update({key: _column(value) for key, value in pairs if any(v != 0.0 for v in _values(value))})
     return out
 
@@ -204,6 +219,10 @@ def _defaults_table(d) -> dict[str, Any]:
         out["outputs"] = [f"{node}:{direction}" for node, direction in d.outputs]
     if d.boundary_nodes:
         out["boundary_nodes"] = list(d.boundary_nodes)
+    for spool, lo, hi in d.operating_ranges:  # in rpm where both read back exactly, else in rad/s
+        rpm = [exact_in_unit(w, rpm_to_rad_s, w * 30.0 / math.pi) for w in (lo, hi)]
+        key, pair = ("operating_range_rpm", rpm) if None not in rpm else ("operating_range_rad_s", [lo, hi])
+        out.setdefault(key, {})[spool] = pair
     return out
 
 

@@ -86,6 +86,9 @@ class CondensedProblem:
         ``dofs``.
     D1 : ndarray, shape (n, n), optional
         ``D(omega) = D + omega D1``.
+    K1 : ndarray, shape (n, n), optional
+        ``K(omega) = K + omega K1`` (the circulatory stiffness of internal damping per unit speed when the spin
+        follows omega, docs/model.md §19).
     """
 
     M: np.ndarray
@@ -96,6 +99,7 @@ class CondensedProblem:
     forcing: Callable[[float], tuple[np.ndarray, np.ndarray]]
     forces: tuple = ()
     D1: np.ndarray | None = None
+    K1: np.ndarray | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -133,8 +137,9 @@ class CondensedProblem:
         n, H, c = self.M.shape[0], self.harmonics.H, list(self.dofs)
         k = np.arange(H + 1)[:, None, None]
         D = self.velocity_matrix(omega)
-        Z = self.K - (k * omega) ** 2 * self.M + 1j * k * omega * D
-        dZ = -2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
+        Z = self.stiffness_matrix(omega) - (k * omega) ** 2 * self.M + 1j * k * omega * D
+        dZ = (-2.0 * k * k * omega * self.M + 1j * k * D + (0.0 if self.D1 is None else 1j * k * omega * self.D1)
+              + (0.0 if self.K1 is None else self.K1))
         f, df = (to_phasors(G.reshape(self.harmonics.size, n)) for G in (F, dF))
         X, Q = dynamic_compliance(Z, c, f)
         Y = dynamic_compliance(Z.transpose(0, 2, 1), c)[0].transpose(0, 2, 1)  # (Z^-1)[c, :]
@@ -208,6 +213,10 @@ class CondensedProblem:
     def velocity_matrix(self, omega: float) -> np.ndarray:
         """D(omega) = D + omega D1 (N s/m)."""
         return self.D if self.D1 is None else self.D + omega * self.D1
+
+    def stiffness_matrix(self, omega: float) -> np.ndarray:
+        """K(omega) = K + omega K1 (N/m)."""
+        return self.K if self.K1 is None else self.K + omega * self.K1
 
     def recover(self, z: np.ndarray, omega: float) -> np.ndarray:
         """The harmonic-major coefficients of every DOF, shape ((2H + 1) n_all,), from the solution ``z``."""

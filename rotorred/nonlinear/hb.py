@@ -4,7 +4,7 @@ The unknowns are the harmonic-major Fourier coefficients ``z`` (:mod:`rotorred.n
 residual is
 
     R(z, omega) = L(omega) z + F_nl(z, omega) - F_ex(omega),
-    L(omega) = I (x) K + omega^2 nabla^2 (x) M + omega nabla (x) D(omega),
+    L(omega) = I (x) K(omega) + omega^2 nabla^2 (x) M + omega nabla (x) D(omega),
 
 with ``nabla`` the d/dtheta operator on one DOF's coefficients and ``(x)`` the Kronecker product; ``F_nl`` is
 the AFT of the nonlinear forces (:mod:`rotorred.nonlinear.forces`). The Jacobian is analytic: the chain rule
@@ -112,6 +112,9 @@ class PeriodicProblem:
     D1 : ndarray, shape (n, n), optional
         A velocity matrix proportional to omega, ``D(omega) = D + omega D1`` (a gyroscopic matrix per unit speed
         when the spin follows omega, as in a synchronous unbalance response).
+    K1 : ndarray, shape (n, n), optional
+        A stiffness proportional to omega, ``K(omega) = K + omega K1`` (N/m per rad/s): the circulatory stiffness
+        of internal damping per unit speed, ``-sum_s a_s N_s``, when the spin follows omega (docs/model.md §19).
     """
 
     M: np.ndarray
@@ -121,6 +124,7 @@ class PeriodicProblem:
     forcing: Callable[[float], tuple[np.ndarray, np.ndarray]]
     forces: tuple = ()
     D1: np.ndarray | None = None
+    K1: np.ndarray | None = None
     _ops: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -132,7 +136,8 @@ class PeriodicProblem:
         h = self.harmonics
         eye_h, nabla = np.eye(h.size), h.nabla
         self._ops.update(IK=np.kron(eye_h, self.K), N2M=np.kron(nabla @ nabla, self.M), NM=np.kron(nabla, self.M), ND=np.kron(nabla, self.D),
-                         ND1=None if self.D1 is None else np.kron(nabla, self.D1))
+                         ND1=None if self.D1 is None else np.kron(nabla, self.D1),
+                         IK1=None if self.K1 is None else np.kron(eye_h, self.K1))
 
     @property
     def n(self) -> int:
@@ -145,7 +150,7 @@ class PeriodicProblem:
         return self.harmonics.size * self.n
 
     def linear(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
-        """``L(omega) = I (x) K + omega^2 nabla^2 (x) M + omega nabla (x) D(omega)`` and ``dL/domega``.
+        """``L(omega) = I (x) K(omega) + omega^2 nabla^2 (x) M + omega nabla (x) D(omega)`` and ``dL/domega``.
 
         Parameters
         ----------
@@ -163,6 +168,9 @@ class PeriodicProblem:
         if o["ND1"] is not None:
             L = L + omega**2 * o["ND1"]
             dL = dL + 2.0 * omega * o["ND1"]
+        if o["IK1"] is not None:
+            L = L + omega * o["IK1"]
+            dL = dL + o["IK1"]
         return L, dL
 
     def linear_response(self, omega: float) -> np.ndarray:
@@ -243,6 +251,20 @@ class PeriodicProblem:
         """
         return self.D if self.D1 is None else self.D + omega * self.D1
 
+    def stiffness_matrix(self, omega: float) -> np.ndarray:
+        """K(omega) = K + omega K1 (N/m).
+
+        Parameters
+        ----------
+        omega : float
+            Response frequency (rad/s).
+
+        Returns
+        -------
+        ndarray, shape (n, n)
+        """
+        return self.K if self.K1 is None else self.K + omega * self.K1
+
     def evaluate(self, z: np.ndarray, omega: float) -> Evaluation:
         """The residual ``R(z, omega) = L(omega) z + F_nl(z, omega) - F_ex(omega)`` (N), and its analytic derivatives on
         first use.
@@ -313,9 +335,9 @@ def local_forces(forces, dofs: tuple[int, ...]) -> tuple:
 
 
 def checked_matrices(problem) -> int:
-    """Check a problem's M, D, K (and D1) as square matrices of one size, and its harmonics; the size n."""
+    """Check a problem's M, D, K (and D1, K1) as square matrices of one size, and its harmonics; the size n."""
     n = np.shape(problem.M)[0] if np.ndim(problem.M) == 2 else 0
-    for name in ("M", "D", "K") + (("D1",) if problem.D1 is not None else ()):
+    for name in ("M", "D", "K") + tuple(k for k in ("D1", "K1") if getattr(problem, k) is not None):
         object.__setattr__(problem, name, checks.array(name, getattr(problem, name), (n, n)))
     if not isinstance(problem.harmonics, Harmonics):
         checks.fail("harmonics", problem.harmonics, "must be a Harmonics")

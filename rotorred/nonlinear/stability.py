@@ -161,7 +161,7 @@ def _half_interval_shift(h: Harmonics) -> np.ndarray:
 
 def _state_matrix(problem, omega: float):
     """The linear state matrix [[0, I], [-M^-1 K, -M^-1 D]] and M^-1's columns of the nonlinear DOFs."""
-    M, K, D = problem.M, problem.K, problem.velocity_matrix(omega)
+    M, K, D = problem.M, problem.stiffness_matrix(omega), problem.velocity_matrix(omega)
     n = M.shape[0]
     Minv = sla.inv(M)
     A0 = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ D]])

@@ -9,10 +9,12 @@ from rotorred.transient.energy import EnergyBalance
 
 
 def draw_energy(balance: EnergyBalance, ax=None, *, title: str = "", figsize: tuple[float, float] = (8.0, 5.0)):
-    """The terms of the balance E - E0 = W_drive - W_damping + W_gravity + W_contact (J) against time (s).
+    """The terms of the balance E - E0 = W_drive - W_damping + W_gravity + W_contact (J) against time (s), with
+    internal damping also - W_internal + W_circulatory.
 
     ``E - E0`` solid black, the drive's work, the energy dissipated by damping (W_damping, drawn positive),
-    the works of gravity and of the contacts (where not zero everywhere), and the residual of the balance,
+    the works of gravity and of the contacts, the energy dissipated by internal damping and the work of its
+    circulatory force (each where not zero everywhere), and the residual of the balance,
     whose largest magnitude and relative size (:attr:`EnergyBalance.relative_residual`) the legend gives.
 
     Parameters
@@ -32,7 +34,9 @@ def draw_energy(balance: EnergyBalance, ax=None, *, title: str = "", figsize: tu
     ax.plot(t, balance.energy, color="black", lw=1.8, label="E − E₀ (kinetic + strain)")
     ax.plot(t, balance.drive, lw=1.2, label="W_drive (unbalances, spin coupling)")
     ax.plot(t, balance.damping, lw=1.2, label="W_damping (dissipated)")
-    for work, name in ((balance.gravity, "W_gravity"), (balance.contact, "W_contact")):
+    for work, name in ((balance.gravity, "W_gravity"), (balance.contact, "W_contact"),
+                       (balance.internal, "W_internal (dissipated by internal damping)"),
+                       (balance.circulatory, "W_circulatory (internal damping's circulatory force)")):
         if np.any(work != 0):
             ax.plot(t, work, lw=1.2, label=name)
     residual = balance.residual

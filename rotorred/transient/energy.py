@@ -9,9 +9,14 @@ of ``psi_s`` gives the torque the drive applies beyond ``J_s Omega_s'``,
 supplies through the eccentric masses. The energy ``E = T + 1/2 q^T K q`` then obeys
 (docs/model.md, Eq. R5)
 
-    E(t) - E(0) = W_drive - W_damping + W_gravity + W_contact,
+    E(t) - E(0) = W_drive - W_damping - W_internal + W_circulatory + W_gravity + W_contact,
     W_drive = int q'^T F_u dt + sum_s int Omega_s d(q'^T K_G,s q),
     W_damping = int q'^T C q' dt,  W_gravity = int q'^T F_g dt,  W_contact = int q'^T B f dt,
+
+and, with internal (rotating) damping (docs/model.md §19: the damping C_r,s and the circulatory stiffness
+-Omega_s N_s of each spool in the fixed frame), W_internal = int q'^T (sum_s C_r,s) q' dt dissipated by it and
+W_circulatory = int q'^T (sum_s Omega_s N_s) q dt, the work of its circulatory force (what the drive feeds the
+whirl through the internal damping: positive where a forward whirl is slower than the spin),
 
 every integral evaluated from the records with the trapezoidal rule in ``q`` (``sum f_avg . dq``),
 the rule of the average-acceleration step. The residual is that of the quadrature: second
@@ -48,6 +53,9 @@ class EnergyBalance(Result):
     drive, damping, gravity, contact : ndarray
         ``W_drive`` (unbalances and spin coupling), ``W_damping`` (dissipated, >= 0 for C >= 0), the work
         of gravity and of the contact forces on the rotor.
+    internal, circulatory : ndarray
+        With internal damping (docs/model.md §19): ``W_internal``, dissipated by its fixed-frame damping
+        (>= 0), and ``W_circulatory``, the work of its circulatory force; zero without.
     """
 
     t: np.ndarray
@@ -56,11 +64,19 @@ class EnergyBalance(Result):
     damping: np.ndarray
     gravity: np.ndarray
     contact: np.ndarray
+    internal: np.ndarray | None = None
+    circulatory: np.ndarray | None = None
+
+    def __post_init__(self):
+        for name in ("internal", "circulatory"):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.zeros_like(self.t, dtype=float))
 
     @property
     def residual(self) -> np.ndarray:
-        """``E - E0 - (W_drive - W_damping + W_gravity + W_contact)`` (J)."""
-        return self.energy - (self.drive - self.damping + self.gravity + self.contact)
+        """``E - E0 - (W_drive - W_damping - W_internal + W_circulatory + W_gravity + W_contact)`` (J)."""
+        return self.energy - (self.drive - self.damping - self.internal + self.circulatory + self.gravity
+                              + self.contact)
 
     @property
     def relative_residual(self) -> float:
@@ -73,8 +89,9 @@ class EnergyBalance(Result):
         lines = [f"{len(self.t)} records, t = {self.t[0]:.6g}-{self.t[-1]:.6g} s",
                  f"at the end: E - E0 = {self.energy[-1]:.4g} J, W_drive = {self.drive[-1]:.4g} J, "
                  f"W_damping = {self.damping[-1]:.4g} J"]
-        others = [f"{name} = {w[-1]:.4g} J" for name, w in (("W_gravity", self.gravity), ("W_contact", self.contact))
-                  if np.any(w != 0)]
+        others = [f"{name} = {w[-1]:.4g} J" for name, w in (("W_gravity", self.gravity), ("W_contact", self.contact),
+                                                              ("W_internal", self.internal),
+                                                              ("W_circulatory", self.circulatory)) if np.any(w != 0)]
         if others:
             lines.append("at the end: " + ", ".join(others))
         lines.append(f"residual: largest {np.max(np.abs(self.residual)):.3g} J, relative {self.relative_residual:.3g}")
@@ -100,14 +117,17 @@ class EnergyBalance(Result):
 
     def to_xarray(self):
         """The balance as an :class:`xarray.Dataset`: dimension ``time`` (coordinate, s); variables ``energy``,
-        ``drive``, ``damping``, ``gravity``, ``contact`` and ``residual`` (J), as the attributes of the same names."""
+        ``drive``, ``damping``, ``gravity``, ``contact``, ``internal``, ``circulatory`` and ``residual`` (J), as the
+        attributes of the same names."""
         import xarray as xr
 
         terms = {"energy": "E - E0: kinetic (with the spin coupling) plus strain energy",
                  "drive": "work of the drive W_drive (unbalances and spin coupling)",
                  "damping": "energy dissipated by damping W_damping", "gravity": "work of gravity W_gravity",
                  "contact": "work of the contact forces W_contact",
-                 "residual": "E - E0 - (W_drive - W_damping + W_gravity + W_contact)"}
+                 "internal": "energy dissipated by internal (rotating) damping W_internal",
+                 "circulatory": "work of internal damping's circulatory force W_circulatory",
+                 "residual": "E - E0 - (W_drive - W_damping - W_internal + W_circulatory + W_gravity + W_contact)"}
         return xr.Dataset({name: ("time", getattr(self, name), {"units": "J", "long_name": text})
                            for name, text in terms.items()},
                           {"time": ("time", self.t, {"units": "s", "long_name": "record time"})},
@@ -163,7 +183,10 @@ def energy_balance(model, result, operating: Operating, loads: Loads = Loads()) 
     W = profile.speed(result.t)
     # bearing tables sit on spools of constant speed (a run-up of their spool is refused): K, C at the first speeds
     first = {s: float(W[s][0]) for s in spools}
-    K, C = model.stiffness(first), model.dissipation(first)
+    C_r, K_c = model.rotating_damping(first)  # internal damping: its dissipation and circulatory work apart
+    K, C = model.stiffness(first) - K_c, model.dissipation(first) - C_r
+    N = {s: r.at(model.loss_frequency)[1] for s, r in model.rotating.items()}
+    circulatory = sum((W[s][:, None] * (q @ N_s.T) for s, N_s in N.items()), np.zeros_like(q))
     coupling = {s: np.einsum("ij,ij->i", v, q @ K_G[s].T) for s in spools}  # q'^T K_G,s q
     energy = (0.5 * np.einsum("ij,ij->i", v @ model.M, v) + 0.5 * np.einsum("ij,ij->i", q @ K, q)
               + sum(W[s] * coupling[s] for s in spools))
@@ -176,4 +199,5 @@ def energy_balance(model, result, operating: Operating, loads: Loads = Loads()) 
     return EnergyBalance(t=result.t, energy=energy - energy[0], drive=_trapezoid_work(F_u, q) + spin,
                          damping=_trapezoid_work(v @ C.T, q),
                          gravity=_trapezoid_work(np.broadcast_to(F_g, q.shape), q),
-                         contact=_trapezoid_work(f_contact, q))
+                         contact=_trapezoid_work(f_contact, q), internal=_trapezoid_work(v @ C_r.T, q),
+                         circulatory=_trapezoid_work(circulatory, q))

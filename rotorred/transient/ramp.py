@@ -118,31 +118,54 @@ class Operators:
     K: np.ndarray
     G: np.ndarray    # (n_s, n, n) per unit speed
     K_G: np.ndarray  # (n_s, n, n) per unit acceleration
+    N: np.ndarray | None = None  # (n_s, n, n) circulatory stiffness of internal damping, -N_s per unit speed
+
+    @property
+    def blocks(self) -> int:
+        """Blocks a spool in the pass operator: G, K_G (and -N with internal damping)."""
+        return 2 if self.N is None else 3
 
     def D(self, speeds) -> np.ndarray:
         """``C + sum_s Omega_s G_s`` for speeds of shape (n_s,)."""
         return self.C + np.tensordot(speeds, self.G, axes=1)
 
-    def K_of(self, accelerations) -> np.ndarray:
-        """``K + sum_s Omega_s' K_G,s`` for accelerations of shape (n_s,)."""
-        return self.K + np.tensordot(accelerations, self.K_G, axes=1)
+    def K_of(self, speeds, accelerations) -> np.ndarray:
+        """``K + sum_s Omega_s' K_G,s - sum_s Omega_s N_s`` for speeds and accelerations of shape (n_s,)."""
+        K = self.K + np.tensordot(accelerations, self.K_G, axes=1)
+        return K if self.N is None else K - np.tensordot(speeds, self.N, axes=1)
 
     def speed_blocks(self) -> np.ndarray:
-        """``[G_0, K_G,0, G_1, K_G,1, ...]``, shape (n, 2 n_s n)."""
-        return np.hstack([m for s in range(len(self.G)) for m in (self.G[s], self.K_G[s])])
+        """``[G_0, K_G,0, G_1, K_G,1, ..., (-N_0, -N_1, ...)]``, shape (n, blocks n_s n)."""
+        blocks = [m for s in range(len(self.G)) for m in (self.G[s], self.K_G[s])]
+        return np.hstack(blocks + ([] if self.N is None else [-N_s for N_s in self.N]))
+
+
+def operators(model, K_G: dict) -> Operators:
+    """The :class:`Operators` of ``model`` (spin-acceleration matrices ``K_G`` of :func:`check_profile_run`): its
+    internal damping (docs/model.md §19) in ``C`` and, per spool, the circulatory ``N_s`` (a loss factor at the
+    model's ``loss_frequency``)."""
+    spools = model.spools
+    C_r, _ = model.rotating_damping({})
+    N = None
+    if model.rotating:
+        zero = np.zeros_like(model.M)
+        N = np.array([model.rotating[s].at(model.loss_frequency)[1] if s in model.rotating else zero for s in spools])
+    return Operators(M=np.asarray(model.M, float), C=np.asarray(model.C + C_r, float), K=np.asarray(model.K, float),
+                     G=np.array([model.G[s] for s in spools], float), K_G=np.array([K_G[s] for s in spools]), N=N)
 
 
 def _pass_operators(ops: Operators, ref: np.ndarray, dt: float, n_levels: int) -> tuple[np.ndarray, np.ndarray]:
-    """``R`` per level (shape (L, n, 2 n_s n)) and the infinity norms of its blocks (shape (L, n_s, 2))."""
-    D, K, blocks = ops.D(ref[:, 0]), ops.K_of(ref[:, 1]), ops.speed_blocks()
-    n, n_s = len(D), len(ops.G)
+    """``R`` per level (shape (L, n, b n_s n)) and the infinity norms of its blocks (shape (L, n_s, b)), b =
+    ``ops.blocks``: for spool s its G and K_G blocks, then its -N block among the last n_s."""
+    D, K, blocks = ops.D(ref[:, 0]), ops.K_of(ref[:, 0], ref[:, 1]), ops.speed_blocks()
+    n, n_s, b = len(D), len(ops.G), ops.blocks
     R, norms = [], []
     for level in range(n_levels):
         c = newmark_coefficients(dt / 2**level, 0.5, 0.25)
         Rl = sla.lu_solve(sla.lu_factor(c[0] * ops.M + c[3] * D + K, check_finite=False), blocks, check_finite=False)
         R.append(Rl)
-        norms.append([[np.abs(Rl[:, (2 * s + j) * n:(2 * s + j + 1) * n]).sum(axis=1).max() for j in (0, 1)]
-                      for s in range(n_s)])
+        columns = [[2 * s + j for j in (0, 1)] + ([2 * n_s + s] if b == 3 else []) for s in range(n_s)]
+        norms.append([[np.abs(Rl[:, k * n:(k + 1) * n]).sum(axis=1).max() for k in blocks_of] for blocks_of in columns])
     return np.ascontiguousarray(np.array(R)), np.array(norms)
 
 
@@ -151,17 +174,20 @@ def interval_widths(ops: Operators, ref: np.ndarray, dt: float, rho_target: floa
     _, norms = _pass_operators(ops, ref, dt, 1)
     c3 = 2.0 / dt
     n_s = len(ops.G)
-    return rho_target / (n_s * c3 * np.maximum(norms[0, :, 0], 1e-300))
+    speed_part = c3 * norms[0, :, 0] + (norms[0, :, 2] if ops.blocks == 3 else 0.0)
+    return rho_target / (n_s * np.maximum(speed_part, 1e-300))
 
 
 def interval_state(ops: Operators, B, forces: ForceColumns, plates, interval: SpeedInterval, dt: float,
                    n_levels: int) -> tuple[kernel.Levels, np.ndarray, np.ndarray]:
     """Levels at the interval's reference, ``R`` and the contraction bound ``rho`` per level."""
-    D, K = ops.D(interval.ref[:, 0]), ops.K_of(interval.ref[:, 1])
+    D, K = ops.D(interval.ref[:, 0]), ops.K_of(interval.ref[:, 0], interval.ref[:, 1])
     levels = step_levels(ops.M, D, K, B, forces, plates, dt, 0.5, 0.25, 0.0, n_levels)
     R, norms = _pass_operators(ops, interval.ref, dt, n_levels)
     c3 = levels.coef[:, 3]
     rho = (c3 * (norms[:, :, 0] @ interval.delta) + norms[:, :, 1] @ interval.epsilon)
+    if ops.blocks == 3:
+        rho = rho + norms[:, :, 2] @ interval.delta
     return levels, R, rho
 
 
@@ -208,8 +234,7 @@ def run_profile(run: stepping.Run, rho_target: float = RHO_TARGET, pass_tol: flo
     model, profile, control = run.system, run.profile, run.control
     K_G = check_profile_run(model, profile, run.scheme)
     spools = model.spools
-    ops = Operators(M=np.asarray(model.M, float), C=np.asarray(model.C, float), K=np.asarray(model.K, float),
-                    G=np.array([model.G[s] for s in spools], float), K_G=np.array([K_G[s] for s in spools]))
+    ops = operators(model, K_G)
     # 1. forces per unit Omega^2 (gravity: constant), plates at the speeds of t = 0
     forces = force_columns(model, {s: 1.0 for s in spools}, run.spool_of, run.loads.unbalances, run.loads.gravity)
     constant = ForceColumns(F=forces.F, kind=np.zeros(len(forces.kind), dtype=np.int64),
@@ -227,7 +252,7 @@ def run_profile(run: stepping.Run, rho_target: float = RHO_TARGET, pass_tol: flo
     W0, A0 = np.array([s0[s][0] for s in spools]), np.array([s0[s][1] for s in spools])
     F0 = ForceColumns(F=forces_at(forces, tables["profile"], 0.0).T, kind=np.zeros(1, dtype=np.int64),
                       omega=np.zeros(1))
-    state = stepping.initial_state(ops.M, ops.D(W0), ops.K_of(A0), B, par, run.plates, F0, run.x0, run.start)
+    state = stepping.initial_state(ops.M, ops.D(W0), ops.K_of(W0, A0), B, par, run.plates, F0, run.x0, run.start)
     # 3. record plan and speed intervals
     plan = stepping.record_plan(run.t_end, run.dt, run.recording.start, run.recording.decimate)
     rows = stepping.record_rows(model, run.recording.outputs, run.recording.states)
@@ -254,7 +279,7 @@ def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, re
     spare = kernel.spare_state(state)
     n, n_s = len(ops.M), len(ops.G)
     work = kernel.work_arrays(n, len(plates), len(forces.kind))
-    rwork = ramp_kernel.ramp_work(n, n_s, len(forces.kind))
+    rwork = ramp_kernel.ramp_work(n, n_s, len(forces.kind), ops.blocks)
     chunk = chunk_steps or max(2000, min(n_steps, 100_000))
     status, build, load, compiled = RUNNING, 0.0, 0.0, False
     wall = cpu = 0.0

@@ -2,9 +2,10 @@
 
 The equation of motion with speeds ``Omega_s(t)`` (docs/model.md, Eqs. R1-R3) is
 
-    M q'' + (C + sum_s Omega_s G_s) q' + (K + sum_s Omega_s' K_G,s) q = F_u(t) + F_g + B f,
+    M q'' + (C + sum_s Omega_s G_s) q' + (K + sum_s Omega_s' K_G,s - sum_s Omega_s N_s) q = F_u(t) + F_g + B f,
 
-with the unbalance forces of :mod:`rotorred.transient.matrices` at the spin angle ``phi_s(t)``.
+(``N_s`` the circulatory matrix of spool s's internal damping, docs/model.md §19), with the unbalance forces of
+:mod:`rotorred.transient.matrices` at the spin angle ``phi_s(t)``.
 Average-acceleration Newmark (gamma = 1/2, beta = 1/4) with the equation at both ends of a step
 (``a`` eliminated through the equation at ``ta``) gives, with ``D_i, K_i`` at ``t_i``,
 
@@ -16,18 +17,20 @@ speeds ``Omega_r`` and accelerations ``Omega_r'`` of the current speed interval 
 interval by :mod:`rotorred.transient.ramp`), so that
 
     dq = dq_r + sum_s P_s [(Omega_s1 - Omega_s0) v_0 - (2/h) delta_s dq]
-              - sum_s Q_s [(Omega_s0' + Omega_s1' - 2 Omega_sr') q_0 + epsilon_s dq],
+              - sum_s Q_s [(Omega_s0' + Omega_s1' - 2 Omega_sr') q_0 + epsilon_s dq]
+              - sum_s S_s [(Omega_s0 + Omega_s1 - 2 Omega_sr) q_0 + delta_s dq],
 
 with ``dq_r`` the constant-speed step at the reference (the kernel's own predictor and contact
 condensation, :mod:`rotorred.transient.kernel`), ``P_s = A_r^-1 G_s``, ``Q_s = A_r^-1 K_G,s``,
+``S_s = -A_r^-1 N_s`` (only where a spool has internal damping: then every spool has the third block),
 ``delta_s = Omega_s1 - Omega_sr`` and ``epsilon_s = Omega_s1' - Omega_sr'``. The ``dq`` on the right is the
 step's own: the step is solved by fixed-point passes, each a linear predictor plus the exact
 implicit contact solve, until ``dq`` is converged (:func:`_ramp_substep`). The map contracts
-by ``rho <= sum_s (2/h) |delta_s| ||P_s|| + |epsilon_s| ||Q_s||`` (``Varying.rho``, kept small by the
-interval length), so a converged pass is the exact implicit step with ``A_1``; a step that does not
+by ``rho <= sum_s (2/h) |delta_s| ||P_s|| + |epsilon_s| ||Q_s|| + |delta_s| ||S_s||`` (``Varying.rho``, kept small
+by the interval length), so a converged pass is the exact implicit step with ``A_1``; a step that does not
 converge within ``Varying.max_passes`` is halved like a failed contact solve.
 
-One matrix-vector product with ``R = [P_0, Q_0, P_1, Q_1, ...]`` per pass; without contact a pass is
+One matrix-vector product with ``R = [P_0, Q_0, P_1, Q_1, ..., (S_0, S_1, ...)]`` per pass; without contact a pass is
 accepted on the a-posteriori bound ``rho / (1 - rho) |dq_k - dq_k-1| <= tol |dq_k|`` (the error of ``dq_k``),
 with contact after two passes that agree to ``tol``.
 """
@@ -81,8 +84,9 @@ class Varying(NamedTuple):
 
     Attributes
     ----------
-    R : ndarray, shape (L, n, 2 n_s n)
-        ``[A_r^-1 G_0, A_r^-1 K_G,0, A_r^-1 G_1, ...]`` per step size level (s/kg... per rad/s, per rad/s^2).
+    R : ndarray, shape (L, n, b n_s n)
+        ``[A_r^-1 G_0, A_r^-1 K_G,0, A_r^-1 G_1, ...]`` per step size level (s/kg... per rad/s, per rad/s^2), b = 2
+        blocks a spool; b = 3 with internal damping: ``-A_r^-1 N_0, -A_r^-1 N_1, ...`` after all those (per rad/s).
     rho : ndarray, shape (L,)
         Bound of the passes' contraction over the interval, per level (-).
     ref : ndarray, shape (n_s, 2)
@@ -114,16 +118,16 @@ class RampWork(NamedTuple):
     s1: np.ndarray     # (n_s, 3) and at its end
     fw: np.ndarray     # (nf,) mean of the force weights at both ends
     qbase: np.ndarray  # (n,) constant-speed predictor at the reference
-    yfix: np.ndarray   # (2 n_s n,) the pass input's part fixed in the step
-    y: np.ndarray      # (2 n_s n,) the pass input
+    yfix: np.ndarray   # (b n_s n,) the pass input's part fixed in the step
+    y: np.ndarray      # (b n_s n,) the pass input
     e: np.ndarray      # (n,) R y
     dq: np.ndarray     # (n,) the step's dq, last pass
 
 
-def ramp_work(n: int, n_s: int, nf: int) -> RampWork:
-    """Empty :class:`RampWork` (Python side)."""
+def ramp_work(n: int, n_s: int, nf: int, blocks: int = 2) -> RampWork:
+    """Empty :class:`RampWork` (Python side); ``blocks`` a spool in ``Varying.R`` (3 with internal damping)."""
     return RampWork(s0=np.empty((n_s, 3)), s1=np.empty((n_s, 3)), fw=np.empty(nf), qbase=np.empty(n),
-                    yfix=np.empty(2 * n_s * n), y=np.empty(2 * n_s * n), e=np.empty(n), dq=np.empty(n))
+                    yfix=np.empty(blocks * n_s * n), y=np.empty(blocks * n_s * n), e=np.empty(n), dq=np.empty(n))
 
 
 @njit(cache=True, inline="always")
@@ -197,13 +201,20 @@ def _ramp_predictor(level, ta, tb, cur, levels, var, plates, w, rw):
         _disk_forces(cur.z, plates.par, w.frot)
         _add_columns(rw.qbase, w.frot, levels.S0T[level], 1.0)
     n = rw.qbase.shape[0]
-    for s in range(rw.s0.shape[0]):
+    n_s = rw.s0.shape[0]
+    for s in range(n_s):
         dW = rw.s1[s, 0] - rw.s0[s, 0]
         sig = rw.s0[s, 1] + rw.s1[s, 1] - 2.0 * var.ref[s, 1]
         off = 2 * s * n
         for ii in range(n):
             rw.yfix[off + ii] = dW * cur.x[n + ii]
             rw.yfix[off + n + ii] = -sig * cur.x[ii]
+    if rw.yfix.shape[0] > 2 * n_s * n:  # internal damping: the S_s blocks after all the others
+        for s in range(n_s):
+            sw = rw.s0[s, 0] + rw.s1[s, 0] - 2.0 * var.ref[s, 0]
+            off = (2 * n_s + s) * n
+            for ii in range(n):
+                rw.yfix[off + ii] = -sw * cur.x[ii]
     # first guess of dq: h v0 + h^2/2 a0
     h = levels.coef[level, 7]
     for ii in range(n):
@@ -218,6 +229,7 @@ def _ramp_substep(level, ta, tb, first_try, cur, new, levels, var, plates, setti
     c3 = levels.coef[level, 3]
     rho = var.rho[level]
     has_plates = plates.par.shape[0] > 0
+    circulatory = rw.y.shape[0] > 2 * rw.s1.shape[0] * n
     for p in range(var.max_passes):
         # the pass input y(dq) and the correction e = R y
         for s in range(rw.s1.shape[0]):
@@ -227,6 +239,12 @@ def _ramp_substep(level, ta, tb, first_try, cur, new, levels, var, plates, setti
             for ii in range(n):
                 rw.y[off + ii] = rw.yfix[off + ii] - c3 * delta * rw.dq[ii]
                 rw.y[off + n + ii] = rw.yfix[off + n + ii] - eps * rw.dq[ii]
+        if circulatory:  # internal damping's S_s blocks
+            for s in range(rw.s1.shape[0]):
+                delta = rw.s1[s, 0] - var.ref[s, 0]
+                off = (2 * rw.s1.shape[0] + s) * n
+                for ii in range(n):
+                    rw.y[off + ii] = rw.yfix[off + ii] - delta * rw.dq[ii]
         _matvec(var.R[level], rw.y, rw.e)
         for ii in range(n):
             w.qn[ii] = rw.qbase[ii] + rw.e[ii]
