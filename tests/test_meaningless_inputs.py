@@ -1,14 +1,15 @@
 """Inputs whose results would be meaningless, refused before computing, and results that are not finite, refused
-before writing (issue 41, Build 4 for `harmonic` and `campbell`; docs/model.md, "Physical bounds of command inputs").
+before writing (issue 41, Build 4 for `harmonic`, `campbell` and `modes`; docs/model.md, "Physical bounds of command
+inputs").
 
 On the issue's main, `harmonic` with an absurd unbalance, speed or ratio wrote a response.csv of NaN/inf with exit 0,
 and `campbell --ratio 1e300` printed UNSTABLE lines at frequencies of 1e76 Hz and more.
 
-Bad-input kinds tested here (counted in the README): 11 absurd or non-finite magnitudes (harmonic: unbalance, speed,
-ratio, a spool's speed on the line, FRF frequencies, cutoff, a non-finite speed; campbell: ratio, a spool's ratio,
-harmonic order, speed), 2 non-finite results (harmonic response, campbell whirl frequency), 4 conflicting options
-(harmonic: --modes, --cutoff, --boundary-nodes without --reduced, --frequencies without --frf), and 3 mode counts
-beyond the model named by their option (campbell --reduce, --modes; harmonic --modes): 20 kinds.
+Bad-input kinds tested here (counted in the README), 22: 13 absurd or non-finite magnitudes (harmonic: unbalance,
+speed, ratio, a spool's speed on the line, FRF frequencies, cutoff, a non-finite speed; campbell: ratio, a spool's
+ratio, harmonic order, speed; modes: speed, ratio), 2 non-finite results (harmonic response, campbell whirl frequency),
+4 conflicting options (harmonic: --modes, --cutoff, --boundary-nodes without --reduced, --frequencies without --frf)
+and 3 mode counts beyond the model named by their option (campbell --reduce, --modes; harmonic --modes).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ _HARMONIC = [  # (arguments, the option the one error line names)
     (["--speeds", "0:1e300:5"], "--speeds = '0:1e300:5': must be at most 1e+06 rpm"),
     (["--speeds", "0:6000:5", "--ratio", "1e300"], "--ratio = '1e300': must be at most 100 "),
     (["--speeds", "0:600000:5", "--ratio", "50"],
-     "--speeds and --ratio = '0:600000:5 and 50': put spool 'outer' at 3e+07 rpm; a spool must turn at most 1e+06"),
+     "the speed of spool 'outer' (rpm) = 30000000.0: must be at most 1e+06 rpm (twice the fastest machine rotors"),
     (["--speeds", "0:6000:5", "--frf", "18:x>13:x", "--frequencies", "0:1e9:3"],
      "--frequencies = '0:1e9:3': must be at most 1e+06 Hz"),
     (["--speeds", "0:6000:5", "--reduced", "--cutoff", "1e300"], "--cutoff = 1e+300: must be at most 1e+06 Hz"),
@@ -42,6 +43,21 @@ _CAMPBELL = [
     (["--speeds", "0:6000:5", "--harmonics", "1e9"], "--harmonics = '1e9': must be at most 1000 "),
     (["--speeds", "0:1e9:5"], "--speeds = '0:1e9:5': must be at most 1e+06 rpm"),
 ]
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["--speed", "1e300"], "the speed of spool 'inner' (rpm) = 1e+300: must be at most 1e+06 rpm"),
+    (["--speed", "3000", "--ratio", "1e300"], "--ratio = '1e300': must be at most 100 "),
+], ids=["--speed 1e300", "--ratio 1e300"])
+def test_modes_refuses_meaningless_magnitudes_before_computing(tmp_path, capsys, args, expected):
+    """`modes` (a command of issue 38) printed 67 modes at up to 6e136 Hz for --speed 1e300, exit 0: every command
+    that builds its speed line by options.speed_line has each spool bounded."""
+    out = tmp_path / "out"
+    assert main(["modes", "seed-rig", *args, "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"rotorred modes: error: {expected}"), captured.err
+    assert captured.out == "" and not out.exists()
 
 
 def _refused(command, args, expected, tmp_path, capsys) -> None:

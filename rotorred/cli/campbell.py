@@ -14,7 +14,7 @@ import numpy as np
 
 from rotorred import checks, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (bounded_line, grid, number_list, options_named, out_dir, provenance, ratio_number,
+from rotorred.cli.options import (grid, number_list, options_named, out_dir, provenance, ratio_number,
                                   speed_line, spool_ratios, stage_summary)
 
 
@@ -138,7 +138,6 @@ def run(args) -> int:
     record = provenance(args, "rotor", writers.toml_text(document))
     check_model_size(rotor, args.force)
     operating = speed_line(rotor, speeds, args.reference, ratios_to_reference(ratio, rotor, args.reference), "rpm")
-    bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds, ",".join(args.ratio) or "default"))
     with writers.OutputFolder(out) as folder:
         with options_named({"n_modes": "--reduce"}):
             model = rotor if args.reduce is None else _reduced(rotor, args.reduce)

@@ -30,7 +30,7 @@ import numpy as np
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
-from rotorred.cli.options import (bounded_line, dof_list, grid, node_list, options_named, out_dir, provenance,
+from rotorred.cli.options import (dof_list, grid, node_list, options_named, out_dir, provenance,
                                   ratio_number, speed_line, spool_ratios, stage_summary)
 
 #: unbalance magnitude (kg m) put on the first disk of each spool when neither the user nor the rotor
@@ -243,7 +243,6 @@ def run(args) -> int:
     outputs = _outputs(args, rotor, scene, unbalances)
     operating = speed_line(rotor, speeds, reference, _ratios(args.ratio, rotor, reference), "rad/s",
                            ("--reference-spool", "--ratio"))
-    bounded_line(rotor, operating, ("--speeds", "--ratio"), (args.speeds or "default", args.ratio or "default"))
     frf_pairs = _frf_pairs(args.frf, rotor.spool_of) if args.frf else []
     frf_freqs = 2 * math.pi * _frequencies(args.frequencies or FRF_FREQUENCIES) if args.frf else None
     _check_model_options(args, scene)

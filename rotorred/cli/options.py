@@ -15,8 +15,7 @@ from rotorred import checks
 from rotorred import Operating, parse_dof
 
 __all__ = ["grid", "number_list", "dof_list", "node_list", "ratio_number", "spool_ratios", "speed_line", "out_dir",
-           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings", "bounded_line",
-           "options_named"]
+           "provenance", "stage_summary", "MAX_COUNT", "SCENE_UNITS", "add_settings", "options_named"]
 
 #: most values a START:STOP:COUNT grid may hold (each value is a solve)
 MAX_COUNT = 100_000
@@ -143,6 +142,11 @@ def speed_line(rotor, speeds, reference: str | None, ratios: Mapping[str, float]
     Returns
     -------
     Operating
+
+    Raises
+    ------
+    InputError
+        A spool beyond :data:`rotorred.checks.BOUNDS` ``["speed"]`` on the line, or a ratio the rotor does not give.
     """
     reference_option, ratio_option = options
     names = [s.name for s in rotor.spools]
@@ -154,30 +158,19 @@ def speed_line(rotor, speeds, reference: str | None, ratios: Mapping[str, float]
         operating.lines(rotor)
     except checks.InputError as exc:  # a spool whose ratio the rotor does not give
         raise checks.InputError(ratio_option, dict(ratios) if ratios else None, exc.requirement) from None
+    _bounded_spools(operating, rotor, ratio_option)
     return operating
 
 
-def bounded_line(rotor, operating: Operating, options: tuple[str, str], texts: tuple) -> None:
-    """Refuse a speed line on which a spool turns beyond :data:`rotorred.checks.BOUNDS` ``["speed"]``: a ratio within
-    its bound times a speed within its bound may still exceed it.
-
-    Parameters
-    ----------
-    rotor : Rotor
-    operating : Operating
-        The line of :func:`speed_line`.
-    options : (str, str)
-        The names of the speed and the ratio options.
-    texts : (str, str)
-        Their values as typed.
-    """
+def _bounded_spools(operating: Operating, rotor, ratio_option: str) -> None:
+    """Refuse a line on which a spool turns beyond :data:`rotorred.checks.BOUNDS` ``["speed"]`` (a speed and a ratio
+    each within its bound can still give one), naming the spool and its top speed."""
     limit = checks.BOUNDS["speed"].limit
     for spool, speeds in operating.speeds(rotor).items():
-        top = float(np.max(np.abs(speeds), initial=0.0)) * 30.0 / math.pi  # rpm
+        top = float(np.max(np.abs(speeds), initial=0.0)) * 30.0 / math.pi
         if not top <= limit:
-            checks.fail(f"{options[0]} and {options[1]}", f"{texts[0]} and {texts[1]}",
-                        f"put spool {spool!r} at {top:.6g} rpm; a spool must turn at most "
-                        + checks.bound_text("speed"))
+            checks.fail(f"the speed of spool {spool!r} (rpm)", top, f"must be at most {checks.bound_text('speed')}; "
+                        f"it is the speed given times the spool's {ratio_option}")
 
 
 @contextmanager
