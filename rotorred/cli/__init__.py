@@ -46,8 +46,10 @@ EXIT_STATUSES = {
                 "nothing written",
     EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `map` (and `sweep`) keeps "
                    "the other points and names the failed ones in map.csv and map.txt",
-    EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
-                      "an optional library is missing (the message gives its install command)",
+    EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written (a "
+                      "full disk, a quota, the file-size limit, a folder removed, a non-regular file at its path: one "
+                      "line naming the file, the earlier result intact), memory that cannot be allocated (the size), "
+                      "or an optional library is missing (the message gives its install command)",
     EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
                  "marked INCOMPLETE; `compare`: the runs done, marked INCOMPLETE; `map`: the points done, resumed by "
                  "the same command)",
