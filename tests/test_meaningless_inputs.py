@@ -105,7 +105,7 @@ def test_the_bounds_hold_at_the_bound_and_convert_units():
 def test_the_bounds_are_the_documented_ones():
     """Each bound of checks.BOUNDS is in the table of docs/model.md with its value."""
     text = (Path(__file__).resolve().parents[1] / "docs" / "model.md").read_text(encoding="utf-8")
-    section = text[text.index("## Physical bounds of command inputs"):]
+    section = text[text.index("## 23. Physical bounds of command inputs"):]
     rows = {"speed": "| 1e6 rpm", "ratio": "| 100 |", "unbalance": "| 1000 kg m |", "harmonic": "| 1000 |",
             "frequency": "| 1e6 Hz |"}
     assert set(rows) == set(checks.BOUNDS)
