@@ -16,7 +16,7 @@ __all__ = ["SPARSE_FROM", "is_sparse", "dense", "zeros_like", "nonzero", "cut", 
 
 #: models of at least this many DOFs are assembled sparse (docs/performance.md, "Sparse models": the measured
 #: sizes where a sparse Campbell speed, unbalance response and reduction become quicker than the dense ones)
-SPARSE_FROM = 400
+SPARSE_FROM = 1000
 
 
 def is_sparse(X) -> bool:
