@@ -202,7 +202,7 @@ def format_table(rows: list[dict], checks: list[dict] | None = None) -> str:
         twin = next((d for d in rows if not d["sparse"] and d["refine"] == r["refine"]), None)
         if r["sparse"] and twin is not None and r["refine"] == max(d["refine"] for d in rows if not d["sparse"]):
             lines.append(f"dense / sparse at refined({r['refine']}), {r['n_dof']} DOFs: " + ", ".join(
-                f"{LABELS[t].split(' (')[0]} {twin[t] / r[t]:.0f}x" for t in TASKS[:4]))
+                f"{LABELS[t].split(' (')[0]} {twin[t] / r[t]:.3g}x" for t in TASKS[:4]))
     lines.append("growth exponent (sparse, >= 1000 DOFs): " + ", ".join(
         f"{LABELS[t].split(' (')[0]} n^{p:.2f}" for t, p in exponents(rows).items()))
     for c in checks or ():
