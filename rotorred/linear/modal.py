@@ -60,6 +60,10 @@ WHIRL_MAX_DAMPING_RATIO = 0.99
 #: solves until the eigenvalues found fill a disc about the shift of radius (highest frequency asked for) /
 #: sqrt(1 - this^2) (docs/model.md §22); a mode more damped than this, below that frequency, may be missed
 SPARSE_COMPLETE_DAMPING_RATIO = 0.6
+#: the sparse solve's shift is -this x the softest DOF's own frequency (:func:`_softest`): far below the whirl
+#: frequencies, whose disc about the shift it barely widens, and far enough from the rigid-body eigenvalues at 0
+#: to keep K + sigma D + sigma^2 M regular
+_SHIFT = 1e-4
 #: a sparse model is solved dense (whole) when it asks for more than this share of its 2n eigenvalues
 _SPARSE_MAX_SHARE = 0.25
 
@@ -124,8 +128,7 @@ def _sparse_eigen(M, D, K, wanted: tuple[int, float], min_frequency: float,
     n_wanted, w_wanted = wanted
     n = M.shape[0]
     Mc, Dc, Kc = (sp.csc_array(X) for X in (M, D, K))
-    scale = float(np.sqrt(np.max(np.abs(Kc.diagonal()) / np.maximum(Mc.diagonal(), 1e-300))))
-    sigma = -1e-6 * max(scale, 1.0)  # a little below zero: away from the rigid-body eigenvalues lambda = 0
+    sigma = -_SHIFT * _softest(Kc, Mc)  # a little below zero: away from the rigid-body eigenvalues lambda = 0
     lu = spla.splu((Kc + sigma * Dc + sigma * sigma * Mc).tocsc(), permc_spec="MMD_AT_PLUS_A")
     DsM = (Dc + sigma * Mc).tocsr()
 
@@ -153,7 +156,7 @@ def _sparse_eigen(M, D, K, wanted: tuple[int, float], min_frequency: float,
             keep &= -lam.real < max_damping_ratio * np.abs(lam)
         order = np.flatnonzero(keep)[np.argsort(lam.imag[keep], kind="stable")]
         top = max(w_wanted, lam.imag[order[n_wanted - 1]] if 0 < n_wanted <= len(order) else np.inf)
-        if cover * top <= radius:
+        if cover * top + abs(sigma) <= radius:
             break
         k *= 2
     if n_wanted:
@@ -161,6 +164,14 @@ def _sparse_eigen(M, D, K, wanted: tuple[int, float], min_frequency: float,
     vec = vec[:n, order]
     return EigenSolution(eigenvalues=_rayleigh_quotients(lam[order], vec, (Mc, Dc, Kc)),
                          modes=vec / np.linalg.norm(vec, axis=0))
+
+
+def _softest(K, M) -> float:
+    """sqrt of the smallest positive ratio of K's and M's diagonal entries (rad/s): the frequency of the softest
+    DOF alone, a scale of the model's low frequencies (the largest ratio is the stiffest bearing's), 1 if none."""
+    ratio = np.abs(K.diagonal()) / np.maximum(M.diagonal(), 1e-300)
+    ratio = ratio[ratio > 0]
+    return float(np.sqrt(ratio.min())) if len(ratio) else 1.0
 
 
 def _rayleigh_quotients(lam: np.ndarray, vec: np.ndarray, matrices) -> np.ndarray:
