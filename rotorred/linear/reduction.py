@@ -432,7 +432,7 @@ def _not_restrained(system, b: np.ndarray):
 
 def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict, dict]:
     def p(X):
-        return T.T @ (X @ T)  # a sparse X: X @ T is dense, (n, m)
+        return T.T @ (X @ T) if is_sparse(X) else T.T @ X @ T  # a sparse X: X @ T is dense, (n, m)
 
     def symmetric(X):
         return 0.5 * (X + X.T)

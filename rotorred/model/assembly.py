@@ -103,7 +103,8 @@ class RotatingDamping:
 
     def on(self, T: np.ndarray) -> RotatingDamping:
         """The same damping in the coordinates ``p`` of ``q = T p`` (``T^T X T``; a column selection for supports)."""
-        return RotatingDamping(*(sparse.dense(T.T @ (X @ T)) for X in (self.C_v, self.N_v, self.C_h, self.N_h)))
+        return RotatingDamping(*(T.T @ (X @ T) if sparse.is_sparse(X) else T.T @ X @ T
+                                 for X in (self.C_v, self.N_v, self.C_h, self.N_h)))
 
     def at(self, frequency: float) -> tuple[np.ndarray, np.ndarray]:
         """(C, N) of the viscous damping equivalent at whirl frequency ``frequency`` (rad/s, > 0 where a loss factor
@@ -466,7 +467,7 @@ def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
     Cm = C.matrix(n, as_sparse)
     alpha, beta = rotor.rayleigh
     if alpha or beta:
-        Cm = Cm + alpha * M_shaft.matrix(n, as_sparse) + beta * K_shaft.matrix(n, as_sparse)
+        Cm = Cm + (alpha * M_shaft.matrix(n, as_sparse) + beta * K_shaft.matrix(n, as_sparse))
     rotating = {k: RotatingDamping(*(t.matrix(n, as_sparse) for t in v)) for k, v in parts.items() if v[0].vals}
     free = SystemMatrices(M=M.matrix(n, as_sparse), K=K.matrix(n, as_sparse), C=Cm,
                           G={k: v.matrix(n, as_sparse) for k, v in G.items()}, dofs=dofs,

@@ -111,7 +111,10 @@ def own_elastic_w2(rotor: Rotor) -> dict[str, float]:
     out = {}
     for s in rotor.spools:
         alone = assemble(Rotor((s,), disks=tuple(d for d in rotor.disks if d.node in set(s.nodes))))
-        w2 = sparse.lowest_w2(alone.K, alone.M, 5)[0]
+        if alone.is_sparse:
+            w2 = sparse.lowest_w2(alone.K, alone.M, 5)[0]
+        else:
+            w2 = sla.eigh(alone.K, alone.M, eigvals_only=True, subset_by_index=(0, min(4, alone.n_dof - 1)))
         out[s.name] = float(w2[-1])
     return out
 
