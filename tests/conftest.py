@@ -15,8 +15,8 @@ import pytest  # noqa: E402
 
 def pytest_addoption(parser):
     parser.addoption("--sparse-from", type=int, default=None,
-                     help="assemble models of at least this many DOFs sparse (rotorred.model.sparse.SPARSE_FROM); "
-                          "0 runs every test on the sparse path")
+                     help="assemble and solve models of at least this many DOFs sparse (rotorred.model.sparse."
+                          "SPARSE_FROM, SOLVE_SPARSE_FROM); 0 runs every test on the sparse path")
 
 
 @pytest.fixture(autouse=True)
@@ -27,3 +27,4 @@ def _sparse_from(request, monkeypatch):
         from rotorred.model import sparse
 
         monkeypatch.setattr(sparse, "SPARSE_FROM", value)
+        monkeypatch.setattr(sparse, "SOLVE_SPARSE_FROM", value)

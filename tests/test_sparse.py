@@ -69,10 +69,16 @@ def test_sparse_assembly_is_the_dense_one(name):
     assert np.array_equal(null_space(s)[2][:4], null_space(d)[2][:4])
 
 
-def test_size_decides_the_form():
+def test_size_decides_the_form_and_the_path():
+    """The unrefined rig is assembled and solved dense; refined(16), 1160 DOFs, is assembled dense and solved through
+    its sparse twin (system_of); refined(32), 2312 DOFs, dense too; refined(64) sparse."""
+    from rotorred.model.assembly import system_of
+
     rig = rr.load_rotor("seed-rig")
-    assert not assemble(rig).is_sparse and assemble(rig.refined(16)).is_sparse
-    assert sparse.SPARSE_FROM <= 4 * len(rig.refined(16).nodes)
+    small, mid = assemble(rig), assemble(rig.refined(16))
+    assert not small.is_sparse and not system_of(small, sparse_ok=True).is_sparse
+    assert not mid.is_sparse and system_of(mid, sparse_ok=True).is_sparse and not system_of(mid).is_sparse
+    assert not assemble(rig.refined(32)).is_sparse and assemble(rig.refined(64)).is_sparse
 
 
 def test_sparse_whirl_frequencies_against_extended_precision():

@@ -42,7 +42,7 @@ from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
 from rotorred.model.assembly import (RotatingDamping, SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble,
-                                     model_summary)
+                                     model_summary, system_of)
 from rotorred.model.dofs import DofMap
 from rotorred.model.operating import Operating
 from rotorred.model.sparse import cut, is_sparse, lowest_w2, nonzero
@@ -551,6 +551,7 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
     R. R. Craig, M. C. C. Bampton, "Coupling of substructures for dynamic analyses",
     AIAA Journal 6(7), 1968, 1313–1319.
     """
+    system = system_of(system, "system", sparse_ok=True)  # from SOLVE_SPARSE_FROM DOFs: the sparse path
     n_modes, cutoff, band, target, n_check, check_speeds = _checked_options(
         system, n_modes, cutoff, band, target, n_check, check_speeds)
     ladder = ModeLadder(system, boundary_nodes)

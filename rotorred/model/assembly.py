@@ -12,8 +12,9 @@ docs/model.md, Eq. R2). A spool's internal (rotating) damping adds ``C_r,s`` to 
 ``-Omega_s N_s`` to the stiffness (:class:`RotatingDamping`, docs/model.md §19).
 
 Matrices are built from COO triplets in one pass: dense ndarrays for a model of fewer than
-:data:`rotorred.model.sparse.SPARSE_FROM` DOFs, where dense LAPACK is as quick and keeps eigen-analysis simple,
-``scipy.sparse`` CSR matrices from that size on (a beam model's matrices are banded; docs/performance.md).
+:data:`rotorred.model.sparse.SPARSE_FROM` DOFs, ``scipy.sparse`` CSR matrices from that size on (a beam model's
+matrices are banded); analyses with a sparse path solve a model of :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM`
+DOFs or more through its sparse twin (:func:`system_of`; docs/model.md §22).
 """
 
 from __future__ import annotations
@@ -273,6 +274,17 @@ class SystemMatrices(SpoolSpeedMixin):
         :data:`rotorred.model.sparse.SPARSE_FROM` DOFs) rather than dense ndarrays."""
         return sparse.is_sparse(self.M)
 
+    def sparse(self) -> SystemMatrices:
+        """The same model with CSR arrays (itself if it has them): for an analysis's sparse path."""
+        if self.is_sparse:
+            return self
+        c = sparse.csr
+        return dataclasses.replace(
+            self, M=c(self.M), K=c(self.K), C=c(self.C), G={k: c(v) for k, v in self.G.items()},
+            K_G={k: c(v) for k, v in self.K_G.items()}, tables=tuple(dataclasses.replace(t, rows=c(t.rows))
+                                                                     for t in self.tables),
+            rotating={k: RotatingDamping(*(c(X) for X in (r.C_v, r.N_v, r.C_h, r.N_h))) for k, r in self.rotating.items()})
+
     def dense(self) -> SystemMatrices:
         """The same model with dense ndarrays (itself if it has them): for an analysis that has no sparse path."""
         if not self.is_sparse:
@@ -383,8 +395,9 @@ def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):
     field_name : str
         The argument or key the error names.
     sparse_ok : bool
-        Whether the caller takes a sparse model (:attr:`SystemMatrices.is_sparse`); if not, a sparse one is given
-        dense (:meth:`SystemMatrices.dense`).
+        Whether the caller has a sparse path: it gets a full model of at least
+        :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM` DOFs sparse (:meth:`SystemMatrices.sparse`), as it is
+        otherwise; a caller without one gets it dense (:meth:`SystemMatrices.dense`).
 
     Returns
     -------
@@ -397,10 +410,14 @@ def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):
     """
     if isinstance(model, Rotor):
         model = assemble(model)
-    if isinstance(model, SpoolSpeedMixin):
-        return model if sparse_ok or not isinstance(model, SystemMatrices) else model.dense()
-    checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a ReducedSystem "
-                "(reduce_rotor)")
+    if not isinstance(model, SpoolSpeedMixin):
+        checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a "
+                    "ReducedSystem (reduce_rotor)")
+    if not isinstance(model, SystemMatrices):
+        return model  # a reduced model: small and dense
+    if not sparse_ok:
+        return model.dense()
+    return model.sparse() if model.n_dof >= sparse.SOLVE_SPARSE_FROM else model
 
 
 def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:

@@ -1,9 +1,10 @@
 """Sparse or dense matrices of one model: the few rules every analysis shares.
 
-A model of at least :data:`SPARSE_FROM` DOFs is assembled with ``scipy.sparse`` CSR matrices
-(:func:`rotorred.model.assembly.assemble`), a smaller one with dense ndarrays: below that size dense LAPACK is as
-quick and keeps every analysis simple; above it a beam model's banded matrices make a sparse factorisation O(n) per
-solve where a dense one is O(n^3) (the size was measured: docs/performance.md, validation/bench_sparse.py).
+Two sizes (docs/model.md §22; measured: docs/performance.md, validation/bench_sparse.py). A model of at least
+:data:`SPARSE_FROM` DOFs is assembled with ``scipy.sparse`` CSR matrices (:func:`rotorred.model.assembly.assemble`),
+a smaller one with dense ndarrays, which code can read as arrays. An analysis with a sparse path solves a model of at
+least :data:`SOLVE_SPARSE_FROM` DOFs sparse, a dense one through its sparse twin: from that size a beam model's banded
+matrices make a sparse factorisation about O(n) per solve where a dense one is O(n^3).
 """
 
 from __future__ import annotations
@@ -12,11 +13,15 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["SPARSE_FROM", "is_sparse", "dense", "zeros_like", "nonzero", "cut", "lowest_w2"]
+__all__ = ["SPARSE_FROM", "SOLVE_SPARSE_FROM", "is_sparse", "dense", "csr", "zeros_like", "nonzero", "cut", "lowest_w2"]
 
-#: models of at least this many DOFs are assembled sparse (docs/performance.md, "Sparse models": the measured
-#: sizes where a sparse Campbell speed, unbalance response and reduction become quicker than the dense ones)
-SPARSE_FROM = 1000
+#: models of at least this many DOFs are assembled sparse: their dense matrices would take 50 MB each, seven of
+#: them at least (M, K, C and a G and K_G per spool); a smaller model's can be read as arrays
+SPARSE_FROM = 2500
+#: analyses with a sparse path (Campbell, responses, Craig-Bampton) solve models of at least this many DOFs sparse
+#: (docs/performance.md, "Sparse models": sparse is quicker from about 150 DOFs for a Campbell speed, from 300-600 for
+#: a response and a reduction; below 1000 a dense solve costs at most about a second)
+SOLVE_SPARSE_FROM = 1000
 
 
 def is_sparse(X) -> bool:
@@ -27,6 +32,11 @@ def is_sparse(X) -> bool:
 def dense(X):
     """``X`` as a dense ndarray (itself if it is one)."""
     return X.toarray() if sp.issparse(X) else X
+
+
+def csr(X):
+    """``X`` as a CSR array (itself if it is one)."""
+    return X if sp.issparse(X) else sp.csr_array(X)
 
 
 def zeros_like(X):
