@@ -1,7 +1,8 @@
 """Cost against model size, sparse beside dense: the seed rig refined(1, 2, 4, ..., 128), 80 to 9224 DOFs.
 
-For each mesh and each form of the full model (``assemble(rotor, as_sparse=...)``; dense up to ``--dense-up-to``,
-default refined(16), beyond which a dense eigen-solve takes minutes), one subprocess measures, one thread
+For each mesh and each form of the full model (``assemble(rotor, as_sparse=...)``, solved on the same path whatever
+its size; dense up to ``--dense-up-to``, default refined(16), beyond which a dense eigen-solve takes minutes), one
+subprocess measures, one thread
 (OPENBLAS/OMP/MKL/NUMBA_NUM_THREADS=1 before numpy loads):
 
 * ``assembly``: :func:`rotorred.model.assembly.assemble`;
@@ -91,6 +92,10 @@ def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
     from rotorred.model.assembly import assemble
     from rotorred.model.loads import Unbalance
 
+    from rotorred.model import sparse
+
+    if not as_sparse:
+        sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §22)
     rotor = rr.load_rotor("seed-rig").refined(refine)
     warm = assemble(rr.load_rotor("seed-rig"), as_sparse=as_sparse)  # first calls load modules: not timed
     modes_at(warm, rr.Operating.line(_rpm([0.0, TOP_RPM])).lines(warm), 100.0, 12)
