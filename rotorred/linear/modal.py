@@ -123,7 +123,7 @@ def _sparse_eigen(M, D, K, wanted: tuple[int, float], min_frequency: float,
     LU per call (real: sigma is real, a little below zero, so a free spool's singular K is factorised). The number of
     eigenvalues k is doubled until the modes wanted, ``wanted`` = (the lowest n, every one below a frequency w), are
     certified: every eigenvalue within the radius R = max |lambda - sigma| found is found, so every mode of damping
-    ratio below :data:`SPARSE_COMPLETE_DAMPING_RATIO` with Im(lambda) <= R sqrt(1 - zeta^2) is.
+    ratio below :data:`SPARSE_COMPLETE_DAMPING_RATIO` with Im(lambda) <= (R - |sigma|) sqrt(1 - zeta^2) is.
     """
     n_wanted, w_wanted = wanted
     n = M.shape[0]
