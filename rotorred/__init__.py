@@ -176,6 +176,13 @@ _EXPORTS = {
     "SceneBranch": "rotorred.scenes.branch",
     "write_branch": "rotorred.scenes.branch_outputs",
     "format_branch": "rotorred.scenes.branch_outputs",
+    "compare_models": "rotorred.scenes.compare",
+    "CompareOptions": "rotorred.scenes.compare",
+    "ModelComparison": "rotorred.scenes.compare",
+    "ModelRun": "rotorred.scenes.compare",
+    "check_comparison": "rotorred.scenes.compare",
+    "format_comparison": "rotorred.scenes.compare",
+    "write_comparison": "rotorred.scenes.compare",
     # maps
     "MapSpec": "rotorred.maps.spec",
     "Axis": "rotorred.maps.spec",

@@ -73,3 +73,29 @@ def dof_coordinates(dim: str, dofs: Sequence[tuple[int, str]], long_name: str) -
             f"{prefix}node": (dim, np.array([n for n, _ in dofs], np.int64), {"units": "1", "long_name": "node"}),
             f"{prefix}direction": (dim, np.array([d for _, d in dofs], dtype=object),
                                    {"units": "1", "long_name": "direction (x, y, tx, ty)"})}
+
+
+def strongest_lines(outputs: Sequence[tuple[int, str]], amplitudes: np.ndarray, where: Sequence[str],
+                    n: int = 3, shown: int = 8) -> list[str]:
+    """Summary lines of each output's ``n`` strongest lines, ``"node 14 y: 2.79 µm at 91.37 Hz, ..."``, for the first
+    ``shown`` outputs, then how many more.
+
+    Parameters
+    ----------
+    outputs : sequence of (int, str)
+        The DOFs (node, direction), one per column of ``amplitudes``.
+    amplitudes : ndarray, shape (K, len(outputs))
+        Amplitude of each line (m).
+    where : sequence of str, length K
+        Where each line is, e.g. ``"91.37 Hz"``.
+    n, shown : int
+        Lines per output, outputs listed.
+    """
+    lines = []
+    for j, (node, direction) in enumerate(outputs[:shown]):
+        top = np.argsort(-amplitudes[:, j])[:n]
+        lines.append(f"node {node} {direction}: " + ", ".join(
+            f"{1e6 * amplitudes[k, j]:.4g} µm at {where[k]}" for k in top if amplitudes[k, j] > 0))
+    if len(outputs) > shown:
+        lines.append(f"... {len(outputs) - shown} more outputs")
+    return lines

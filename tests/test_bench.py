@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rotorred.signals.compare import ResponseMeasures, measure_errors
+
 VALIDATION = Path(__file__).resolve().parents[1] / "validation"
 
 
@@ -107,14 +109,14 @@ def test_scene_checks(bp, tiny):
 def test_errors_definition(bp):
     """Spectral error is the worst relative error over the reference's largest lines (DC excluded)."""
     f = np.arange(6) * 10.0
-    ref = bp.Measures({(13, "x"): np.array([5.0, 1.0, 4.0, 0.5, 2.0, 0.1])}, f, 1e-4, 0.1)
-    other = bp.Measures({(13, "x"): np.array([0.0, 1.1, 4.0, 0.5, 2.0, 0.1])}, f, 1.1e-4, 0.12)
-    e = bp.errors(other, ref, n_lines=3)
+    ref = ResponseMeasures({(13, "x"): np.array([5.0, 1.0, 4.0, 0.5, 2.0, 0.1])}, f, 1e-4, 0.1)
+    other = ResponseMeasures({(13, "x"): np.array([0.0, 1.1, 4.0, 0.5, 2.0, 0.1])}, f, 1.1e-4, 0.12)
+    e = measure_errors(other, ref, n_lines=3)
     assert e.spectral == pytest.approx(0.1) and e.worst_line == "13x 10 Hz"
     assert e.orbit == pytest.approx(0.1) and e.contact == pytest.approx(0.2)
     # line 5 (0.1) is not among the three largest: changing it does not count
-    other2 = bp.Measures({(13, "x"): np.array([5.0, 1.0, 4.0, 0.5, 2.0, 9.9])}, f, 1e-4, 0.1)
-    assert bp.errors(other2, ref, n_lines=3).spectral == 0.0
+    other2 = ResponseMeasures({(13, "x"): np.array([5.0, 1.0, 4.0, 0.5, 2.0, 9.9])}, f, 1e-4, 0.1)
+    assert measure_errors(other2, ref, n_lines=3).spectral == 0.0
 
 
 def test_plot_writes_png(bp, tiny, tmp_path):

@@ -188,7 +188,7 @@ def test_every_exported_result_type_shows_itself_and_is_checked():
 # --- the CLI keeps its units and names them in every option's help (issue 35, Build 1) ------------------------------
 #: options whose values carry no physical unit: counts, names, paths, DOFs, ratios, tolerances, choices
 UNITLESS = {"--out", "--ratio", "--reference", "--reference-spool", "--modes", "--harmonics", "--samples", "--tol",
-            "--model", "--boundary-nodes", "--outputs", "--frf", "--reduce", "--direction", "--workers",
+            "--model", "--boundary-nodes", "--refine", "--outputs", "--frf", "--reduce", "--direction", "--workers",
             "--scheduler"}
 #: a unit named in a help text: a parenthesised or spelled-out SI or CLI unit
 UNIT = re.compile(r"(?<![\w'])(rpm|Hz|rad/s|s|m|µm|kg m|N/m|degrees|deg)(?![\w'/])|scene units")

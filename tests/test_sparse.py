@@ -1,4 +1,4 @@
-"""Sparse models (docs/model.md §22): the sparse assembly equals the dense one, and each sparse analysis (Campbell,
+"""Sparse models (docs/model.md §23): the sparse assembly equals the dense one, and each sparse analysis (Campbell,
 unbalance response, Craig-Bampton) equals the dense one on small models, with the independent references of
 validation/sparse_eigen.py (an extended-precision eigenvalue) where round-off decides. Large models belong in
 validation/bench_sparse.py; ``pytest --sparse-from 0`` runs any test file on the sparse path."""

@@ -19,7 +19,9 @@ full model on ``refined(2 REFINE)`` to quantify the mesh error, which is common 
 Last, the scene as shipped (its own unrefined rig, its mode count, dt and method) and with the
 reduction's automatic mode count are measured against the same reference (:func:`scene_checks`).
 
-Error measures (meaningful for a rubbing rotor, where a pointwise time-history error is not):
+Error measures (meaningful for a rubbing rotor, where a pointwise time-history error is not), by
+:func:`rotorred.signals.compare.response_measures` and :func:`~rotorred.signals.compare.measure_errors`, the ones of
+``rotorred compare``:
 
 * ``spectral``: the ten largest spectral amplitudes (0 Hz excluded) of the reference at nodes 13
   and 14 (x and y), relative error of each, worst of the 40 (the largest errors sit on the small
@@ -62,7 +64,8 @@ from rotorred.transient.newmark import (Initial, Loads, Recording, Scheme, Simul
 from rotorred.linear.reduction import default_boundary_nodes, reduce  # noqa: E402
 from rotorred.scenes.run import settled_state  # noqa: E402
 from rotorred.scenes.schema import Scene, load_scene  # noqa: E402
-from rotorred.signals.spectra import settled_spectrum  # noqa: E402
+from rotorred.signals.compare import (N_LINES, MeasureErrors, ResponseMeasures, measure_errors,  # noqa: E402
+                                      response_measures)
 
 REFINE = 4                   # mesh of the comparison: Rotor.refined(4) of the 20-node rig
 T_END = 2.5                  # s: the rub response settles onto a period-2 (0.2 s) orbit by about 2 s
@@ -72,7 +75,6 @@ DT_REF = 2.5e-6              # s, reference step
 DTS = (1e-4, 5e-5, 2e-5, 1e-5, 5e-6)
 MODES = (8, 10, 16, 24, 48)  # fixed-interface modes (10: the automatic count; 24: the scene's)
 HHT_ALPHA = -0.05
-N_LINES = 10                 # spectral amplitudes compared per signal
 SPECTRAL_NODES = (13, 14)
 ORBIT_NODE = 18
 TARGET = 0.01                # the "1 % spectral error" of the issue
@@ -152,71 +154,14 @@ def run(model, case: RubCase, dt: float, method: str = "newmark", alpha: float |
                     control=StepControl(progress=False))
 
 
-@dataclass(frozen=True)
-class Measures:
-    """What is compared against the reference.
-
-    Attributes
-    ----------
-    spectra : dict of (int, str) to ndarray
-        Amplitude spectrum (m) of each spectral output, on the common-period bins.
-    frequencies : ndarray
-        Bin frequencies (Hz).
-    peak_radius : float
-        Peak orbit radius at the orbit node (m).
-    contact_fraction : float
-        Fraction of the recorded steps in contact (-).
-    """
-
-    spectra: dict
-    frequencies: np.ndarray
-    peak_radius: float
-    contact_fraction: float
-
-
-def measures(result, case: RubCase) -> Measures:
-    """Spectra at nodes 13 and 14, peak orbit radius at node 18 and contact fraction of a run."""
-    step = int(round(case.sample_dt / result.dt))
-    if abs(step * result.dt - case.sample_dt) > 1e-9 * case.sample_dt:
-        raise ValueError(f"`dt` = {result.dt} s must divide the sample interval {case.sample_dt} s")
+def measures(result, case: RubCase) -> ResponseMeasures:
+    """Spectra at nodes 13 and 14, peak orbit radius at node 18 and contact fraction of a run, its records
+    resampled to ``case.sample_dt`` (:func:`rotorred.signals.compare.response_measures`, the measure of
+    ``rotorred compare``)."""
     f_L, f_H = case.speeds["inner"] / (2 * math.pi), case.speeds["outer"] / (2 * math.pi)
-    spectra, freqs = {}, None
-    for o in case.outputs:
-        if o[0] in SPECTRAL_NODES:
-            # records start at record_start; resampling from the end keeps the last sample
-            y = result.outputs[o][::-1][::step][::-1]
-            spec = settled_spectrum(y, case.sample_dt, f_L, f_H)
-            spectra[o] = spec.amplitudes
-            freqs = spec.frequencies
-    r = np.hypot(result.outputs[(ORBIT_NODE, "x")], result.outputs[(ORBIT_NODE, "y")])
-    contact = 1.0 - result.contacts[0].fraction("open")
-    return Measures(spectra=spectra, frequencies=freqs, peak_radius=float(r.max()), contact_fraction=contact)
-
-
-@dataclass(frozen=True)
-class Errors:
-    """Relative errors against the reference (-); see the module docstring."""
-
-    spectral: float
-    orbit: float
-    contact: float
-    worst_line: str = ""
-
-
-def errors(m: Measures, ref: Measures, n_lines: int = N_LINES) -> Errors:
-    """Relative errors of ``m`` against ``ref``: worst of the ``n_lines`` largest lines per signal, orbit, contact."""
-    worst, where = 0.0, ""
-    for o, A_ref in ref.spectra.items():
-        order = np.argsort(A_ref[1:])[::-1][:n_lines] + 1      # bin 0 (the mean) excluded
-        rel = np.abs(m.spectra[o][order] - A_ref[order]) / A_ref[order]
-        k = int(np.argmax(rel))
-        if rel[k] > worst:
-            worst = float(rel[k])
-            where = f"{o[0]}{o[1]} {ref.frequencies[order[k]]:.0f} Hz"
-    orbit = abs(m.peak_radius - ref.peak_radius) / ref.peak_radius
-    contact = (abs(m.contact_fraction - ref.contact_fraction) / ref.contact_fraction
-               if ref.contact_fraction > 0 else abs(m.contact_fraction))
-    return Errors(spectral=worst, orbit=orbit, contact=contact, worst_line=where)
+    dofs = [o for o in case.outputs if o[0] in SPECTRAL_NODES]
+    return response_measures(result.outputs, result.dt, case.sample_dt, (f_L, f_H), dofs, ORBIT_NODE,
+                             1.0 - result.contacts[0].fraction("open"))
 
 
 @dataclass(frozen=True)
@@ -244,7 +189,7 @@ class Row:
     us_per_step : float
         Median step-loop time per step (µs).
     n_steps : int
-    errors : Errors or None
+    errors : MeasureErrors or None
         None when the run diverged.
     note : str
     """
@@ -260,7 +205,7 @@ class Row:
     reduce_time: float
     us_per_step: float
     n_steps: int
-    errors: Errors | None
+    errors: MeasureErrors | None
     note: str = ""
 
 
@@ -270,11 +215,11 @@ class Reference:
 
     dt: float
     n_dof: int
-    measures: Measures
+    measures: ResponseMeasures
     wall: float
     check_dt: float
-    check: Errors | None = None    # the full Newmark run at check_dt against the reference (from the grid)
-    mesh: Errors | None = None     # the full model on refined(2 REFINE) at check_dt against the reference
+    check: MeasureErrors | None = None    # the full Newmark run at check_dt against the reference (from the grid)
+    mesh: MeasureErrors | None = None     # the full model on refined(2 REFINE) at check_dt against the reference
     mesh_refine: int = 0
     extra: dict = field(default_factory=dict)
 
@@ -294,7 +239,7 @@ def reference(case: RubCase, dt_ref: float = DT_REF, mesh_check: bool = False, s
     if mesh_check:
         refine = 2 * case.refine
         fine = paper_rub(refine, case.t_end, int(round((case.t_end - case.record_start) / 0.1)))
-        mesh = errors(measures(run(assemble(fine.rotor), fine, check_dt), fine), ref)
+        mesh = measure_errors(measures(run(assemble(fine.rotor), fine, check_dt), fine), ref)
         mesh_refine = refine
     return Reference(dt=dt_ref, n_dof=system.M.shape[0], measures=ref, wall=wall, check_dt=check_dt,
                      mesh=mesh, mesh_refine=mesh_refine)
@@ -350,7 +295,7 @@ def grid(case: RubCase, ref: Reference, dts=DTS, modes=MODES, methods=("newmark"
                                 (min(walls), max(walls)), statistics.median(cpus), len(walls),
                                 statistics.median(red_walls),
                                 statistics.median(r.us_per_step for r in results), res.n_steps,
-                                errors(measures(res, case), ref.measures),
+                                measure_errors(measures(res, case), ref.measures),
                                 f"{res.n_substeps} half-steps" if res.n_substeps else ""))
     return rows
 
@@ -387,7 +332,7 @@ class SceneCheck:
     ----------
     label : str
         The scene's model (:func:`rotorred.scenes.run.build_model`), method and dt.
-    errors : Errors or None
+    errors : MeasureErrors or None
         None when the scene's dt does not divide the sample interval.
     wall : float
         Wall time of the model build plus one run of ``T_END`` (s).
@@ -395,7 +340,7 @@ class SceneCheck:
     """
 
     label: str
-    errors: Errors | None
+    errors: MeasureErrors | None
     wall: float
     note: str = ""
 
@@ -423,7 +368,7 @@ def scene_checks(ref: Reference, t_end: float = T_END, n_periods: int = N_PERIOD
         what = built.label.split(" (")[0] + (f" ({n_modes} modes)" if n_modes is not None else "")
         label = f"{name}: {what}, {s.method} dt = {s.dt:g} s"
         try:
-            out.append(SceneCheck(label, errors(measures(res, case), ref.measures), wall))
+            out.append(SceneCheck(label, measure_errors(measures(res, case), ref.measures), wall))
         except ValueError as exc:
             out.append(SceneCheck(label, None, wall, str(exc)))
     return out
@@ -519,7 +464,7 @@ def plot(rows: list[Row], path: str, ref: Reference) -> str:
     ax.axhline(TARGET, color="0.5", lw=0.8, ls=":")
     ax.text(ax.get_xlim()[0], TARGET, f" {100 * TARGET:g} %", va="bottom", fontsize=8, color="0.4")
     ax.set_xlabel("wall time per run (s), median, after compilation (reduction included)")
-    ax.set_ylabel("spectral error (-): worst of the 10 largest lines, nodes 13/14")
+    ax.set_ylabel(f"spectral error (-): worst of the {N_LINES} largest lines, nodes 13/14")
     ax.set_title(f"Rub transient, seed rig refined({REFINE}), {T_END:g} s simulated: time against error\n"
                  f"reference: full {ref.n_dof} DOF, Newmark dt = {ref.dt:g} s; labels: dt (s)", fontsize=10)
     ax.grid(True, which="both", lw=0.3)

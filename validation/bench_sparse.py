@@ -95,7 +95,7 @@ def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
     from rotorred.model import sparse
 
     if not as_sparse:
-        sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §22)
+        sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §23)
     rotor = rr.load_rotor("seed-rig").refined(refine)
     warm = assemble(rr.load_rotor("seed-rig"), as_sparse=as_sparse)  # first calls load modules: not timed
     modes_at(warm, rr.Operating.line(_rpm([0.0, TOP_RPM])).lines(warm), 100.0, 12)

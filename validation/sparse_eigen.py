@@ -3,7 +3,7 @@
 On the seed rig refined (``--refine``, default 16: 1160 DOFs) at one spool speed pair, the lowest 12 whirl
 eigenvalues of M q'' + D q' + K q = 0 from
 
-* the sparse path (:func:`rotorred.linear.modal.eigen` on the sparse model: shift-invert Arnoldi, docs/model.md §22),
+* the sparse path (:func:`rotorred.linear.modal.eigen` on the sparse model: shift-invert Arnoldi, docs/model.md §23),
 * the dense M^-1 form (the same function on the dense model: LAPACK on [[0, I], [-M^-1 K, -M^-1 D]]),
 * the dense generalised pencil (LAPACK ``eig(A, B)``, A = [[0, I], [-K, -D]], B = [[I, 0], [0, M]]),
 

@@ -27,6 +27,7 @@ from pathlib import Path
 COMMANDS = [
     "branch",  # rotorred continue
     "campbell",
+    "compare",
     "convert",
     "harmonic",
     "map",
@@ -48,7 +49,8 @@ EXIT_STATUSES = {
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written, or "
                       "an optional library is missing (the message gives its install command)",
     EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
-                 "marked INCOMPLETE; `map`: the points done, resumed by the same command)",
+                 "marked INCOMPLETE; `compare`: the runs done, marked INCOMPLETE; `map`: the points done, resumed by "
+                 "the same command)",
     EXIT_SIGTERM: "terminated (SIGTERM): as 130",
 }
 
@@ -80,6 +82,9 @@ EXAMPLES = {
                  "rotorred campbell my_rotor.toml --speeds 0:20000:81 --ratio 1.4 --harmonics 1,2 --out cd"],
     "modes": ["rotorred modes seed-rig --speed 3000 --out modes",
               "rotorred modes my_rotor.toml --speed 9000 --ratio outer=1.3 --modes 8 --out modes"],
+    "compare": ["rotorred compare paper-rub --modes 8,16,24 --out compare",
+                "rotorred compare paper-rub --modes 16,24 --dt 5e-5,2e-5,1e-5 --out front",
+                "rotorred compare paper-rub --refine 4 --dt 2e-5,5e-6,2.5e-6 --set output.nodes=[13,14] --out refined"],
     "convert": ["rotorred convert rotor_saved_by_ross.toml rotor.toml"],
     "harmonic": ["rotorred harmonic seed-rig --speeds 0:12000:241 --out bode"],
     "map": ["rotorred map paper-rub --vary rub.clearance=10e-6:60e-6:11 --out clearance",

@@ -2,7 +2,7 @@
 
 Shared by the Campbell analysis and the reduced-vs-full checks. A dense model is solved whole (LAPACK); a sparse
 one (:mod:`rotorred.model.sparse`) for its lowest modes only, by shift-invert Arnoldi (ARPACK) on the state-space
-pencil with one sparse LU of the n x n quadratic matrix per solve (:func:`_sparse_eigen`, docs/model.md §22).
+pencil with one sparse LU of the n x n quadratic matrix per solve (:func:`_sparse_eigen`, docs/model.md §23).
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ WHIRL_MAX_DAMPING_RATIO = 0.99
 
 #: a sparse eigen-solution finds every mode below the frequency asked for whose damping ratio is below this: it
 #: solves until the eigenvalues found fill a disc about the shift of radius (highest frequency asked for) /
-#: sqrt(1 - this^2) (docs/model.md §22); a mode more damped than this, below that frequency, may be missed
+#: sqrt(1 - this^2) (docs/model.md §23); a mode more damped than this, below that frequency, may be missed
 SPARSE_COMPLETE_DAMPING_RATIO = 0.6
 #: the sparse solve's shift is -this x the softest DOF's own frequency (:func:`_softest`): far below the whirl
 #: frequencies, whose disc about the shift it barely widens, and far enough from the rigid-body eigenvalues at 0
@@ -77,7 +77,7 @@ def eigen(M: np.ndarray, D: np.ndarray, K: np.ndarray, n_modes: int | None = Non
     ----------
     M, D, K : ndarray or sparse matrix, shape (n, n)
         Mass, total velocity (damping plus gyroscopic) and stiffness matrices; sparse ones (all three) are solved for
-        the lowest modes only (``n_modes`` or ``below`` given): shift-invert (docs/model.md §22).
+        the lowest modes only (``n_modes`` or ``below`` given): shift-invert (docs/model.md §23).
     n_modes : int, optional
         Keep the lowest ``n_modes`` frequencies (default all).
     min_frequency : float

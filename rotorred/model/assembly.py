@@ -14,7 +14,7 @@ docs/model.md, Eq. R2). A spool's internal (rotating) damping adds ``C_r,s`` to 
 Matrices are built from COO triplets in one pass: dense ndarrays for a model of fewer than
 :data:`rotorred.model.sparse.SPARSE_FROM` DOFs, ``scipy.sparse`` CSR matrices from that size on (a beam model's
 matrices are banded); analyses with a sparse path solve a model of :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM`
-DOFs or more through its sparse twin (:func:`system_of`; docs/model.md §22).
+DOFs or more through its sparse twin (:func:`system_of`; docs/model.md §23).
 """
 
 from __future__ import annotations

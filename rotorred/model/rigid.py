@@ -10,18 +10,26 @@ largest w^2, which is the stiffest bearing's: bearings of 1e15 N/m put it 1e10 t
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import scipy.linalg as sla
 
 from rotorred.model import sparse
 from rotorred.model.assembly import assemble
+from rotorred.model.elements import Material
 from rotorred.model.rotor import Rotor
 
-__all__ = ["RIGID_RTOL", "NULL_RTOL", "null_space", "rigid_body_motions", "own_elastic_w2"]
+__all__ = ["RIGID_RTOL", "NULL_RTOL", "RHO_REFERENCE", "null_space", "rigid_body_motions", "own_elastic_w2",
+           "elastic_scale_w2"]
 
 #: generalised eigenvalues w^2 of (K, M) below this fraction of the spool's own first elastic w^2 (its shaft and
 #: disks free-free, no bearing; :func:`own_elastic_w2`) span the null space of K: w below 1e-4 of that frequency
 RIGID_RTOL = 1e-8
+#: density (kg/m^3) of the shaft the threshold's scale is computed with (:func:`elastic_scale_w2`): steel's, so that
+#: the scale is the shaft's geometry and stiffness, not its mass distribution (a near-massless Jeffcott shaft under a
+#: heavy disk has a free-free w^2 far above its supported disk mode's)
+RHO_REFERENCE = 7850.0
 #: ... or below this fraction of the largest w^2 of the model: the round-off of the eigen-solve (about 45 eps),
 #: under which no w^2 is distinguishable from zero; alone, it is the rule of a model built by hand (no rotor)
 NULL_RTOL = 1e-14
@@ -31,7 +39,8 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The eigenpairs of K phi = w^2 M phi and which of them are rigid-body motions.
 
     A vector is rigid when w^2 <= max(RIGID_RTOL sum_s e_s w2_s, NULL_RTOL max|w^2|): e_s is the share of its
-    squared displacement on spool s's nodes, w2_s the spool's own first elastic w^2 (:func:`own_elastic_w2`).
+    squared displacement on spool s's nodes, w2_s the first elastic w^2 of spool s's shaft free-free at the reference
+    density (:func:`elastic_scale_w2`).
 
     Parameters
     ----------
@@ -53,7 +62,7 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         w2, phi = sla.eigh(model.K, model.M)
         largest = float(np.max(np.abs(w2)))
     limit = np.full(len(w2), NULL_RTOL * max(largest, 1e-300))
-    own = own_elastic_w2(model.rotor) if model.rotor is not None else {}
+    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     if own:
         candidates = np.flatnonzero(w2 <= RIGID_RTOL * max(own.values()))
         shares = _spool_shares(model, phi[:, candidates])  # (n_spools, candidates)
@@ -69,7 +78,7 @@ def _lowest_of_sparse(model) -> tuple[np.ndarray, np.ndarray, float]:
     round-off rule compares with a smaller value; it matters only for a model built by hand)."""
     K = 0.5 * (model.K + model.K.T)
     largest = float(np.max(np.abs(K.diagonal()) / np.maximum(model.M.diagonal(), 1e-300)))
-    own = own_elastic_w2(model.rotor) if model.rotor is not None else {}
+    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     top = max(RIGID_RTOL * max(own.values()) if own else 0.0, NULL_RTOL * largest)
     k = 4 * len(model.spools) + 2 * len(model.full_dofs.translational) + 4
     while True:
@@ -117,6 +126,29 @@ def own_elastic_w2(rotor: Rotor) -> dict[str, float]:
             w2 = sla.eigh(alone.K, alone.M, eigvals_only=True, subset_by_index=(0, min(4, alone.n_dof - 1)))
         out[s.name] = float(w2[-1])
     return out
+
+
+def elastic_scale_w2(rotor: Rotor) -> dict[str, float]:
+    """The scale of each spool's elastic w^2 for the rigid-body test (rad^2/s^2): the first elastic w^2 of its shaft
+    elements and sleeves, free-free, without bearings or disks, every material at the density :data:`RHO_REFERENCE`
+    (docs/model.md §20).
+
+    Parameters
+    ----------
+    rotor : Rotor
+
+    Returns
+    -------
+    dict of str to float
+        Spool name -> w^2 (rad^2/s^2).
+    """
+    def reference(e):
+        m = e.material
+        return dataclasses.replace(e, material=Material(m.name, m.E, RHO_REFERENCE, G=m.G))
+
+    shafts = [dataclasses.replace(s, elements=tuple(map(reference, s.elements)),
+                                  sleeves=tuple(map(reference, s.sleeves))) for s in rotor.spools]
+    return own_elastic_w2(Rotor(tuple(shafts)))
 
 
 def _spool_shares(model, vectors: np.ndarray) -> np.ndarray:

@@ -1,6 +1,6 @@
 """Sparse or dense matrices of one model: the few rules every analysis shares.
 
-Two sizes (docs/model.md §22; measured: docs/performance.md, validation/bench_sparse.py). A model of at least
+Two sizes (docs/model.md §23; measured: docs/performance.md, validation/bench_sparse.py). A model of at least
 :data:`SPARSE_FROM` DOFs is assembled with ``scipy.sparse`` CSR matrices (:func:`rotorred.model.assembly.assemble`),
 a smaller one with dense ndarrays, which code can read as arrays. An analysis with a sparse path solves a model of at
 least :data:`SOLVE_SPARSE_FROM` DOFs sparse, a dense one through its sparse twin: from that size a beam model's banded

@@ -28,7 +28,7 @@ from rotorred import checks
 from rotorred.model.operating import Operating, checked as checked_operating
 from rotorred.nonlinear.fourier import to_phasors
 from rotorred.nonlinear.hb import coefficient_variables
-from rotorred.results import Result, dof_coordinates
+from rotorred.results import Result, dof_coordinates, strongest_lines
 from rotorred.scenes.balance_harmonics import cold_solution, samples_for
 from rotorred.scenes.branch import BranchOptions, SceneBranch, check_key, continue_scene
 from rotorred.scenes.built import balance_loads, built_scene, plates_on, recorded_nodes, rotor_model
@@ -157,14 +157,7 @@ class RubBalance(Result):
                  f"f_0 = {p.f0:.6g} Hz, {self.H} harmonics, {p.problem.harmonics.N} samples a period; "
                  f"{len(p.problem.dofs)} unknowns",
                  f"relative residual {self.residual:.3g}; started by {self.start}"]
-        A = self.amplitudes
-        for j, dof in enumerate(self.outputs[:8]):
-            top = np.argsort(-A[:, j])[:3]
-            lines.append(f"node {dof[0]} {dof[1]}: " + ", ".join(
-                f"{1e6 * A[k, j]:.4g} µm at {self.frequencies[k]:.6g} Hz" for k in top if A[k, j] > 0))
-        if len(self.outputs) > 8:
-            lines.append(f"... {len(self.outputs) - 8} more outputs")
-        return lines
+        return lines + strongest_lines(self.outputs, self.amplitudes, [f"{f:.6g} Hz" for f in self.frequencies])
 
     def plot(self, ax=None, *, title: str | None = None):
         """The amplitude of each harmonic of each output at its frequency (µm, log scale).

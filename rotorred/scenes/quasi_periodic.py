@@ -29,7 +29,7 @@ from rotorred.checks import InputError
 from rotorred.model.operating import Operating, checked as checked_operating
 from rotorred.nonlinear.hb import coefficient_variables
 from rotorred.nonlinear.torus import TorusSolution, solve_torus
-from rotorred.results import Result, dof_coordinates
+from rotorred.results import Result, dof_coordinates, strongest_lines
 from rotorred.scenes.built import balance_loads, built_scene, plates_on, rotor_model
 from rotorred.scenes.harmonic_balance import unknown_records
 from rotorred.scenes.run import settled_state
@@ -194,15 +194,8 @@ class RubTorus(Result):
                  f"{len(self.problem.problem.dofs)} unknowns",
                  f"{s.iterations} Newton iterations, relative residual {s.residual:.3g}; started from {self.start}; "
                  f"{self.solve_time:.3g} s"]
-        A, f = self.amplitudes, self.frequencies
-        for j, dof in enumerate(self.outputs[:8]):
-            top = np.argsort(-A[:, j])[:3]
-            lines.append(f"node {dof[0]} {dof[1]}: " + ", ".join(
-                f"{1e6 * A[k, j]:.4g} µm at {f[k]:.6g} Hz {tuple(int(v) for v in self.orders[k])}" for k in top
-                if A[k, j] > 0))
-        if len(self.outputs) > 8:
-            lines.append(f"... {len(self.outputs) - 8} more outputs")
-        return lines
+        where = [f"{f:.6g} Hz {tuple(int(v) for v in k)}" for f, k in zip(self.frequencies, self.orders)]
+        return lines + strongest_lines(self.outputs, self.amplitudes, where)
 
     def plot(self, ax=None, *, title: str | None = None):
         """The amplitude of each order's line of each output at its frequency (µm, log scale).
