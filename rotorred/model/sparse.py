@@ -10,6 +10,7 @@ matrices make a sparse factorisation about O(n) per solve where a dense one is O
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -75,8 +76,6 @@ def lowest_w2(K, M, k: int) -> tuple[np.ndarray, np.ndarray]:
     phi : ndarray, shape (n, min(k, n))
         M-orthonormal eigenvectors.
     """
-    import scipy.linalg as sla
-
     n = M.shape[0]
     k = min(k, n)
     if not sp.issparse(M) or 3 * k + 20 > n:
