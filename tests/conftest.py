@@ -9,3 +9,22 @@ import os
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
+
+import pytest  # noqa: E402
+
+
+def pytest_addoption(parser):
+    parser.addoption("--sparse-from", type=int, default=None,
+                     help="assemble and solve models of at least this many DOFs sparse (rotorred.model.sparse."
+                          "SPARSE_FROM, SOLVE_SPARSE_FROM); 0 runs every test on the sparse path")
+
+
+@pytest.fixture(autouse=True)
+def _sparse_from(request, monkeypatch):
+    """``--sparse-from N``: the size from which models are assembled sparse, for this run."""
+    value = request.config.getoption("--sparse-from")
+    if value is not None:
+        from rotorred.model import sparse
+
+        monkeypatch.setattr(sparse, "SPARSE_FROM", value)
+        monkeypatch.setattr(sparse, "SOLVE_SPARSE_FROM", value)

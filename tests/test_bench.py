@@ -178,3 +178,14 @@ def test_ross_comparison_when_installed():
     assert tc.diff_consistent < 1e-8
     # the public API starts from a = 0: an O(dt^2) different first step, visible but small
     assert 1e-8 < tc.diff_public < 1e-1
+
+
+def test_sparse_bench_worker_table_and_plot(tmp_path):
+    """validation/bench_sparse.py on the unrefined rig, both forms (no rub run): every task measured, a table and a
+    plot."""
+    bs = _load("bench_sparse")
+    rows = [bs.worker(1, as_sparse, False) for as_sparse in (True, False)]
+    assert all(r["n_dof"] == 80 and all(r[t] > 0 for t in bs.TASKS[:4]) for r in rows)
+    text = bs.format_table(rows)
+    assert "refined(1)   sparse" in text and "dense / sparse at refined(1)" in text
+    assert Path(bs.plot(rows, str(tmp_path / "sparse.png"))).stat().st_size > 10_000

@@ -83,7 +83,7 @@ def undamped_critical_speeds(rotor: Rotor, ratios: dict[str, float], spool: str,
     G = sum_s r_s G_s, gives K v = Omega^2 (c^2 M - i c G) v: the Hermitian-definite problem
     B v = mu K v (K positive definite), mu = 1 / Omega^2. Damping is ignored (C must be 0 for exactness).
     """
-    sm = assemble(rotor)
+    sm = assemble(rotor, as_sparse=False)  # the dense reference, whatever the size
     G = sum(r * sm.G[s] for s, r in ratios.items())
     c = harmonic * ratios[spool]
     mu = sla.eigh(c * c * sm.M - 1j * c * G, sm.K, eigvals_only=True)

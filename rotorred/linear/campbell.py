@@ -50,11 +50,14 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from scipy.optimize import brentq, linear_sum_assignment
 
 from rotorred import checks, writers
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen, mac
 from rotorred.model.assembly import SystemMatrices, system_of
+from rotorred.model.sparse import is_sparse
 from rotorred.model.operating import Operating, SpoolLine
 from rotorred.model.operating import checked as checked_operating
 from rotorred.model.rigid import rigid_body_motions
@@ -741,6 +744,8 @@ class _Solver:
         multiple eigenvalue, where the bordered matrix is singular).
         """
         D, K = self.matrices(Omega)
+        if is_sparse(self.M):
+            return _local_sparse(self.M, D, K, (lam0, v0), max_iter)
         n = len(v0)
         lam, v = complex(lam0), v0.astype(complex)
         J = np.zeros((n + 1, n + 1), complex)
@@ -758,15 +763,59 @@ class _Solver:
             if not np.all(np.isfinite(step)):
                 return None
             v, lam = v + step[:n], lam + step[n]
-            # converged when the update is at roundoff level (a residual test relative to ||K|| would
-            # accept a wrong eigenvalue of a soft mode on a stiff structure): below 1e-13 |lam|, or
-            # stagnating below 1e-9 |lam| (the roundoff floor of Q(lam) v when ||K|| >> |lam|^2 ||M||)
-            d = abs(step[n])
-            if np.linalg.norm(step[:n]) <= 1e-7 * np.linalg.norm(v) and (
-                    d <= 1e-13 * abs(lam) or (d <= 1e-9 * abs(lam) and d >= 0.5 * previous)):
+            if _converged(step, v, lam, previous):
                 return lam, v / np.linalg.norm(v)
-            previous = d
+            previous = abs(step[n])
         return None
+
+
+def _converged(step: np.ndarray, v: np.ndarray, lam: complex, previous: float, floor: float = 1e-9) -> bool:
+    """Whether a Newton step of :meth:`_Solver.local` (``step`` = (dv, dlam)) is at round-off level: a residual test
+    relative to ||K|| would accept a wrong eigenvalue of a soft mode on a stiff structure; so below 1e-13 |lam|, or
+    stagnating below ``floor`` |lam| (the round-off floor of Q(lam) v when ||K|| >> |lam|^2 ||M||)."""
+    d = abs(step[-1])
+    return bool(np.linalg.norm(step[:-1]) <= 1e-7 * np.linalg.norm(v) and (
+        d <= 1e-13 * abs(lam) or (d <= floor * abs(lam) and d >= 0.5 * previous)))
+
+
+#: the most sparse LUs of one local Newton solve (:func:`_local_sparse`); a dense one takes up to 12 Newton steps
+_MAX_FACTORISATIONS = 5
+#: a sparse model's local Newton solve stagnates at up to this relative step: the round-off floor of Q(lam) v grows
+#: with ||K|| / (|lam|^2 ||M||), and a fine mesh is stiff (measured 1e-9 to 6e-8 for the lowest mode, 15 Hz, of the
+#: rig refined(128))
+_SPARSE_FLOOR = 1e-7
+
+
+def _local_sparse(M, D, K, start: tuple[complex, np.ndarray], max_iter: int):
+    """:meth:`_Solver.local` of a sparse model: the bordered Newton system factorised by a sparse LU at the start
+    only (a chord method: the residual is exact, so the fixed point is; it converges linearly at a rate of the
+    distance from the start), factorised again where a step does not shrink the last one by half, at most
+    ``_MAX_FACTORISATIONS`` times (a start that Newton's method does not take to a root quickly: None)."""
+    lam0, v0 = start
+    lam, v = complex(lam0), v0.astype(complex)
+    border = sp.csr_array(v0.conj()[None, :])
+    previous, lu, factorisations = np.inf, None, 0
+    for _ in range(3 * max_iter):
+        Q = (lam * lam) * M + lam * D + K
+        if lu is None:
+            factorisations += 1
+            if factorisations > _MAX_FACTORISATIONS:
+                return None
+            column = sp.csr_array(((2.0 * lam) * (M @ v) + D @ v)[:, None])
+            try:
+                lu = spla.splu(sp.block_array([[Q, column], [border, None]], format="csc"), permc_spec="MMD_AT_PLUS_A")
+            except RuntimeError:  # exactly singular
+                return None
+        step = lu.solve(np.concatenate([-(Q @ v), [0.0]]))
+        if not np.all(np.isfinite(step)):
+            return None
+        v, lam = v + step[:-1], lam + step[-1]
+        if _converged(step, v, lam, previous, _SPARSE_FLOOR):
+            return lam, v / np.linalg.norm(v)
+        if abs(step[-1]) > 0.5 * previous:
+            lu = None  # the chord is too far from the root: a Newton step
+        previous = abs(step[-1])
+    return None
 
 
 def _assign(prev_modes, prev_freq, lam, modes):
@@ -911,7 +960,7 @@ def default_mode_count(model, operating: Operating, *, harmonics: Sequence[float
 def _setup(model, operating, harmonics):
     """The model (:func:`system_of`), the checked reference speeds (rad/s, strictly increasing), harmonics
     (sorted, distinct), each spool's speed line (:meth:`Operating.lines`) and the reference spool."""
-    sm = system_of(model)
+    sm = system_of(model, sparse_ok=True)
     operating = checked_operating(operating)
     operating.speeds(sm)  # refuses a profile
     Omega = checks.vector("operating.Omega", operating.Omega.tolist(), "rad/s", min_len=1, ge=0.0, increasing=True)
@@ -930,10 +979,11 @@ def _mode_count(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray, h: tuple[
     solver = _Solver(sm, lines, sm.n_dof)
     ends = tuple(sorted({float(Omega[0]), top}))
     below, available = [], []
-    for W in ends:
-        lam = eigen(solver.M, *solver.matrices(W), max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues
+    for W in ends:  # a sparse model: the lowest modes, every one below the limit (modal.eigen)
+        lam = eigen(solver.M, *solver.matrices(W), max_damping_ratio=WHIRL_MAX_DAMPING_RATIO,
+                    below=margin * limit, n_modes=MIN_DEFAULT_MODES if is_sparse(solver.M) else None).eigenvalues
         below.append(int(np.sum(lam.imag < margin * limit)))
-        available.append(len(lam))
+        available.append(sm.n_dof if is_sparse(solver.M) else len(lam))
     n = max(1, min(max(MIN_DEFAULT_MODES, *below), *available))
     return ModeCount(n_modes=n, limit=limit, margin=margin, spool=spool, harmonic=max(h), top_speed=top,
                      speeds=ends, below=tuple(below))

@@ -43,9 +43,12 @@ from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from rotorred import checks, writers
 from rotorred.model.assembly import system_of
+from rotorred.model.sparse import is_sparse
 from rotorred.model.loads import Unbalance
 from rotorred.results import Result, dof_coordinates, label_coordinate
 from rotorred.model.operating import Operating
@@ -500,7 +503,7 @@ def steady_state(model, operating: Operating, unbalances: Sequence[Unbalance]) -
     SteadyState
         Phasors of shape (n_dof,) in the model's coordinates.
     """
-    model = system_of(model)
+    model = system_of(model, sparse_ok=True)
     speeds = checked_operating(operating).single(model)
     forces = unbalance_forces(model, unbalances)
     matrices = _Matrices(model, speeds)
@@ -510,7 +513,7 @@ def steady_state(model, operating: Operating, unbalances: Sequence[Unbalance]) -
         if w == 0.0:
             phasors[s] = np.zeros(model.n_dof, dtype=complex)
             continue
-        phasors[s] = sla.solve(matrices.dynamic_stiffness(w), w * w * f, check_finite=False)
+        phasors[s] = matrices.solve(w, w * w * f)
     return SteadyState(speeds=speeds, phasors=phasors, operating=operating)
 
 
@@ -532,6 +535,14 @@ class _Matrices:
         else:
             D, K = self.model.damping(self.speeds, w), self.model.stiffness(self.speeds, w)
         return K - w * w * self.model.M + 1j * w * D
+
+    def solve(self, w: float, rhs: np.ndarray) -> np.ndarray:
+        """``dynamic_stiffness(w)^-1 rhs``, ``rhs`` shape (n,) or (n, k): a dense LU, or a sparse one (SuperLU, a
+        fill-reducing order of A + A^T: a beam model's banded matrix factorises in O(n)) for a sparse model."""
+        A = self.dynamic_stiffness(w)
+        if is_sparse(A):
+            return spla.splu(sp.csc_array(A), permc_spec="MMD_AT_PLUS_A").solve(np.asarray(rhs, complex))
+        return sla.solve(A, rhs, check_finite=False)
 
 
 def unbalance_forces(model, unbalances: Sequence[Unbalance]) -> dict[str, np.ndarray]:
@@ -590,7 +601,7 @@ def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalan
         If a spool's speed does not follow from ``operating`` (:meth:`Operating.lines`), ``outputs`` is empty,
         or an unbalance or an output names a DOF the model does not have.
     """
-    model = system_of(model)
+    model = system_of(model, sparse_ok=True)
     operating = checked_operating(operating)
     spool_speeds = operating.speeds(model)
     speeds = operating.Omega
@@ -607,7 +618,7 @@ def unbalance_response(model, operating: Operating, unbalances: Sequence[Unbalan
             w = at[s]
             if w == 0.0:
                 continue  # no unbalance force at rest
-            phasors[s][k] = R @ sla.solve(matrices.dynamic_stiffness(w), w * w * f, check_finite=False)
+            phasors[s][k] = R @ matrices.solve(w, w * w * f)
     return UnbalanceResponse(
         speeds=speeds, reference_spool=operating.reference_of(model), spool_speeds=spool_speeds, outputs=outputs,
         phasors={s: {o: phasors[s][:, j].copy() for j, o in enumerate(outputs)} for s in phasors},
@@ -670,7 +681,7 @@ def frequency_response(model, operating: Operating, inputs: Sequence[Output], ou
         If ``operating`` is not one point, ``inputs`` or ``outputs`` is empty or names a DOF the model does not
         have, or a frequency is negative.
     """
-    model = system_of(model)
+    model = system_of(model, sparse_ok=True)
     speeds = checked_operating(operating).single(model)
     inputs = model.full_dofs.checked_outputs(inputs, "inputs")
     outputs = model.full_dofs.checked_outputs(outputs, "outputs")
@@ -684,6 +695,6 @@ def frequency_response(model, operating: Operating, inputs: Sequence[Output], ou
     R = model.output_rows(outputs)
     H = np.empty((len(w_all), len(outputs), len(inputs)), dtype=complex)
     for k, w in enumerate(w_all):
-        H[k] = R @ sla.solve(matrices.dynamic_stiffness(w), B.astype(complex), check_finite=False)
+        H[k] = R @ matrices.solve(w, B.astype(complex))
     return FrequencyResponse(frequencies=w_all, speeds=speeds, inputs=inputs, outputs=outputs, H=H,
                              operating=operating)

@@ -292,7 +292,7 @@ def separation_margins(model, result: CampbellResult, operating_range: Operating
                     "operating speed line)")
     if operating_range is not None and not isinstance(operating_range, OperatingRange):
         checks.fail("operating_range", operating_range, "must be an OperatingRange(minimum, maximum) (rad/s)")
-    sm = system_of(model)
+    sm = system_of(model, sparse_ok=True)
     return tuple(_margin(sm, result, c, operating_range) for c in result.critical_speeds)
 
 

@@ -254,7 +254,7 @@ def mode_shapes(model, operating: Operating, *, n_modes: int | None = None) -> M
         If ``operating`` is not one point, the model has no rotor, or ``n_modes`` is out of range (as
         :func:`rotorred.campbell`).
     """
-    sm = system_of(model)
+    sm = system_of(model, sparse_ok=True)
     operating = checked_operating(operating)
     if operating.kind != "point":
         checks.fail("operating", operating.describe(), "must be one operating point (Operating.point, or "

@@ -35,14 +35,17 @@ from typing import Mapping, Sequence
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from rotorred import checks
 from rotorred.linear.harmonic import response_error, unbalance_response
 from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO, eigen  # noqa: F401 - WHIRL_MAX_DAMPING_RATIO also read here
 from rotorred.model.assembly import (RotatingDamping, SpoolSpeedMixin, SystemMatrices, TabulatedSupport, assemble,
-                                     model_summary)
+                                     model_summary, system_of)
 from rotorred.model.dofs import DofMap
 from rotorred.model.operating import Operating
+from rotorred.model.sparse import cut, is_sparse, lowest_w2, nonzero
 from rotorred.model.operating import checked as checked_operating
 from rotorred.model.rotor import Rotor, node_ranges
 from rotorred.results import Result
@@ -374,26 +377,62 @@ class _Basis:
         return T
 
 
-def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray) -> _Basis:
+def _basis(system: SystemMatrices, b: np.ndarray, i: np.ndarray, n_modes: int | None = None) -> _Basis:
+    """The constraint modes and the lowest ``n_modes`` fixed-interface modes (None: all; a dense model gets all).
+
+    A sparse model (:attr:`SystemMatrices.is_sparse`) is never made dense: ``Psi`` by a sparse LU of ``K_ii`` and
+    the modes by shift-invert Lanczos (:func:`rotorred.model.sparse.lowest_w2`)."""
     K, M = system.K, system.M
-    K_ii, M_ii, K_ib = K[np.ix_(i, i)], M[np.ix_(i, i)], K[np.ix_(i, b)]
+    K_ii, M_ii, K_ib = cut(K, i, i), cut(M, i, i), cut(K, i, b)
     if len(i) == 0:
         return _Basis(b, i, np.zeros((0, len(b))), np.zeros((0, 0)), np.zeros(0))
+    if is_sparse(K):
+        Psi = -_sparse_solve(system, b, K_ii, K_ib.toarray())
+        lam, Phi = lowest_w2(K_ii, M_ii, len(i) if n_modes is None else max(n_modes, 1))
+        return _Basis(b, i, Psi, Phi, np.sqrt(np.clip(lam, 0.0, None)))
     try:
         chol = sla.cho_factor(K_ii)
     except np.linalg.LinAlgError:
-        checks.fail("boundary_nodes", sorted({system.dofs.node_of(int(d)) for d in b}), "must restrain the "
-                    "interior part of the model when fixed: it is not restrained (K_ii is singular); add a node "
-                    "of each free part")
+        _not_restrained(system, b)
     Psi = -sla.cho_solve(chol, K_ib)
     lam, Phi = sla.eigh(K_ii, M_ii)
     omega = np.sqrt(np.clip(lam, 0.0, None))
     return _Basis(b, i, Psi, Phi, omega)
 
 
+#: a pivot of K_ii's sparse LU at or below this fraction of the largest makes K_ii singular (a free interior part);
+#: round-off of a stiffness matrix with pivots spanning 1e6 is ~1e-16 of its largest
+_SINGULAR_PIVOT = 1e-13
+
+
+def _sparse_solve(system, b: np.ndarray, K_ii, rhs: np.ndarray) -> np.ndarray:
+    """``K_ii^-1 rhs`` by a sparse LU (a fill-reducing order of K_ii + K_ii^T, pivots on the diagonal: those of a
+    symmetric LDL^T). A pivot at or below ``_SINGULAR_PIVOT`` times the largest is a free interior part (the
+    dense path's Cholesky fails there: a pivot of round-off size, of either sign)."""
+    try:
+        lu = spla.splu(sp.csc_array(K_ii), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular
+        _not_restrained(system, b)
+    pivots = lu.U.diagonal()
+    if np.min(pivots) <= _SINGULAR_PIVOT * np.max(np.abs(pivots)):
+        _not_restrained(system, b)
+    out = lu.solve(rhs)
+    if not np.all(np.isfinite(out)):
+        _not_restrained(system, b)
+    return out
+
+
+def _not_restrained(system, b: np.ndarray):
+    """Refuse a boundary that leaves the interior free (K_ii singular)."""
+    checks.fail("boundary_nodes", sorted({system.dofs.node_of(int(d)) for d in b}), "must restrain the "
+                "interior part of the model when fixed: it is not restrained (K_ii is singular); add a node "
+                "of each free part")
+
+
 def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict, dict]:
     def p(X):
-        return T.T @ X @ T
+        return T.T @ (X @ T) if is_sparse(X) else T.T @ X @ T  # a sparse X: X @ T is dense, (n, m)
 
     def symmetric(X):
         return 0.5 * (X + X.T)
@@ -402,7 +441,7 @@ def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndar
     # cross-coupled stiffness k_xy != k_yx, is projected on its own and kept
     Mr, Kr = symmetric(p(system.M)), symmetric(p(symmetric(system.K)))
     K_skew = 0.5 * (system.K - system.K.T)
-    if np.any(K_skew):
+    if nonzero(K_skew):
         X = p(K_skew)
         Kr = Kr + 0.5 * (X - X.T)
     return (Mr, Kr, p(system.C), {s: p(G) for s, G in system.G.items()},
@@ -410,15 +449,18 @@ def _project(system: SystemMatrices, T: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 
-def whirl_frequencies(model, speeds: Mapping[str, float]) -> np.ndarray:
+def whirl_frequencies(model, speeds: Mapping[str, float], n_modes: int | None = None,
+                      below: float | None = None) -> np.ndarray:
     """Damped whirl frequencies Im(lambda) (rad/s) of ``model`` at spool speeds ``speeds``, ascending.
 
     Heavily damped eigenvalues (damping ratio >= ``WHIRL_MAX_DAMPING_RATIO``, e.g. the
     high-frequency shaft modes that stiffness-proportional Rayleigh damping makes
     overdamped) do not whirl visibly and are left out, in the full and reduced model alike.
+    A sparse model gives its lowest ``n_modes`` and every one below ``below`` (rad/s) only
+    (:func:`rotorred.linear.modal.eigen`); a dense one all.
     """
-    return eigen(model.M, model.damping(speeds), model.stiffness(speeds),
-                 max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues.imag
+    return eigen(model.M, model.damping(speeds), model.stiffness(speeds), n_modes=n_modes,
+                 max_damping_ratio=WHIRL_MAX_DAMPING_RATIO, below=below).eigenvalues.imag
 
 
 def whirl_error(reference: Sequence[np.ndarray], model, speeds_list: Sequence[Mapping[str, float]],
@@ -509,6 +551,7 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
     R. R. Craig, M. C. C. Bampton, "Coupling of substructures for dynamic analyses",
     AIAA Journal 6(7), 1968, 1313–1319.
     """
+    system = system_of(system, "system", sparse_ok=True)  # from SOLVE_SPARSE_FROM DOFs: the sparse path
     n_modes, cutoff, band, target, n_check, check_speeds = _checked_options(
         system, n_modes, cutoff, band, target, n_check, check_speeds)
     ladder = ModeLadder(system, boundary_nodes)
@@ -519,14 +562,15 @@ def reduce(system: SystemMatrices, boundary_nodes: Sequence[int], n_modes: int |
             checks.fail("n_modes", n_modes, f"must be <= {n_i}, the number of interior DOFs")
         selection = ModeSelection("count", n_modes, n_i)
     elif cutoff is not None:
-        n_modes = int(np.count_nonzero(ladder.frequencies <= cutoff))
+        n_modes = ladder.count_below(cutoff)
         selection = ModeSelection("cutoff", n_modes, n_i, cutoff=float(cutoff), band=band)
     else:
         if check_speeds is None:
             check_speeds = ({s: 0.0 for s in system.G},)
         if band is None and n_check is None:
             n_check = DEFAULT_N_CHECK
-        reference = [whirl_frequencies(system, s) for s in check_speeds]
+        reference = [whirl_frequencies(system, s, n_modes=n_check, below=None if band is None else band[1])
+                     for s in check_speeds]
         full_response = response.run(system) if response is not None else None
         history = []
         resp_err = None
@@ -575,6 +619,10 @@ def _checked_options(system: SystemMatrices, n_modes, cutoff, band, target, n_ch
     return n_modes, cutoff, band, target, n_check, check_speeds
 
 
+#: fixed-interface modes a sparse model's ladder computes first (:meth:`ModeLadder._ensure` adds more as needed)
+_FIRST_SPARSE_MODES = 24
+
+
 class ModeLadder:
     """The Craig–Bampton models of ``system`` with the boundary ``boundary_nodes`` and any number of fixed-interface
     modes, all from one basis: the constraint modes and the interior eigen-decomposition are computed once (an
@@ -590,7 +638,20 @@ class ModeLadder:
     def __init__(self, system: SystemMatrices, boundary_nodes: Sequence[int]):
         self.system = system
         self.nodes, b, i = _boundary(system, boundary_nodes)
-        self.basis = _basis(system, b, i)
+        self.basis = _basis(system, b, i, _FIRST_SPARSE_MODES)
+
+    def _ensure(self, n_modes: int):
+        """Hold at least ``n_modes`` fixed-interface modes (a sparse model's are computed as needed, doubling)."""
+        have = len(self.basis.omega)
+        if n_modes > have and have < self.n_interior:
+            k = min(self.n_interior, max(n_modes, 2 * have))
+            self.basis = _basis(self.system, self.basis.b, self.basis.i, k)
+
+    def count_below(self, cutoff: float) -> int:
+        """Number of fixed-interface modes of natural frequency <= ``cutoff`` (rad/s)."""
+        while self.basis.omega[-1:].max(initial=-1.0) <= cutoff and len(self.basis.omega) < self.n_interior:
+            self._ensure(2 * len(self.basis.omega))
+        return int(np.count_nonzero(self.basis.omega <= cutoff))
 
     @property
     def n_interior(self) -> int:
@@ -599,12 +660,14 @@ class ModeLadder:
 
     @property
     def frequencies(self) -> np.ndarray:
-        """Fixed-interface natural frequencies (rad/s), ascending, shape (n_interior,)."""
+        """Fixed-interface natural frequencies (rad/s), ascending, shape (n_interior,) (a sparse model's: those computed
+        so far, the lowest)."""
         return self.basis.omega
 
     def model(self, n_modes: int, selection: ModeSelection | None = None) -> ReducedSystem:
         """The model with the lowest ``n_modes`` fixed-interface modes (``selection`` default: a given count)."""
         selection = selection or ModeSelection("count", n_modes, self.n_interior)
+        self._ensure(n_modes)
         return _make(self.system, self.nodes, self.basis, self.basis.T(n_modes), n_modes, selection)
 
 

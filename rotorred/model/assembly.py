@@ -11,9 +11,10 @@ spin-acceleration matrices per unit angular acceleration (1 rad/s^2; zero at con
 docs/model.md, Eq. R2). A spool's internal (rotating) damping adds ``C_r,s`` to the damping and
 ``-Omega_s N_s`` to the stiffness (:class:`RotatingDamping`, docs/model.md §19).
 
-Matrices are dense ndarrays: rotorred's models have at most a few thousand DOFs, where
-dense LAPACK beats sparse solvers and keeps eigen-analysis simple. They are built from COO
-triplets in one pass.
+Matrices are built from COO triplets in one pass: dense ndarrays for a model of fewer than
+:data:`rotorred.model.sparse.SPARSE_FROM` DOFs, ``scipy.sparse`` CSR matrices from that size on (a beam model's
+matrices are banded); analyses with a sparse path solve a model of :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM`
+DOFs or more through its sparse twin (:func:`system_of`; docs/model.md §24).
 """
 
 from __future__ import annotations
@@ -24,7 +25,9 @@ from typing import Mapping
 
 import numpy as np
 from scipy.linalg import eigh
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_array
+
+from rotorred.model import sparse
 
 from rotorred import checks
 from rotorred.model.dofs import DIRECTIONS, DofMap  # noqa: F401 - DofMap, DIRECTIONS re-exported here
@@ -67,6 +70,8 @@ class TabulatedSupport:
         still, as in ``gyroscopic``) minus the nominal one, on the model's coordinates, shape (n, n)."""
         b = self.table.at(speeds.get(self.spool, 0.0))
         delta = b.block(matrix) - self.nominal.block(matrix)
+        if sparse.is_sparse(self.rows):
+            return (self.rows.T @ coo_array(delta) @ self.rows).tocsr()
         return self.rows.T @ delta @ self.rows
 
 
@@ -99,12 +104,13 @@ class RotatingDamping:
 
     def on(self, T: np.ndarray) -> RotatingDamping:
         """The same damping in the coordinates ``p`` of ``q = T p`` (``T^T X T``; a column selection for supports)."""
-        return RotatingDamping(*(T.T @ X @ T for X in (self.C_v, self.N_v, self.C_h, self.N_h)))
+        return RotatingDamping(*(T.T @ (X @ T) if sparse.is_sparse(X) else T.T @ X @ T
+                                 for X in (self.C_v, self.N_v, self.C_h, self.N_h)))
 
     def at(self, frequency: float) -> tuple[np.ndarray, np.ndarray]:
         """(C, N) of the viscous damping equivalent at whirl frequency ``frequency`` (rad/s, > 0 where a loss factor
         is given): ``beta + eta / |frequency|`` for each element."""
-        if not np.any(self.C_h):
+        if not sparse.nonzero(self.C_h):
             return self.C_v, self.N_v
         w = abs(frequency)
         return self.C_v + self.C_h / w, self.N_v + self.N_h / w
@@ -143,7 +149,7 @@ class SpoolSpeedMixin:
     def gyroscopic(self, speeds: Mapping[str, float]) -> np.ndarray:
         """``sum_s Omega_s G_s`` for spool speeds ``speeds`` (rad/s), shape (n, n)."""
         checks.keys("speeds", speeds, self.G)
-        out = np.zeros_like(self.M)
+        out = sparse.zeros_like(self.M)
         for name, Omega in speeds.items():
             if Omega:
                 out += Omega * self.G[name]
@@ -182,7 +188,7 @@ class SpoolSpeedMixin:
         and the circulatory stiffness ``-sum_s Omega_s N_s`` (N/m, skew), shape (n, n) each, at spool speeds
         ``speeds`` (rad/s; a spool left out stands still). A loss factor eta enters as the viscous ``eta / |omega|``
         at the whirl ``frequency`` omega (rad/s); None: at :attr:`loss_frequency`."""
-        C, N = np.zeros_like(self.M), np.zeros_like(self.M)
+        C, N = sparse.zeros_like(self.M), sparse.zeros_like(self.M)
         w = self.loss_frequency if frequency is None else frequency
         for s, r in self.rotating.items():
             C_s, N_s = r.at(w)
@@ -194,7 +200,7 @@ class SpoolSpeedMixin:
     def frequency_dependent(self) -> bool:
         """Whether the model's damping and stiffness depend on the whirl frequency: an internal loss factor (taken at
         the excitation frequency in a harmonic response, docs/model.md §19)."""
-        return any(np.any(r.C_h) for r in self.rotating.values())
+        return any(sparse.nonzero(r.C_h) for r in self.rotating.values())
 
     @property
     def speed_dependent(self) -> bool:
@@ -261,6 +267,34 @@ class SystemMatrices(SpoolSpeedMixin):
     def full_dofs(self) -> DofMap:
         """The physical DOF numbering (the model's own, here; a reduced model's full one)."""
         return self.dofs
+
+    @property
+    def is_sparse(self) -> bool:
+        """Whether the matrices are ``scipy.sparse`` CSR arrays (a model of at least
+        :data:`rotorred.model.sparse.SPARSE_FROM` DOFs) rather than dense ndarrays."""
+        return sparse.is_sparse(self.M)
+
+    def sparse(self) -> SystemMatrices:
+        """The same model with CSR arrays (itself if it has them): for an analysis's sparse path."""
+        if self.is_sparse:
+            return self
+        c = sparse.csr
+        return dataclasses.replace(
+            self, M=c(self.M), K=c(self.K), C=c(self.C), G={k: c(v) for k, v in self.G.items()},
+            K_G={k: c(v) for k, v in self.K_G.items()}, tables=tuple(dataclasses.replace(t, rows=c(t.rows))
+                                                                     for t in self.tables),
+            rotating={k: RotatingDamping(*(c(X) for X in (r.C_v, r.N_v, r.C_h, r.N_h))) for k, r in self.rotating.items()})
+
+    def dense(self) -> SystemMatrices:
+        """The same model with dense ndarrays (itself if it has them): for an analysis that has no sparse path."""
+        if not self.is_sparse:
+            return self
+        d = sparse.dense
+        return dataclasses.replace(
+            self, M=d(self.M), K=d(self.K), C=d(self.C), G={k: d(v) for k, v in self.G.items()},
+            K_G={k: d(v) for k, v in self.K_G.items()}, tables=tuple(dataclasses.replace(t, rows=d(t.rows))
+                                                                     for t in self.tables),
+            rotating={k: RotatingDamping(*(d(X) for X in (r.C_v, r.N_v, r.C_h, r.N_h))) for k, r in self.rotating.items()})
 
     def physical_index(self, node: int, direction: str) -> int:
         """Index of the physical DOF ``direction`` at ``node`` in this model's coordinates.
@@ -339,14 +373,16 @@ class _Triplets:
         self.cols.append(c.ravel())
         self.vals.append(np.asarray(block, dtype=float).ravel())
 
-    def dense(self, n: int) -> np.ndarray:
+    def matrix(self, n: int, as_sparse: bool):
+        """The sum of the blocks, shape (n, n): a CSR array if ``as_sparse``, else a dense ndarray."""
         if not self.vals:
-            return np.zeros((n, n))
+            return coo_array((n, n)).tocsr() if as_sparse else np.zeros((n, n))
         rows, cols, vals = (np.concatenate(x) for x in (self.rows, self.cols, self.vals))
-        return coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
+        X = coo_array((vals, (rows, cols)), shape=(n, n))
+        return X.tocsr() if as_sparse else X.toarray()
 
 
-def system_of(model, field_name: str = "model"):
+def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):
     """The model of an analysis: a :class:`Rotor` assembled (:func:`assemble`), or a :class:`SystemMatrices` or a
     reduced model (:class:`rotorred.linear.reduction.ReducedSystem`) as given.
 
@@ -358,6 +394,10 @@ def system_of(model, field_name: str = "model"):
         The model as the caller gives it.
     field_name : str
         The argument or key the error names.
+    sparse_ok : bool
+        Whether the caller has a sparse path: it gets a full model of at least
+        :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM` DOFs sparse (:meth:`SystemMatrices.sparse`), as it is
+        otherwise; a caller without one gets it dense (:meth:`SystemMatrices.dense`).
 
     Returns
     -------
@@ -369,20 +409,27 @@ def system_of(model, field_name: str = "model"):
         For anything else, naming ``field_name``.
     """
     if isinstance(model, Rotor):
-        return assemble(model)
-    if isinstance(model, SpoolSpeedMixin):
-        return model
-    checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a ReducedSystem "
-                "(reduce_rotor)")
+        model = assemble(model)
+    if not isinstance(model, SpoolSpeedMixin):
+        checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a "
+                    "ReducedSystem (reduce_rotor)")
+    if not isinstance(model, SystemMatrices):
+        return model  # a reduced model: small and dense
+    if not sparse_ok:
+        return model.dense()
+    return model.sparse() if model.n_dof >= sparse.SOLVE_SPARSE_FROM else model
 
 
-def assemble(rotor: Rotor) -> SystemMatrices:
+def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
     """Assemble the global matrices of ``rotor``.
 
     Parameters
     ----------
     rotor : Rotor
         The rotor; its tabulated bearings enter ``K`` and ``C`` at its nominal speeds (docs/model.md §10).
+    as_sparse : bool, optional
+        Sparse CSR matrices (True) or dense ones (False); default by size: sparse from
+        :data:`rotorred.model.sparse.SPARSE_FROM` DOFs on.
 
     Returns
     -------
@@ -392,6 +439,7 @@ def assemble(rotor: Rotor) -> SystemMatrices:
     n_internal = sum(e.n_internal for s in rotor.spools for e in s.all_elements)
     dofs = DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals))
     n = dofs.n_dof
+    as_sparse = n >= sparse.SPARSE_FROM if as_sparse is None else bool(as_sparse)
     next_internal = n - n_internal
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
     parts = {s.name: [_Triplets() for _ in range(4)] for s in rotor.spools}  # C_v, N_v, C_h, N_h of RotatingDamping
@@ -427,21 +475,23 @@ def assemble(rotor: Rotor) -> SystemMatrices:
         rows = _deflection_rows(dofs, b)
         if isinstance(b, (BearingTable, IntershaftBearingTable)):
             spool = _table_spool(b, spool_of)
-            tables.append(TabulatedSupport(b, spool, rows, b.at(rotor.speeds[spool])))
+            tables.append(TabulatedSupport(b, spool, coo_array(rows).tocsr() if as_sparse else rows,
+                                           b.at(rotor.speeds[spool])))
             b = tables[-1].nominal
         idx = np.flatnonzero(np.any(rows != 0.0, axis=0))  # the DOFs the bearing's deflection reads
         K.add(idx, rows[:, idx].T @ b.block("K") @ rows[:, idx])
         C.add(idx, rows[:, idx].T @ b.block("C") @ rows[:, idx])
-    Cm = C.dense(n)
+    Cm = C.matrix(n, as_sparse)
     alpha, beta = rotor.rayleigh
     if alpha or beta:
-        Cm += alpha * M_shaft.dense(n) + beta * K_shaft.dense(n)
-    rotating = {k: RotatingDamping(*(t.dense(n) for t in v)) for k, v in parts.items() if v[0].vals}
-    free = SystemMatrices(M=M.dense(n), K=K.dense(n), C=Cm, G={k: v.dense(n) for k, v in G.items()}, dofs=dofs,
-                          K_G={k: v.dense(n) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor,
+        Cm = Cm + (alpha * M_shaft.matrix(n, as_sparse) + beta * K_shaft.matrix(n, as_sparse))
+    rotating = {k: RotatingDamping(*(t.matrix(n, as_sparse) for t in v)) for k, v in parts.items() if v[0].vals}
+    free = SystemMatrices(M=M.matrix(n, as_sparse), K=K.matrix(n, as_sparse), C=Cm,
+                          G={k: v.matrix(n, as_sparse) for k, v in G.items()}, dofs=dofs,
+                          K_G={k: v.matrix(n, as_sparse) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor,
                           rotating=rotating)
     supported = _supported(free, rotor.supports)
-    if any(np.any(r.C_h) for r in rotating.values()):
+    if any(sparse.nonzero(r.C_h) for r in rotating.values()):
         supported = dataclasses.replace(supported, loss_frequency=first_natural_frequency(supported.M, supported.K))
     return supported
 
@@ -455,11 +505,32 @@ def first_natural_frequency(M: np.ndarray, K: np.ndarray) -> float:
     """The lowest natural frequency of the undamped model at rest, ``K phi = w^2 M phi`` (rad/s), rigid-body
     motions (w^2 <= 1e-10 max w^2) left out: where a loss factor is taken when an analysis has no whirl frequency
     of its own (docs/model.md §19)."""
+    if sparse.is_sparse(M):
+        return _first_natural_frequency_sparse(M, K)
     w2 = eigh(0.5 * (K + K.T), M, eigvals_only=True)
     w2 = np.sort(w2[w2 > _RIGID_RTOL * max(float(np.max(np.abs(w2))), 1e-300)])
     if not len(w2):
         checks.fail("internal_loss_factor", "given", "needs a rotor with an elastic mode (every mode is rigid)")
     return float(np.sqrt(w2[0]))
+
+
+def _first_natural_frequency_sparse(M, K) -> float:
+    """:func:`first_natural_frequency` of a sparse model: the lowest eigenpairs by shift-invert
+    (:func:`rotorred.model.sparse.lowest_w2`), more until one is elastic; the largest w^2 that the rigid-body test
+    compares with is bounded by the largest ratio of K's and M's diagonal entries (Rayleigh quotients of unit
+    vectors, a lower bound of the largest w^2; rigid motions are round-off zeros far below both)."""
+    K = 0.5 * (K + K.T)
+    limit = _RIGID_RTOL * float(np.max(np.abs(K.diagonal()) / np.maximum(M.diagonal(), 1e-300)))
+    k = 8
+    while True:
+        w2 = sparse.lowest_w2(K, M, k)[0]
+        elastic = w2[w2 > limit]
+        if len(elastic) or k >= M.shape[0]:
+            break
+        k *= 4
+    if not len(elastic):
+        checks.fail("internal_loss_factor", "given", "needs a rotor with an elastic mode (every mode is rigid)")
+    return float(np.sqrt(elastic[0]))
 
 
 def _deflection_rows(dofs: DofMap, b) -> np.ndarray:
@@ -490,9 +561,10 @@ def _supported(system: SystemMatrices, supports) -> SystemMatrices:
     keep = dofs.free_in(system.dofs)
 
     def cut(X):
-        return X[np.ix_(keep, keep)]
+        return sparse.cut(X, keep, keep)
 
-    e_y = system.output_rows([(n, "y") for n in system.dofs.nodes]).sum(axis=0)  # every node moves 1 in y
+    e_y = np.zeros(system.n_dof)  # every node moves 1 in y
+    e_y[[system.dofs.index(n, "y") for n in system.dofs.nodes]] = 1.0
     return SystemMatrices(M=cut(system.M), K=cut(system.K), C=cut(system.C), G={k: cut(v) for k, v in system.G.items()},
                           dofs=dofs, K_G={k: cut(v) for k, v in system.K_G.items()},
                           tables=tuple(dataclasses.replace(t, rows=t.rows[:, keep]) for t in system.tables),

@@ -15,6 +15,7 @@ import dataclasses
 import numpy as np
 import scipy.linalg as sla
 
+from rotorred.model import sparse
 from rotorred.model.assembly import assemble
 from rotorred.model.elements import Material
 from rotorred.model.rotor import Rotor
@@ -48,15 +49,19 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     Returns
     -------
-    w2 : ndarray, shape (n,)
-        Eigenvalues w^2 (rad^2/s^2), ascending.
-    phi : ndarray, shape (n, n)
+    w2 : ndarray, shape (n,), or (k,) for a sparse model
+        Eigenvalues w^2 (rad^2/s^2), ascending. A sparse model gives its lowest k only (:func:`_lowest_of_sparse`).
+    phi : ndarray, shape (n, n), or (n, k)
         M-orthonormal eigenvectors, columns.
-    rigid : ndarray of bool, shape (n,)
+    rigid : ndarray of bool, shape (n,), or (k,)
         Whether each is a rigid-body motion.
     """
-    w2, phi = sla.eigh(model.K, model.M)
-    limit = np.full(len(w2), NULL_RTOL * max(float(np.max(np.abs(w2))), 1e-300))
+    if sparse.is_sparse(model.M):
+        w2, phi, largest = _lowest_of_sparse(model)
+    else:
+        w2, phi = sla.eigh(model.K, model.M)
+        largest = float(np.max(np.abs(w2)))
+    limit = np.full(len(w2), NULL_RTOL * max(largest, 1e-300))
     own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     if own:
         candidates = np.flatnonzero(w2 <= RIGID_RTOL * max(own.values()))
@@ -64,6 +69,23 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         scale = np.array([own[s] for s in model.spools]) @ shares
         limit[candidates] = np.maximum(limit[candidates], RIGID_RTOL * scale)
     return w2, phi, w2 <= limit
+
+
+def _lowest_of_sparse(model) -> tuple[np.ndarray, np.ndarray, float]:
+    """The lowest eigenpairs of a sparse model, enough to hold every rigid-body motion (4 per spool and 2 per pedestal
+    at most, with margin; more while the highest found is still rigid), and a bound of its largest w^2 (the largest
+    ratio of K's and M's diagonal entries, Rayleigh quotients of unit vectors: at most the largest w^2, so the
+    round-off rule compares with a smaller value; it matters only for a model built by hand)."""
+    K = 0.5 * (model.K + model.K.T)
+    largest = float(np.max(np.abs(K.diagonal()) / np.maximum(model.M.diagonal(), 1e-300)))
+    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
+    top = max(RIGID_RTOL * max(own.values()) if own else 0.0, NULL_RTOL * largest)
+    k = 4 * len(model.spools) + 2 * len(model.full_dofs.translational) + 4
+    while True:
+        w2, phi = sparse.lowest_w2(K, model.M, k)
+        if w2[-1] > top or k >= model.n_dof:
+            return w2, phi, largest
+        k *= 2
 
 
 def rigid_body_motions(model) -> np.ndarray:
@@ -98,7 +120,10 @@ def own_elastic_w2(rotor: Rotor) -> dict[str, float]:
     out = {}
     for s in rotor.spools:
         alone = assemble(Rotor((s,), disks=tuple(d for d in rotor.disks if d.node in set(s.nodes))))
-        w2 = sla.eigh(alone.K, alone.M, eigvals_only=True, subset_by_index=(0, min(4, alone.n_dof - 1)))
+        if alone.is_sparse:
+            w2 = sparse.lowest_w2(alone.K, alone.M, 5)[0]
+        else:
+            w2 = sla.eigh(alone.K, alone.M, eigvals_only=True, subset_by_index=(0, min(4, alone.n_dof - 1)))
         out[s.name] = float(w2[-1])
     return out
 

@@ -1,0 +1,279 @@
+"""Cost against model size, sparse beside dense: the seed rig refined(1, 2, 4, ..., 128), 80 to 9224 DOFs.
+
+For each mesh and each form of the full model (``assemble(rotor, as_sparse=...)``, solved on the same path whatever
+its size; dense up to ``--dense-up-to``, default refined(16), beyond which a dense eigen-solve takes minutes), one
+subprocess measures, one thread
+(OPENBLAS/OMP/MKL/NUMBA_NUM_THREADS=1 before numpy loads):
+
+* ``assembly``: :func:`rotorred.model.assembly.assemble`;
+* ``Campbell/speed``: one Campbell grid speed, the eigen-solution for the lowest 12 modes with the forward/backward
+  basis (:func:`rotorred.linear.campbell.modes_at`: 2 x 12 + 4 candidates), the median of three speeds;
+* ``unbalance/freq``: :func:`rotorred.unbalance_response` over 20 speeds (two unbalances, two outputs), per speed;
+* ``reduction``: Craig-Bampton with the default boundary and 10 fixed-interface modes (the automatic count);
+* ``rub 1 s``: the paper-rub scene (validation/bench_pareto.py) on that mesh's 10-mode reduced model, 1 s at
+  dt = 1e-5 s (1e5 steps), its µs per step (the reduced model does not depend on the form: sparse form only).
+
+Memory: ``MB`` is each task's peak of traced Python/numpy allocations (``tracemalloc``, in a second, untimed run of
+the task; SuperLU's own work arrays are not traced), ``RSS`` the subprocess's peak resident set after all its tasks (``ru_maxrss``), interpreter and
+libraries included. The growth exponent of each task is the slope of log(cost) against log(DOFs) over the sparse
+rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
+the 61-speed Campbell 0-12 000 rpm with critical speeds (default mode count), the unbalance response at 200
+speeds, the automatic Craig-Bampton reduction, and the rub transient's µs per step against the unrefined rig's
+(median of three alternating runs).
+
+Run ``python validation/bench_sparse.py [--quick] [--checks] [--dense-up-to N] [--plot PATH]``.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import importlib.util  # noqa: E402
+import json  # noqa: E402
+import statistics  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import tracemalloc  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+REFINES = (1, 2, 4, 8, 16, 32, 64, 128)
+QUICK = (1, 4, 16, 64)
+TASKS = ("assembly", "campbell_speed", "unbalance_freq", "reduction", "rub_us_step")
+LABELS = {"assembly": "assembly (s)", "campbell_speed": "Campbell/speed (s)", "unbalance_freq": "unbalance/freq (s)",
+          "reduction": "reduction (s)", "rub_us_step": "rub µs/step"}
+TOP_RPM = 12000.0
+RUB_SECONDS = 1.0
+DT = 1e-5
+
+
+def _bench_pareto():
+    """validation/bench_pareto.py (the paper-rub case), imported by path."""
+    name = "rotorred_bench_pareto"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, HERE / "bench_pareto.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+def _timed(f):
+    """(result, wall time (s), traced peak (MB)) of ``f()``: timed untraced (tracemalloc slows down code that makes
+    many small arrays several-fold), then run again traced for the memory."""
+    t0 = time.perf_counter()
+    out = f()
+    seconds = time.perf_counter() - t0
+    tracemalloc.start()
+    f()
+    peak = tracemalloc.get_traced_memory()[1] / 2**20
+    tracemalloc.stop()
+    return out, seconds, peak
+
+
+def _rpm(x) -> np.ndarray:
+    return np.asarray(x, float) * np.pi / 30.0
+
+
+def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
+    """Every task on one mesh and form, in this process."""
+    import resource
+
+    import rotorred as rr
+    from rotorred.linear.campbell import modes_at
+    from rotorred.linear.reduction import default_boundary_nodes, reduce
+    from rotorred.model.assembly import assemble
+    from rotorred.model.loads import Unbalance
+
+    from rotorred.model import sparse
+
+    if not as_sparse:
+        sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §24)
+    rotor = rr.load_rotor("seed-rig").refined(refine)
+    warm = assemble(rr.load_rotor("seed-rig"), as_sparse=as_sparse)  # first calls load modules: not timed
+    modes_at(warm, rr.Operating.line(_rpm([0.0, TOP_RPM])).lines(warm), 100.0, 12)
+    out = {"refine": refine, "sparse": as_sparse}
+    system, out["assembly"], out["assembly_mb"] = _timed(lambda: assemble(rotor, as_sparse=as_sparse))
+    out["n_dof"] = system.n_dof
+    lines = rr.Operating.line(_rpm([0.0, TOP_RPM])).lines(system)
+    times = []
+    for rpm in (2000.0, 6000.0, 10000.0):
+        t0 = time.perf_counter()
+        modes_at(system, lines, float(_rpm(rpm)), 12)
+        times.append(time.perf_counter() - t0)
+    out["campbell_speed"] = statistics.median(times)
+    out["campbell_speed_mb"] = _timed(lambda: modes_at(system, lines, float(_rpm(6000.0)), 12))[2]
+    sweep = rr.Operating.line(_rpm(np.linspace(300.0, TOP_RPM, 20)))
+    unbalances = [Unbalance(11, 1e-5), Unbalance(16, 1e-5, 1.5)]
+    _, t, out["unbalance_freq_mb"] = _timed(lambda: rr.unbalance_response(system, sweep, unbalances,
+                                                                          [(13, "x"), (18, "y")]))
+    out["unbalance_freq"] = t / 20
+    boundary = default_boundary_nodes(rotor, (18,))
+    model, out["reduction"], out["reduction_mb"] = _timed(lambda: reduce(system, boundary, n_modes=10))
+    if rub:
+        out["rub_us_step"] = rub_us_per_step(refine, model)
+    out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return out
+
+
+def rub_us_per_step(refine: int, model) -> float:
+    """µs per step of the paper-rub scene's 1 s transient on ``model`` (a reduced model of the rig refined
+    ``refine`` times), after a warm-up run that loads the compiled kernel."""
+    import dataclasses
+
+    bp = _bench_pareto()
+    warm = bp.paper_rub(refine, t_end=0.01, n_periods=0)
+    bp.run(model, warm, DT)
+    case = dataclasses.replace(bp.paper_rub(refine, t_end=RUB_SECONDS, n_periods=0), record_start=0.0)
+    return float(bp.run(model, case, DT).us_per_step)
+
+
+def check(name: str) -> dict:
+    """One of the issue's checks on refined(128), in this process: wall time (s), peak RSS (MB) and its result."""
+    import resource
+
+    import rotorred as rr
+    from rotorred.linear.reduction import reduce_rotor
+    from rotorred.model.assembly import assemble
+    from rotorred.model.loads import Unbalance
+
+    rotor = rr.load_rotor("seed-rig").refined(128)
+    out = {"check": name}
+    t0 = time.perf_counter()
+    if name == "campbell61":
+        result = rr.campbell(rotor, rr.Operating.line(_rpm(np.linspace(0.0, TOP_RPM, 61))))
+        out.update(n_modes=result.n_modes, n_critical=len(result.critical_speeds),
+                   critical_rpm=[round(c.speed_rpm, 3) for c in result.critical_speeds[:6]])
+    elif name == "unbalance200":
+        rr.unbalance_response(rotor, rr.Operating.line(_rpm(np.linspace(0.0, TOP_RPM, 200))),
+                              [Unbalance(11, 1e-5), Unbalance(16, 1e-5, 1.5)], [(13, "x"), (18, "y")])
+    elif name == "reduction":
+        red = reduce_rotor(rotor, (18,), system=assemble(rotor))
+        out.update(n_modes=red.n_modes, error=red.selection.error)
+    elif name == "rub":
+        bp = _bench_pareto()
+        models = {refine: bp.reduced_model(bp.paper_rub(refine), 10) for refine in (1, 128)}
+        runs = {refine: [] for refine in models}
+        for _ in range(3):  # alternating, the median of three: a busy machine moves one run by up to 60 %
+            for refine, model in models.items():
+                runs[refine].append(rub_us_per_step(refine, model))
+        out.update({f"us_step_{refine}": statistics.median(v) for refine, v in runs.items()})
+    out["seconds"] = time.perf_counter() - t0
+    out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return out
+
+
+def _subprocess(args: list[str]) -> dict:
+    done = subprocess.run([sys.executable, str(Path(__file__).resolve()), *args], capture_output=True, text=True,
+                          check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"worker {args} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def measure(refines=REFINES, dense_up_to: int = 16, progress: bool = True) -> list[dict]:
+    """Every mesh, sparse and (up to ``dense_up_to``) dense, each in a fresh subprocess."""
+    rows = []
+    for refine in refines:
+        for as_sparse in (True, False) if refine <= dense_up_to else (True,):
+            rows.append(_subprocess(["--worker", json.dumps([refine, as_sparse, as_sparse])]))
+            if progress:
+                r = rows[-1]
+                print(f"  refined({refine}) {'sparse' if as_sparse else 'dense'}: Campbell/speed "
+                      f"{r['campbell_speed']:.3g} s", file=sys.stderr, flush=True)
+    return rows
+
+
+def exponents(rows: list[dict], from_dofs: int = 1000) -> dict[str, float]:
+    """Slope of log(cost) against log(DOFs) of each task over the sparse rows of at least ``from_dofs`` DOFs."""
+    sel = [r for r in rows if r["sparse"] and r["n_dof"] >= from_dofs]
+    out = {}
+    for task in TASKS:
+        pts = [(r["n_dof"], r[task]) for r in sel if r.get(task)]
+        if len(pts) >= 2:
+            x, y = np.log(np.array(pts, float)).T
+            out[task] = float(np.polyfit(x, y, 1)[0])
+    return out
+
+
+def format_table(rows: list[dict], checks: list[dict] | None = None) -> str:
+    head = (f"{'mesh':<13}{'form':<7}{'DOF':>6}" + "".join(f"{LABELS[t]:>20}" for t in TASKS)
+            + f"{'peak MB':>9}{'RSS MB':>8}")
+    lines = ["one thread; the seed rig refined; peak MB: the largest traced peak of the tasks", head, "-" * len(head)]
+    for r in sorted(rows, key=lambda r: (r["refine"], not r["sparse"])):
+        cells = "".join(f"{r[t]:>20.4g}" if r.get(t) is not None else f"{'':>20}" for t in TASKS)
+        peak = max(r[f"{t}_mb"] for t in ("assembly", "campbell_speed", "unbalance_freq", "reduction"))
+        lines.append(f"refined({r['refine']})".ljust(13) + f"{'sparse' if r['sparse'] else 'dense':<7}{r['n_dof']:>6}"
+                     + cells + f"{peak:>9.1f}{r['rss_mb']:>8.0f}")
+    for r in rows:
+        twin = next((d for d in rows if not d["sparse"] and d["refine"] == r["refine"]), None)
+        if r["sparse"] and twin is not None and r["refine"] == max(d["refine"] for d in rows if not d["sparse"]):
+            lines.append(f"dense / sparse at refined({r['refine']}), {r['n_dof']} DOFs: " + ", ".join(
+                f"{LABELS[t].split(' (')[0]} {twin[t] / r[t]:.3g}x" for t in TASKS[:4]))
+    lines.append("growth exponent (sparse, >= 1000 DOFs): " + ", ".join(
+        f"{LABELS[t].split(' (')[0]} n^{p:.2f}" for t, p in exponents(rows).items()))
+    for c in checks or ():
+        lines.append("refined(128) check: " + ", ".join(f"{k} {v}" for k, v in c.items() if k != "check")
+                     + f"  [{c['check']}]")
+    return "\n".join(lines)
+
+
+def plot(rows: list[dict], path: str) -> str:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 4.2))
+    ax1, ax2 = fig.subplots(1, 2)
+    for k, task in enumerate(TASKS[:4]):
+        for as_sparse, style in ((True, "-o"), (False, "--s")):
+            sel = sorted((r for r in rows if r["sparse"] == as_sparse), key=lambda r: r["n_dof"])
+            if sel:
+                ax1.loglog([r["n_dof"] for r in sel], [r[task] for r in sel], style, color=f"C{k}", mfc="none"
+                           if not as_sparse else None, label=f"{LABELS[task].split(' (')[0]}, "
+                           f"{'sparse' if as_sparse else 'dense'}")
+                ax2.loglog([r["n_dof"] for r in sel], [r[f"{task}_mb"] for r in sel], style, color=f"C{k}",
+                           mfc="none" if not as_sparse else None)
+    ax1.set_ylabel("wall time (s), one thread")
+    ax2.set_ylabel("peak traced allocations (MB)")
+    for ax, title in ((ax1, "Cost against model size"), (ax2, "Memory")):
+        ax.set_xlabel("full-model DOFs (seed rig refined 1 ... 128)")
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
+    ax1.legend(fontsize=6.5, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    return path
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help=f"refined{QUICK} only")
+    parser.add_argument("--checks", action="store_true", help="also the issue's checks on refined(128)")
+    parser.add_argument("--dense-up-to", type=int, default=16, help="largest refinement solved dense too")
+    parser.add_argument("--plot", metavar="PATH")
+    parser.add_argument("--worker", help=argparse.SUPPRESS)
+    parser.add_argument("--check", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        print(json.dumps(worker(*json.loads(args.worker))))
+        return 0
+    if args.check:
+        print(json.dumps(check(args.check)))
+        return 0
+    rows = measure(QUICK if args.quick else REFINES, args.dense_up_to)
+    checks = [_subprocess(["--check", c]) for c in ("campbell61", "unbalance200", "reduction", "rub")] \
+        if args.checks else []
+    print(format_table(rows, checks))
+    if args.plot:
+        print(f"plot: {plot(rows, args.plot)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
