@@ -83,3 +83,74 @@ def test_a_map_resumed_with_other_options_refuses_naming_them(scene_file, tmp_pa
     assert "the start (--cold): False in the points, True now" in capsys.readouterr().err
     assert _map(scene_file, out, "--set", "rub.K_nr=4e10") == 2
     assert "rub[0].K_nr (50000000000.0 in the points, 40000000000.0 now)" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- 3. sizes before work
+def _limited(*args: str, memory: int = 3 << 30, timeout: float = 60.0):
+    """``rotorred ARGS`` in a child process limited to ``memory`` bytes of address space: (exit status, stderr,
+    seconds)."""
+    import resource
+    import subprocess
+    import sys
+    import time
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+    t0 = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", "import sys; from rotorred.cli import main; sys.exit(main())", *args],
+                          capture_output=True, text=True, timeout=timeout, preexec_fn=limit)
+    return done.returncode, done.stderr, time.perf_counter() - t0
+
+
+def test_a_map_of_a_hundred_thousand_points_is_answered_at_once(tmp_path):
+    """Issue 41: a --vary of 100 000 points did not answer in 90 s (on main: no answer in 20 s, every point's scene
+    read before the size check). Now the map's estimate from its first point refuses it at once (exit 2), naming
+    --vary, the points, the steps and --force; nothing is written."""
+    status, err, seconds = _limited("map", "paper-rub", "--vary", "rub.clearance=1e-6:1e-4:100000", "--workers", "0",
+                                    *SHORT, "--out", str(tmp_path / "big"), "-q", timeout=30)
+    assert status == 2 and seconds < 15, (status, err, seconds)
+    assert err.startswith("rotorred map: error: --vary = 'rub.clearance=<100000 values> (100000 points)': gives "
+                          "2e+09 steps in all") and "use --force" in err, err
+    assert not (tmp_path / "big").exists()
+
+
+@pytest.mark.parametrize("command", ["map", "run"])
+def test_a_billion_values_are_refused_not_a_memory_error(tmp_path, command):
+    """Issue 41: --vary KEY=START:STOP:1e9 ended in a MemoryError (on main: "internal error (MemoryError)", exit 1,
+    within 3 GiB of address space). Now refused before the list is made, in every option of that form."""
+    option = "--vary" if command == "map" else "--set"
+    status, err, _ = _limited(command, "paper-rub", option, "rub.clearance=1e-6:1e-4:1000000000", "--out",
+                              str(tmp_path / "o"), "-q")
+    assert status == 2 and "MemoryError" not in err, err
+    assert f"{option} rub.clearance = '1e-6:1e-4:1000000000': must have N <= 1e+06 values" in err
+
+
+def test_more_workers_than_cores_are_capped_with_a_warning(caplog):
+    """--workers above the cores: warned and capped unless --force (on main: 100 worker processes on 2 cores)."""
+    import argparse
+    import logging
+    import os
+
+    from rotorred.cli.map import workers
+
+    cores = os.cpu_count()
+    args = argparse.Namespace(workers=cores + 98, scheduler=None, force=False)
+    with caplog.at_level(logging.WARNING, logger="rotorred"):
+        assert workers(args) == cores
+    assert f"--workers = {cores + 98} is more than the {cores} cores of this machine: capped at {cores}" in caplog.text
+    assert workers(argparse.Namespace(workers=cores + 98, scheduler=None, force=True)) == cores + 98
+    assert workers(argparse.Namespace(workers=None, scheduler=None, force=False)) == cores
+    assert workers(argparse.Namespace(workers=0, scheduler=None, force=False)) == 0
+
+
+@pytest.mark.parametrize("options, named", [(["--harmonics", "100000", "--samples", "200002", "--no-stability"], "--harmonics = 100000"),
+                                            (["--harmonics", "20", "--samples", "100000000"], "--samples = 100000000")])
+def test_a_branch_beyond_the_limits_is_refused_before_work(tmp_path, options, named):
+    """Issue 41: `continue` had no size check (on main both were internal errors, MemoryError of 298 GiB and 30.5 GiB,
+    exit 1, with a traceback log in --out). Now its estimate (unknowns, Jacobians, monodromy steps) refuses at once
+    (exit 2) naming the option and --force."""
+    status, err, seconds = _limited("continue", "paper-rub", "--param", "rub.clearance=45e-6:40e-6", *options,
+                                    "--out", str(tmp_path / "b"), "-q")
+    assert status == 2 and seconds < 15, (status, err, seconds)
+    assert err.startswith(f"rotorred continue: error: {named}: gives a run beyond the limits") and "--force" in err

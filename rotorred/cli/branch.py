@@ -41,6 +41,8 @@ def add_parser(subparsers):
     p.add_argument("--tol", type=float, default=1e-9, help="relative residual of every point (default 1e-9)")
     p.add_argument("--no-stability", action="store_true", help="skip the Floquet multipliers (the slow part)")
     p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--force", action="store_true",
+                   help="go on with a branch beyond the size limits (steps, memory, model size; see the message)")
     return p
 
 
@@ -75,13 +77,15 @@ def run(args) -> int:
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
+    options = BranchOptions(H, N, tol, not args.no_stability)
+    options.estimate(scene).check(force=args.force)
     record = provenance(args, "scene", scene_toml(scene))  # with the base scene; --param in the command line
     model = build_model(scene).model
     report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
     interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
     progress.stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
     with _Progress(key) as tracing:
-        branch = continue_scene(scene, model, key, start, stop, BranchOptions(H, N, tol, not args.no_stability),
+        branch = continue_scene(scene, model, key, start, stop, options,
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
     for f in _write(branch, out, tuple(interrupts), record):

@@ -46,7 +46,8 @@ def add_parser(subparsers):
 
 
 def spec_of(args):
-    """The :class:`rotorred.maps.spec.MapSpec` of the options, every point's scene validated."""
+    """The :class:`rotorred.maps.spec.MapSpec` of the options (its size and points checked by
+    :func:`rotorred.maps.run.run_map`)."""
     from rotorred import Axis, MapSpec, parse_setting
 
     fixed = []
@@ -58,11 +59,28 @@ def spec_of(args):
         fixed.append((key, values[0]))
     axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
     ratios = tuple(spool_ratios("--ratio", args.ratio, bound="> 0", example="inner=0.7778").items())
+    return MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
+
+
+def workers(args) -> int | None:
+    """The local workers of ``--workers`` (None: one per core; 0: serial): more than the machine's cores is warned
+    about and capped at them unless ``--force`` (each worker holds a point's model and record, and they would share
+    the cores); with ``--scheduler`` the scheduler's workers, None."""
+    import logging
+    import os
+
     if args.workers is not None:
         checks.integer("--workers", args.workers, ge=0)
-    spec = MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
-    spec.check_size(force=args.force)
-    return spec
+    if args.scheduler:
+        return None
+    cores = os.cpu_count() or 1
+    if args.workers is None:
+        return cores
+    if args.workers > cores and not args.force:
+        logging.getLogger(__name__).warning("--workers = %d is more than the %d cores of this machine: "
+                                            "capped at %d (--force to start %d)", args.workers, cores, cores, args.workers)
+        return cores
+    return args.workers
 
 
 def base_scene_toml(spec) -> str:
@@ -91,12 +109,14 @@ def run(args) -> int:
     from rotorred import format_map, run_map
 
     out = out_dir("--out", args.out)
+    n_workers = workers(args)
     spec = spec_of(args)
     report(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
            f"{'/'.join(spec.directions)}, {spec.n_points} points, "
            f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
     record = provenance(args, "scene", base_scene_toml(spec))
-    result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler, provenance=record)
+    result = run_map(spec, out, workers=n_workers, scheduler=args.scheduler, provenance=record,
+                     force=args.force)
     report(format_map(result.dataset, spec))
     for f in result.files:
         report(f"wrote {f}")

@@ -1,7 +1,8 @@
 """``run_map``: check a map, run its points (serially or on Dask), and write the dataset, tables and figures.
 
 Order of work
-    1. Check: every grid point's scene is loaded and validated (:meth:`MapSpec.scenes`), the
+    1. Check: the map's size at once from its first point, then every grid point's scene loaded, validated and
+       within the limits (:func:`rotorred.maps.store.check_map_size`; refused unless ``force``), the
        folder is locked (a second map into it is refused), and points already in
        ``folder/points`` of another map are refused. Nothing runs before this passes.
     2. Run the points not on disk (:func:`rotorred.maps.execute.run_points`), each written as
@@ -26,7 +27,7 @@ import numpy as np
 from rotorred.maps.execute import connect, local_cluster, run_points
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
-from rotorred.maps.store import PointStore, to_dataset, write_tables
+from rotorred.maps.store import PointStore, check_map_size, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
 from rotorred.progress import stage
 from rotorred.provenance import Provenance
@@ -143,7 +144,8 @@ def _client(workers: int | None, scheduler: str | None):
 
 
 def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
-            progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None) -> MapRun:
+            progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None,
+            force: bool = False) -> MapRun:
     """Run a map into ``out`` (module docstring); resumable.
 
     Parameters
@@ -164,6 +166,8 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     provenance : rotorred.provenance.Provenance, optional
         What made the map (the command line's, with the base scene): written as ``scene.toml``, at the top of
         ``map.txt`` and as attributes of ``map.nc``.
+    force : bool
+        Go on with a map beyond the size limits (:mod:`rotorred.scenes.budget`).
 
     Returns
     -------
@@ -172,10 +176,15 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     Raises
     ------
     InputError
-        If a point's scene is invalid, or the folder holds points of another map, before any point runs.
+        If a point's scene is invalid, the map is beyond the size limits (without ``force``), or the folder holds
+        points of another map, before any point runs.
     """
+    import os
+
     t0 = time.perf_counter()
-    scenes = spec.scenes()  # 1. every point validated before anything runs
+    at_once = 1 if scheduler or workers == 0 else (workers or os.cpu_count() or 1)
+    check_map_size(spec, at_once, force)  # 1. the whole map at once, then every point, before anything runs
+    scenes = spec.scenes()
     out = Path(out)
     with OutputFolder(out) as folder:
         store = PointStore(out, spec)

@@ -186,8 +186,9 @@ class MapSpec:
         return [self.scene_at(ix) for ix in itertools.product(*(range(n) for n in self.shape))]
 
     def check_size(self, force: bool = False) -> None:
-        """Every point's scene validated and within the size limits (:mod:`rotorred.scenes.budget`), and the
-        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS``.
+        """Every point's scene validated and within the size limits of a run (:mod:`rotorred.scenes.budget`), and the
+        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS`` (a varied ``solver.dt`` or
+        duration). :func:`rotorred.maps.store.map_estimate` checks the whole map at once, from its first point.
 
         Parameters
         ----------
@@ -209,11 +210,49 @@ class MapSpec:
                             "choose its own model and step): choose the settings with `rotorred run --set "
                             "solver.tolerance=...` at a representative point and give them to the map")
             budget.scene_estimate(scene).check(force=force)
-            total += max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
+            total += self.steps_at(scene)
+        self.check_steps(total, force)
+
+    def check_steps(self, total: float, force: bool = False) -> None:
+        """Refuse ``total`` steps of the map beyond ``budget.MAX_STEPS`` (unless ``force``).
+
+        Parameters
+        ----------
+        total : float
+            The map's steps in all, every point and sweep.
+        force : bool
+            Let a map beyond the limit go on.
+
+        Raises
+        ------
+        InputError
+            Naming ``--vary``, the points, the steps and ``--force``.
+        """
+        from rotorred.scenes import budget
+
         if total > budget.MAX_STEPS and not force:
-            checks.fail("--vary", " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes),
+            checks.fail("--vary", self.described,
                         f"gives {total:.3g} steps in all (--limit {self.limit or 'the scene duration'}), more than "
                         f"{budget.MAX_STEPS:.3g}; use --force to go on")
+
+    def steps_at(self, scene: Scene) -> float:
+        """Steps of one grid point's ``scene`` in every sweep, each run to ``limit`` s.
+
+        Parameters
+        ----------
+        scene : Scene
+            A grid point's validated scene (:meth:`scene_at`).
+
+        Returns
+        -------
+        float
+        """
+        return max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
+
+    @property
+    def described(self) -> str:
+        """The varied keys and the points, as a message names them: ``rub.clearance=<11 values> (11 points)``."""
+        return " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes) + f" ({self.n_points} points)"
 
     def chains(self) -> list[Chain]:
         """The chains along the continuation axis: one per direction and combination of the other axes."""

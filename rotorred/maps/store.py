@@ -35,7 +35,7 @@ from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.transient.results import FinalState
 from rotorred.writers import write_csv, write_npz, write_text
 
-__all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
+__all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS", "point_bytes", "check_map_size"]
 
 #: the per-point scalars: name -> (dtype, missing value, units, long name). CF units: "1" for every dimensionless
 #: variable, counts and the string variables (status, reason, kind, start) included
@@ -97,6 +97,52 @@ def _point(arrays) -> PointResult:
     vectors["line_label"] = tuple(str(s) for s in vectors["line_label"])
     return PointResult(**scalars, **vectors, torus=(int(arrays["torus_k"]), int(arrays["torus_j"])),
                        peak_orbit=arrays["peak_orbit"], final=final)
+
+
+def point_bytes(n_nodes: int) -> int:
+    """Memory of one point in the map's dataset (bytes): its scalars, vectors and the peak orbit of ``n_nodes``
+    nodes, as :func:`to_dataset` holds them."""
+    scalars = sum(np.dtype(dtype).itemsize for dtype, *_ in SCALARS.values())
+    vectors = sum(n * np.dtype(dtype).itemsize for _, n, dtype, *_ in VECTORS.values())
+    return scalars + vectors + 8 * n_nodes
+
+
+def check_map_size(spec: MapSpec, workers: int = 1, force: bool = False) -> None:
+    """Refuse a map beyond the size limits of a run (:mod:`rotorred.scenes.budget`), unless ``force``: first at once,
+    from its first grid point's scene before any other is read (a grid of 1e5 points is answered at once), then point
+    by point (:meth:`MapSpec.check_size`).
+
+    At once: the first point's own estimate (naming its key), its steps times the grid points
+    (:meth:`MapSpec.check_steps`), and the memory of ``workers`` points' records and models at once and of the map's
+    dataset (:func:`point_bytes`, times 3: the dataset, its tables and NetCDF).
+
+    Parameters
+    ----------
+    spec : MapSpec
+        The map.
+    workers : int
+        Points run at once, >= 1.
+    force : bool
+        Let a map beyond the limits go on.
+
+    Raises
+    ------
+    InputError
+        Naming the key or ``--vary``, the estimate and ``--force``; or a point's scene is invalid.
+    """
+    import math
+
+    from rotorred.scenes import budget
+
+    scene = spec.scene_at((0,) * len(spec.axes))
+    one = budget.scene_estimate(scene).check(force=force)
+    spec.check_steps(math.prod(spec.shape) * spec.steps_at(scene), force)
+    at_once = max(1, min(int(workers), spec.n_points))
+    dataset = 3 * spec.n_points * point_bytes(len(scene.output.nodes))
+    fields = {"steps": ("--vary", spec.described), "memory": ("--vary", spec.described), "dofs": one.fields["dofs"]}
+    budget.Estimate(0, at_once * one.samples, at_once * one.record_bytes + dataset, one.n_dof,
+                    at_once * one.model_bytes, fields, "recorded samples at once and the map's dataset").check(force)
+    spec.check_size(force)
 
 
 class PointStore:

@@ -457,6 +457,23 @@ class BranchOptions:
         checks.boolean("stability", self.stability)
         checks.integer("max_points", self.max_points, ge=2)
 
+    def estimate(self, scene):
+        """The work and memory of a branch of ``scene`` with these options
+        (:func:`rotorred.scenes.budget.branch_estimate`); check it with its ``check(force)``.
+
+        Parameters
+        ----------
+        scene : Scene
+            A validated scene with rub plates.
+
+        Returns
+        -------
+        rotorred.scenes.budget.Estimate
+        """
+        from rotorred.scenes.budget import branch_estimate
+
+        return branch_estimate(scene, self.harmonics, self.samples, self.max_points, self.stability)
+
 
 def continue_scene(scene, model, key: str, start: float, end: float, options: BranchOptions = BranchOptions(), *,
                    progress=None, interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> SceneBranch:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from rotorred import checks
 
-__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "MAX_STEPS", "MAX_DOFS",
+__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "branch_estimate", "MAX_STEPS", "MAX_DOFS",
            "MEMORY_FRACTION", "format_bytes"]
 
 MAX_STEPS = 100_000_000
@@ -67,6 +67,8 @@ class Estimate:
     fields : dict of str to (str, object)
         The key or option (and its value) a message names for each limit: ``"steps"``,
         ``"memory"``, ``"dofs"`` (e.g. ``("solver.duration", 1e6)``).
+    held : str
+        What :attr:`record_bytes` holds, as the message names it (default "recorded samples").
     """
 
     steps: int
@@ -75,11 +77,12 @@ class Estimate:
     n_dof: int
     model_bytes: int
     fields: dict
+    held: str = "recorded samples"
 
     def describe(self) -> str:
         """One line: the steps, the recorded samples and their memory, the model's DOFs and its matrices' memory."""
         parts = [f"{self.steps:.3g} steps" if self.steps else "",
-                 f"{self.samples:.3g} recorded samples ({format_bytes(self.record_bytes)})" if self.samples else "",
+                 f"{self.samples:.3g} {self.held} ({format_bytes(self.record_bytes)})" if self.samples else "",
                  f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
         return "estimate: " + ", ".join(p for p in parts if p)
 
@@ -174,3 +177,35 @@ def scene_estimate(scene) -> Estimate:
     fields = {"steps": ("solver.duration", s.duration), "dofs": model,
               "memory": ("solver.record_start", s.record_start) if record >= model_bytes else model}
     return Estimate(steps, samples, record, n_dof, model_bytes, fields)
+
+
+def branch_estimate(scene, harmonics: int, samples: int, max_points: int, stability: bool) -> Estimate:
+    """Work and memory of a branch by harmonic balance (``rotorred continue``), at most ``max_points`` points.
+
+    Each point solves for the plates' unknowns (4 a plate: its disk's x, y and the plate's u_n, u_t) in
+    ``2 harmonics + 1`` coefficients each, with dense Jacobians of that size and ``samples`` AFT samples of every
+    unknown; its stability integrates the monodromy matrix of the whole linearised system (at most the full model's
+    DOFs and the plates', a dense state matrix of twice that) over ``samples`` x 4 substeps, counted as steps.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene with rub plates.
+    harmonics, samples, max_points : int
+        Harmonics H, AFT samples N a period and the most points of the branch.
+    stability : bool
+        Whether each point's multipliers are computed.
+
+    Returns
+    -------
+    Estimate
+        Its fields name ``--samples`` (steps), ``--harmonics`` (memory) and the rotor (DOFs).
+    """
+    n_dof, model_bytes = model_estimate(scene.rotor)
+    unknowns = 4 * len(scene.plates) * (2 * harmonics + 1)
+    state = 2 * (n_dof + 2 * len(scene.plates))
+    steps = max_points * samples * 4 if stability else 0
+    held = 8 * (4 * unknowns ** 2 + 4 * samples * 4 * len(scene.plates) + max_points * unknowns
+                + (4 * state ** 2 if stability else 0))
+    fields = {"steps": ("--samples", samples), "memory": ("--harmonics", harmonics), "dofs": ("rotor", scene.rotor_source)}
+    return Estimate(steps, max_points * unknowns, held, n_dof, model_bytes, fields, "unknowns of the branch")
