@@ -154,3 +154,211 @@ def test_a_branch_beyond_the_limits_is_refused_before_work(tmp_path, options, na
                                     "--out", str(tmp_path / "b"), "-q")
     assert status == 2 and seconds < 15, (status, err, seconds)
     assert err.startswith(f"rotorred continue: error: {named}: gives a run beyond the limits") and "--force" in err
+
+
+# --------------------------------------------------------------------------- 2. interrupts at random moments
+#: the commands interrupted: a 1-point map (serial), a short clearance branch (10 harmonics), a 1-s run-up to 0.3 x
+#: its speeds; each with an option that the interrupted runs change, so that their result differs from the earlier
+INTERRUPTED = {
+    "map": (["map", "paper-rub", "--vary", "rub.clearance=20e-6", "--workers", "0", *SHORT,
+             "--set", "solver.duration=0.3", "--set", "solver.record_start=0.1", "--set", "output.plot_window=[0.1, 0.2]"],
+            []),
+    "continue": (["continue", "paper-rub", "--param", "rub.clearance=45e-6:40e-6", "--harmonics", "10", "--samples",
+                  "64"], ["--tol", "1e-8"]),
+    "runup": (["run", "runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3",
+               "--set", "runup.orbits_hz=[10.0, 20.0]", "--set", "output.plots=[]"], ["--set", "runup.to=0.31"]),
+}
+#: a signal's exit statuses: the command's (it caught the signal), or the signal's own (-2, -15: it came after the
+#: command had returned, while the interpreter shut down; its result is then complete)
+SIGNALS = {"SIGINT": (130, -2), "SIGTERM": (143, -15)}
+#: the earliest moment of an interrupt (s): once the command's own handlers are set, past Python's start and the import
+#: of rotorred.cli (0.5 s: `rotorred --version` takes 0.47 s here), where SIGINT is Python's own KeyboardInterrupt
+#: traceback (exit -2), before rotorred runs
+START = 0.6
+
+
+def _command(*args: str):
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    return subprocess.Popen([sys.executable, "-c", "import sys; from rotorred.cli import main; sys.exit(main())",
+                             *args, "-q"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # as in a terminal
+
+
+def _snapshot(folder: Path) -> dict:
+    import hashlib
+
+    if not folder.exists():
+        return {}
+    return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _consistent_partial(kind: str, out: Path) -> str:
+    """What is wrong with ``out`` as a partial result marked INCOMPLETE ("" if nothing)."""
+    import csv
+
+    import xarray as xr
+
+    from rotorred import writers
+
+    listed = (out / writers.MANIFEST).read_text().split()
+    if writers.INCOMPLETE not in listed or not all((out / name).exists() for name in listed):
+        return f"manifest {listed} against {sorted(p.name for p in out.iterdir())}"
+    if kind == "map":
+        with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
+            done = int((ds["status"].values != "").sum())
+        kept = len(list((out / "points").rglob("*.npz")))
+        return "" if done == kept else f"map.nc holds {done} points, points/ {kept}"
+    if kind == "continue":
+        with open(out / "branch.csv", newline="") as f:
+            rows = len(list(csv.reader(f))) - 1
+        with xr.open_dataset(out / "branch.nc", engine="h5netcdf") as ds:
+            points = ds.sizes["point"]
+        text = (out / "branch.txt").read_text()
+        return "" if rows == points and "INCOMPLETE: interrupted" in text else f"{rows} rows, {points} points"
+    return "" if (out / "summary.txt").read_text().count("INCOMPLETE") else "summary.txt not marked"
+
+
+def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) -> str:
+    """Run ``kind`` into ``out`` (a copy of ``earlier``, or new for a map), send ``sig`` after ``delay`` s; what went
+    wrong ("" if nothing)."""
+    import signal
+    import time
+
+    args, changed = INTERRUPTED[kind]
+    while True:  # a moment after the command ended (a machine less busy than when it was measured): earlier
+        shutil.rmtree(out, ignore_errors=True)
+        if kind != "map":
+            shutil.copytree(earlier, out)
+        before = _snapshot(out)
+        proc = _command(*args, *changed, "--out", str(out))
+        time.sleep(delay)
+        if proc.poll() is None:
+            break
+        proc.communicate()
+        if proc.returncode != 0:
+            return f"{kind} without a signal: exit {proc.returncode}"
+        delay = START + 0.6 * (delay - START)
+    proc.send_signal(getattr(signal, sig))
+    _, err = proc.communicate(timeout=120)
+    said = f"{kind} {sig} at {delay:.2f} s: exit {proc.returncode}, {err.strip()[-300:]!r}"
+    if proc.returncode not in SIGNALS[sig] or "Traceback" in err:
+        return said
+    leftovers = [p.name for p in out.glob(".rotorred*") if p.name != ".rotorred-files"] if out.exists() else []
+    if leftovers:
+        return f"{said}; left {leftovers}"
+    now = _snapshot(out)
+    committed = {k: v for k, v in now.items() if not k.startswith("points/")}
+    if committed == {k: v for k, v in before.items() if not k.startswith("points/")}:
+        return ""  # the earlier result (a map's points/ kept for the same command to resume)
+    from rotorred import writers
+
+    listed = (out / writers.MANIFEST).read_text().split()
+    if writers.INCOMPLETE not in listed and all((out / name).exists() for name in listed) \
+            and _complete(kind, out, before):
+        return ""  # the signal came after the commit: the new result, complete
+    wrong = _consistent_partial(kind, out)
+    return f"{said}; {wrong}" if wrong else ""
+
+
+def _complete(kind: str, out: Path, before: dict) -> bool:
+    """Whether ``out`` holds the command's complete new result: every file of the earlier one written again."""
+    now = _snapshot(out)
+    return set(before) <= set(now) and all(now[k] != v for k, v in before.items() if k.endswith(".txt"))
+
+
+def test_sigint_and_sigterm_at_random_moments_leave_the_earlier_or_a_partial_result(tmp_path):
+    """Issue 41: SIGINT and SIGTERM at 10 random moments (seed 41) of a short map, continue and run-up, two at a time:
+    every exit 130 (SIGINT) or 143 (SIGTERM), no traceback, no staging folder or lock left, and every folder either its
+    earlier result (a map's finished points kept for the resume) or a consistent partial one marked INCOMPLETE. On
+    main: a SIGTERM of a map left no dataset, and continue ... (the commit message of this test says what failed)."""
+    import random
+    import time
+    from concurrent.futures import ThreadPoolExecutor
+
+    def earlier(kind):
+        t0 = time.perf_counter()
+        proc = _command(*INTERRUPTED[kind][0], "--out", str(tmp_path / f"{kind}-earlier"))
+        _, err = proc.communicate(timeout=120)
+        assert proc.returncode == 0, err
+        return time.perf_counter() - t0
+
+    with ThreadPoolExecutor(2) as pool:
+        took = dict(zip(INTERRUPTED, pool.map(earlier, INTERRUPTED)))
+    rng = random.Random(41)
+    cases = [(kind, tmp_path / f"{kind}-earlier", tmp_path / f"{kind}-{i}", rng.choice(list(SIGNALS)),
+              rng.uniform(START, 0.9 * took[kind])) for kind in INTERRUPTED for i in range(10)]
+    with ThreadPoolExecutor(2) as pool:
+        wrong = [w for w in pool.map(lambda c: _one_interrupt(*c), cases) if w]
+    assert not wrong, "\n".join(wrong)
+
+
+# --------------------------------------------------------------------------- 2. a Dask cluster lost under a map
+@pytest.fixture()
+def dask_cluster():
+    """A scheduler and one worker without a nanny, each a process of its own: {"address", "scheduler", "worker"}."""
+    import os
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    from distributed import Client
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
+    procs = {"scheduler": subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
+                                            "127.0.0.1", "--port", str(port), "--no-dashboard"], **quiet)}
+    procs["worker"] = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads",
+                                        "1", "--no-nanny", "--no-dashboard"], **quiet)
+    with Client(address, timeout="30s") as client:
+        client.wait_for_workers(1, timeout=60)
+    yield {"address": address, **procs}
+    for p in procs.values():
+        p.kill()
+        p.wait()
+
+
+@pytest.mark.parametrize("victim", ["worker", "scheduler"])
+def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplete(dask_cluster, tmp_path, monkeypatch,
+                                                                                  capsys, victim):
+    """Issue 41: killing the only worker or the scheduler gave internal errors and no dataset (on main: the map with
+    its only worker killed waited for ever; with its scheduler killed, an internal error, exit 1, no map.nc). Now the
+    map ends there with exit 3, one line saying the Dask cluster was lost, and map.nc holds the point done, the folder
+    INCOMPLETE; the same command resumes it."""
+    import signal
+
+    import xarray as xr
+
+    import rotorred.maps.execute as execute
+    import rotorred.maps.run as map_run
+
+    real = map_run.run_points
+    monkeypatch.setattr(execute, "NO_WORKER_WAIT", 3.0)
+
+    def killing(spec, store, client, on_point):
+        def kill(*args):
+            on_point(*args)
+            dask_cluster[victim].send_signal(signal.SIGKILL)
+        return real(spec, store, client, on_point=kill)
+
+    monkeypatch.setattr(map_run, "run_points", killing)
+    out = tmp_path / "out"
+    status = main(["map", "paper-rub", "--vary", "rub.clearance=20e-6,30e-6,40e-6", "--scheduler",
+                   dask_cluster["address"], *SHORT, "--out", str(out), "-q"])
+    err = capsys.readouterr().err
+    assert status == 3, err
+    assert err.startswith("rotorred map: error: the Dask cluster was lost (") and "after 1 of 3 points" in err, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert (out / "INCOMPLETE").read_text().startswith("the Dask cluster was lost")
+    with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
+        assert list(ds["status"].values.ravel()) == ["ok", "", ""]

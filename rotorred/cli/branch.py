@@ -64,8 +64,7 @@ def _param(text: str) -> tuple[str, float, float]:
 
 def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
-    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
-    from rotorred.cli.run import _settings
+    from rotorred.cli.run import _settings, interrupted_status, interrupts as signals
     from rotorred import BranchOptions, build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
@@ -82,7 +81,7 @@ def run(args) -> int:
     record = provenance(args, "scene", scene_toml(scene))  # with the base scene; --param in the command line
     model = build_model(scene).model
     report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
-    interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
+    interrupts = signals()
     progress.stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
     with _Progress(key) as tracing:
         branch = continue_scene(scene, model, key, start, stop, options,
@@ -92,7 +91,7 @@ def run(args) -> int:
         report(f"wrote {f}")
     if branch.interrupted:
         error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
-        return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[branch.interrupt]
+        return interrupted_status(branch.interrupt)
     return 0
 
 

@@ -104,8 +104,10 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
 
 
 def run(args) -> int:
-    """Check everything, then run the map into ``--out`` (exit 3 when points failed, 130 when interrupted)."""
-    from rotorred.cli import EXIT_DIVERGED, EXIT_SIGINT
+    """Check everything, then run the map into ``--out`` (exit 3 when points failed or the Dask cluster was lost, 130
+    or 143 when SIGINT or SIGTERM ended it: the points done written, the folder marked INCOMPLETE)."""
+    from rotorred.cli import EXIT_DIVERGED
+    from rotorred.cli.run import interrupted_status, interrupts
     from rotorred import format_map, run_map
 
     out = out_dir("--out", args.out)
@@ -116,15 +118,15 @@ def run(args) -> int:
            f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
     record = provenance(args, "scene", base_scene_toml(spec))
     result = run_map(spec, out, workers=n_workers, scheduler=args.scheduler, provenance=record,
-                     force=args.force)
+                     force=args.force, interrupts=interrupts())
     report(format_map(result.dataset, spec))
     for f in result.files:
         report(f"wrote {f}")
     report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
            f"wall time {result.wall_time:.2f} s")
     if result.incomplete:
-        error(result.incomplete)
-        return EXIT_SIGINT
+        error(f"{result.incomplete}; the points done are written, the folder marked INCOMPLETE")
+        return interrupted_status(result.interrupt) if result.interrupt else EXIT_DIVERGED
     if result.n_failed:
         error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
               "points are kept")

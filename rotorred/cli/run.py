@@ -68,6 +68,23 @@ def run(args) -> int:
     return status
 
 
+def interrupts() -> dict:
+    """The exceptions of SIGINT and SIGTERM in a command (``KeyboardInterrupt``; :class:`rotorred.cli.Terminated`,
+    raised by :func:`rotorred.cli.main`'s handler) and the signal each stands for: the one mapping ``map``,
+    ``continue`` and the run-ups end their work on, keeping what they have (``interrupts`` of
+    :func:`rotorred.run_map` and :func:`rotorred.continue_scene`)."""
+    from rotorred.cli import Terminated
+
+    return {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
+
+
+def interrupted_status(signal_name: str) -> int:
+    """The exit status of a command its signal ended, its partial result written: 130 (SIGINT) or 143 (SIGTERM)."""
+    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM
+
+    return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[signal_name]
+
+
 def _figure_pool(scene):
     """The :class:`rotorred.plots.pool.FigurePool` of ``scene``: its workers draw the figures while the data files are
     written, their fork server importing matplotlib and preparing the figures' frames while the scene is solved; for

@@ -9,13 +9,21 @@ Order of work
        it finishes, with a progress bar (points done, failures, ETA).
     3. Build the dataset from every point on disk and write ``map.nc``, ``map.csv``,
        ``map_lines.csv``, the figures and ``map.txt`` through a staged
-       :class:`rotorred.writers.OutputFolder`. When interrupted (Ctrl-C) or when a worker's
-       error stops the run, step 3 still runs on the points finished so far, the folder is
-       marked INCOMPLETE with the reason, and the same command later completes it.
+       :class:`rotorred.writers.OutputFolder`.
+
+Interrupts and lost clusters
+    An interrupt in step 2 (``interrupts``: SIGINT's ``KeyboardInterrupt`` and whatever the caller names, the
+    command line's SIGTERM), or a Dask cluster lost under it (a worker killed more often than Dask retries, a
+    scheduler that died or cannot be reached: :func:`rotorred.maps.execute.is_lost`), ends the run there: step 3
+    runs on the points finished so far with SIGINT and SIGTERM held back (:func:`rotorred.writers.signals_held`, a
+    second signal does not cut it), the folder is marked INCOMPLETE with the reason, :attr:`MapRun.interrupt` names
+    the signal, and the same command later completes the map. A signal anywhere else (the checks, the model, the
+    writing of a complete map) leaves the folder's earlier result, its points kept.
 """
 
 from __future__ import annotations
 
+import contextlib
 import textwrap
 import time
 from collections import Counter
@@ -24,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.maps.execute import connect, local_cluster, run_points
+from rotorred.maps.execute import connect, is_lost, local_cluster, run_points
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, check_map_size, to_dataset, write_tables
@@ -33,7 +41,8 @@ from rotorred.progress import stage
 from rotorred.provenance import Provenance
 from rotorred.results import Result
 from rotorred.scenes.run import table_dof
-from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
+from rotorred.nonlinear.continuation import INTERRUPTS, interrupt_name
+from rotorred.writers import OutputFolder, render_table, signals_held, write_netcdf, write_text
 
 __all__ = ["MapRun", "run_map", "format_map"]
 
@@ -56,6 +65,9 @@ class MapRun(Result):
         Why the map stopped early (the folder is marked INCOMPLETE), or None.
     wall_time : float
         Time the run took (s).
+    interrupt : str
+        The signal that ended the map ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "" (none; a lost
+        cluster, if :attr:`incomplete`).
     """
 
     spec: MapSpec
@@ -66,6 +78,7 @@ class MapRun(Result):
     n_failed: int
     incomplete: str | None
     wall_time: float
+    interrupt: str = ""
 
     def summary(self) -> list[str]:
         """The map's scene, keys and sweeps, the points run, resumed and failed, the classes found, and whether it
@@ -145,7 +158,7 @@ def _client(workers: int | None, scheduler: str | None):
 
 def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
             progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None,
-            force: bool = False) -> MapRun:
+            force: bool = False, interrupts=INTERRUPTS) -> MapRun:
     """Run a map into ``out`` (module docstring); resumable.
 
     Parameters
@@ -168,6 +181,9 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         ``map.txt`` and as attributes of ``map.nc``.
     force : bool
         Go on with a map beyond the size limits (:mod:`rotorred.scenes.budget`).
+    interrupts : mapping of exception type to str
+        The exceptions that end the map where it is, its points kept (module docstring), and the signal each stands
+        for (default: SIGINT's ``KeyboardInterrupt``).
 
     Returns
     -------
@@ -193,30 +209,59 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         stage("running %d of %d points (%d kept from an earlier run) %s", spec.n_points - n_resumed, spec.n_points,
               n_resumed, "in this process" if client is None else "on Dask")
         bar = _Progress(spec.n_points, n_resumed, progress)
-        incomplete = None
+        incomplete, interrupt = None, ""
         try:
             points = run_points(spec, store, client, on_point=bar)
-        except KeyboardInterrupt:
-            incomplete = "interrupted (Ctrl-C); run the same command again to complete the map"
+        except tuple(interrupts) as exc:
+            interrupt = interrupt_name(exc, interrupts)
+            incomplete = f"interrupted ({interrupt}) after {_done(store)} of {spec.n_points} points; run the same " \
+                         "command again to complete the map"
+        except Exception as exc:  # noqa: BLE001 -- a lost cluster is told apart by is_lost; anything else is raised
+            if client is None or not is_lost(exc):
+                raise
+            why = (str(exc).strip().splitlines() or [""])[0].rstrip(":")[:200]
+            incomplete = f"the Dask cluster was lost ({type(exc).__name__}: {why}) after {_done(store)} of " \
+                         f"{spec.n_points} points; run the same command again to complete the map"
         finally:
             bar.close()
             if client is not None:
                 _close(client, scheduler)
-        if incomplete is not None:
+        run = _committed(spec, scenes[0], store, folder, figures, provenance, n_resumed, incomplete, interrupts)
+    return replace(run, wall_time=time.perf_counter() - t0, interrupt=interrupt)
+
+
+def _done(store: PointStore) -> int:
+    return len(store.read())
+
+
+def _committed(spec, scene, store, folder, figures, provenance, n_resumed, incomplete, interrupts) -> MapRun:
+    """Build the map of every point on disk, write and commit it; an incomplete map (its points are all it has) with
+    SIGINT and SIGTERM held back, a signal that came meanwhile dropped once it is committed (the exit status is the
+    first's)."""
+    try:
+        with signals_held() if incomplete else contextlib.nullcontext():
             points = store.read()
-        run = MapRun(spec, _dataset(spec, scenes[0], points), (), len(points) - n_resumed, n_resumed,
-                     sum(p.status != "ok" for p in points.values()), incomplete, 0.0)
-        _write(run, folder, figures, provenance)
-        files = tuple(folder.commit(incomplete))
-    return replace(run, files=files, wall_time=time.perf_counter() - t0)
+            run = MapRun(spec, _dataset(spec, scene, points), (), len(points) - n_resumed, n_resumed,
+                         sum(p.status != "ok" for p in points.values()), incomplete, 0.0)
+            _write(run, folder, figures, provenance)
+            run = replace(run, files=tuple(folder.commit(incomplete)))
+    except tuple(interrupts):
+        if not (incomplete and folder.committed):
+            raise
+    return run
 
 
 def _close(client, scheduler: str | None) -> None:
-    """Close the client, and the local cluster it started (not a cluster given by ``--scheduler``)."""
+    """Close the client, and the local cluster it started (not a cluster given by ``--scheduler``); a cluster
+    already lost is let go (its errors are not the map's)."""
     cluster = None if scheduler else client.cluster
-    client.close()
-    if cluster is not None:
-        cluster.close()
+    try:
+        client.close(timeout=10)
+        if cluster is not None:
+            cluster.close(timeout=10)
+    except Exception as exc:  # noqa: BLE001 -- closing what is left of a lost cluster
+        if not is_lost(exc):
+            raise
 
 
 def _dataset(spec: MapSpec, scene, points: dict):
