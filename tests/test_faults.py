@@ -362,3 +362,51 @@ def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplet
     assert (out / "INCOMPLETE").read_text().startswith("the Dask cluster was lost")
     with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
         assert list(ds["status"].values.ravel()) == ["ok", "", ""]
+
+
+# --------------------------------------------------------------------------- 4. inputs a command cannot honour
+@pytest.mark.parametrize("command", [["map", "runup-rub", "--vary", "rub.clearance=20e-6,30e-6", "--workers", "0"],
+                                     ["continue", "runup-rub", "--param", "rub.clearance=45e-6:40e-6"]])
+def test_a_run_up_scene_is_refused_where_its_runup_cannot_be_honoured(tmp_path, capsys, command):
+    """Issue 41: `map` on a run-up scene ignored [runup] (on main: the map ran its points at the scene's steady speeds,
+    exit 0). Now map and continue refuse it before anything runs (exit 2), naming [runup] and `rotorred run`."""
+    out = tmp_path / "o"
+    assert main([*command, "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "has a [runup], which a " in err and "cannot honour" in err and "rotorred run" in err, err
+    assert not out.exists()
+
+
+def test_a_ratio_that_conflicts_with_a_fixed_speed_is_refused_naming_both(tmp_path, capsys):
+    """Issue 41: --ratio silently overrode --set speeds.* while map.nc recorded the overridden value (on main: exit 0).
+    Now refused (exit 2) naming both options and their values."""
+    out = tmp_path / "o"
+    assert main(["map", "paper-rub", "--vary", "speeds.outer=89,90", "--ratio", "inner=0.7778", "--set",
+                 "speeds.inner=60", "--workers", "0", *SHORT, "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "--ratio = 'inner=0.7778': conflicts with --set speeds.inner=60: both set the inner spool's speed" in err, err
+    assert not out.exists()
+
+
+def test_run_ups_say_what_a_steady_run_says_of_a_long_step_and_a_large_orbit(tmp_path, capsys):
+    """Issue 41: run-ups gave neither the small-displacement warning of a steady run nor a warning at a few steps a
+    revolution (on main: a run-up at 3.7 steps a revolution with orbits of 0.7 m said neither, exit 0). Now the
+    step's warning comes before computing, from one implementation (budget.step_warnings) for steady runs, run-ups and
+    maps, and the run-up's summary warns of each node beyond the small-displacement range as a steady run's does."""
+    runup = ["runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3", "--set", "runup.orbits_hz=[10.0, 20.0]",
+             "--set", "output.plots=[]"]
+    assert main(["run", *runup, "--set", "solver.dt=0.01", "--set", "runup.record_dt=0.01", "--set",
+                 "unbalance[1].m_e=3.5", "--out", str(tmp_path / "r")]) == 0
+    captured = capsys.readouterr()
+    assert "warning: solver.dt = 0.01 s gives 3.7 steps a revolution of the outer spool at 27 Hz (its highest in the " \
+           "run-up), fewer than 20" in captured.err, captured.err
+    assert "WARNING: node 18 orbits " in captured.out and "beyond the model's small-displacement range" in captured.out
+    assert "WARNING: node 18 orbits " in (tmp_path / "r" / "summary.txt").read_text()
+    assert main(["run", *runup, "--out", str(tmp_path / "fine")]) == 0  # the scene's own step: 1852 a revolution
+    captured = capsys.readouterr()
+    assert "steps a revolution" not in captured.err and "WARNING" not in captured.out
+    assert main(["run", "paper-rub", "--set", "solver.dt=0.01", "--set", "solver.duration=2.0", "--set",
+                 "solver.record_start=1.0", "--set", "output.plots=[]", "--set", "output.plot_window=[1.0, 1.5]",
+                 "--out", str(tmp_path / "steady")]) == 0
+    assert "warning: solver.dt = 0.01 s gives 1.11 steps a revolution of the outer spool at 90 Hz, fewer than 20" \
+        in capsys.readouterr().err

@@ -59,13 +59,21 @@ def run(args) -> int:
     scene = load_scene(args.scene, settings)
     if out is None:
         out = out_dir("--out", f"rotorred-{scene.name}")
-    scene_estimate(scene).check(force=args.force)
+    warn(scene_estimate(scene).check(force=args.force).warnings)
     record = provenance(args, "scene", scene_toml(scene))
     with writers.OutputFolder(out) as folder, _figure_pool(scene) as pool:  # the pool stops before the folder cleans up
         progress.stage("running %s into %s", scene.name, out)  # the first line, once the input is checked and --out locked
         status = _compute_and_write(scene, args, folder, out, pool, record)
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     return status
+
+
+def warn(texts) -> None:
+    """Say each warning (an estimate's, :attr:`rotorred.Estimate.warnings`) before computing."""
+    import logging
+
+    for text in texts:
+        logging.getLogger(__name__).warning(text)
 
 
 def interrupts() -> dict:
