@@ -206,6 +206,8 @@ def _consistent_partial(kind: str, out: Path) -> str:
 
     from rotorred import writers
 
+    if not (out / writers.MANIFEST).exists():
+        return f"{said}; {len(points)} finished points without a dataset"
     listed = (out / writers.MANIFEST).read_text().split()
     if writers.INCOMPLETE not in listed or not all((out / name).exists() for name in listed):
         return f"manifest {listed} against {sorted(p.name for p in out.iterdir())}"
@@ -224,6 +226,13 @@ def _consistent_partial(kind: str, out: Path) -> str:
     return "" if (out / "summary.txt").read_text().count("INCOMPLETE") else "summary.txt not marked"
 
 
+def _ended(proc) -> bool:
+    """Whether ``proc`` has exited (without reaping it: a signal sent after a check that says no reaches it)."""
+    import os
+
+    return os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
+
+
 def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) -> str:
     """Run ``kind`` into ``out`` (a copy of ``earlier``, or new for a map), send ``sig`` after ``delay`` s; what went
     wrong ("" if nothing)."""
@@ -238,13 +247,13 @@ def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) 
         before = _snapshot(out)
         proc = _command(*args, *changed, "--out", str(out))
         time.sleep(delay)
-        if proc.poll() is None:
+        if not _ended(proc):
+            proc.send_signal(getattr(signal, sig))  # microseconds after the check: it was running
             break
         proc.communicate()
         if proc.returncode != 0:
             return f"{kind} without a signal: exit {proc.returncode}"
         delay = START + 0.6 * (delay - START)
-    proc.send_signal(getattr(signal, sig))
     _, err = proc.communicate(timeout=120)
     said = f"{kind} {sig} at {delay:.2f} s: exit {proc.returncode}, {err.strip()[-300:]!r}"
     if proc.returncode not in SIGNALS[sig] or "Traceback" in err:
@@ -254,10 +263,13 @@ def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) 
         return f"{said}; left {leftovers}"
     now = _snapshot(out)
     committed = {k: v for k, v in now.items() if not k.startswith("points/")}
-    if committed == {k: v for k, v in before.items() if not k.startswith("points/")}:
-        return ""  # the earlier result (a map's points/ kept for the same command to resume)
+    points = [k for k in now if k.startswith("points/") and k.endswith(".npz")]
+    if committed == {k: v for k, v in before.items() if not k.startswith("points/")} and not points:
+        return ""  # the earlier result (a map's: none, and no point finished)
     from rotorred import writers
 
+    if not (out / writers.MANIFEST).exists():
+        return f"{said}; {len(points)} finished points without a dataset"
     listed = (out / writers.MANIFEST).read_text().split()
     if writers.INCOMPLETE not in listed and all((out / name).exists() for name in listed) \
             and _complete(kind, out, before):
@@ -274,12 +286,14 @@ def _complete(kind: str, out: Path, before: dict) -> bool:
 
 def test_sigint_and_sigterm_at_random_moments_leave_the_earlier_or_a_partial_result(tmp_path):
     """Issue 41: SIGINT and SIGTERM at 10 random moments (seed 41) of a short map, continue and run-up, two at a time:
-    every exit 130 (SIGINT) or 143 (SIGTERM), no traceback, no staging folder or lock left, and every folder either its
-    earlier result (a map's finished points kept for the resume) or a consistent partial one marked INCOMPLETE. On
-    main: a SIGTERM of a map left no dataset, and continue ... (the commit message of this test says what failed)."""
+    every exit 130 (SIGINT) or 143 (SIGTERM) (or the signal's own, -2 or -15, when it came after the command had
+    returned), no traceback, no staging folder or lock left, and every folder its earlier result, a consistent partial
+    one marked INCOMPLETE, or (the signal after the commit) the complete new one; a map's finished point is never
+    left without its dataset. On main a SIGTERM, or a SIGINT as the map was written, left the finished point without
+    map.nc. Moments from START s on: see START."""
     import random
     import time
-    from concurrent.futures import ThreadPoolExecutor
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
     def earlier(kind):
         t0 = time.perf_counter()
@@ -293,8 +307,9 @@ def test_sigint_and_sigterm_at_random_moments_leave_the_earlier_or_a_partial_res
     rng = random.Random(41)
     cases = [(kind, tmp_path / f"{kind}-earlier", tmp_path / f"{kind}-{i}", rng.choice(list(SIGNALS)),
               rng.uniform(START, 0.9 * took[kind])) for kind in INTERRUPTED for i in range(10)]
-    with ThreadPoolExecutor(2) as pool:
-        wrong = [w for w in pool.map(lambda c: _one_interrupt(*c), cases) if w]
+    with ProcessPoolExecutor(2) as pool:  # not threads: a thread waiting for the GIL between the check that the
+        # command runs and the signal could send it after the command ended
+        wrong = [w for w in pool.map(_one_interrupt, *zip(*cases)) if w]
     assert not wrong, "\n".join(wrong)
 
 
@@ -410,3 +425,22 @@ def test_run_ups_say_what_a_steady_run_says_of_a_long_step_and_a_large_orbit(tmp
                  "--out", str(tmp_path / "steady")]) == 0
     assert "warning: solver.dt = 0.01 s gives 1.11 steps a revolution of the outer spool at 90 Hz, fewer than 20" \
         in capsys.readouterr().err
+
+
+def test_an_error_raised_from_an_interrupt_is_the_interrupt():
+    """A signal that comes as a module is imported or a class made is raised again as another error, its cause the
+    interrupt (seen at random moments: ``ImportError: initialization failed``, ``RuntimeError: Error calling
+    __set_name__``, each an internal error, exit 1, before): the commands raise the interrupt itself."""
+    from rotorred.cli import Terminated
+    from rotorred.cli.run import interruptible
+
+    def importing(args):
+        try:
+            raise Terminated()
+        except Terminated as exc:
+            raise ImportError("initialization failed") from exc
+
+    with pytest.raises(Terminated):
+        interruptible(importing)(None)
+    with pytest.raises(ValueError):
+        interruptible(lambda args: int("x"))(None)

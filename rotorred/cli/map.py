@@ -17,6 +17,7 @@ from __future__ import annotations
 from rotorred import checks
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
+from rotorred.cli.run import interruptible
 
 
 def add_parser(subparsers):
@@ -103,6 +104,7 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
     return key, tuple(float(v) for v in values)
 
 
+@interruptible
 def run(args) -> int:
     """Check everything, then run the map into ``--out`` (exit 3 when points failed or the Dask cluster was lost, 130
     or 143 when SIGINT or SIGTERM ended it: the points done written, the folder marked INCOMPLETE)."""
@@ -127,6 +129,9 @@ def run(args) -> int:
     if result.incomplete:
         error(f"{result.incomplete}; the points done are written, the folder marked INCOMPLETE")
         return interrupted_status(result.interrupt) if result.interrupt else EXIT_DIVERGED
+    if result.interrupt:  # the signal came as the complete map was written: it was written whole first
+        error(f"interrupted ({result.interrupt}) as the complete map was written; it is written whole")
+        return interrupted_status(result.interrupt)
     if result.n_failed:
         error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
               "points are kept")

@@ -17,13 +17,13 @@ Interrupts and lost clusters
     scheduler that died or cannot be reached: :func:`rotorred.maps.execute.is_lost`), ends the run there: step 3
     runs on the points finished so far with SIGINT and SIGTERM held back (:func:`rotorred.writers.signals_held`, a
     second signal does not cut it), the folder is marked INCOMPLETE with the reason, :attr:`MapRun.interrupt` names
-    the signal, and the same command later completes the map. A signal anywhere else (the checks, the model, the
-    writing of a complete map) leaves the folder's earlier result, its points kept.
+    the signal, and the same command later completes the map. Step 3 of a complete map holds the signals back too (a
+    signal then is named in :attr:`MapRun.interrupt` once the map is written whole), so that no signal leaves points
+    without their dataset. A signal before step 2 (the checks, the model) leaves the folder's earlier result.
 """
 
 from __future__ import annotations
 
-import contextlib
 import textwrap
 import time
 from collections import Counter
@@ -37,7 +37,7 @@ from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
 from rotorred.maps.store import PointStore, check_map_size, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
-from rotorred.progress import stage
+from rotorred.progress import interrupt_in, stage
 from rotorred.provenance import Provenance
 from rotorred.results import Result
 from rotorred.scenes.run import table_dof
@@ -66,8 +66,8 @@ class MapRun(Result):
     wall_time : float
         Time the run took (s).
     interrupt : str
-        The signal that ended the map ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "" (none; a lost
-        cluster, if :attr:`incomplete`).
+        The signal that ended the map ("SIGINT", "SIGTERM": the caller's ``interrupts``; one that came as a complete
+        map was written is named too, the map complete), or "" (none; a lost cluster, if :attr:`incomplete`).
     """
 
     spec: MapSpec
@@ -209,46 +209,58 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         stage("running %d of %d points (%d kept from an earlier run) %s", spec.n_points - n_resumed, spec.n_points,
               n_resumed, "in this process" if client is None else "on Dask")
         bar = _Progress(spec.n_points, n_resumed, progress)
-        incomplete, interrupt = None, ""
-        try:
-            points = run_points(spec, store, client, on_point=bar)
-        except tuple(interrupts) as exc:
-            interrupt = interrupt_name(exc, interrupts)
-            incomplete = f"interrupted ({interrupt}) after {_done(store)} of {spec.n_points} points; run the same " \
-                         "command again to complete the map"
-        except Exception as exc:  # noqa: BLE001 -- a lost cluster is told apart by is_lost; anything else is raised
-            if client is None or not is_lost(exc):
-                raise
-            why = (str(exc).strip().splitlines() or [""])[0].rstrip(":")[:200]
-            incomplete = f"the Dask cluster was lost ({type(exc).__name__}: {why}) after {_done(store)} of " \
-                         f"{spec.n_points} points; run the same command again to complete the map"
-        finally:
+
+        def close():
             bar.close()
             if client is not None:
                 _close(client, scheduler)
-        run = _committed(spec, scenes[0], store, folder, figures, provenance, n_resumed, incomplete, interrupts)
-    return replace(run, wall_time=time.perf_counter() - t0, interrupt=interrupt)
+        try:
+            run_points(spec, store, client, on_point=bar)
+            stopped = None
+        except tuple(interrupts) as exc:
+            stopped = exc
+        except Exception as exc:  # noqa: BLE001 -- an interrupt's error or a lost cluster; anything else is raised
+            stopped = interrupt_in(exc, tuple(interrupts))
+            if stopped is None and (client is None or not is_lost(exc)):
+                close()
+                raise
+            stopped = stopped or exc
+        run = _committed(spec, scenes[0], store, folder, (figures, provenance, n_resumed), stopped, interrupts, close)
+    return replace(run, wall_time=time.perf_counter() - t0)
 
 
-def _done(store: PointStore) -> int:
-    return len(store.read())
-
-
-def _committed(spec, scene, store, folder, figures, provenance, n_resumed, incomplete, interrupts) -> MapRun:
-    """Build the map of every point on disk, write and commit it; an incomplete map (its points are all it has) with
-    SIGINT and SIGTERM held back, a signal that came meanwhile dropped once it is committed (the exit status is the
-    first's)."""
+def _committed(spec, scene, store, folder, outputs: tuple, stopped, interrupts, close) -> MapRun:
+    """Close the progress bar and the cluster (``close``), build the map of every point on disk, write and commit it,
+    all with SIGINT and SIGTERM held back (a signal cannot leave the points without their dataset); INCOMPLETE when
+    ``stopped`` (an interrupt or a lost cluster) ended the run. A signal that came meanwhile is dropped once the
+    map is committed and named in :attr:`MapRun.interrupt` (the exit status is the first signal's)."""
+    figures, provenance, n_resumed = outputs
+    interrupt = interrupt_name(stopped, interrupts) if isinstance(stopped, tuple(interrupts)) else ""
+    run = None
     try:
-        with signals_held() if incomplete else contextlib.nullcontext():
+        with signals_held():
+            close()
             points = store.read()
+            incomplete = None if stopped is None else _stopped(stopped, interrupt, len(points), spec.n_points)
             run = MapRun(spec, _dataset(spec, scene, points), (), len(points) - n_resumed, n_resumed,
-                         sum(p.status != "ok" for p in points.values()), incomplete, 0.0)
+                         sum(p.status != "ok" for p in points.values()), incomplete, 0.0, interrupt)
             _write(run, folder, figures, provenance)
             run = replace(run, files=tuple(folder.commit(incomplete)))
-    except tuple(interrupts):
-        if not (incomplete and folder.committed):
+    except tuple(interrupts) as exc:
+        if run is None or not folder.committed:
             raise
+        run = replace(run, interrupt=interrupt or interrupt_name(exc, interrupts))
     return run
+
+
+def _stopped(exc: BaseException, interrupt: str, done: int, total: int) -> str:
+    """Why a map stopped early: the signal, or the lost cluster (the first line of its error), and the points done."""
+    if interrupt:
+        cause = f"interrupted ({interrupt})"
+    else:
+        why = (str(exc).strip().splitlines() or [""])[0].rstrip(":")[:200]
+        cause = f"the Dask cluster was lost ({type(exc).__name__}: {why})"
+    return f"{cause} after {done} of {total} points; run the same command again to complete the map"
 
 
 def _close(client, scheduler: str | None) -> None:
