@@ -2,7 +2,7 @@
 run-ups, sizes before work, and inputs a command cannot honour. Each test first reproduced its example on main
 (named in its docstring) and passes now.
 
-Fault kinds tested here: :data:`FAULT_KINDS` (the README states their number)."""
+Fault kinds tested here: :data:`FAULT_KINDS` (25; the README states their number)."""
 
 from __future__ import annotations
 
@@ -12,6 +12,24 @@ from pathlib import Path
 import pytest
 
 from rotorred.cli import main
+
+#: the fault kinds these tests try, each at least once (the README states their number)
+FAULT_KINDS = (
+    # 1. a map resumed after a change: its scene's content, its rotor file's content, --cold, a --set
+    "resume: scene content", "resume: rotor content", "resume: --cold", "resume: --set",
+    # 3. sizes: 1e5 map points, 1e9 values (map --vary, run --set), --workers above the cores, continue's memory
+    # and monodromy steps
+    "size: 1e5 points", "size: 1e9 --vary", "size: 1e9 --set", "size: --workers", "size: --harmonics",
+    "size: --samples",
+    # 2. interrupts: SIGINT and SIGTERM at random moments of map, continue, run-up; a worker or the scheduler lost;
+    # an error raised from an interrupt
+    "SIGINT map", "SIGTERM map", "SIGINT continue", "SIGTERM continue", "SIGINT run-up", "SIGTERM run-up",
+    "Dask worker killed", "Dask scheduler killed", "interrupt inside an import",
+    # 4. inputs: [runup] in map and continue, --ratio against --set speeds, run-up and steady steps a revolution,
+    # run-up beyond the small-displacement range
+    "map [runup]", "continue [runup]", "--ratio with --set speeds", "run-up steps a revolution",
+    "steady steps a revolution", "run-up small displacement",
+)
 
 #: a short paper-rub map point: 0.4 s run, 0.2 s recorded, no figures or files of the scene
 SHORT = ["--set", "solver.duration=0.4", "--set", "solver.record_start=0.2", "--set", "output.plot_window=[0.2, 0.3]",
