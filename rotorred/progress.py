@@ -29,7 +29,7 @@ import sys
 import unicodedata
 from contextlib import contextmanager
 
-__all__ = ["LOG", "stage", "bar", "shown", "muted", "ascii_text", "ascii_fallback", "ASCII_FORMS"]
+__all__ = ["LOG", "stage", "bar", "shown", "muted", "interrupt_in", "ascii_text", "ascii_fallback", "ASCII_FORMS"]
 
 #: the package's logger: the parent of every module's logger
 LOG = logging.getLogger("rotorred")
@@ -91,6 +91,36 @@ def muted():
         yield
     finally:
         LOG.setLevel(level)
+
+
+def interrupt_in(exc: BaseException, kinds: tuple) -> BaseException | None:
+    """The interrupt (an exception of ``kinds``: SIGINT's ``KeyboardInterrupt``, a command's SIGTERM) that ``exc`` is or
+    was raised from, or None.
+
+    A signal's exception raised while a module is imported or a class is made comes back as another error, its cause
+    the interrupt: ``ImportError: initialization failed`` (an extension module's), ``RuntimeError: Error calling
+    __set_name__`` (matplotlib's classes). Long work that ends on an interrupt (a map, a branch, a run-up) ends on
+    those too.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception raised.
+    kinds : tuple of exception types
+        The interrupts.
+
+    Returns
+    -------
+    BaseException or None
+        The first interrupt in ``exc``'s chain of causes and contexts.
+    """
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, kinds):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
 
 
 def _terminal() -> bool:

@@ -10,18 +10,18 @@ against the key: stable solid, unstable dashed, folds and corners marked) and ``
 
 SIGINT or SIGTERM while the branch is traced or its stability computed ends it there and keeps every point traced:
 the files are written with them all (those without their stability marked "unknown", the folder INCOMPLETE, the
-summary saying which signal, where, how many points traced and with their stability), exit 130 or 143. They are
-written with the signals held back (a second signal does not cut them). Before the first point (the cold start), or
-while a complete branch is written, a signal leaves the earlier result, as in every command.
+summary saying which signal, where, how many points traced and with their stability), exit 130 or 143. The files
+(of an interrupted or a complete branch) are written with the signals held back: a signal then does not cut them, and
+is answered with exit 130 or 143 once they are written. Before the first point (the cold start), a signal leaves the
+earlier result, as in every command.
 """
 
 from __future__ import annotations
 
-import contextlib
-
 from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance
+from rotorred.cli.run import interruptible
 
 
 def add_parser(subparsers):
@@ -41,6 +41,8 @@ def add_parser(subparsers):
     p.add_argument("--tol", type=float, default=1e-9, help="relative residual of every point (default 1e-9)")
     p.add_argument("--no-stability", action="store_true", help="skip the Floquet multipliers (the slow part)")
     p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--force", action="store_true",
+                   help="go on with a branch beyond the size limits (steps, memory, model size; see the message)")
     return p
 
 
@@ -60,10 +62,10 @@ def _param(text: str) -> tuple[str, float, float]:
     return key.strip(), start, stop
 
 
+@interruptible
 def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
-    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
-    from rotorred.cli.run import _settings
+    from rotorred.cli.run import _settings, interrupted_status, interrupts as signals
     from rotorred import BranchOptions, build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
@@ -75,38 +77,46 @@ def run(args) -> int:
     tol = checks.positive("--tol", args.tol)
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
+    options = BranchOptions(H, N, tol, not args.no_stability)
+    options.estimate(scene).check(force=args.force)
     record = provenance(args, "scene", scene_toml(scene))  # with the base scene; --param in the command line
     model = build_model(scene).model
     report(f"branch of {scene.name} in {key} from {start:g} to {stop:g}: {H} harmonics, {N} samples a period")
-    interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
+    interrupts = signals()
     progress.stage("tracing the branch of %s in %s from %g to %g", scene.name, key, start, stop)
     with _Progress(key) as tracing:
-        branch = continue_scene(scene, model, key, start, stop, BranchOptions(H, N, tol, not args.no_stability),
+        branch = continue_scene(scene, model, key, start, stop, options,
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
-    for f in _write(branch, out, tuple(interrupts), record):
+    files, late = _write(branch, out, interrupts, record)
+    for f in files:
         report(f"wrote {f}")
     if branch.interrupted:
         error(f"{branch.stopped}; every point traced is written, the folder marked INCOMPLETE")
-        return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[branch.interrupt]
+        return interrupted_status(branch.interrupt)
+    if late:  # the signal came as the complete branch was written: it was written whole first
+        error(f"interrupted ({late}) as the complete branch was written; it is written whole")
+        return interrupted_status(late)
     return 0
 
 
-def _write(branch, out, interrupts: tuple, record=None) -> list:
-    """Stage and commit the branch's files into ``out``: those of an interrupted branch with SIGINT and SIGTERM held
-    back (``writers.signals_held``, as a commit is), so that a second signal does not cut the points the first
-    one kept; it is dropped once they are committed (the exit status is the first's). The files written."""
+def _write(branch, out, interrupts: dict, record=None) -> tuple[list, str]:
+    """Stage and commit the branch's files into ``out`` with SIGINT and SIGTERM held back (``writers.signals_held``,
+    as a commit is), so that a signal does not cut them (nor leave a file half made): the points an interrupt kept,
+    or a complete branch, are written whole. A signal that came meanwhile is dropped once they are committed. The
+    files written, and that signal ("SIGINT", "SIGTERM"; "" if none)."""
     from rotorred import write_branch, writers
 
-    folder, files = writers.OutputFolder(out), []
+    folder, files, late = writers.OutputFolder(out), [], ""
     try:
-        with writers.signals_held() if branch.interrupted else contextlib.nullcontext(), folder:
+        with writers.signals_held(), folder:
             write_branch(branch, folder, record)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
-    except interrupts:
-        if not (branch.interrupted and folder.committed):
+    except tuple(interrupts) as exc:
+        if not folder.committed:
             raise
-    return files
+        late = next(name for kind, name in interrupts.items() if isinstance(exc, kind))
+    return files, late
 
 
 class _Progress:

@@ -17,6 +17,7 @@ from __future__ import annotations
 from rotorred import checks
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
+from rotorred.cli.run import interruptible
 
 
 def add_parser(subparsers):
@@ -46,7 +47,8 @@ def add_parser(subparsers):
 
 
 def spec_of(args):
-    """The :class:`rotorred.maps.spec.MapSpec` of the options, every point's scene validated."""
+    """The :class:`rotorred.maps.spec.MapSpec` of the options (its size and points checked by
+    :func:`rotorred.maps.run.run_map`)."""
     from rotorred import Axis, MapSpec, parse_setting
 
     fixed = []
@@ -58,11 +60,28 @@ def spec_of(args):
         fixed.append((key, values[0]))
     axes = tuple(Axis(*_values(parse_setting(item, option="--vary"), item)) for item in args.vary)
     ratios = tuple(spool_ratios("--ratio", args.ratio, bound="> 0", example="inner=0.7778").items())
+    return MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
+
+
+def workers(args) -> int | None:
+    """The local workers of ``--workers`` (None: one per core; 0: serial): more than the machine's cores is warned
+    about and capped at them unless ``--force`` (each worker holds a point's model and record, and they would share
+    the cores); with ``--scheduler`` the scheduler's workers, None."""
+    import logging
+    import os
+
     if args.workers is not None:
         checks.integer("--workers", args.workers, ge=0)
-    spec = MapSpec(args.scene, axes, tuple(fixed), ratios, args.direction, args.cold, args.limit)
-    spec.check_size(force=args.force)
-    return spec
+    if args.scheduler:
+        return None
+    cores = os.cpu_count() or 1
+    if args.workers is None:
+        return cores
+    if args.workers > cores and not args.force:
+        logging.getLogger(__name__).warning("--workers = %d is more than the %d cores of this machine: "
+                                            "capped at %d (--force to start %d)", args.workers, cores, cores, args.workers)
+        return cores
+    return args.workers
 
 
 def base_scene_toml(spec) -> str:
@@ -85,26 +104,34 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
     return key, tuple(float(v) for v in values)
 
 
+@interruptible
 def run(args) -> int:
-    """Check everything, then run the map into ``--out`` (exit 3 when points failed, 130 when interrupted)."""
-    from rotorred.cli import EXIT_DIVERGED, EXIT_SIGINT
+    """Check everything, then run the map into ``--out`` (exit 3 when points failed or the Dask cluster was lost, 130
+    or 143 when SIGINT or SIGTERM ended it: the points done written, the folder marked INCOMPLETE)."""
+    from rotorred.cli import EXIT_DIVERGED
+    from rotorred.cli.run import interrupted_status, interrupts
     from rotorred import format_map, run_map
 
     out = out_dir("--out", args.out)
+    n_workers = workers(args)
     spec = spec_of(args)
     report(f"map of {spec.scene}: {' x '.join(f'{a.key} ({len(a.values)})' for a in spec.axes)}, "
            f"{'/'.join(spec.directions)}, {spec.n_points} points, "
            f"{'cold starts' if spec.cold else 'continuation along ' + spec.axes[0].key}")
     record = provenance(args, "scene", base_scene_toml(spec))
-    result = run_map(spec, out, workers=args.workers, scheduler=args.scheduler, provenance=record)
+    result = run_map(spec, out, workers=n_workers, scheduler=args.scheduler, provenance=record,
+                     force=args.force, interrupts=interrupts())
     report(format_map(result.dataset, spec))
     for f in result.files:
         report(f"wrote {f}")
     report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
            f"wall time {result.wall_time:.2f} s")
     if result.incomplete:
-        error(result.incomplete)
-        return EXIT_SIGINT
+        error(f"{result.incomplete}; the points done are written, the folder marked INCOMPLETE")
+        return interrupted_status(result.interrupt) if result.interrupt else EXIT_DIVERGED
+    if result.interrupt:  # the signal came as the complete map was written: it was written whole first
+        error(f"interrupted ({result.interrupt}) as the complete map was written; it is written whole")
+        return interrupted_status(result.interrupt)
     if result.n_failed:
         error(f"{result.n_failed} of {spec.n_points} points failed (named in map.csv and map.txt); the other "
               "points are kept")

@@ -16,6 +16,10 @@ Both write each point (:class:`rotorred.maps.store.PointStore`) as soon as it ha
 skip the points already on disk: a map that was interrupted resumes where it stopped, each
 resumed chain from its last finished point's final state. ``on_point`` is called after each
 point (the progress bar).
+
+A cluster lost under a map (:func:`is_lost`: a worker killed more often than Dask retries, a scheduler gone, or one
+without workers for :data:`NO_WORKER_WAIT` s) ends :func:`run_points` with that error; the points finished are on
+disk (:func:`rotorred.maps.run.run_map` writes them, marked INCOMPLETE).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from rotorred.maps.spec import Chain, MapSpec
 from rotorred.maps.store import PointStore
 from rotorred.scenes.run import SceneModel, build_model, model_key
 
-__all__ = ["run_points", "local_cluster", "connect"]
+__all__ = ["run_points", "local_cluster", "connect", "is_lost"]
 
 
 def _models(spec: MapSpec) -> dict:
@@ -111,8 +115,6 @@ def _run_serial(spec: MapSpec, store: PointStore, models: dict, done: dict, repo
 
 
 def _run_dask(spec: MapSpec, store: PointStore, client, models: dict, done: dict, report) -> dict:
-    from distributed import as_completed
-
     scattered = {key: client.scatter(m, broadcast=True) for key, m in models.items()}
     futures = {}
     for chain in spec.chains():
@@ -123,13 +125,45 @@ def _run_dask(spec: MapSpec, store: PointStore, client, models: dict, done: dict
             previous = client.submit(_point_task, scene, scattered[model_key(scene)], previous, spec.cold, spec.limit,
                                      pure=False)
             futures[previous] = (direction, index)
-    for future in as_completed(futures):
+    for future in _completed(client, futures):
         direction, index = futures[future]
         p = future.result()
         store.write(direction, index, p)
         done[(direction, index)] = p
         report(direction, index, p)
     return done
+
+
+#: how long a map waits for a worker when its scheduler has none (s): a killed worker without a nanny, or
+#: the last one gone, leaves the tasks waiting for ever
+NO_WORKER_WAIT = 60.0
+
+
+class NoWorkers(RuntimeError):
+    """The scheduler of a map has had no worker for :data:`NO_WORKER_WAIT` s."""
+
+
+def _completed(client, futures, poll: float = 2.0):
+    """The futures as they finish (any order); :class:`NoWorkers` when the scheduler has had no worker for
+    :data:`NO_WORKER_WAIT` s meanwhile."""
+    import time
+
+    from distributed import wait
+
+    pending, idle_since = set(futures), None
+    while pending:
+        try:
+            done = wait(pending, timeout=poll, return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            done = set()
+        pending -= done
+        yield from done
+        if done or client.scheduler_info()["workers"]:
+            idle_since = None
+        elif idle_since is None:
+            idle_since = time.monotonic()
+        elif time.monotonic() - idle_since > NO_WORKER_WAIT:
+            raise NoWorkers(f"its scheduler has had no worker for {NO_WORKER_WAIT:g} s")
 
 
 #: the periodic callbacks of the workers', nannies' and scheduler's event loops, slowed (local_cluster)
@@ -182,3 +216,28 @@ def connect(address: str, timeout: float = 10.0):
     except (OSError, TimeoutError) as exc:
         checks.fail("--scheduler", address, f"must be a reachable Dask scheduler address (tcp://host:port); "
                     f"none answered within {timeout:g} s ({type(exc).__name__})")
+
+
+def is_lost(exc: BaseException) -> bool:
+    """Whether ``exc`` says the Dask cluster under a map was lost, not that a point failed: a worker killed more often
+    than Dask retries a task (``KilledWorker``), a task cancelled as its scheduler went (``CancelledError``), a
+    connection to the scheduler closed or timed out (``CommClosedError``, ``TimeoutError``), a scheduler left without
+    workers (:class:`NoWorkers`).
+
+    Parameters
+    ----------
+    exc : BaseException
+        An exception raised while a map's points ran on Dask or its client closed.
+
+    Returns
+    -------
+    bool
+    """
+    from concurrent.futures import CancelledError
+
+    try:
+        from distributed.comm.core import CommClosedError
+        from distributed.scheduler import KilledWorker
+    except ImportError:  # no Dask: no cluster to lose
+        return False
+    return isinstance(exc, (KilledWorker, CancelledError, CommClosedError, TimeoutError, NoWorkers))

@@ -1,16 +1,25 @@
 """``run_map``: check a map, run its points (serially or on Dask), and write the dataset, tables and figures.
 
 Order of work
-    1. Check: every grid point's scene is loaded and validated (:meth:`MapSpec.scenes`), the
+    1. Check: the map's size at once from its first point, then every grid point's scene loaded, validated and
+       within the limits (:func:`rotorred.maps.store.check_map_size`; refused unless ``force``), the
        folder is locked (a second map into it is refused), and points already in
        ``folder/points`` of another map are refused. Nothing runs before this passes.
     2. Run the points not on disk (:func:`rotorred.maps.execute.run_points`), each written as
        it finishes, with a progress bar (points done, failures, ETA).
     3. Build the dataset from every point on disk and write ``map.nc``, ``map.csv``,
        ``map_lines.csv``, the figures and ``map.txt`` through a staged
-       :class:`rotorred.writers.OutputFolder`. When interrupted (Ctrl-C) or when a worker's
-       error stops the run, step 3 still runs on the points finished so far, the folder is
-       marked INCOMPLETE with the reason, and the same command later completes it.
+       :class:`rotorred.writers.OutputFolder`.
+
+Interrupts and lost clusters
+    An interrupt in step 2 (``interrupts``: SIGINT's ``KeyboardInterrupt`` and whatever the caller names, the
+    command line's SIGTERM), or a Dask cluster lost under it (a worker killed more often than Dask retries, a
+    scheduler that died or cannot be reached: :func:`rotorred.maps.execute.is_lost`), ends the run there: step 3
+    runs on the points finished so far with SIGINT and SIGTERM held back (:func:`rotorred.writers.signals_held`, a
+    second signal does not cut it), the folder is marked INCOMPLETE with the reason, :attr:`MapRun.interrupt` names
+    the signal, and the same command later completes the map. Step 3 of a complete map holds the signals back too (a
+    signal then is named in :attr:`MapRun.interrupt` once the map is written whole), so that no signal leaves points
+    without their dataset. A signal before step 2 (the checks, the model) leaves the folder's earlier result.
 """
 
 from __future__ import annotations
@@ -23,16 +32,17 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorred.maps.execute import connect, local_cluster, run_points
+from rotorred.maps.execute import connect, is_lost, local_cluster, run_points
 from rotorred.maps.spec import MapSpec
 from rotorred.scenes.keys import key_unit
-from rotorred.maps.store import PointStore, to_dataset, write_tables
+from rotorred.maps.store import PointStore, check_map_size, to_dataset, write_tables
 from rotorred.progress import bar as progress_bar
-from rotorred.progress import stage
+from rotorred.progress import interrupt_in, stage
 from rotorred.provenance import Provenance
 from rotorred.results import Result
 from rotorred.scenes.run import table_dof
-from rotorred.writers import OutputFolder, render_table, write_netcdf, write_text
+from rotorred.nonlinear.continuation import INTERRUPTS, interrupt_name
+from rotorred.writers import OutputFolder, render_table, signals_held, write_netcdf, write_text
 
 __all__ = ["MapRun", "run_map", "format_map"]
 
@@ -55,6 +65,9 @@ class MapRun(Result):
         Why the map stopped early (the folder is marked INCOMPLETE), or None.
     wall_time : float
         Time the run took (s).
+    interrupt : str
+        The signal that ended the map ("SIGINT", "SIGTERM": the caller's ``interrupts``; one that came as a complete
+        map was written is named too, the map complete), or "" (none; a lost cluster, if :attr:`incomplete`).
     """
 
     spec: MapSpec
@@ -65,6 +78,7 @@ class MapRun(Result):
     n_failed: int
     incomplete: str | None
     wall_time: float
+    interrupt: str = ""
 
     def summary(self) -> list[str]:
         """The map's scene, keys and sweeps, the points run, resumed and failed, the classes found, and whether it
@@ -143,7 +157,8 @@ def _client(workers: int | None, scheduler: str | None):
 
 
 def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, scheduler: str | None = None,
-            progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None) -> MapRun:
+            progress: bool | None = None, figures: bool = True, provenance: Provenance | None = None,
+            force: bool = False, interrupts=INTERRUPTS) -> MapRun:
     """Run a map into ``out`` (module docstring); resumable.
 
     Parameters
@@ -164,6 +179,11 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     provenance : rotorred.provenance.Provenance, optional
         What made the map (the command line's, with the base scene): written as ``scene.toml``, at the top of
         ``map.txt`` and as attributes of ``map.nc``.
+    force : bool
+        Go on with a map beyond the size limits (:mod:`rotorred.scenes.budget`).
+    interrupts : mapping of exception type to str
+        The exceptions that end the map where it is, its points kept (module docstring), and the signal each stands
+        for (default: SIGINT's ``KeyboardInterrupt``).
 
     Returns
     -------
@@ -172,10 +192,15 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
     Raises
     ------
     InputError
-        If a point's scene is invalid, or the folder holds points of another map, before any point runs.
+        If a point's scene is invalid, the map is beyond the size limits (without ``force``), or the folder holds
+        points of another map, before any point runs.
     """
+    import os
+
     t0 = time.perf_counter()
-    scenes = spec.scenes()  # 1. every point validated before anything runs
+    at_once = 1 if scheduler or workers == 0 else (workers or os.cpu_count() or 1)
+    check_map_size(spec, at_once, force)  # 1. the whole map at once, then every point, before anything runs
+    scenes = spec.scenes()
     out = Path(out)
     with OutputFolder(out) as folder:
         store = PointStore(out, spec)
@@ -184,30 +209,71 @@ def run_map(spec: MapSpec, out: str | Path, *, workers: int | None = None, sched
         stage("running %d of %d points (%d kept from an earlier run) %s", spec.n_points - n_resumed, spec.n_points,
               n_resumed, "in this process" if client is None else "on Dask")
         bar = _Progress(spec.n_points, n_resumed, progress)
-        incomplete = None
-        try:
-            points = run_points(spec, store, client, on_point=bar)
-        except KeyboardInterrupt:
-            incomplete = "interrupted (Ctrl-C); run the same command again to complete the map"
-        finally:
+
+        def close():
             bar.close()
             if client is not None:
                 _close(client, scheduler)
-        if incomplete is not None:
+        try:
+            run_points(spec, store, client, on_point=bar)
+            stopped = None
+        except tuple(interrupts) as exc:
+            stopped = exc
+        except Exception as exc:  # noqa: BLE001 -- an interrupt's error or a lost cluster; anything else is raised
+            stopped = interrupt_in(exc, tuple(interrupts))
+            if stopped is None and (client is None or not is_lost(exc)):
+                close()
+                raise
+            stopped = stopped or exc
+        run = _committed(spec, scenes[0], store, folder, (figures, provenance, n_resumed), stopped, interrupts, close)
+    return replace(run, wall_time=time.perf_counter() - t0)
+
+
+def _committed(spec, scene, store, folder, outputs: tuple, stopped, interrupts, close) -> MapRun:
+    """Close the progress bar and the cluster (``close``), build the map of every point on disk, write and commit it,
+    all with SIGINT and SIGTERM held back (a signal cannot leave the points without their dataset); INCOMPLETE when
+    ``stopped`` (an interrupt or a lost cluster) ended the run. A signal that came meanwhile is dropped once the
+    map is committed and named in :attr:`MapRun.interrupt` (the exit status is the first signal's)."""
+    figures, provenance, n_resumed = outputs
+    interrupt = interrupt_name(stopped, interrupts) if isinstance(stopped, tuple(interrupts)) else ""
+    run = None
+    try:
+        with signals_held():
+            close()
             points = store.read()
-        run = MapRun(spec, _dataset(spec, scenes[0], points), (), len(points) - n_resumed, n_resumed,
-                     sum(p.status != "ok" for p in points.values()), incomplete, 0.0)
-        _write(run, folder, figures, provenance)
-        files = tuple(folder.commit(incomplete))
-    return replace(run, files=files, wall_time=time.perf_counter() - t0)
+            incomplete = None if stopped is None else _stopped(stopped, interrupt, len(points), spec.n_points)
+            run = MapRun(spec, _dataset(spec, scene, points), (), len(points) - n_resumed, n_resumed,
+                         sum(p.status != "ok" for p in points.values()), incomplete, 0.0, interrupt)
+            _write(run, folder, figures, provenance)
+            run = replace(run, files=tuple(folder.commit(incomplete)))
+    except tuple(interrupts) as exc:
+        if run is None or not folder.committed:
+            raise
+        run = replace(run, interrupt=interrupt or interrupt_name(exc, interrupts))
+    return run
+
+
+def _stopped(exc: BaseException, interrupt: str, done: int, total: int) -> str:
+    """Why a map stopped early: the signal, or the lost cluster (the first line of its error), and the points done."""
+    if interrupt:
+        cause = f"interrupted ({interrupt})"
+    else:
+        why = (str(exc).strip().splitlines() or [""])[0].rstrip(":")[:200]
+        cause = f"the Dask cluster was lost ({type(exc).__name__}: {why})"
+    return f"{cause} after {done} of {total} points; run the same command again to complete the map"
 
 
 def _close(client, scheduler: str | None) -> None:
-    """Close the client, and the local cluster it started (not a cluster given by ``--scheduler``)."""
+    """Close the client, and the local cluster it started (not a cluster given by ``--scheduler``); a cluster
+    already lost is let go (its errors are not the map's)."""
     cluster = None if scheduler else client.cluster
-    client.close()
-    if cluster is not None:
-        cluster.close()
+    try:
+        client.close(timeout=10)
+        if cluster is not None:
+            cluster.close(timeout=10)
+    except Exception as exc:  # noqa: BLE001 -- closing what is left of a lost cluster
+        if not is_lost(exc):
+            raise
 
 
 def _dataset(spec: MapSpec, scene, points: dict):

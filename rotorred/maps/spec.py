@@ -13,6 +13,7 @@ scene's own message naming the key.
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -122,10 +123,14 @@ class MapSpec:
         key = self.axes[0].key
         if not key.startswith("speeds."):
             checks.fail("--ratio", dict(self.ratios), f"must go with a speeds.<spool> continuation axis, not {key!r}")
+        fixed = dict(self.settings)
         for spool, r in self.ratios:
             checks.positive(f"--ratio {spool}", r)
             if f"speeds.{spool}" == key or any(a.key == f"speeds.{spool}" for a in self.axes):
                 checks.fail("--ratio", spool, "must name a spool that --vary does not vary")
+            if f"speeds.{spool}" in fixed:
+                checks.fail("--ratio", f"{spool}={r:g}", f"conflicts with --set speeds.{spool}="
+                            f"{fixed[f'speeds.{spool}']!r}: both set the {spool} spool's speed; give one of them")
 
     # ------------------------------------------------------------------ grid
     @property
@@ -174,11 +179,17 @@ class MapSpec:
         Raises
         ------
         InputError
-            If the scene with the point's settings is invalid, naming the key.
+            If the scene with the point's settings is invalid, naming the key, or has a ``[runup]`` (a map runs
+            every point at steady speeds).
         """
         index = tuple(index)
         if index not in self._scenes:
-            self._scenes[index] = load_scene(self.scene, self.settings_at(index))
+            scene = load_scene(self.scene, self.settings_at(index))
+            if scene.runup is not None:
+                checks.fail("scene", self.scene, "has a [runup], which a map cannot honour (every point runs at steady "
+                            "speeds, --vary sets them): run the run-up with `rotorred run`, or map a scene without "
+                            "[runup]")
+            self._scenes[index] = scene
         return self._scenes[index]
 
     def scenes(self) -> list[Scene]:
@@ -186,8 +197,9 @@ class MapSpec:
         return [self.scene_at(ix) for ix in itertools.product(*(range(n) for n in self.shape))]
 
     def check_size(self, force: bool = False) -> None:
-        """Every point's scene validated and within the size limits (:mod:`rotorred.scenes.budget`), and the
-        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS``.
+        """Every point's scene validated and within the size limits of a run (:mod:`rotorred.scenes.budget`), and the
+        map's steps in all, each point run to ``limit`` s, at most ``budget.MAX_STEPS`` (a varied ``solver.dt`` or
+        duration). :func:`rotorred.maps.store.map_estimate` checks the whole map at once, from its first point.
 
         Parameters
         ----------
@@ -202,18 +214,59 @@ class MapSpec:
         """
         from rotorred.scenes import budget
 
-        total = 0
+        total, warned = 0, []
         for scene in self.scenes():
             if scene.solver.tolerance is not None:
                 checks.fail("solver.tolerance", scene.solver.tolerance, "is not available in maps yet (each point would "
                             "choose its own model and step): choose the settings with `rotorred run --set "
                             "solver.tolerance=...` at a representative point and give them to the map")
-            budget.scene_estimate(scene).check(force=force)
-            total += max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
+            warned += budget.scene_estimate(scene).check(force=force).warnings
+            total += self.steps_at(scene)
+        self.check_steps(total, force)
+        if warned:  # the first point's, and how many points have one
+            logging.getLogger(__name__).warning("%s%s", warned[0], f" (and at {len(warned) - 1} other points of the "
+                                                                   "map)" if len(warned) > 1 else "")
+
+    def check_steps(self, total: float, force: bool = False) -> None:
+        """Refuse ``total`` steps of the map beyond ``budget.MAX_STEPS`` (unless ``force``).
+
+        Parameters
+        ----------
+        total : float
+            The map's steps in all, every point and sweep.
+        force : bool
+            Let a map beyond the limit go on.
+
+        Raises
+        ------
+        InputError
+            Naming ``--vary``, the points, the steps and ``--force``.
+        """
+        from rotorred.scenes import budget
+
         if total > budget.MAX_STEPS and not force:
-            checks.fail("--vary", " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes),
+            checks.fail("--vary", self.described,
                         f"gives {total:.3g} steps in all (--limit {self.limit or 'the scene duration'}), more than "
                         f"{budget.MAX_STEPS:.3g}; use --force to go on")
+
+    def steps_at(self, scene: Scene) -> float:
+        """Steps of one grid point's ``scene`` in every sweep, each run to ``limit`` s.
+
+        Parameters
+        ----------
+        scene : Scene
+            A grid point's validated scene (:meth:`scene_at`).
+
+        Returns
+        -------
+        float
+        """
+        return max(self.limit or 0.0, scene.solver.duration) / scene.solver.dt * len(self.directions)
+
+    @property
+    def described(self) -> str:
+        """The varied keys and the points, as a message names them: ``rub.clearance=<11 values> (11 points)``."""
+        return " ".join(f"{a.key}=<{len(a.values)} values>" for a in self.axes) + f" ({self.n_points} points)"
 
     def chains(self) -> list[Chain]:
         """The chains along the continuation axis: one per direction and combination of the other axes."""

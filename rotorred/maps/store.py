@@ -3,8 +3,12 @@
 Layout of ``--out``
     ``points/<direction>/<i>_<j>....npz``: one file per finished point (written atomically by
     :func:`rotorred.writers.write_npz`, so a killed run leaves whole files only), with the
-    state the next point of its chain starts from. ``spec.json`` names the map the points belong
-    to: a run into a folder holding another map's points is refused, the same map resumes.
+    state the next point of its chain starts from. ``spec.json`` holds what defines every point, by content
+    (:meth:`PointStore.identity`): the resolved scene of the first grid point (every key, the rotor's tables
+    inline; not the scene's path), the varied keys and their values, the ratios, the start, the limit and the
+    rotorred version. The same map resumes (the same scene file moved, or with only its comments changed, too); a
+    run whose identity differs in anything is refused, naming what differs (the scene's keys with both values),
+    before any point runs: the folder keeps its points, and removing ``points/`` runs the map from the start.
     ``map.nc``, ``map.csv``, ``map_lines.csv`` and the figures are rebuilt from the points.
 
 Dataset (:func:`to_dataset`, xarray)
@@ -31,7 +35,7 @@ from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.transient.results import FinalState
 from rotorred.writers import write_csv, write_npz, write_text
 
-__all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS"]
+__all__ = ["PointStore", "to_dataset", "write_tables", "SCALARS", "point_bytes", "check_map_size"]
 
 #: the per-point scalars: name -> (dtype, missing value, units, long name). CF units: "1" for every dimensionless
 #: variable, counts and the string variables (status, reason, kind, start) included
@@ -95,6 +99,52 @@ def _point(arrays) -> PointResult:
                        peak_orbit=arrays["peak_orbit"], final=final)
 
 
+def point_bytes(n_nodes: int) -> int:
+    """Memory of one point in the map's dataset (bytes): its scalars, vectors and the peak orbit of ``n_nodes``
+    nodes, as :func:`to_dataset` holds them."""
+    scalars = sum(np.dtype(dtype).itemsize for dtype, *_ in SCALARS.values())
+    vectors = sum(n * np.dtype(dtype).itemsize for _, n, dtype, *_ in VECTORS.values())
+    return scalars + vectors + 8 * n_nodes
+
+
+def check_map_size(spec: MapSpec, workers: int = 1, force: bool = False) -> None:
+    """Refuse a map beyond the size limits of a run (:mod:`rotorred.scenes.budget`), unless ``force``: first at once,
+    from its first grid point's scene before any other is read (a grid of 1e5 points is answered at once), then point
+    by point (:meth:`MapSpec.check_size`).
+
+    At once: the first point's own estimate (naming its key), its steps times the grid points
+    (:meth:`MapSpec.check_steps`), and the memory of ``workers`` points' records and models at once and of the map's
+    dataset (:func:`point_bytes`, times 3: the dataset, its tables and NetCDF).
+
+    Parameters
+    ----------
+    spec : MapSpec
+        The map.
+    workers : int
+        Points run at once, >= 1.
+    force : bool
+        Let a map beyond the limits go on.
+
+    Raises
+    ------
+    InputError
+        Naming the key or ``--vary``, the estimate and ``--force``; or a point's scene is invalid.
+    """
+    import math
+
+    from rotorred.scenes import budget
+
+    scene = spec.scene_at((0,) * len(spec.axes))
+    one = budget.scene_estimate(scene).check(force=force)
+    spec.check_steps(math.prod(spec.shape) * spec.steps_at(scene), force)
+    at_once = max(1, min(int(workers), spec.n_points))
+    dataset = 3 * spec.n_points * point_bytes(len(scene.output.nodes))
+    fields = {"steps": ("--vary", spec.described), "memory": ("--vary", spec.described), "dofs": one.fields["dofs"]}
+    budget.Estimate(0, at_once * one.samples, at_once * one.record_bytes + dataset, one.n_dof,
+                    at_once * one.model_bytes, fields, "recorded samples at once and the map's dataset").check(force)
+    spec.check_size(force)
+
+
 class PointStore:
     """The finished points of one map in ``folder/points``: written as they finish, read back on resume."""
 
@@ -103,25 +153,37 @@ class PointStore:
         self.spec = spec
         self._check_spec()
 
-    def _identity(self) -> str:
+    def identity(self) -> dict:
+        """What defines every point of the map, by content (module docstring): ``scene`` (the resolved scene of the
+        first grid point, TOML text), ``axes``, ``ratios``, ``cold``, ``limit`` and ``rotorred`` (the version)."""
+        from rotorred.provenance import package_version
+        from rotorred.scenes.resolved import scene_toml
+
         s = self.spec
-        return json.dumps({"scene": s.scene, "axes": [[a.key, list(a.values)] for a in s.axes],
-                           "settings": [[k, repr(v)] for k, v in s.settings], "ratios": [list(r) for r in s.ratios],
-                           "cold": s.cold, "limit": s.limit}, sort_keys=True)
+        return {"scene": scene_toml(s.scene_at((0,) * len(s.axes))),
+                "axes": [[a.key, list(a.values)] for a in s.axes], "ratios": [list(r) for r in s.ratios],
+                "cold": s.cold, "limit": s.limit, "rotorred": package_version()}
 
     def _check_spec(self) -> None:
         from rotorred import checks
 
         path = self.root / "spec.json"
-        if path.exists() and path.read_text(encoding="utf-8") != self._identity():
-            checks.fail("--out", str(self.root.parent), "holds the points of a different map (points/spec.json); "
-                        "choose another --out or remove its points/ folder")
+        if not path.exists():
+            return
+        try:
+            kept = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError):
+            kept = None
+        differences = _differences(kept, self.identity())
+        if differences:
+            checks.fail("--out", str(self.root.parent), f"holds the points of a different map ({'; '.join(differences)}"
+                        f"); choose another --out, or remove {self.root} to run this map from the start")
 
     def write(self, direction: str, index: tuple[int, ...], point: PointResult) -> Path:
         """Write one finished point (atomically)."""
         path = self.root / _point_name(direction, index)
         if not (self.root / "spec.json").exists():
-            write_text(self.root / "spec.json", self._identity())
+            write_text(self.root / "spec.json", json.dumps(self.identity(), sort_keys=True, indent=1))
         return write_npz(path, _arrays(point))
 
     def read(self) -> dict:
@@ -133,6 +195,46 @@ class PointStore:
                 with np.load(path) as arrays:
                     out[(direction, index)] = _point(dict(arrays))
         return out
+
+
+#: what each field of a map's identity is, as a refusal names it
+_IDENTITY_NAMES = {"axes": "the varied keys or their values (--vary)", "ratios": "the speed ratios (--ratio)",
+                   "cold": "the start (--cold)", "limit": "the time limit (--limit)", "rotorred": "the rotorred version"}
+
+
+def _differences(kept, now: dict) -> list[str]:
+    """What differs between the identity of the points on disk (``kept``, parsed ``spec.json``) and ``now``: a
+    phrase per field, the scene's by its keys (at most 3, with both values)."""
+    if not isinstance(kept, dict) or set(kept) != set(now):
+        return ["points/spec.json is not one this rotorred version writes, so the points cannot be told to be of "
+                "this map"]
+    out = [f"{name}: {kept[field]!r} in the points, {now[field]!r} now" for field, name in _IDENTITY_NAMES.items()
+           if kept[field] != now[field]]
+    if kept["scene"] != now["scene"]:
+        out.insert(0, "the scene's content differs at " + _scene_differences(kept["scene"], now["scene"]))
+    return out
+
+
+def _scene_differences(kept: str, now: str, most: int = 3) -> str:
+    """The keys at which two resolved scenes (TOML text) differ, with both values: ``rub[0].mu_d (0.3 in the points,
+    0.2 now)``."""
+    from rotorred.checks import InputError
+    from rotorred.model.rotor_file import read_toml
+
+    def flat(value, path=""):
+        if isinstance(value, dict):
+            return {k: v for key, item in value.items() for k, v in flat(item, f"{path}.{key}" if path else key).items()}
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            return {k: v for i, item in enumerate(value) for k, v in flat(item, f"{path}[{i}]").items()}
+        return {path: value}
+
+    try:
+        a, b = flat(read_toml(kept)), flat(read_toml(now))
+    except InputError:
+        return "its text"
+    keys = [k for k in sorted(set(a) | set(b)) if a.get(k, "<none>") != b.get(k, "<none>")]
+    shown = [f"{k} ({a.get(k, '<none>')!r} in the points, {b.get(k, '<none>')!r} now)" for k in keys[:most]]
+    return ", ".join(shown) + (f" and {len(keys) - most} more keys" if len(keys) > most else "")
 
 
 def _padded(values, n: int, dtype: str, missing):

@@ -351,7 +351,7 @@ def dof_name(dof) -> str:
 
 def check_key(scene, key: str, start: float, end: float | None = None) -> None:
     """Refuse, before anything is computed, a key the branch cannot follow in ``scene`` (:data:`KEYS`), a scene
-    without a plate, speeds that are not commensurate at ``start`` (for a speed key) or now, and a plate's number the
+    without a plate or with a ``[runup]``, speeds that are not commensurate at ``start`` (for a speed key) or now, and a plate's number the
     plate refuses at ``start`` or ``end``.
 
     Parameters
@@ -372,6 +372,9 @@ def check_key(scene, key: str, start: float, end: float | None = None) -> None:
     """
     if not scene.plates:
         checks.fail("SCENE", scene.name, "must have a rub plate ([[rub]]): the branch is of the rub response")
+    if getattr(scene, "runup", None) is not None:
+        checks.fail("SCENE", scene.name, "has a [runup], which a branch cannot honour (its points are periodic "
+                    "responses at steady speeds): run the run-up with `rotorred run`, or follow a scene without [runup]")
     spools = tuple(scene.speeds)
     allowed = ("rub.clearance",) + tuple(f"speeds.{s}" for s in spools) + tuple(PLATE_KEYS)
     if key not in allowed:
@@ -456,6 +459,23 @@ class BranchOptions:
         checks.positive("tol", self.tol)
         checks.boolean("stability", self.stability)
         checks.integer("max_points", self.max_points, ge=2)
+
+    def estimate(self, scene):
+        """The work and memory of a branch of ``scene`` with these options
+        (:func:`rotorred.scenes.budget.branch_estimate`); check it with its ``check(force)``.
+
+        Parameters
+        ----------
+        scene : Scene
+            A validated scene with rub plates.
+
+        Returns
+        -------
+        rotorred.scenes.budget.Estimate
+        """
+        from rotorred.scenes.budget import branch_estimate
+
+        return branch_estimate(scene, self.harmonics, self.samples, self.max_points, self.stability)
 
 
 def continue_scene(scene, model, key: str, start: float, end: float, options: BranchOptions = BranchOptions(), *,

@@ -16,10 +16,15 @@ from dataclasses import dataclass
 
 from rotorred import checks
 
-__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "MAX_STEPS", "MAX_DOFS",
+__all__ = ["Estimate", "available_memory", "scene_estimate", "model_estimate", "branch_estimate",
+           "step_warnings", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS", "MAX_DOFS",
            "MEMORY_FRACTION", "format_bytes"]
 
 MAX_STEPS = 100_000_000
+#: fewest time steps a revolution of the fastest spool before a run is warned about: at 20 a period the average-
+#: acceleration Newmark step lengthens the period by (2 pi / 20)^2 / 12 = 0.8 %, and the
+#: unbalance forcing is sampled 20 times a turn; fewer resolve neither the 1x response nor the contact
+MIN_STEPS_PER_REVOLUTION = 20
 MAX_DOFS = 20_000
 MEMORY_FRACTION = 0.5
 #: bytes of one CSV value as written (9 significant digits, sign, exponent, separator)
@@ -67,6 +72,10 @@ class Estimate:
     fields : dict of str to (str, object)
         The key or option (and its value) a message names for each limit: ``"steps"``,
         ``"memory"``, ``"dofs"`` (e.g. ``("solver.duration", 1e6)``).
+    held : str
+        What :attr:`record_bytes` holds, as the message names it (default "recorded samples").
+    warnings : tuple of str
+        What makes the run's result doubtful though within the limits (:func:`step_warnings`), said before computing.
     """
 
     steps: int
@@ -75,11 +84,13 @@ class Estimate:
     n_dof: int
     model_bytes: int
     fields: dict
+    held: str = "recorded samples"
+    warnings: tuple = ()
 
     def describe(self) -> str:
         """One line: the steps, the recorded samples and their memory, the model's DOFs and its matrices' memory."""
         parts = [f"{self.steps:.3g} steps" if self.steps else "",
-                 f"{self.samples:.3g} recorded samples ({format_bytes(self.record_bytes)})" if self.samples else "",
+                 f"{self.samples:.3g} {self.held} ({format_bytes(self.record_bytes)})" if self.samples else "",
                  f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
         return "estimate: " + ", ".join(p for p in parts if p)
 
@@ -173,4 +184,76 @@ def scene_estimate(scene) -> Estimate:
     model = ("rotor", scene.rotor_source)
     fields = {"steps": ("solver.duration", s.duration), "dofs": model,
               "memory": ("solver.record_start", s.record_start) if record >= model_bytes else model}
-    return Estimate(steps, samples, record, n_dof, model_bytes, fields)
+    return Estimate(steps, samples, record, n_dof, model_bytes, fields, warnings=tuple(step_warnings(scene)))
+
+
+def branch_estimate(scene, harmonics: int, samples: int, max_points: int, stability: bool) -> Estimate:
+    """Work and memory of a branch by harmonic balance (``rotorred continue``), at most ``max_points`` points.
+
+    Each point solves for the plates' unknowns (4 a plate: its disk's x, y and the plate's u_n, u_t) in
+    ``2 harmonics + 1`` coefficients each, with dense Jacobians of that size and ``samples`` AFT samples of every
+    unknown; its stability integrates the monodromy matrix of the whole linearised system (at most the full model's
+    DOFs and the plates', a dense state matrix of twice that) over ``samples`` x 4 substeps, counted as steps.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene with rub plates.
+    harmonics, samples, max_points : int
+        Harmonics H, AFT samples N a period and the most points of the branch.
+    stability : bool
+        Whether each point's multipliers are computed.
+
+    Returns
+    -------
+    Estimate
+        Its fields name ``--samples`` (steps), ``--harmonics`` (memory) and the rotor (DOFs).
+    """
+    n_dof, model_bytes = model_estimate(scene.rotor)
+    unknowns = 4 * len(scene.plates) * (2 * harmonics + 1)
+    state = 2 * (n_dof + 2 * len(scene.plates))
+    steps = max_points * samples * 4 if stability else 0
+    held = 8 * (4 * unknowns ** 2 + 4 * samples * 4 * len(scene.plates) + max_points * unknowns
+                + (4 * state ** 2 if stability else 0))
+    fields = {"steps": ("--samples", samples), "memory": ("--harmonics", harmonics), "dofs": ("rotor", scene.rotor_source)}
+    return Estimate(steps, max_points * unknowns, held, n_dof, model_bytes, fields, "unknowns of the branch")
+
+
+def step_warnings(scene) -> list[str]:
+    """A warning when ``solver.dt`` gives fewer than :data:`MIN_STEPS_PER_REVOLUTION` steps a revolution of the
+    fastest spool at its highest speed (a run-up: over its profile; a steady run: at its speeds); else none.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene (steady or with ``[runup]``).
+
+    Returns
+    -------
+    list of str
+        At most one warning, naming ``solver.dt``, the spool, its speed (Hz) and the steps a revolution.
+    """
+    import math
+
+    import numpy as np
+
+    runup = getattr(scene, "runup", None)
+    if runup is not None:
+        times = np.linspace(0.0, scene.solver.duration, 2001)
+        speeds = {}
+        for t in times:
+            for spool, w in runup.profile.speeds_at(float(t)).items():
+                speeds[spool] = max(speeds.get(spool, 0.0), abs(w))
+    else:
+        speeds = {spool: abs(w) for spool, w in scene.speeds.items()}
+    if not speeds or max(speeds.values()) <= 0:
+        return []
+    spool = max(speeds, key=speeds.get)
+    f = speeds[spool] / (2 * math.pi)
+    steps = 1.0 / (f * scene.solver.dt)
+    if steps >= MIN_STEPS_PER_REVOLUTION:
+        return []
+    return [f"solver.dt = {scene.solver.dt:g} s gives {steps:.3g} steps a revolution of the {spool} spool at "
+            f"{f:.6g} Hz{' (its highest in the run-up)' if runup is not None else ''}, fewer than "
+            f"{MIN_STEPS_PER_REVOLUTION}: the response is not resolved (give solver.dt <= "
+            f"{1.0 / (MIN_STEPS_PER_REVOLUTION * f):.3g} s)"]

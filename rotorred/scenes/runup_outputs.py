@@ -15,6 +15,7 @@ import numpy as np
 from rotorred.progress import stage
 from rotorred.provenance import Provenance
 from rotorred.scenes.runup import RUB_GAP_REVS, RunupResult
+from rotorred.scenes.summary import range_warnings
 from rotorred.writers import render_table, write_csv, write_mat, write_npz, write_text
 
 __all__ = ["write_runup_outputs", "format_runup_summary", "runup_arrays"]
@@ -166,6 +167,9 @@ def format_runup_summary(result: RunupResult, files=()) -> str:
             rows.append([str(node), f"{1e6 * radius[k]:.2f}", f"{speed[k] * HZ:.2f}", f"{60 * speed[k] * HZ:.0f}"])
         lines += ["", f"largest orbit radius against {ref} speed:",
                   render_table(["node", "radius (um)", f"at {ref} (Hz)", "(rpm)"], rows)]
+    warned = range_warnings(result)  # as a steady run's summary
+    if warned:
+        lines += ["", warned]
     if result.tracks:
         rows = []
         for track, dof in zip(result.tracks, result.track_dofs):

@@ -395,6 +395,8 @@ def scene_from_dict(data: dict, source: str = "<string>", base: Path | None = No
 
 
 # --------------------------------------------------------------------------- settings (--set)
+#: most values of one START:STOP:N setting (a map of them is refused by its size estimate long before)
+MAX_VALUES = 1_000_000
 _SET_FORM = "must be KEY=VALUES (e.g. rub.clearance=10e-6,20e-6) or KEY=START:STOP:N"
 
 
@@ -437,6 +439,8 @@ def parse_setting(text: str, option: str = "--set") -> tuple[str, list]:
             n = None
         if n is None or n < 2:
             fail(f"{option} {key}", rhs, "must be START:STOP:N with numbers START, STOP and an integer N >= 2")
+        if n > MAX_VALUES:  # refused before a list of n numbers is made (1e9 of them: a MemoryError)
+            fail(f"{option} {key}", rhs, f"must have N <= {MAX_VALUES:g} values")
         return key, [a + (b - a) * i / (n - 1) for i in range(n)]
     return key, [_toml_value(v.strip(), key) for v in _split_top(rhs) if v.strip()]
 

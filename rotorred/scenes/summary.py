@@ -43,7 +43,7 @@ def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
     str
         Blocks separated by blank lines; peaks in µm, speeds in rpm and Hz, line frequencies in Hz.
     """
-    parts = [_incomplete(result), _setup(result), _peaks(result), _range_warnings(result),
+    parts = [_incomplete(result), _setup(result), _peaks(result), range_warnings(result),
              _contacts(result), _lines(result) if result.spectra else "", _line_fit(result)]
     if files:
         parts.append("\n".join(f"wrote {f}" for f in files))
@@ -70,8 +70,9 @@ def small_displacement_limit(scene) -> float:
     return SMALL_DISPLACEMENT_FRACTION * (max(radii) if radii else DEFAULT_RADIUS)
 
 
-def _range_warnings(result: SceneResult) -> str:
-    """A warning per node whose orbit (or translation) leaves the small-displacement range."""
+def range_warnings(result) -> str:
+    """A warning per node whose orbit (or translation) leaves the small-displacement range (a steady run's or a
+    run-up's ``result``: its ``scene`` and ``outputs``)."""
     limit = small_displacement_limit(result.scene)
     lines = []
     for node in dict.fromkeys(d[0] for d in result.scene.output.dofs):

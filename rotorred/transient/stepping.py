@@ -4,6 +4,7 @@ plan and buffers, loading the kernel, the progress bar and the packaging of the 
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import time
@@ -23,6 +24,7 @@ from rotorred.model.speeds import SpeedProfile
 from rotorred.transient.contact_solve import C_PASSES
 from rotorred.transient.matrices import ForceColumns, disk_radii
 from rotorred.transient.options import Initial, Loads, Recording, Scheme, StepControl, within
+from rotorred.writers import signals_held
 from rotorred.transient.results import (FinalState, SimulationDiverged, TransientResult, contact_histories,
                                         failure)
 
@@ -289,7 +291,10 @@ def load_kernel(args: tuple, dispatcher=None) -> tuple[float, bool]:
     it), or load it from numba's on-disk cache, before the timed loop.
 
     A compilation is announced by a stage line (:data:`COMPILING_NOTE`, :func:`rotorred.progress.stage`), so
-    neither the wait nor the µs per step of the first run after an install hide it.
+    neither the wait nor the µs per step of the first run after an install hide it. A load from the cache holds
+    SIGINT and SIGTERM back (:func:`rotorred.writers.signals_held`, a fraction of a second): a signal inside it came
+    back through llvmlite's ctypes callbacks, where Python ignores it, or crashed the interpreter at exit; a
+    compilation (tens of seconds, once per install) is left interruptible.
 
     Returns
     -------
@@ -311,7 +316,8 @@ def load_kernel(args: tuple, dispatcher=None) -> tuple[float, bool]:
     else:
         LOG.debug("loading the step kernel %s from numba's cache", dispatcher.__name__)
     misses = _misses(dispatcher)
-    dispatcher.compile(sig)
+    with contextlib.nullcontext() if expected else signals_held():  # a load cut by a signal leaves llvmlite's
+        dispatcher.compile(sig)  # objects half made: Python ignored the interrupt, or crashed at exit (issue 41)
     compiled = expected if misses is None else _misses(dispatcher) > misses
     if compiled and not expected:
         stage("compiled the step kernel: its cache entry could not be loaded", logger=LOG)
