@@ -462,3 +462,10 @@ def test_an_error_raised_from_an_interrupt_is_the_interrupt():
         interruptible(importing)(None)
     with pytest.raises(ValueError):
         interruptible(lambda args: int("x"))(None)
+
+
+def test_the_readme_states_the_number_of_fault_kinds():
+    """The README's sentence on the faults tested gives the number of FAULT_KINDS, each named once."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    assert len(set(FAULT_KINDS)) == len(FAULT_KINDS)
+    assert f"`tests/test_faults.py` tries\n{len(FAULT_KINDS)} kinds of fault" in text

@@ -83,7 +83,21 @@ def _rpm(x) -> np.ndarray:
 
 
 def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
-    """Every task on one mesh and form, in this process."""
+    """Every task on one mesh and form, in this process; the dense rows solve dense at every size, and the size at
+    which analyses solve sparse is restored after (a test runs this in the test process)."""
+    from rotorred.model import sparse
+
+    solve_from = sparse.SOLVE_SPARSE_FROM
+    try:
+        if not as_sparse:
+            sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §24)
+        return _tasks(refine, as_sparse, rub)
+    finally:
+        sparse.SOLVE_SPARSE_FROM = solve_from
+
+
+def _tasks(refine: int, as_sparse: bool, rub: bool) -> dict:
+    """Every task on one mesh and form (:func:`worker`)."""
     import resource
 
     import rotorred as rr
@@ -92,10 +106,6 @@ def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
     from rotorred.model.assembly import assemble
     from rotorred.model.loads import Unbalance
 
-    from rotorred.model import sparse
-
-    if not as_sparse:
-        sparse.SOLVE_SPARSE_FROM = 10**9  # the dense rows solve dense at every size (docs/model.md §24)
     rotor = rr.load_rotor("seed-rig").refined(refine)
     warm = assemble(rr.load_rotor("seed-rig"), as_sparse=as_sparse)  # first calls load modules: not timed
     modes_at(warm, rr.Operating.line(_rpm([0.0, TOP_RPM])).lines(warm), 100.0, 12)
