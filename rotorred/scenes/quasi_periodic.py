@@ -282,21 +282,16 @@ def torus_balance(model, operating: Operating, loads: Loads, contacts: Sequence[
     for k, dof in enumerate(outputs):
         system.full_dofs.checked_outputs([dof], f"options.outputs[{k}]")
     turning = sorted(w / (2 * math.pi) for w in speeds.values() if w > 0)
-    if options.bases is not None:
-        try:  # every check of the problem before the transient runs
-            torus_rub_problem(scene, system, options.bases, *options.orders, *options.n_grid, options.f_max)
-        except InputError as exc:
-            if exc.field != "torus":
-                raise
-            checks.fail("options.bases", options.bases, exc.requirement, exc.unit)
-    elif options.start_window is None or len(turning) != 2:
+    if options.bases is None and (options.start_window is None or len(turning) != 2):
         checks.fail("options.bases", None, "must be given where they cannot be found in a transient (a start window "
                     f"and exactly two turning spools; here {len(turning)} turning"
                     + (", no start window)" if options.start_window is None else ")"), "Hz")
+    # bases given: the problem, with every check of it, before the transient runs
+    rp = None if options.bases is None else _problem(scene, system, options.bases, options)
     t0 = time.perf_counter()
     record = None if options.start_window is None else _start_record(scene, system, operating, options)
-    bases = options.bases or _found_bases(record, plates[0].node, turning)
-    rp = torus_rub_problem(scene, system, bases, *options.orders, *options.n_grid, options.f_max)
+    if rp is None:
+        rp = _problem(scene, system, _found_bases(record, plates[0].node, turning), options)
     if record is None:
         z0, start = rp.problem.linear_response(), FROM_LINEAR
     else:
@@ -308,6 +303,17 @@ def torus_balance(model, operating: Operating, loads: Loads, contacts: Sequence[
         start = FROM_RECORD
     solution = solve_torus(rp.problem, z0, tol=options.tol)
     return RubTorus(rp, solution, start, outputs, operating, dict(speeds), time.perf_counter() - t0)
+
+
+def _problem(scene, system, bases, options: TorusOptions) -> TorusRubProblem:
+    """The torus problem on ``bases`` (Hz) with the options' orders, grid and band; a spool frequency that is no
+    order of the bases is refused as ``options.bases``."""
+    try:
+        return torus_rub_problem(scene, system, bases, *options.orders, *options.n_grid, options.f_max)
+    except InputError as exc:
+        if exc.field != "torus":
+            raise
+        checks.fail("options.bases", bases, exc.requirement, exc.unit)
 
 
 def _start_record(scene, system, operating: Operating, options: TorusOptions):

@@ -568,10 +568,10 @@ def _inline_rotor(tables: dict) -> Rotor:
         raise exc.within("rotor") from None
 
 
-def _operating(value, rotor: Rotor) -> Operating:
+def _operating(value, rotor: Rotor) -> tuple[Operating, dict[str, float]]:
     """``[speeds]`` (Hz) as an operating point (:meth:`Operating.point`: the spools given at their speeds, the first
     the reference, a spool left out following it at the rotor's nominal ratio); none given: the rotor's nominal
-    speeds. At least one spool must turn."""
+    speeds. At least one spool must turn. Returns the point and every spool's speed there (rad/s)."""
     spools = [s.name for s in rotor.spools]
     table = {} if value is None else checks.table("speeds", value)
     checks.keys("speeds", table, spools)
@@ -587,7 +587,7 @@ def _operating(value, rotor: Rotor) -> Operating:
         shown = {s: w / (2 * math.pi) for s, w in speeds.items()} if value is None else value
         fail("speeds", shown, f"must give at least one spool of {', '.join(speeds)} a speed > 0"
              + ("; the rotor's nominal speeds are all 0" if value is None else ""), "Hz")
-    return operating
+    return operating, speeds
 
 
 def _runup(value, rotor: Rotor, speeds: dict[str, float]) -> RunupSpec | None:
@@ -839,8 +839,7 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
     name = checks.string("name", data.get("name", Path(source).stem if base is not None else source))
     description = checks.string("description", data.get("description", ""))
     rotor, rotor_source, rotor_data = _rotor(data["rotor"], base, source)
-    operating = _operating(data.get("speeds"), rotor)
-    speeds = operating.single(rotor, "speeds")
+    operating, speeds = _operating(data.get("speeds"), rotor)
     unbalances = _unbalances(data.get("unbalance", []), rotor)
     plates = _plates(data.get("rub", []), rotor)
     runup = _runup(data.get("runup"), rotor, speeds)
