@@ -423,7 +423,7 @@ class CampbellResult(Result):
 
     @property
     def damping_ratio(self) -> np.ndarray:
-        """Damping ratio zeta = -Re(lambda) / |lambda| = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
+        """Damping ratio zeta = -Re(lambda)/abs(lambda) = delta / sqrt(delta^2 + 4 pi^2), shape (n_speeds, n_modes)."""
         return self.log_dec / np.sqrt(self.log_dec ** 2 + 4.0 * np.pi ** 2)
 
     def summary(self) -> list[str]:
@@ -638,9 +638,9 @@ def whirl_direction(modes: np.ndarray, x_rows: np.ndarray, y_rows: np.ndarray) -
     Returns
     -------
     list of str, length k
-        ``"forward"`` if the nodes whirling forward (|X + iY| > |X - iY|) carry all but at most 1 % of
+        ``"forward"`` if the nodes whirling forward (``|X + iY|`` > ``|X - iY|``) carry all but at most 1 % of
         the mode's orbit size sum_n (|X_n|^2 + |Y_n|^2), ``"backward"`` likewise, ``"mixed"`` otherwise,
-        ``"planar"`` if every orbit is a straight line (|X + iY| = |X - iY|).
+        ``"planar"`` if every orbit is a straight line (``|X + iY|`` = ``|X - iY|``).
     """
     X, Y = _take(x_rows, modes), _take(y_rows, modes)
     f2, b2 = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2

@@ -97,7 +97,7 @@ class UnbalanceResponse(Result):
         return tuple(self.phasors)
 
     def amplitude(self, output: Output, spool: str) -> np.ndarray:
-        """|Q| (m) of ``output`` at ``spool``'s frequency, shape (n,).
+        """``|Q|`` (m) of ``output`` at ``spool``'s frequency, shape (n,).
 
         Parameters
         ----------
@@ -247,7 +247,7 @@ class UnbalanceResponse(Result):
 
         Dimensions ``speed`` (coordinate: the reference spool's speed, rad/s), ``spool``, ``excited_spool``
         (spools carrying an unbalance) and ``output`` (labels ``"13:x"``, with coordinates ``node`` and
-        ``direction``). Variables ``spool_speed`` (spool, speed) in rad/s, ``amplitude`` |Q| (m) and ``phase``
+        ``direction``). Variables ``spool_speed`` (spool, speed) in rad/s, ``amplitude`` ``|Q|`` (m) and ``phase``
         arg Q (rad) (excited_spool, speed, output), and ``peak_bound`` (speed, output) in m (:meth:`peak`).
         """
         import xarray as xr
@@ -311,7 +311,7 @@ class FrequencyResponse(Result):
         return self.H[:, self.outputs.index(tuple(output)), self.inputs.index(tuple(input))]
 
     def write_csv(self, path: str | Path) -> Path:
-        """Write |H| (m/N) and phase (deg) of every pair against frequency (Hz).
+        """Write ``|H|`` (m/N) and phase (deg) of every pair against frequency (Hz).
 
         Parameters
         ----------
@@ -333,7 +333,7 @@ class FrequencyResponse(Result):
         return writers.write_csv(path, header, cols, digits=CSV_DIGITS)
 
     def summary(self) -> list[str]:
-        """The sweep, the spool speeds, and the largest |H| of each pair."""
+        """The sweep, the spool speeds, and the largest ``|H|`` of each pair."""
         f = self.frequencies / (2 * math.pi)
         lines = [f"receptance of {len(self.outputs)} output(s) x {len(self.inputs)} input(s) at {len(f)} frequencies, "
                  f"{f.min():.4g}-{f.max():.4g} Hz",
@@ -349,8 +349,8 @@ class FrequencyResponse(Result):
         return lines
 
     def plot(self, ax=None, **options):
-        """Bode plot of every pair, |H| (m/N, log) above the phase (deg) against frequency (Hz)
-        (:func:`rotorred.plots.harmonic.draw_frf`; into a given ``ax``, |H| only).
+        """Bode plot of every pair, ``|H|`` (m/N, log) above the phase (deg) against frequency (Hz)
+        (:func:`rotorred.plots.harmonic.draw_frf`; into a given ``ax``, ``|H|`` only).
 
         Parameters
         ----------
@@ -370,7 +370,7 @@ class FrequencyResponse(Result):
     def to_xarray(self):
         """The FRFs as an :class:`xarray.Dataset`: dimensions ``frequency`` (coordinate in Hz), ``output`` and
         ``input`` (labels ``"13:x"``, with ``*_node`` and ``*_direction``), ``spool``; variables ``amplitude``
-        |H| (m/N) and ``phase`` arg H (rad) (frequency, output, input), and ``spool_speed`` (spool) in rad/s."""
+        ``|H|`` (m/N) and ``phase`` arg H (rad) (frequency, output, input), and ``spool_speed`` (spool) in rad/s."""
         import xarray as xr
 
         dims = ("frequency", "output", "input")
@@ -443,7 +443,7 @@ class SteadyState(Result):
         With ``model=`` and ``node=``, the node's orbit (µm) over a few revolutions, its start q(0) marked:
         what a rotordynamics engineer checks of a steady state (its size and shape, the rosette of two spools,
         the initial condition a transient starts from). By default, without a model (the result holds only
-        model coordinates): the amplitude |Q| of every model coordinate per excited spool.
+        model coordinates): the amplitude ``|Q|`` of every model coordinate per excited spool.
 
         Parameters
         ----------
@@ -462,7 +462,7 @@ class SteadyState(Result):
 
     def to_xarray(self):
         """The phasors as an :class:`xarray.Dataset`: dimensions ``coordinate`` (index of the model's coordinate),
-        ``excited_spool`` and ``spool``; variables ``amplitude`` |Q| and ``phase`` arg Q (rad) (excited_spool,
+        ``excited_spool`` and ``spool``; variables ``amplitude`` ``|Q|`` and ``phase`` arg Q (rad) (excited_spool,
         coordinate), and ``spool_speed`` (spool) in rad/s. The amplitudes have the units of the model's
         coordinates, m and rad for a full model (its DOF order), those of the recovery map for a reduced one:
         the ``units`` attribute says "1" and ``comment`` says so."""

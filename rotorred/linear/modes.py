@@ -116,12 +116,12 @@ class ModeShapes(Result):
 
     @property
     def forward_radius(self) -> np.ndarray:
-        """|X + iY| / 2: radius of each node orbit's forward circle (-), shape (n_modes, n_nodes)."""
+        """``|X + iY|`` / 2: radius of each node orbit's forward circle (-), shape (n_modes, n_nodes)."""
         return np.abs(self.X + 1j * self.Y) / 2.0
 
     @property
     def backward_radius(self) -> np.ndarray:
-        """|X - iY| / 2: radius of each node orbit's backward circle (-), shape (n_modes, n_nodes)."""
+        """``|X - iY|`` / 2: radius of each node orbit's backward circle (-), shape (n_modes, n_nodes)."""
         return np.abs(self.X - 1j * self.Y) / 2.0
 
     @property

@@ -141,7 +141,7 @@ class Branch(Result):
         return np.array([to_phasors(zi.reshape(-1, self.n)) for zi in self.z])
 
     def amplitude(self, dof: int, order: int = 1) -> np.ndarray:
-        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (|a_0| for 0) of the unknown ``dof`` at each point.
+        """The amplitude sqrt(a^2 + b^2) of harmonic ``order`` (``|a_0|`` for 0) of the unknown ``dof`` at each point.
 
         Parameters
         ----------

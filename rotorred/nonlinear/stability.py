@@ -62,7 +62,7 @@ class Floquet:
 
     @property
     def stable(self) -> bool:
-        """Every multiplier inside the unit circle (by a margin of 1e-9 in |mu| over a period)."""
+        """Every multiplier inside the unit circle (by a margin of 1e-9 in ``|mu|`` over a period)."""
         return self.max_real * self.period < -1e-9
 
 

@@ -181,7 +181,7 @@ class SceneBranch(Result):
     dofs : tuple of (int, str)
         The output DOFs (the scene's).
     peaks : ndarray, shape (p, len(dofs))
-        Largest |q(t)| over the period of each output DOF (m).
+        Largest ``|q(t)|`` over the period of each output DOF (m).
     z : ndarray, shape (p, (2H + 1) m)
         Each point's solution: the Fourier coefficients of the unknowns (:class:`RubProblem`; its ``final_state``
         starts a transient on it).

@@ -178,7 +178,7 @@ class SceneResult(Result):
         return self.analyses.get(table_dof(self.scene))
 
     def peak(self, dof) -> float:
-        """Largest |displacement| of ``dof`` in the window; 0 for an empty (diverged) record.
+        """Largest ``|displacement|`` of ``dof`` in the window; 0 for an empty (diverged) record.
 
         Parameters
         ----------

@@ -80,7 +80,7 @@ class EnergyBalance(Result):
 
     @property
     def relative_residual(self) -> float:
-        """Largest |residual| over the largest of |W_drive|, W_damping and |E - E0| (-)."""
+        """Largest ``|residual|`` over the largest of ``|W_drive|``, W_damping and ``|E - E0|`` (-)."""
         scale = max(np.max(np.abs(self.drive)), np.max(np.abs(self.damping)), np.max(np.abs(self.energy)))
         return float(np.max(np.abs(self.residual)) / scale) if scale > 0 else 0.0
 
