@@ -25,6 +25,7 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(DOCS / "sphinxext"))  # rotorred_figures: the gallery's scraper of rotorred's figures
 
 os.environ.setdefault("MPLBACKEND", "agg")
 # one thread for BLAS and numba in the executed scripts, as the commands run (2 cores: the build runs alone)
@@ -104,10 +105,10 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "show_signature": False,
     "remove_config_comments": True,
-    "min_reported_time": 1,
+    "min_reported_time": 0,  # every page says how long its script ran (tests/e2e/test_site.py reads it)
     "capture_repr": ("_repr_html_", "__repr__"),
     "matplotlib_animations": False,
-    "image_scrapers": ("matplotlib",),
+    "image_scrapers": ("rotorred_figures.scrape", "matplotlib"),  # result.plot() figures, then pyplot's
     "reset_modules": ("matplotlib",),
     "within_subsection_order": "FileNameSortKey",
 }
