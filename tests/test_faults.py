@@ -2,7 +2,7 @@
 run-ups, sizes before work, and inputs a command cannot honour. Each test first reproduced its example on main
 (named in its docstring) and passes now.
 
-Fault kinds tested here: :data:`FAULT_KINDS` (25; the README states their number)."""
+Fault kinds tested here: :data:`FAULT_KINDS` (25; docs/commands.md states their number)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 
 from rotorred.cli import main
 
-#: the fault kinds these tests try, each at least once (the README states their number)
+#: the fault kinds these tests try, each at least once (docs/commands.md states their number)
 FAULT_KINDS = (
     # 1. a map resumed after a change: its scene's content, its rotor file's content, --cold, a --set
     "resume: scene content", "resume: rotor content", "resume: --cold", "resume: --set",
@@ -465,7 +465,7 @@ def test_an_error_raised_from_an_interrupt_is_the_interrupt():
 
 
 def test_the_readme_states_the_number_of_fault_kinds():
-    """The README's sentence on the faults tested gives the number of FAULT_KINDS, each named once."""
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    """docs/commands.md's sentence on the faults tested gives the number of FAULT_KINDS, each named once."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "commands.md").read_text(encoding="utf-8")
     assert len(set(FAULT_KINDS)) == len(FAULT_KINDS)
     assert f"`tests/test_faults.py` tries\n{len(FAULT_KINDS)} kinds of fault" in text

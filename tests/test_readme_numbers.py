@@ -1,14 +1,17 @@
-"""Numbers stated in README.md that no other test asserts, asserted here (fast: a few seconds in all).
+"""Numbers stated in README.md and on the site's pages (docs/) that no other test asserts, asserted here (fast: a few
+seconds in all). The README's Validation, Performance, Commands and Rotor-file sections moved to the site
+(docs/validation.md, docs/benchmarks.md, docs/commands.md, docs/rotor-files.md, docs/python.md) with their numbers;
+each test names the page that states its numbers now.
 
-Project rule: every number in the README is asserted by a test or printed by a validation script the README
-names beside it. Timings are never asserted here (the scripts print them). Sources of each number:
+Project rule: every number in the README or the docs is asserted by a test or printed by a validation script named
+beside it. Timings are never asserted here (the scripts print them). Sources of each number:
 
 * measured values (3e-6, 20.4 %, 4.4e-13, 3.7e-8 / 3.9e-8) are recomputed with the validation scripts' or
   the other tests' own functions, so there is one definition of each computation; the tolerance of each is
-  stated beside it (the rounding of the README's digits, or ~10x the measured deviation);
+  stated beside it (the rounding of the page's digits, or ~10x the measured deviation);
 * sizes and counts (DOFs, modes, boundary nodes, the step map's shape) are recomputed from the model;
-* run parameters the README quotes (dt, durations, grids, thresholds) are read from the scripts and the
-  built-in scene, so that changing one of them without the README fails here.
+* run parameters the pages quote (dt, durations, grids, thresholds) are read from the scripts and the
+  built-in scene, so that changing one of them without the page fails here.
 """
 
 from __future__ import annotations
@@ -50,9 +53,9 @@ def other_test(name: str):
 # --- Validation table: measured values -------------------------------------------------------------------------
 
 def test_nelson_mcvaugh_worst_whirl_error_is_3e_6():
-    """README, Validation: "first six whirl speeds of the Nelson–McVaugh rotor at 0–40000 rpm against an
+    """docs/validation.md: "first six whirl speeds of the Nelson–McVaugh rotor at 0–40000 rpm against an
     independent code (ROSS): worst 3e-6". Measured 2.96e-6 (isotropic; orthotropic 2.85e-6).
-    tests/test_campbell.py asserts < 1e-5; here the README's one digit: [2.5e-6, 3.5e-6)."""
+    tests/test_campbell.py asserts < 1e-5; here the page's one digit: [2.5e-6, 3.5e-6)."""
     nm = validation("nelson_mcvaugh")
     rpm, ours, _ = nm.whirl_speeds("isotropic")
     assert rpm.min() == 0.0 and rpm.max() == 40000.0 and ours.shape[1] == nm.N_MODES == 6
@@ -60,23 +63,23 @@ def test_nelson_mcvaugh_worst_whirl_error_is_3e_6():
 
 
 def test_campbell_rig_margin_is_20_4_percent():
-    """README, Validation: "margin of the operating point (20.4 %)" of the rig's Campbell diagram (90/70).
-    Measured 20.411 %; tests/test_campbell.py asserts only >= 10 %. Tolerance: the README's last digit
+    """docs/validation.md: "margin of the operating point (20.4 %)" of the rig's Campbell diagram (90/70).
+    Measured 20.411 %; tests/test_campbell.py asserts only >= 10 %. Tolerance: the page's last digit
     (+-0.05 %, 10x the 0.011 % by which the measured value differs from 20.4)."""
     rig = validation("campbell_rig")
     assert rig.RATIO == pytest.approx(90 / 70) and rig.OPERATING_RPM == 4200.0
-    # "61 speeds 0–12000 rpm, 10 tracked modes with critical speeds" (Performance, At a glance)
+    # "61 speeds 0–12000 rpm, 10 tracked modes with critical speeds" (docs/benchmarks.md, At a glance)
     assert len(rig.SPEEDS_RPM) == 61 and rig.SPEEDS_RPM[0] == 0.0 and rig.SPEEDS_RPM[-1] == 12000.0
     assert rig.N_MODES == 10
     assert 100 * rig.min_margin() == pytest.approx(20.4, abs=0.05)
 
 
-# --- Validation, "Besides": energy balance and round-off -------------------------------------------------------
+# --- docs/validation.md, "Besides": energy balance and round-off ----------------------------------------------
 
 def test_energy_balance_measured_4_4e_13():
-    """README: the discrete energy balance of a rub run closes "to 1e-9 relative (measured 4.4e-13)".
+    """docs/validation.md: the discrete energy balance of a rub run closes "to 1e-9 relative (measured 4.4e-13)".
     tests/test_energy.py asserts 1e-9; the measured value (round-off of 5000 steps, 4.40e-13 here) is
-    machine dependent, so this pins its order of magnitude: < 10x the README's value."""
+    machine dependent, so this pins its order of magnitude: < 10x the page's value."""
     te = other_test("test_energy")
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
@@ -90,10 +93,10 @@ def test_energy_balance_measured_4_4e_13():
 
 
 def test_roundoff_measured_3_9e_8_against_3_7e_8():
-    """README: at dt = 6.25e-7 s the reduced model's error against the settled solution is "within 2x the full
-    model's (3.9e-8 against 3.7e-8 ...)". tests/test_roundoff.py asserts full < 4e-7 and reduced <= 2 full;
+    """docs/validation.md: at dt = 6.25e-7 s the reduced model's error against the settled solution is "within 2x
+    the full model's (3.9e-8 against 3.7e-8 ...)". tests/test_roundoff.py asserts full < 4e-7 and reduced <= 2 full;
     here the two stated values. Measured 3.945e-8 and 3.727e-8 (the scheme's O(dt^2) error, deterministic);
-    10 % allowed (~10x the larger deviation from the README's rounding, 1.2 %)."""
+    10 % allowed (~10x the larger deviation from the page's rounding, 1.2 %)."""
     tr = other_test("test_roundoff")
     full, reduced = tr.error_against_settled("full", 6.25e-7), tr.error_against_settled("reduced", 6.25e-7)
     assert full == pytest.approx(3.7e-8, rel=0.1)
@@ -104,9 +107,9 @@ def test_roundoff_measured_3_9e_8_against_3_7e_8():
 # --- sizes and counts -------------------------------------------------------------------------------------------
 
 def test_model_sizes_of_the_performance_tables():
-    """README, Performance: full DOFs 80 / 152 / 296 / 584 / 1160 for refined(1, 2, 4, 8, 16); the Craig–Bampton
-    boundary "nodes 1, 9, 13, 14, 18, 20 = 24 DOFs, plus k fixed-interface modes": CB 8/10/16/24/48 have
-    32/34/40/48/72 DOFs; the scene paper-rub's reduced model (24 modes) has 48 DOFs."""
+    """docs/benchmarks.md (and docs/performance.md): full DOFs 80 / 152 / 296 / 584 / 1160 for refined(1, 2, 4, 8,
+    16); the Craig–Bampton boundary "nodes 1, 9, 13, 14, 18, 20 = 24 DOFs, plus k fixed-interface modes":
+    CB 8/10/16/24/48 have 32/34/40/48/72 DOFs; the scene paper-rub's reduced model (24 modes) has 48 DOFs."""
     from rotorred.linear.reduction import default_boundary_nodes, reduce
     from rotorred.model.assembly import assemble
     from rotorred.scenes.run import build_model
@@ -127,8 +130,8 @@ def test_model_sizes_of_the_performance_tables():
 
 
 def test_automatic_mode_count_is_10():
-    """README: the reduced rig of transient_speed.py has "34 DOFs, 10 modes"; bench_pareto's 10 modes are "the
-    automatic count, chosen on whirl frequencies to 0.1 %", and "with the automatic 10 modes" for the scene.
+    """docs/benchmarks.md: the reduced rig of transient_speed.py has "34 DOFs, 10 modes"; bench_pareto's 10 modes are
+    "the automatic count, chosen on whirl frequencies to 0.1 %", and "with the automatic 10 modes" for the scene.
     tests/test_reduction.py asserts only <= 12 modes."""
     from rotorred.linear.reduction import DEFAULT_TARGET, reduce_rotor
     from rotorred.model.rotor_file import load_rotor
@@ -144,10 +147,10 @@ def test_automatic_mode_count_is_10():
 
 
 def test_step_map_shape_multiply_adds_and_levels():
-    """README, Cost as the model grows: the Newmark step is "one dense m x 2m product on (q, v)", "about 2300
-    multiply-adds at m = 34 and 4600 at m = 48"; the full model holds "its step matrices at five step sizes (one
-    per allowed halving), 5 x 2n^2 x 8 bytes for Newmark (3n^2 for HHT-alpha)". At n = 1160 one Newmark map is
-    therefore 2 n^2 x 8 = 21.5 MB (the README's "32 MB map" is the HHT-alpha size, 3 n^2 x 8 = 32.3 MB)."""
+    """docs/performance.md and docs/benchmarks.md, Cost as the model grows: the Newmark step is "one dense m x 2m
+    product on (q, v)", "about 2300 multiply-adds at m = 34 and 4600 at m = 48"; the full model holds "its step
+    matrices at five step sizes (one per allowed halving), 5 x 2n^2 x 8 bytes for Newmark (3n^2 for HHT-alpha)". At n = 1160 one Newmark map is
+    therefore 2 n^2 x 8 = 21.5 MB (docs/performance.md's "32 MB map" is the HHT-alpha size, 3 n^2 x 8 = 32.3 MB)."""
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
     from rotorred.transient.matrices import contact_rows, force_columns, step_levels
@@ -170,10 +173,11 @@ def test_step_map_shape_multiply_adds_and_levels():
     assert 3 * 1160**2 * 8 / 1e6 == pytest.approx(32.3, abs=0.05)
 
 
-# --- run parameters the README quotes ---------------------------------------------------------------------------
+# --- run parameters the README and the pages quote --------------------------------------------------------------------
 
 def test_scene_parameters():
-    """README: paper-rub is "the paper's rig with a rub at node 18", "inner 70 Hz, outer 90 Hz", "unbalance at
+    """README and docs/benchmarks.md, docs/python.md: paper-rub is "the paper's rig with a rub at node 18", "inner
+    70 Hz, outer 90 Hz", "unbalance at
     nodes 11 and 18", "2.6 s simulated", the scene "asks for 24 modes", "Newmark dt = 2e-5 s"; the Python block's
     speeds np.linspace(0, 2 pi 100, 41) are "inner spool 0-6000 rpm"."""
     from rotorred.scenes.schema import load_scene
@@ -188,8 +192,8 @@ def test_scene_parameters():
 
 
 def test_small_displacement_and_memory_limits():
-    """README, Errors: the summary warns "when an orbit exceeds 1 % of the rotor's largest disk radius"; runs are
-    checked against "half the machine's available memory"."""
+    """docs/commands.md, Errors: the summary warns "when an orbit exceeds 1 % of the rotor's largest disk radius";
+    runs are checked against "half the machine's available memory"."""
     from rotorred.scenes import budget
     from rotorred.scenes.schema import load_scene
     from rotorred.scenes.summary import SMALL_DISPLACEMENT_FRACTION, small_displacement_limit
@@ -200,7 +204,7 @@ def test_small_displacement_and_memory_limits():
 
 
 def test_validation_script_parameters():
-    """The grids and run lengths the README quotes beside each script (Validation and Performance)."""
+    """The grids and run lengths docs/validation.md and docs/benchmarks.md quote beside each script."""
     ss = validation("stability_sweep")  # "dt 1e-6–2e-4 s, Hertz stiffness 1e7–1e11 N/m^1.5, friction 0–0.8"
     assert (min(ss.DTS), max(ss.DTS)) == (1e-6, 2e-4) and (min(ss.STIFFNESSES), max(ss.STIFFNESSES)) == (1e7, 1e11)
     assert (min(ss.FRICTIONS), max(ss.FRICTIONS)) == (0.0, 0.8)
@@ -247,16 +251,17 @@ def test_packaging_numbers():
 
 
 def test_readme_rotor_file_example_loads_and_material_bounds():
-    """The README's rotor-file example is a valid rotor; the material bounds it states are the ones enforced."""
+    """docs/rotor-files.md's rotor-file example is a valid rotor; the material bounds it states are the ones
+    enforced."""
     import re as _re
 
     from rotorred.checks import InputError
     from rotorred.model.elements import Material
     from rotorred.model.rotor_file import rotor_from_toml
 
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    block = _re.search(r"## Rotor files.*?```toml\n(.*?)```", readme, _re.S).group(1)
-    rotor = rotor_from_toml(block, source="README")
+    page = (ROOT / "docs" / "rotor-files.md").read_text(encoding="utf-8")
+    block = _re.search(r"# Rotor files.*?```toml\n(.*?)```", page, _re.S).group(1)
+    rotor = rotor_from_toml(block, source="docs/rotor-files.md")
     assert [s.name for s in rotor.spools] == ["inner", "outer"] and rotor.defaults.boundary_nodes == (18,)
     assert "E (Pa, <= 1e18), rho (kg/m^3, 1e-9 to 1e6)" in block
     table = rotor.bearings[1]  # the bearing tabulated against speed
