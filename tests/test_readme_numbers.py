@@ -150,7 +150,8 @@ def test_step_map_shape_multiply_adds_and_levels():
     """docs/performance.md and docs/benchmarks.md, Cost as the model grows: the Newmark step is "one dense m x 2m
     product on (q, v)", "about 2300 multiply-adds at m = 34 and 4600 at m = 48"; the full model holds "its step
     matrices at five step sizes (one per allowed halving), 5 x 2n^2 x 8 bytes for Newmark (3n^2 for HHT-alpha)".
-    At n = 1160 one Newmark map is therefore 2 n^2 x 8 = 21.5 MB (docs/performance.md's "32 MB map" is the HHT-alpha size, 3 n^2 x 8 = 32.3 MB)."""
+    At n = 1160 one Newmark map is therefore 2 n^2 x 8 = 21.5 MB (docs/performance.md's "32 MB map" is the HHT-alpha
+    size, 3 n^2 x 8 = 32.3 MB)."""
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
     from rotorred.transient.matrices import contact_rows, force_columns, step_levels
