@@ -16,7 +16,6 @@ beside it. Timings are never asserted here (the scripts print them). Sources of 
 
 from __future__ import annotations
 
-import dataclasses
 import importlib.util
 import inspect
 import math

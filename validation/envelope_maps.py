@@ -1,11 +1,12 @@
-"""The README's two maps of the operating envelope, and the numbers the README quotes from them.
+"""The two maps of the operating envelope in docs/analyses.md, and the numbers it quotes from them.
 
-Issue 12, Must show "In the README". Runs, on a LocalCluster of one worker per core:
+Issue 12, Must show "In the README" (since issue 36 on the site's page docs/analyses.md). Runs, on a LocalCluster
+of one worker per core:
 
 1. ``rotorred map paper-rub --vary speeds.outer=60:110:101 --direction both --limit 4`` (inner 70 Hz);
 2. ``rotorred map paper-rub --vary rub.clearance=0:45e-6:10 --direction both --limit 4`` (70/90 Hz);
 
-and prints what the README says of them: the speeds without contact, the class of 90 Hz up and
+and prints what docs/analyses.md says of them: the speeds without contact, the class of 90 Hz up and
 down, the chaotic points (count, and in 74.5-86.5 Hz), the speeds where up and down differ in
 class, the peak orbit at node 14 at 63 Hz; for the clearance map, the contact fraction and orbit
 radius at node 18 at 45 µm each way, and the Poincaré samples' range per sweep below 30 µm.

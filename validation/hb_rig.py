@@ -20,7 +20,7 @@ Prints:
    multiplier modulus; < 1 stable);
 5. transients started on each orbit (its state at t = 0, ``RubProblem.final_state``) and run for 2 s: the distance of
    their last period from each orbit (relative, in the Fourier coefficients of the unknowns);
-6. the cost table of the README's Performance section: transient, HB from the transient, HB cold, continuation a
+6. the cost table of docs/benchmarks.md: transient, HB from the transient, HB cold, continuation a
    point (solve times only).
 """
 

@@ -1,10 +1,10 @@
-"""The built-in run-up scenes and the numbers the README quotes from them (issue 13).
+"""The built-in run-up scenes and the numbers docs/analyses.md quotes from them (issue 13).
 
 Runs `runup`, `runup-rub` and `coastdown-rub` (12 s each on the 48-DOF reduced rig) and prints, per
 scene: the largest orbit radius at nodes 14 and 18 with the inner speed where it occurs, the 1x outer
 peak at node 18 against the outer line's 42.9 Hz critical speed (inner), the rub intervals, and the
-cost. ``--images DIR`` also writes each scene's figures there (the README's come from
-``--images docs/images``).
+cost. ``--images DIR`` also writes each scene's figures there, as ``<scene>_<figure>.png`` (figures are never
+committed under docs/: the site's are drawn by its gallery when it is built).
 
 Run ``python validation/runup_scenes.py [--images DIR]`` (about 30 s).
 """
@@ -35,7 +35,7 @@ FIGURES = {"runup": ("runup_amplitude",), "runup-rub": ("runup_amplitude", "wate
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--images", default=None, help="copy the README's figures into this folder")
+    parser.add_argument("--images", default=None, help="copy each scene's figures into this folder")
     args = parser.parse_args()
     for name in ("runup", "runup-rub", "coastdown-rub"):
         r = run_runup(load_scene(name), progress=False)

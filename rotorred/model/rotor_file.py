@@ -1,7 +1,7 @@
 """Rotor files (TOML): load and validate, with errors that name the field, the value and what is allowed.
 
 A rotor is given by a preset name (``seed-rig``, ``nelson-mcvaugh``; see :func:`presets`) or a
-path to a TOML file. The format is documented in the README ("Rotor files"); in short::
+path to a TOML file. The format is documented in docs/rotor-files.md; in short::
 
     name = "my-rotor"
     [[material]]                       # E (Pa), rho (kg/m^3), nu (-) or G (Pa, shear modulus)

@@ -42,7 +42,7 @@ __all__ = ["CompareOptions", "ModelRun", "ModelComparison", "compare_models", "c
 
 LOG = logging.getLogger(__name__)
 
-#: fixed-interface mode counts compared by default (bench_pareto's 8, 16 and 24: README "Run time against error")
+#: fixed-interface mode counts compared by default (bench_pareto's 8, 16 and 24: docs/benchmarks.md)
 DEFAULT_MODES = (8, 16, 24)
 #: interrupts ending the comparison with the runs done (the command line adds SIGTERM's)
 INTERRUPTS = {KeyboardInterrupt: "SIGINT"}

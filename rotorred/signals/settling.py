@@ -21,7 +21,7 @@ Method
        frequencies, or the lowest one's distance from 0), so that they stay resolved in every
        window (the fit's condition stays <= 3, see :mod:`rotorred.signals.linefit`); and, for
        commensurate speeds, a whole number of periods of the torus's common base, at least
-       ``N_BASE_PERIODS`` = 2 (the README's two common periods at 70/90 Hz): every line is then
+       ``N_BASE_PERIODS`` = 2 (docs/benchmarks.md's two common periods at 70/90 Hz): every line is then
        orthogonal to the others in every window; for speeds that are not commensurate, at least
        ``n_cycles`` = 10 periods of the slowest labelled line, so that the window mean square of
        a component ripples by at most ``1 / (2 pi n_cycles)`` = 1.6 % (0.8 % in rms) from the
