@@ -114,18 +114,23 @@ sphinx_gallery_conf = {
 }
 
 # --- the API reference --------------------------------------------------------------------------------------------
-#: the API's groups, one page each, in the order of the layers (tests/test_architecture.py): (page, title, the
-#: modules whose names it holds). Every name of rotorred.__all__ must fall in exactly one group.
+#: the API's groups, one page each, in the order of the layers (tests/test_architecture.py): (page, title, what it
+#: holds, the modules whose names it holds). Every name of rotorred.__all__ must fall in exactly one group.
 API_GROUPS = (
-    ("model", "Model: rotors, elements, assembly, operating points", ("rotorred.model",)),
-    ("linear", "Linear analyses: Campbell, modes, margins, responses, reduction", ("rotorred.linear",)),
-    ("transient", "Transient: Newmark step, rub plates, energy", ("rotorred.transient",)),
-    ("nonlinear", "Nonlinear: harmonic balance, continuation, Floquet stability", ("rotorred.nonlinear",)),
-    ("signals", "Signals: spectra, line fit, settling, classes, order tracks", ("rotorred.signals",)),
-    ("scenes", "Scenes: scene files, runs, run-ups, branches, comparisons", ("rotorred.scenes",)),
-    ("maps", "Maps of the operating envelope", ("rotorred.maps",)),
-    ("plots", "Plots: figures and the figure pool", ("rotorred.plots",)),
-    ("services", "Services: input checks, writers, progress, provenance", (
+    ("model", "Model", "rotors, elements, assembly, loads, speed profiles, operating points", ("rotorred.model",)),
+    ("linear", "Linear analyses", "Campbell diagrams, critical speeds, mode shapes, separation margins, unbalance and "
+     "frequency responses, Craig–Bampton reduction", ("rotorred.linear",)),
+    ("transient", "Transient", "the compiled Newmark/HHT-α step, rub plates, options, results, energy balance",
+     ("rotorred.transient",)),
+    ("nonlinear", "Nonlinear", "harmonic balance (periodic and on a torus), continuation through folds, Floquet "
+     "stability", ("rotorred.nonlinear",)),
+    ("signals", "Signals", "spectra, line fit, settling, response classes, Poincaré samples, order tracks",
+     ("rotorred.signals",)),
+    ("scenes", "Scenes", "scene files, runs, run-ups, harmonic balance of a rub scene, branches, reduced against full",
+     ("rotorred.scenes",)),
+    ("maps", "Maps", "maps of the operating envelope", ("rotorred.maps",)),
+    ("plots", "Plots", "figures and the figure pool", ("rotorred.plots",)),
+    ("services", "Services", "input checks, file writers, progress, provenance (the bottom layer)", (
         "rotorred.checks", "rotorred.writers", "rotorred.progress", "rotorred.provenance", "rotorred.results")),
 )
 
@@ -142,11 +147,11 @@ def api_groups() -> dict[str, list[str]]:
 
     Raises RuntimeError (which stops the build) for a name of ``rotorred.__all__`` that no group holds."""
     order = {name: k for k, name in enumerate([*rotorred._MODULES, *rotorred._EXPORTS])}
-    groups: dict[str, list[str]] = {page: [] for page, _, _ in API_GROUPS}
+    groups: dict[str, list[str]] = {page: [] for page, _, _, _ in API_GROUPS}
     orphans = []
     for name in sorted(rotorred.__all__, key=order.__getitem__):
         module = defining_module(name)
-        pages = [page for page, _, prefixes in API_GROUPS
+        pages = [page for page, _, _, prefixes in API_GROUPS
                  if any(module == p or module.startswith(p + ".") for p in prefixes)]
         if len(pages) != 1:
             orphans.append(f"{name} ({module})")
@@ -162,11 +167,11 @@ def write_api_pages(out: Path = DOCS / "api" / "generated") -> None:
     """Write one page per group (an autosummary table whose stubs, one per name, autosummary generates)."""
     out.mkdir(parents=True, exist_ok=True)
     groups = api_groups()
-    for page, title, prefixes in API_GROUPS:
+    for page, title, what, prefixes in API_GROUPS:
         names = groups[page]
         text = [f".. _api-{page}:", "", title, "=" * len(title), "",
-                "Names defined in " + ", ".join(f"``{p}``" for p in prefixes) + ", all importable from ``rotorred``"
-                " (``import rotorred as rr``).", "", ".. currentmodule:: rotorred", "",
+                what[0].upper() + what[1:] + ": the names defined in " + ", ".join(f"``{p}``" for p in prefixes)
+                + ", all importable from ``rotorred`` (``import rotorred as rr``).", "", ".. currentmodule:: rotorred", "",
                 ".. autosummary::", "   :toctree: .", "", *[f"   {name}" for name in names], ""]
         path = out / f"{page}.rst"
         new = "\n".join(text)

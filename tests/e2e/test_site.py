@@ -225,6 +225,8 @@ def test_search_finds_campbell(served, tab):
     tab.page.goto(served + "search.html?q=Campbell", wait_until="load")
     results = tab.page.locator("#search-results ul.search li")
     results.first.wait_for(timeout=20_000)
+    tab.page.wait_for_function("!document.querySelector('#search-results h2').textContent.startsWith('Searching')",
+                               timeout=20_000)
     tab.screenshot("site-search")
     n = results.count()
     assert n >= 5, n
