@@ -105,6 +105,7 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "show_signature": False,
     "remove_config_comments": True,
+    "write_computation_times": False,  # no "Computation times" pages (each example page gives its own time)
     "min_reported_time": 0,  # every page says how long its script ran (tests/e2e/test_site.py reads it)
     "capture_repr": ("_repr_html_", "__repr__"),
     "matplotlib_animations": False,
