@@ -53,7 +53,6 @@ root_doc = "index"
 templates_path = ["_templates"]
 exclude_patterns = ["_build", "**/README.txt", "gallery/*.md5", "tutorials/*.md5", "**/*.ipynb", "**/*.py",
                     "**/*.zip", "**/*.pickle", "**/*.json"]
-suppress_warnings: list[str] = []
 
 # --- docstrings ---------------------------------------------------------------------------------------------------
 autosummary_generate = True
@@ -93,13 +92,10 @@ html_context = {"default_mode": "light"}
 # --- the gallery and the tutorials (sphinx-gallery) ---------------------------------------------------------------
 #: (scripts folder at the repository's root, generated folder under docs/)
 GALLERIES = (("examples", "gallery"), ("tutorials", "tutorials"))
-_present = [(src, out) for src, out in GALLERIES if (ROOT / src / "README.txt").is_file()]
-if len(_present) < len(GALLERIES):  # until the gallery branch lands: build without it (its toctree entries missing)
-    suppress_warnings += ["toc.not_readable", "ref.doc"]
 
 sphinx_gallery_conf = {
-    "examples_dirs": [f"../{src}" for src, _ in _present],
-    "gallery_dirs": [out for _, out in _present],
+    "examples_dirs": [f"../{src}" for src, _ in GALLERIES],
+    "gallery_dirs": [out for _, out in GALLERIES],
     "filename_pattern": r"\.py$",  # every script is executed, not only plot_*
     "ignore_pattern": r"(__init__|_helpers?)\.py",
     "download_all_examples": False,
