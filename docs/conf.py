@@ -200,7 +200,22 @@ def mathml_renderer(app):
 html_math_renderer = "mathml"
 
 
+# --- a public constant's doc comment ------------------------------------------------------------------------------
+def constant_docstring(app, what, name, obj, options, lines):
+    """A constant exported by ``rotorred`` (an int has int's docstring) gets the ``#:`` comment written above it in
+    the module that defines it."""
+    short = name.rsplit(".", 1)[-1]
+    if what not in ("data", "attribute") or name != f"rotorred.{short}" or short not in rotorred._EXPORTS:
+        return
+    from sphinx.pycode import ModuleAnalyzer
+
+    comment = ModuleAnalyzer.for_module(rotorred._EXPORTS[short]).find_attr_docs().get(("", short))
+    if comment:
+        lines[:] = [line for line in comment if line.strip()] + [""]
+
+
 def setup(app):
     mathml_renderer(app)
+    app.connect("autodoc-process-docstring", constant_docstring)
     return {"parallel_read_safe": True}
 
