@@ -50,8 +50,9 @@ reference = json.loads((ross3 / "ross_reference.json").read_text())["rotors"]["c
 for block in reference["modal"]:
     at = rr.campbell(rotor, rr.Operating.line([block["speed_rad_s"]]), n_modes=16)
     ours, theirs = np.sort(at.frequencies[0]), np.sort(np.array(block["lateral_wd"]))[:16]
-    print(f"{block['speed_rpm']:7.0f} rpm: lowest {ours[0] / (2 * np.pi):7.2f} Hz (ROSS {theirs[0] / (2 * np.pi):7.2f}); "
-          f"largest relative difference of the 16: {np.max(np.abs(ours / theirs - 1)):.1e}")
+    print(f"{block['speed_rpm']:7.0f} rpm: lowest {ours[0] / (2 * np.pi):7.2f} Hz "
+          f"(ROSS {theirs[0] / (2 * np.pi):7.2f}); largest relative difference of the 16: "
+          f"{np.max(np.abs(ours / theirs - 1)):.1e}")
 
 # %%
 # Two codes that build the same matrices agree to rounding. ``tests/test_ross_files.py`` asserts it for five
