@@ -31,13 +31,15 @@ run = rr.run_map(spec, out, workers=0, progress=False, figures=False)
 print(run)
 
 # %%
-# The peak orbit radius at the rub disk (node 18) and the rub's contact fraction at each point, up and down: where the two
-# sweeps differ, two responses coexist at one speed.
+# The peak orbit radius at the rub disk (node 18) and the rub's contact fraction at each point, up and down.
+# Where the two sweeps differ, the response depends on the way the speed was reached, or has not settled in
+# 1.2 s: runs to settling (``limit``) tell which.
 ds = run.to_xarray()
 print("outer (Hz)  peak orbit up / down (µm)  contact up / down (%)")
 for i, f in enumerate(speeds):
     up, down = ds.sel(direction="up").isel(speeds_outer=i), ds.sel(direction="down").isel(speeds_outer=i)
-    print(f"{f:9.2f}  {1e6 * float(up['peak_orbit'].sel(node=18)):10.1f} / {1e6 * float(down['peak_orbit'].sel(node=18)):6.1f}"
+    orbit_up, orbit_down = (1e6 * float(d["peak_orbit"].sel(node=18)) for d in (up, down))
+    print(f"{f:9.2f}  {orbit_up:10.1f} / {orbit_down:6.1f}"
           f"  {100 * float(up['contact_fraction']):13.2f} / {100 * float(down['contact_fraction']):5.2f}")
 
 # %%

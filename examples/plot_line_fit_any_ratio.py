@@ -12,8 +12,6 @@ record and finds the sub-harmonic torus (here f_H/3) that explains them.
 # The paper's rub scene with the outer speed changed, run from the settled linear state to 3 s; the last second
 # (2-3 s) is fitted. A short record: the classification calls a record shorter than two settling windows
 # "unsettled", and a longer one (``solver.duration``, e.g. 8 s) narrows the lines' standard errors.
-import numpy as np
-
 import rotorred as rr
 from rotorred.plots.scene import draw_spectra
 

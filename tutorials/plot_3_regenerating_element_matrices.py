@@ -86,7 +86,7 @@ print("\n".join(ln[:150] for ln in diff[:9]))
 # it and hands the whirl frequencies back through a file; this process computes the original.
 speeds = np.linspace(0.0, 12000.0, 41)
 campbell = ("import numpy as np, rotorred as rr; "
-            f"cd = rr.campbell(rr.load_rotor('seed-rig'), rr.Operating.line(np.linspace(0.0, 12000.0, 41), "
+            "cd = rr.campbell(rr.load_rotor('seed-rig'), rr.Operating.line(np.linspace(0.0, 12000.0, 41), "
             "unit='rpm'), n_modes=10); "
             "np.savez('campbell.npz', f=cd.frequencies_hz, c=[c.speed_rpm for c in cd.critical_speeds]); "
             "print('rotorred from', rr.__file__)")
