@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.transforms import blended_transform_factory
 
 from rotorred.linear.campbell import CampbellResult, CriticalSpeed, excitation_label
 from rotorred.plots.axes import axes
@@ -48,6 +49,7 @@ def draw_campbell(result: CampbellResult, ax=None, *, operating_speed: float | N
     fig, ax = axes(ax, figsize)
     top = max_frequency_hz or 1.1 * float(result.frequencies_hz.max())
     _whirl_curves(ax, result, max_frequency_hz)
+    _mode_numbers(ax, result, top)
     rpm = result.speeds_rpm
     lo, hi = (float(rpm[0]), float(rpm[-1])) if len(rpm) > 1 else (0.0, 1.1 * float(rpm[0]))  # one: from rest
     if hi > lo:
@@ -103,7 +105,7 @@ def draw_critical_speed(critical: CriticalSpeed, ax=None, *, figsize: tuple[floa
         ax.set_ylabel("whirl frequency (Hz)")
         ax.grid(True, alpha=0.3)
     ax.plot([x], [y], **CRITICAL_STYLE, label=None if not new else "critical speed")
-    ax.annotate(f"{x:.0f} rpm, {y:.4g} Hz\nmode {critical.mode} {critical.whirl}, log dec {critical.log_dec:.3g}",
+    ax.annotate(f"{x:.0f} rpm, {y:.4g} Hz\nmode {critical.mode + 1} {critical.whirl}, log dec {critical.log_dec:.3g}",
                 (x, y), xytext=(6, -6), textcoords="offset points", fontsize=8, va="top", zorder=6,
                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
     if new:
@@ -128,9 +130,31 @@ def _whirl_curves(ax, result: CampbellResult, max_frequency_hz: float | None) ->
                 ax.plot(rpm[start:stop], f_hz[start:stop, j], lw=1.8, label=f"{label} whirl" if label else None,
                         marker="o" if len(rpm) == 1 else None, **WHIRL_STYLE[str(w[start])])
                 start = i
-        if f_hz[-1, j] <= (max_frequency_hz or np.inf):
-            ax.annotate(f"{j}", (rpm[-1], f_hz[-1, j]), xytext=(3, 0), textcoords="offset points", fontsize=8,
-                        va="center", color="0.3", annotation_clip=False)
+
+
+#: least vertical distance between two mode numbers at the right end, as a share of the frequency axis
+LABEL_GAP = 0.028
+
+
+def _mode_numbers(ax, result: CampbellResult, top: float) -> None:
+    """Each mode's number (from 1, as in the tables) at the right end of its curve, moved apart where curves end
+    closer than :data:`LABEL_GAP` of the axis, with a leader to the curve's end when moved."""
+    ends = result.frequencies_hz[-1]
+    shown = [j for j in np.argsort(ends) if ends[j] <= top]
+    gap = LABEL_GAP * top
+    placed: list[float] = []
+    for j in shown:  # upwards from the lowest end: each label at least one gap above the last
+        placed.append(max(float(ends[j]), placed[-1] + gap) if placed else float(ends[j]))
+    excess = (placed[-1] - top) if placed else 0.0
+    if excess > 0:  # pushed past the top: shift down as far as the lowest label allows
+        placed = [y - min(excess, placed[0]) for y in placed]
+    x = float(result.speeds_rpm[-1])
+    beside = blended_transform_factory(ax.transAxes, ax.transData)  # x: share of the axes' width, y: Hz
+    for j, y in zip(shown, placed):
+        moved = abs(y - ends[j]) > 1e-3 * gap
+        ax.annotate(f"{j + 1}", (x, ends[j]), xytext=(1.025 if moved else 1.005, y), textcoords=beside,
+                    fontsize=8, va="center", color="0.3", annotation_clip=False,
+                    arrowprops=dict(arrowstyle="-", color="0.6", lw=0.6, shrinkA=1, shrinkB=0) if moved else None)
 
 
 def _excitation_lines(ax, result: CampbellResult, top: float) -> None:
