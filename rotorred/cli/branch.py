@@ -21,6 +21,7 @@ from __future__ import annotations
 from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance
+from rotorred.cli.report import add_html_option, stage_report
 from rotorred.cli.run import interruptible
 
 
@@ -43,6 +44,7 @@ def add_parser(subparsers):
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true",
                    help="go on with a branch beyond the size limits (steps, memory, model size; see the message)")
+    add_html_option(p)
     return p
 
 
@@ -88,7 +90,7 @@ def run(args) -> int:
         branch = continue_scene(scene, model, key, start, stop, options,
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
-    files, late = _write(branch, out, interrupts, record)
+    files, late = _write(branch, out, interrupts, record, args)
     for f in files:
         report(f"wrote {f}")
     if branch.interrupted:
@@ -100,7 +102,7 @@ def run(args) -> int:
     return 0
 
 
-def _write(branch, out, interrupts: dict, record=None) -> tuple[list, str]:
+def _write(branch, out, interrupts: dict, record=None, args=None) -> tuple[list, str]:
     """Stage and commit the branch's files into ``out`` with SIGINT and SIGTERM held back (``writers.signals_held``,
     as a commit is), so that a signal does not cut them (nor leave a file half made): the points an interrupt kept,
     or a complete branch, are written whole. A signal that came meanwhile is dropped once they are committed. The
@@ -111,6 +113,8 @@ def _write(branch, out, interrupts: dict, record=None) -> tuple[list, str]:
     try:
         with writers.signals_held(), folder:
             write_branch(branch, folder, record)
+            if args is not None:
+                stage_report(args, folder, branch)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except tuple(interrupts) as exc:
         if not folder.committed:

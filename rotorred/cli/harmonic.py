@@ -30,6 +30,7 @@ import numpy as np
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
+from rotorred.cli.report import add_html_option, stage_report
 from rotorred.cli.options import (dof_list, grid, node_list, options_named, out_dir, provenance,
                                   ratio_number, speed_line, spool_ratios, stage_summary)
 
@@ -81,6 +82,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help=f"FRF frequencies in Hz START:STOP:N (with --frf; default {FRF_FREQUENCIES})")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
+    add_html_option(p)
     return p
 
 
@@ -258,6 +260,7 @@ def run(args) -> int:
         names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
         text = _report(args, rotor, scene, label, unbalances, elapsed, result)
         names += [f.name for f in stage_summary(folder, "harmonic.txt", text, record)]
+        names += [f.name for f in stage_report(args, folder, result, title=title)]
         folder.commit()
     report(text)
     for name in names:

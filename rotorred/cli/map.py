@@ -17,6 +17,7 @@ from __future__ import annotations
 from rotorred import checks
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
+from rotorred.cli.report import add_html_option, write_report_to
 from rotorred.cli.run import interruptible
 
 
@@ -43,6 +44,7 @@ def add_parser(subparsers):
     p.add_argument("--out", required=True, help="output directory (its points/ are kept: the same command resumes)")
     p.add_argument("--force", action="store_true",
                    help="go on with maps beyond the size limits (steps, memory, model size; see the message)")
+    add_html_option(p)
     return p
 
 
@@ -122,7 +124,7 @@ def run(args) -> int:
     result = run_map(spec, out, workers=n_workers, scheduler=args.scheduler, provenance=record,
                      force=args.force, interrupts=interrupts())
     report(format_map(result.dataset, spec))
-    for f in result.files:
+    for f in list(result.files) + write_report_to(args, out, result):
         report(f"wrote {f}")
     report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
            f"wall time {result.wall_time:.2f} s")
