@@ -196,3 +196,25 @@ def test_the_map_report_embeds_each_points_lines_and_poincare_samples(small_map)
     np.testing.assert_allclose(pts[1]["a"], [2e-6, 1e-6])
     assert len(pts[2]["px"]) == 152 and [p.name for p in rep.panels] == ["classes", "bifurcation", "orbit",
                                                                          "spectrum"]
+
+
+def test_the_report_of_a_202_point_map_at_the_stores_limits_is_at_most_15_mb(tmp_path):
+    """The README's map (speeds.outer 60:110:101, up and down: 202 points), every point at the most the map store
+    keeps (N_LINES lines, N_SAMPLES Poincare samples): the report is at most 15 MB."""
+    from rotorred.maps.point import N_LINES, N_SAMPLES, PointResult
+    from rotorred.maps.store import to_dataset
+
+    rng = np.random.default_rng(0)
+    spec = rr.MapSpec("paper-rub", (rr.Axis("speeds.outer", tuple(np.linspace(60.0, 110.0, 101))),), direction="both")
+    points = {(d, (i,)): PointResult(
+        status="ok", kind="chaotic", settling_time=rng.random(), explained_share=rng.random(),
+        line_frequency=rng.random(N_LINES) * 900, line_amplitude=rng.random(N_LINES) * 1e-5,
+        line_phase=rng.random(N_LINES) * 6, line_label=tuple(f"{k}f_H-{k + 1}f_L" for k in range(N_LINES)),
+        poincare_x=rng.random(N_SAMPLES) * 1e-5, poincare_velocity=rng.random(N_SAMPLES) * 1e-2,
+        peak_orbit=rng.random(3) * 1e-5, contact_fraction=rng.random(), n_impacts=int(rng.integers(100)))
+        for d in ("up", "down") for i in range(101)}
+    run = rr.MapRun(spec, to_dataset(spec, points, (13, 14, 18), {"scene": "paper-rub", "table_dof": "14:y"}),
+                    (), 202, 0, 0, None, 1.0)
+    size = report_of(run).write(tmp_path / "report.html").stat().st_size
+    print(f"report of a 202-point map at the store's limits: {size / 1e6:.2f} MB")
+    assert size <= 15e6

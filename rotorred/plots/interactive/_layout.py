@@ -19,6 +19,15 @@ def layout(title: str, x: str, y: str, **more) -> dict:
     return out
 
 
+#: plotly's default colours, in its order
+COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
+
+
+def color(k: int) -> str:
+    """The ``k``-th colour of :data:`COLORS` (cycled)."""
+    return COLORS[k % len(COLORS)]
+
+
 def hover(*rows: str) -> str:
     """A hover template of ``rows`` (plotly's ``%{...}`` fields), one a line, without the trace box."""
     return "<br>".join(rows) + "<extra></extra>"

@@ -7,12 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotorred.plots.interactive._layout import MICRO, figure, hover, layout
+from rotorred.plots.interactive._layout import MICRO, color, figure, hover, layout
 from rotorred.plots.interactive.report import Panel, Report
 
 #: line of a stretch by its stability flag (1 stable, 0 unstable, -1 not computed)
 _DASH = {1: ("solid", "stable"), 0: ("dash", "unstable"), -1: ("dot", "stability not computed")}
-_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 
 
 def figures(result) -> list[tuple[str, dict]]:
@@ -38,7 +37,7 @@ def _scene_branch(result):
             for a, b, kind in result.bifurcations]
     return (x, ys, result.flags, custom, folds, bifs, f"{result.key} ({xu})", "peak of q(t) over a period (µm)",
             f"harmonic-balance branch of {result.scene} in {result.key}",
-            ("f_0 %{customdata[0]:.6g} Hz", "largest Floquet multiplier |µ| %{customdata[1]:.4g}"))
+            ("f_0 %{customdata[0]:.6~g} Hz", "largest Floquet multiplier |µ| %{customdata[1]:.4~g}"))
 
 
 def _plain_branch(result):
@@ -54,7 +53,7 @@ def _plain_branch(result):
             for i in changes if flags[i] >= 0 and flags[i + 1] >= 0]
     return (x, {"sum of harmonic amplitudes (largest DOF)": amplitude}, flags, custom, folds, bifs,
             f"{name} ({unit})", "sum of |Q_k| (m or rad)", "branch of periodic solutions",
-            ("omega %{customdata[0]:.6g} rad/s", "largest Floquet exponent real part %{customdata[1]:.4g} 1/s"))
+            ("omega %{customdata[0]:.6~g} rad/s", "largest Floquet exponent real part %{customdata[1]:.4~g} 1/s"))
 
 
 def branch_figure(result) -> dict:
@@ -69,8 +68,8 @@ def branch_figure(result) -> dict:
             data.append({"type": "scatter", "mode": "lines", "x": x[part], "y": y[part],
                          "name": f"{name}, {state}", "legendgroup": f"{name} {state}",
                          "showlegend": (name, state) not in shown, "customdata": custom[part],
-                         "line": {"dash": dash, "width": 2, "color": "#999" if flags[lo] < 0 else _COLORS[k % 6]},
-                         "hovertemplate": hover(f"{name}: {state}", f"{xtitle} %{{x:.6g}}", "%{y:.4g}", *extra)})
+                         "line": {"dash": dash, "width": 2, "color": "#999" if flags[lo] < 0 else color(k)},
+                         "hovertemplate": hover(f"{name}: {state}", f"{xtitle} %{{x:.6~g}}", "%{y:.4~g}", *extra)})
             shown.add((name, state))
         if k == 0:
             data += _marks(x, y, folds, bifs)

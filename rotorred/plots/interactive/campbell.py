@@ -75,8 +75,8 @@ def _mode_trace(result, j: int) -> dict:
             "marker": {"symbol": symbols, "size": [10 if u else 6 for u in unstable]}, "line": {"width": 1.5},
             "customdata": custom, "meta": "mode",
             "hovertemplate": hover("mode %{customdata[0]}: %{customdata[1]} whirl %{customdata[4]}",
-                                   "%{x:.6g} rpm", "%{y:.5g} Hz", "log dec %{customdata[2]:.4g}",
-                                   "damping ratio %{customdata[3]:.4g}")}
+                                   "%{x:.6~g} rpm", "%{y:.5~g} Hz", "log dec %{customdata[2]:.4~g}",
+                                   "damping ratio %{customdata[3]:.4~g}")}
 
 
 def _num(value) -> float | None:
@@ -92,16 +92,16 @@ def _critical_traces(result) -> list[dict]:
                     "x": [c.speed_rpm for c in cs], "y": [c.frequency_hz for c in cs],
                     "marker": {"symbol": "diamond", "size": 10, "color": "black"},
                     "customdata": [[c.line, c.mode + 1, c.whirl, _num(c.log_dec), _num(c.damping_ratio)] for c in cs],
-                    "hovertemplate": hover("critical speed %{x:.6g} rpm on %{customdata[0]}",
-                                           "mode %{customdata[1]}, %{customdata[2]} whirl, %{y:.5g} Hz",
-                                           "log dec %{customdata[3]:.4g}, damping ratio %{customdata[4]:.4g}")})
+                    "hovertemplate": hover("critical speed %{x:.6~g} rpm on %{customdata[0]}",
+                                           "mode %{customdata[1]}, %{customdata[2]} whirl, %{y:.5~g} Hz",
+                                           "log dec %{customdata[3]:.4~g}, damping ratio %{customdata[4]:.4~g}")})
     sc = result.stability_changes
     if sc:
         out.append({"type": "scatter", "mode": "markers", "name": "stability change", "meta": "stability",
                     "x": [c.speed_rpm for c in sc], "y": [c.frequency_hz for c in sc],
                     "marker": {"symbol": "star", "size": 13, "color": "red"},
                     "customdata": [[c.mode + 1, "becomes unstable" if c.onset else "becomes stable"] for c in sc],
-                    "hovertemplate": hover("mode %{customdata[0]} %{customdata[1]}", "at %{x:.6g} rpm, %{y:.5g} Hz")})
+                    "hovertemplate": hover("mode %{customdata[0]} %{customdata[1]}", "at %{x:.6~g} rpm, %{y:.5~g} Hz")})
     return out
 
 
@@ -199,7 +199,7 @@ _SCRIPT = r"""
       const cols = [...Array(nN).keys()].filter((n) => S.spool[n] === s), color = colors[s % colors.length];
       data.push({type: 'scatter', mode: 'lines+markers', name: name, x: cols.map((n) => zs[n]), legendgroup: name,
                  y: cols.map((n) => ur * X[n][0] + ui * X[n][2]), line: {color: color, width: 2}, marker: {size: 4},
-                 customdata: cols.map((n) => S.nodes[n]), hovertemplate: 'node %{customdata}, z = %{x:.4g} m<br>' +
+                 customdata: cols.map((n) => S.nodes[n]), hovertemplate: 'node %{customdata}, z = %{x:.4~g} m<br>' +
                  'deflection %{y:.3f}<extra>' + name + '</extra>'});
       const picks = [...new Set([...Array(RR.data.orbits).keys()].map((t) =>
         Math.round(t * (cols.length - 1) / Math.max(RR.data.orbits - 1, 1))))];

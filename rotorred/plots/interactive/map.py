@@ -5,7 +5,8 @@ table DOF (from its labelled lines, its Poincare samples on it) and its line spe
 
 A map stores, per point, the labelled lines (frequency, amplitude, phase) and the Poincare samples of the table DOF
 (:mod:`rotorred.maps.point`), not its time record: the orbit drawn is ``x(t) = sum a cos(2 pi f t + phase)`` against
-its derivative, over :data:`ORBIT_PERIODS` periods of the lowest line.
+its derivative, over :data:`ORBIT_PERIODS` periods of the lowest line, :data:`ORBIT_PER_CYCLE` samples a period of
+the highest.
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from rotorred.plots.interactive.report import Panel, Report
 
 #: Poincare samples of a point drawn in the bifurcation diagram (the last ones), and embedded for its orbit
 BIFURCATION_SAMPLES, ORBIT_SAMPLES = 100, 400
-#: periods of the lowest line the orbit of a clicked point spans, and its samples
-ORBIT_PERIODS, ORBIT_POINTS = 20, 2000
+#: periods of the lowest line the orbit of a clicked point spans, and its samples: at least ORBIT_POINTS,
+#: ORBIT_PER_CYCLE a period of the highest line, at most ORBIT_MOST
+ORBIT_PERIODS, ORBIT_POINTS, ORBIT_PER_CYCLE, ORBIT_MOST = 20, 2000, 40, 40000
 #: colours of the classes
 CLASS_COLORS = {"periodic": "#1f77b4", "quasi-periodic": "#2ca02c", "chaotic": "#d62728", "unexplained": "#9467bd",
                 "unsettled": "#7f7f7f", "failed": "#000000"}
@@ -120,7 +122,7 @@ def bifurcation_figure(ds, pts: list[dict]) -> dict:
                      "y": MICRO * x, "name": f"{d} sweep", "legendgroup": d, "showlegend": d not in shown,
                      "marker": {"size": 3, "color": _DIRECTION_COLORS.get(d, "#444")}, "meta": i,
                      "hovertemplate": hover(row[5], f"class {row[0]}, {row[1]}", f"explained share {row[2]}",
-                                            f"contact {row[3]} of the time, {row[4]} impacts", "%{y:.4g} µm")})
+                                            f"contact {row[3]} of the time, {row[4]} impacts", "%{y:.4~g} µm")})
         shown.add(d)
     return figure(data, layout(f"bifurcation diagram: Poincare samples of {ds.attrs.get('table_dof', 'the table DOF')}",
                                _key_title(ds, keys[0]), "Poincare samples (µm)"))
@@ -136,6 +138,7 @@ def report(result) -> Report:
     ds = result.dataset
     pts = points(ds)
     data = {"dof": ds.attrs.get("table_dof", ""), "periods": ORBIT_PERIODS, "samples": ORBIT_POINTS,
+            "per_cycle": ORBIT_PER_CYCLE, "most": ORBIT_MOST,
             "points": [{"title": f"{_hover_row(p)[5]}: {p['kind']}", "f": p["lines"][0], "a": p["lines"][1],
                         "p": p["lines"][2], "l": p["lines"][3],
                         "px": p["poincare"][0][decimated(p["poincare"][0].size, ORBIT_SAMPLES)],
@@ -157,9 +160,10 @@ _SCRIPT = r"""
   function show(i) {
     const P = D.points[i], f = P.f, a = P.a, ph = P.p;
     const low = Math.min(...f.filter((v) => v > 0)), T = isFinite(low) ? D.periods / low : 1;
+    const n = Math.min(D.most, Math.max(D.samples, Math.ceil(D.per_cycle * Math.max(...f, 0) * T)));
     const x = [], v = [];
-    for (let s = 0; s <= D.samples; s++) {
-      const t = T * s / D.samples;
+    for (let s = 0; s <= n; s++) {
+      const t = T * s / n;
       let xs = 0, vs = 0;
       for (let k = 0; k < f.length; k++) {
         const w = 2 * Math.PI * f[k], arg = w * t + ph[k];
@@ -169,16 +173,16 @@ _SCRIPT = r"""
     }
     Plotly.react(orbit, [
       {type: 'scatter', mode: 'lines', x: x, y: v, name: 'from the lines', line: {width: 1},
-       hovertemplate: '%{x:.4g} µm, %{y:.4g} µm/s<extra></extra>'},
+       hovertemplate: '%{x:.4~g} µm, %{y:.4~g} µm/s<extra></extra>'},
       {type: 'scatter', mode: 'markers', x: P.px.map((u) => 1e6 * u), y: P.pv.map((u) => 1e6 * u),
        name: 'Poincare samples', marker: {size: 4, color: 'black'},
-       hovertemplate: '%{x:.4g} µm, %{y:.4g} µm/s<extra></extra>'}],
+       hovertemplate: '%{x:.4~g} µm, %{y:.4~g} µm/s<extra></extra>'}],
       {title: {text: 'orbit of ' + D.dof + ' (phase plane) - ' + P.title, font: {size: 13}}, margin: margin,
        hovermode: 'closest', xaxis: {title: {text: 'displacement (µm)'}}, yaxis: {title: {text: 'velocity (µm/s)'}},
        legend: {orientation: 'h', y: -0.2}}, RR.config);
     const top = Math.max(...f, 1);
     Plotly.react(spectrum, [{type: 'bar', x: f, y: a.map((u) => 1e6 * u), width: f.map(() => top / 150),
-       customdata: P.l, name: 'lines', hovertemplate: '%{customdata}<br>%{x:.6g} Hz<br>%{y:.4g} µm<extra></extra>'}],
+       customdata: P.l, name: 'lines', hovertemplate: '%{customdata}<br>%{x:.6~g} Hz<br>%{y:.4~g} µm<extra></extra>'}],
       {title: {text: 'line spectrum of ' + D.dof + ' - ' + P.title, font: {size: 13}}, margin: margin,
        hovermode: 'closest', xaxis: {title: {text: 'frequency (Hz)'}}, yaxis: {title: {text: 'amplitude (µm)'}}},
       RR.config);

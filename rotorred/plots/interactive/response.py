@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotorred.plots.interactive._layout import MICRO, RPM, figure, hover, layout
+from rotorred.plots.interactive._layout import MICRO, RPM, color, figure, hover, layout
 from rotorred.plots.interactive.report import Panel, Report
 
 
@@ -32,12 +32,12 @@ def _series(result):
 def bode_figure(result) -> dict:
     """Amplitude (µm) above, phase (deg) below, against the reference spool's speed (rpm)."""
     data = []
-    tip = hover("%{meta}", f"{result.reference_spool} %{{x:.6g}} rpm (excited spool %{{customdata[0]:.6g}} rpm)",
-                "amplitude %{customdata[1]:.4g} µm, phase %{customdata[2]:.4g} deg")
+    tip = hover("%{meta}", f"{result.reference_spool} %{{x:.6~g}} rpm (excited spool %{{customdata[0]:.6~g}} rpm)",
+                "amplitude %{customdata[1]:.4~g} µm, phase %{customdata[2]:.4~g} deg")
     for k, (name, rpm, spool_rpm, amp, phase) in enumerate(_series(result)):
         custom = np.column_stack([spool_rpm, amp, phase])
         common = {"type": "scatter", "mode": "lines", "x": rpm, "meta": name, "customdata": custom,
-                  "hovertemplate": tip, "legendgroup": name, "line": {"color": _color(k)}}
+                  "hovertemplate": tip, "legendgroup": name, "line": {"color": color(k)}}
         data.append({**common, "y": amp, "name": name})
         data.append({**common, "y": phase, "yaxis": "y2", "showlegend": False})
     return figure(data, layout(f"unbalance response - Bode ({result.reference_spool} speed)", "",
@@ -53,17 +53,12 @@ def polar_figure(result) -> dict:
     data = []
     for k, (name, rpm, spool_rpm, amp, phase) in enumerate(_series(result)):
         data.append({"type": "scatterpolar", "mode": "lines+markers", "r": amp, "theta": phase, "name": name,
-                     "customdata": rpm, "marker": {"size": 3}, "line": {"color": _color(k)},
-                     "hovertemplate": hover(name, f"{result.reference_spool} %{{customdata:.6g}} rpm",
-                                            "%{r:.4g} µm at %{theta:.4g} deg")})
+                     "customdata": rpm, "marker": {"size": 3}, "line": {"color": color(k)},
+                     "hovertemplate": hover(name, f"{result.reference_spool} %{{customdata:.6~g}} rpm",
+                                            "%{r:.4~g} µm at %{theta:.4~g} deg")})
     return figure(data, {"title": {"text": "unbalance response - polar (amplitude µm, phase deg)"},
                          "polar": {"angularaxis": {"direction": "counterclockwise"}}, "height": 560,
                          "legend": {"font": {"size": 11}}})
-
-
-def _color(k: int) -> str:
-    return ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
-            "#17becf")[k % 10]
 
 
 def report(result, title: str = "") -> Report:

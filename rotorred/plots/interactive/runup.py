@@ -45,8 +45,8 @@ def amplitude_figure(result) -> dict:
     data = []
     for node, (speed, radius) in result.overall.items():
         data.append({"type": "scatter", "mode": "lines", "x": np.asarray(speed) * RPM, "y": MICRO * np.asarray(radius),
-                     "name": f"node {node}", "hovertemplate": hover(f"node {node}", f"{ref} %{{x:.6g}} rpm",
-                                                                    "largest orbit radius %{y:.4g} µm")})
+                     "name": f"node {node}", "hovertemplate": hover(f"node {node}", f"{ref} %{{x:.6~g}} rpm",
+                                                                    "largest orbit radius %{y:.4~g} µm")})
     shapes, notes = _critical_marks(result)
     for r in result.rubs:
         x0, x1 = sorted((60.0 * r.speed_start[ref], 60.0 * r.speed_end[ref]))  # (Hz)
@@ -64,7 +64,7 @@ def orders_figure(result) -> dict:
         data.append({"type": "scatter", "mode": "lines", "x": np.asarray(track.speed) * RPM,
                      "y": MICRO * np.asarray(track.amplitude), "name": name,
                      "visible": True if track.order == 1 else "legendonly",
-                     "hovertemplate": hover(name, f"{track.spool} %{{x:.6g}} rpm", "%{y:.4g} µm (µrad)")})
+                     "hovertemplate": hover(name, f"{track.spool} %{{x:.6~g}} rpm", "%{y:.4~g} µm (µrad)")})
     return figure(data, layout(f"{result.scene.name}: order tracks (click the legend: more orders)",
                                "spool speed (rpm)", "order amplitude (µm; µrad for a rotation)"))
 
@@ -77,7 +77,7 @@ def waterfall_figure(result) -> dict:
     n, d = result.waterfall_dof
     return figure([{"type": "heatmap", "x": w.frequencies, "y": speed, "z": MICRO * np.asarray(w.amplitudes),
                     "colorscale": "Viridis", "colorbar": {"title": {"text": "µm"}},
-                    "hovertemplate": hover("%{x:.5g} Hz", f"{ref} %{{y:.6g}} rpm", "%{z:.4g} µm")}],
+                    "hovertemplate": hover("%{x:.5~g} Hz", f"{ref} %{{y:.6~g}} rpm", "%{z:.4~g} µm")}],
                   layout(f"{result.scene.name}: waterfall of node {n} {direction_name(d)}", "frequency (Hz)",
                          f"{ref} speed (rpm)"))
 

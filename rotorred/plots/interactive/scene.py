@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from rotorred.model.dofs import direction_name
-from rotorred.plots.interactive._layout import MICRO, decimated, figure, hover, layout
+from rotorred.plots.interactive._layout import MICRO, color, decimated, figure, hover, layout
 from rotorred.plots.interactive.report import Panel, Report
 
 #: most samples a waveform or orbit trace embeds (every k-th sample beyond)
@@ -71,12 +71,13 @@ def _waveforms(t, signals: dict, title: str, window) -> dict:
     part = np.flatnonzero((t >= lo) & (t <= hi))
     pick = part[decimated(part.size, MOST_SAMPLES)]
     data = []
-    for name, series in signals.items():
+    for k, (name, series) in enumerate(signals.items()):
         for label, x in series.items():
             full = f"{name} {label}".strip()
             data.append({"type": "scatter", "mode": "lines", "x": t[pick], "y": MICRO * np.asarray(x)[pick],
-                         "name": full, "line": {"width": 1.2, "dash": "dot" if label == "normal" else "solid"},
-                         "hovertemplate": hover(full, "t = %{x:.5g} s", f"%{{y:.4g}} {_unit(name)}")})
+                         "name": full, "line": {"width": 1.2, "dash": "dot" if label == "normal" else "solid",
+                                                "color": color(k)},
+                         "hovertemplate": hover(full, "t = %{x:.5~g} s", f"%{{y:.4~g}} {_unit(name)}")})
     return figure(data, layout(title, "time (s)", "displacement (µm) or rotation (µrad)"))
 
 
@@ -92,15 +93,15 @@ def _spectra(result, node: int) -> dict:
             pick = decimated(f.size, MOST_BINS)
             data.append({"type": "scatter", "mode": "lines", "x": f[pick], "y": MICRO * a[pick],
                          "name": f"{label} {direction_name(d)}", "line": {"width": 1},
-                         "hovertemplate": hover(f"{label} {direction_name(d)}", "%{x:.5g} Hz", f"%{{y:.4g}} {unit}")})
+                         "hovertemplate": hover(f"{label} {direction_name(d)}", "%{x:.5~g} Hz", f"%{{y:.4~g}} {unit}")})
         lines = result.lines[dof].lines
         known += [ln.frequency_hz for ln in lines]
         data.append({"type": "scatter", "mode": "markers", "name": f"lines {direction_name(d)}",
                      "x": [ln.frequency_hz for ln in lines], "y": [MICRO * ln.amplitude for ln in lines],
                      "marker": {"symbol": "triangle-down", "size": 9},
                      "customdata": [[ln.label, ln.share] for ln in lines],
-                     "hovertemplate": hover("%{customdata[0]}", "%{x:.6g} Hz", f"%{{y:.4g}} {unit}",
-                                            "share %{customdata[1]:.3g}")})
+                     "hovertemplate": hover("%{customdata[0]}", "%{x:.6~g} Hz", f"%{{y:.4~g}} {unit}",
+                                            "share %{customdata[1]:.3~g}")})
     f_max = sc.output.f_max_hz or max(1.1 * max(known, default=0.0), 3.0 * result.f_H)
     top = max((np.nanmax(t["y"]) for t in data if len(t["y"])), default=1.0)
     decades = np.log10(max(top, 1e-30))
@@ -114,13 +115,14 @@ def _orbits(result, pairs) -> dict:
     sc, data = result.scene, []
     n = result.t.size
     pick = decimated(n, MOST_SAMPLES)
-    for node in sc.output.nodes:
+    for k, node in enumerate(sc.output.nodes):
         for label, r in pairs:
             name = f"node {node} ({sc.rotor.spool_of[node]}) {label}"
-            data.append({"type": "scatter", "mode": "lines", "name": name, "line": {"width": 1},
+            data.append({"type": "scatter", "mode": "lines", "name": name,
+                         "line": {"width": 1, "color": color(k), "dash": "dot" if label == "normal" else "solid"},
                          "x": MICRO * np.asarray(r.outputs[(node, "x")])[pick],
                          "y": MICRO * np.asarray(r.outputs[(node, "y")])[pick],
-                         "hovertemplate": hover(name, "x %{x:.4g} µm, y %{y:.4g} µm")})
+                         "hovertemplate": hover(name, "x %{x:.4~g} µm, y %{y:.4~g} µm")})
     for p in sc.plates:
         angle = p.theta
         data.append({"type": "scatter", "mode": "markers", "name": f"plate at node {p.node}",
@@ -139,7 +141,7 @@ def _poincare(result) -> dict:
     unit = _unit(_dof_name(a.dof))
     return figure([{"type": "scatter", "mode": "markers", "name": c.label, "x": MICRO * c.poincare.x,
                     "y": MICRO * c.poincare.velocity, "marker": {"size": 4},
-                    "hovertemplate": hover(c.label, f"%{{x:.5g}} {unit}", f"%{{y:.5g}} {unit}/s")}],
+                    "hovertemplate": hover(c.label, f"%{{x:.5~g}} {unit}", f"%{{y:.5~g}} {unit}/s")}],
                   layout(f"{result.scene.name}: Poincare section of {_dof_name(a.dof)}: {c.label}, once per "
                          f"{1.0 / c.poincare.frequency_hz:.4g} s", f"displacement ({unit})", f"velocity ({unit}/s)"))
 
