@@ -218,3 +218,22 @@ def test_the_report_of_a_202_point_map_at_the_stores_limits_is_at_most_15_mb(tmp
     size = report_of(run).write(tmp_path / "report.html").stat().st_size
     print(f"report of a 202-point map at the store's limits: {size / 1e6:.2f} MB")
     assert size <= 15e6
+
+
+def test_a_full_disk_while_writing_a_report_is_exit_4_naming_report_html(tmp_path):
+    """Under a file-size limit of 1 MB (below plotly.js, above every other file of the command), ``rotorred campbell``
+    exits 4 with one line naming --out's report.html and the limit; nothing of the result is kept (the folder, new,
+    is removed)."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("resource", reason="RLIMIT_FSIZE needs POSIX")
+    out = tmp_path / "out"
+    code = ("import resource, sys\nfrom rotorred.cli import main\n"
+            "resource.setrlimit(resource.RLIMIT_FSIZE, (1_000_000, resource.RLIM_INFINITY))\n"
+            f"sys.exit(main(['campbell', 'seed-rig', '--speeds', '0:6000:5', '--out', {str(out)!r}]))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    errors = [line for line in done.stderr.splitlines() if ": error: " in line]
+    assert done.returncode == 4 and len(errors) == 1, done.stderr[-2000:]
+    assert f"could not write {str(out / 'report.html')!r}: the file would exceed the file-size limit" in errors[0]
+    assert not out.exists() and "Traceback" not in done.stderr
