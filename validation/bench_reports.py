@@ -2,7 +2,7 @@
 
 ``rotorred campbell seed-rig --speeds 0:12000:61`` runs ``ROUNDS`` times each way, alternating (with, without, with,
 ...), each a fresh subprocess (one BLAS thread); the table gives each way's median wall time, their difference (what
-the report adds: the mode shapes at 21 speeds, one eigen-solve each, and the page with plotly.js inlined) and the
+the report adds: the mode shapes at 16 speeds, one eigen-solve each, and the page with plotly.js inlined) and the
 report's size. The issue's limits: at most 1 s added, at most 5 MB. Where the machine is shared, say so beside the
 numbers (both ways ran in the same minutes, alternating). On a loaded machine wall times swing by seconds, so the
 report's own cost is also measured in one process as CPU time (``time.process_time``, one thread): the Campbell

@@ -21,7 +21,7 @@ QUANTUM = 127
 ORBITS = 6
 #: most speeds whose mode shapes a report embeds (every k-th of the diagram's, the first and last among them): one
 #: eigen-solve each, as costly as the diagram's own; a click shows the shape at the nearest of them
-SHAPE_SPEEDS = 21
+SHAPE_SPEEDS = 16
 
 
 def figures(result, operating_speed: float | None = None) -> list[tuple[str, dict]]:

@@ -23,7 +23,8 @@ BIFURCATION_SAMPLES, ORBIT_SAMPLES = 100, 400
 ORBIT_PERIODS, ORBIT_POINTS, ORBIT_PER_CYCLE, ORBIT_MOST = 20, 2000, 40, 40000
 #: colours of the classes
 CLASS_COLORS = {"periodic": "#1f77b4", "quasi-periodic": "#2ca02c", "chaotic": "#d62728", "unexplained": "#9467bd",
-                "unsettled": "#7f7f7f", "failed": "#000000"}
+                "unsettled": "#7f7f7f", "failed": "#000000", "period-2": "#e377c2", "period-3": "#bcbd22",
+                "period-4": "#17becf"}
 _DIRECTION_COLORS = {"up": "#1f77b4", "down": "#ff7f0e"}
 
 
@@ -97,7 +98,7 @@ def class_figure(ds, pts: list[dict]) -> dict:
         x = [p["value"][keys[0]] for _, p in group]
         y = [p["direction"] for _, p in group] if len(keys) == 1 else [p["value"][keys[1]] for _, p in group]
         data.append({"type": "scatter", "mode": "markers", "name": kind, "x": x, "y": y, "meta": "points",
-                     "marker": {"size": 11, "color": CLASS_COLORS.get(kind, "#e377c2"), "line": {"width": 1},
+                     "marker": {"size": 11, "color": CLASS_COLORS.get(kind, "#8c564b"), "line": {"width": 1},
                                 "symbol": ["circle-open" if len(keys) > 1 and p["direction"] == "down" else "circle"
                                            for _, p in group]},
                      "customdata": [[i, *_hover_row(p)] for i, p in group], "hovertemplate": _POINT_HOVER})

@@ -163,10 +163,16 @@ def to_json(value) -> str:
     return "".join(_json_parts(value))
 
 
+def _number(value: float) -> str:
+    return f"{value:.{DIGITS}g}" if math.isfinite(value) else "null"
+
+
 def _json_parts(value):
     if isinstance(value, np.ndarray):
         value = value.tolist()
-    if isinstance(value, Mapping):
+    if type(value) is list and value and all(type(v) is float for v in value):  # the bulk: a row of numbers
+        yield "[" + ",".join(map(_number, value)) + "]"
+    elif isinstance(value, (dict, Mapping)):
         yield "{"
         for i, (k, v) in enumerate(value.items()):
             yield ("," if i else "") + json.dumps(str(k)) + ":"
@@ -184,6 +190,6 @@ def _json_parts(value):
     elif isinstance(value, (int, np.integer)):
         yield str(int(value))
     elif isinstance(value, (float, np.floating)):
-        yield f"{float(value):.{DIGITS}g}" if math.isfinite(value) else "null"
+        yield _number(float(value))
     else:
         yield json.dumps(str(value), ensure_ascii=False)
