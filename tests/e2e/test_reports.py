@@ -102,8 +102,8 @@ def _campbell_rows(folder: Path) -> list[dict]:
 
 
 def test_the_campbell_view_shows_a_point_a_row_and_its_hover_and_click(reports, tab):
-    """Points drawn = rows of campbell.csv; a mouse hover on mode 10 at 6000 rpm shows that row's frequency and
-    whirl; a click draws that mode's shape."""
+    """Points drawn = rows of campbell.csv; a mouse hover on mode 10 at a speed near 6000 rpm whose shape the report
+    embeds shows that row's frequency and whirl; a click draws that mode's shape at that speed."""
     folder = reports["campbell"]
     rows = _campbell_rows(folder)
     _open(tab, folder)
@@ -111,8 +111,11 @@ def test_the_campbell_view_shows_a_point_a_row_and_its_hover_and_click(reports, 
         const traces = gd.querySelectorAll('.scatterlayer .trace');
         return gd.data.map((t, i) => t.meta === 'mode' ? traces[i].querySelectorAll('path.point').length : 0); }""")
     assert sum(counts) == len(rows) == 61 * len([c for c in counts if c])
-    row = next(r for r in rows if float(r["speed_rpm"]) == 6000.0 and r["mode"] == "10")
-    x, y = tab.page.evaluate(_MARKER, ["campbell", 9, 30])
+    at = tab.page.evaluate("RR.data.shapes.at")
+    i = min(at, key=lambda k: abs(k - 30))
+    rpm = f"{200 * i}"  # 0:12000:61
+    row = next(r for r in rows if float(r["speed_rpm"]) == float(rpm) and r["mode"] == "10")
+    x, y = tab.page.evaluate(_MARKER, ["campbell", 9, i])
     tab.page.mouse.move(x, y)
     tab.page.wait_for_selector("#rr-campbell .hoverlayer .hovertext", timeout=10000)
     text = tab.page.evaluate("""() => { const t = document.querySelector('#rr-campbell .hoverlayer .hovertext text');
@@ -120,10 +123,11 @@ def test_the_campbell_view_shows_a_point_a_row_and_its_hover_and_click(reports, 
         return lines.length ? lines.join('\\n') : t.textContent; }""")
     shown = float(re.search(r"([\d.]+) Hz", text).group(1))
     assert shown == pytest.approx(float(row["frequency_hz"]), rel=5e-5), text
-    assert f"mode 10: {row['whirl']} whirl" in text and "\n6000 rpm\n" in text, text
+    assert f"mode 10: {row['whirl']} whirl" in text and f"\n{rpm} rpm\n" in text, text
     tab.screenshot("report-campbell-hover")
     tab.page.mouse.click(x, y)
-    tab.page.wait_for_function("RR.div('shape').layout.title.text.startsWith('mode 10 at 6000 rpm')", timeout=10000)
+    tab.page.wait_for_function(f"RR.div('shape').layout.title.text.startsWith('mode 10 at {rpm} rpm: ')",
+                               timeout=10000)
     tab.screenshot("report-campbell-click")
     assert tab.errors == [] and tab.refused == []
 

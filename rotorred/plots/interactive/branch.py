@@ -1,5 +1,5 @@
 """Interactive branch of periodic solutions: amplitude against the continuation parameter, stable solid, unstable
-dashed, not computed dotted grey; folds and bifurcations marked with their values on hover
+dashed, not computed dotted; folds and bifurcations marked with their values on hover
 (:class:`rotorred.scenes.branch.SceneBranch`, ``rotorred continue``;
 :class:`rotorred.nonlinear.continuation.Branch`)."""
 
@@ -68,7 +68,7 @@ def branch_figure(result) -> dict:
             data.append({"type": "scatter", "mode": "lines", "x": x[part], "y": y[part],
                          "name": f"{name}, {state}", "legendgroup": f"{name} {state}",
                          "showlegend": (name, state) not in shown, "customdata": custom[part],
-                         "line": {"dash": dash, "width": 2, "color": "#999" if flags[lo] < 0 else color(k)},
+                         "line": {"dash": dash, "width": 2, "color": color(k)},
                          "hovertemplate": hover(f"{name}: {state}", f"{xtitle} %{{x:.6~g}}", "%{y:.4~g}", *extra)})
             shown.add((name, state))
         if k == 0:

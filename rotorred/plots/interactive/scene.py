@@ -85,20 +85,22 @@ def _spectra(result, node: int) -> dict:
     """The amplitude spectra of ``node``'s directions (log amplitude, µm) with each fitted line marked, its label,
     frequency, amplitude and share on hover."""
     sc, data, known = result.scene, [], []
-    for d in sc.output.directions:
+    for k, d in enumerate(sc.output.directions):
         dof, unit = (node, d), _unit(_dof_name((node, d)))
         for label, r in _pairs(result):
             s = r.spectra[dof]
             f, a = np.asarray(s.frequencies, float), np.asarray(s.amplitudes, float)
             pick = decimated(f.size, MOST_BINS)
             data.append({"type": "scatter", "mode": "lines", "x": f[pick], "y": MICRO * a[pick],
-                         "name": f"{label} {direction_name(d)}", "line": {"width": 1},
+                         "name": f"{label} {direction_name(d)}",
+                         "line": {"width": 1, "color": color(k), "dash": "dot" if label == "normal" else "solid"},
                          "hovertemplate": hover(f"{label} {direction_name(d)}", "%{x:.5~g} Hz", f"%{{y:.4~g}} {unit}")})
         lines = result.lines[dof].lines
         known += [ln.frequency_hz for ln in lines]
         data.append({"type": "scatter", "mode": "markers", "name": f"lines {direction_name(d)}",
                      "x": [ln.frequency_hz for ln in lines], "y": [MICRO * ln.amplitude for ln in lines],
-                     "marker": {"symbol": "triangle-down", "size": 9},
+                     "marker": {"symbol": "triangle-down", "size": 9, "color": color(k),
+                                "line": {"width": 1, "color": "black"}},
                      "customdata": [[ln.label, ln.share] for ln in lines],
                      "hovertemplate": hover("%{customdata[0]}", "%{x:.6~g} Hz", f"%{{y:.4~g}} {unit}",
                                             "share %{customdata[1]:.3~g}")})
