@@ -6,7 +6,8 @@ its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.
 each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key, the
 peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of each
 harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png`` (peak
-against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``.
+against the key: stable solid, unstable dashed, folds and corners marked), ``branch.txt`` and ``report.html`` (the
+same, interactive; ``--no-html``: none).
 
 SIGINT or SIGTERM while the branch is traced or its stability computed ends it there and keeps every point traced:
 the files are written with them all (those without their stability marked "unknown", the folder INCOMPLETE, the

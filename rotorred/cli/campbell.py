@@ -2,7 +2,9 @@
 
 Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv`` (with the API 684 / 617 amplification factors and
 separation margins, :mod:`rotorred.linear.margins`), ``campbell.txt`` (what it prints, under the
-rotorred version, command line and date) and ``rotor.toml`` (the rotor as read, a rotor file that gives it again).
+rotorred version, command line and date), ``rotor.toml`` (the rotor as read, a rotor file that gives it again) and
+``report.html`` (the interactive diagram: hover a point for its mode, whirl and damping, click it for its mode shape;
+``--no-html`` leaves it out: :mod:`rotorred.cli.report`).
 """
 
 from __future__ import annotations

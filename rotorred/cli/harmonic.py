@@ -8,7 +8,8 @@ model ("full" or "reduced", with its mode count, cutoff, boundary nodes and rub 
 Writes ``response.csv`` (speeds in rpm, amplitudes in µm, phases in deg), ``bode.png`` and
 ``polar.png`` into ``--out``; with ``--frf`` also ``frf.csv`` and ``frf.png``; and ``harmonic.txt`` (what it prints,
 under the rotorred version, command line and date) with the resolved input: ``rotor.toml`` (the rotor as read) or,
-for a scene, ``scene.toml`` (:mod:`rotorred.scenes.resolved`).
+for a scene, ``scene.toml`` (:mod:`rotorred.scenes.resolved`); and ``report.html``, the Bode and polar plots with
+hover (``--no-html`` leaves it out: :mod:`rotorred.cli.report`).
 
 Defaults (documented in ``--help``):
 

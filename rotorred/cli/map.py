@@ -8,7 +8,8 @@ LocalCluster, one single-threaded worker per core, unless ``--scheduler`` names 
 0`` runs serially), each point from its neighbour's final state along the first key (``--cold``:
 from the scene's start), up, down or both ways, each until settled or ``--limit`` seconds. Writes
 ``map.nc`` (xarray/NetCDF), ``map.csv``, ``map_lines.csv``, ``map.txt``, the figures and ``scene.toml`` (the
-resolved base scene; the command line, with the varied keys, is at the top of ``map.txt`` and in ``map.nc``); the
+resolved base scene; the command line, with the varied keys, is at the top of ``map.txt`` and in ``map.nc``),
+``report.html`` (class map and bifurcation diagram, a point's orbit and spectrum on a click; ``--no-html``: none); the
 points are kept in ``DIR/points`` as they finish, and the same command resumes an interrupted map.
 """
 

@@ -9,7 +9,8 @@ and in the NPZ and .mat: :mod:`rotorred.provenance`), and prints the summary. A 
 built-in ``runup``, ``runup-rub``, ``coastdown-rub``) writes ``runup_amplitude.png``,
 ``order_tracks.png``, ``waterfall.png``, ``runup_orbits.png``, their CSV files
 (``runup_amplitude.csv``, ``order_tracks.csv``, ``rub_intervals.csv``, ``critical_speeds.csv``),
-the record and ``summary.txt``.
+the record and ``summary.txt``. Both write ``report.html``, the interactive figures (``--no-html`` leaves it out:
+:mod:`rotorred.cli.report`).
 
 Everything is checked before computing (the scene, ``--out``, the size estimate of
 :mod:`rotorred.scenes.budget`); the files are staged and moved into ``--out`` when complete
