@@ -157,6 +157,9 @@ _EXPORTS = {
     "FigurePool": "rotorred.plots.pool",
     "save_figure": "rotorred.plots.axes",
     "scene_frames": "rotorred.plots.scene",
+    # interactive views (plotly): report.html of every command, Result.view()
+    "write_report": "rotorred.plots.interactive",
+    "report_of": "rotorred.plots.interactive",
     "run_scene": "rotorred.scenes.run",
     "SceneResult": "rotorred.scenes.run",
     "write_outputs": "rotorred.scenes.outputs",

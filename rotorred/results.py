@@ -8,6 +8,8 @@ branch, ...) derives from :class:`Result` and gives three things:
 - :meth:`Result.plot` -- ``plot(ax=None, **options)`` draws the result into ``ax`` (a new figure
   when ``None``) and returns the matplotlib ``Figure``. The drawing lives in :mod:`rotorred.plots`;
   ``plot`` imports it when called, so that building a result never loads matplotlib.
+- :meth:`Result.view` -- ``view(**options)``: the result as an interactive plotly ``Figure`` (inline in Jupyter),
+  drawn by :mod:`rotorred.plots.interactive` (imported when called); ``_repr_html_`` shows the summary in a notebook.
 - :meth:`Result.to_xarray` -- an :class:`xarray.Dataset` with named dimensions and a ``units``
   attribute on every variable and coordinate (``"1"`` for a dimensionless one), so that
   :func:`rotorred.writers.write_netcdf` writes it as CF NetCDF and reads it back as it was.
@@ -33,11 +35,15 @@ class Result:
         """What was computed, on what, and the headline numbers: a few short lines without arrays."""
         raise NotImplementedError(f"{type(self).__name__}.summary")
 
-    def __repr__(self) -> str:
-        lines = [str(line) for line in self.summary()]
-        if len(lines) > MAX_REPR_LINES - 1:  # a bug of the type's summary: keep the repr short all the same
-            lines = lines[: MAX_REPR_LINES - 2] + [f"... ({len(lines) - MAX_REPR_LINES + 2} more lines)"]
-        return "\n".join([f"{type(self).__name__}:"] + [f"  {line}" for line in lines])
+    def __repr__(self) -> str:  # (borrowed by types with a summary that are not results, e.g. Rotor)
+        return "\n".join([f"{type(self).__name__}:"] + [f"  {line}" for line in _short_summary(self)])
+
+    def _repr_html_(self) -> str:
+        """The summary as a notebook shows it: the type's name and its lines, HTML-escaped."""
+        import html
+
+        return (f'<div class="rotorred-result"><strong>{html.escape(type(self).__name__)}</strong>'
+                f'<pre>{html.escape(chr(10).join(_short_summary(self)))}</pre></div>')
 
     def plot(self, ax=None, **options):
         """Draw the result into ``ax`` (a new figure when None); return the matplotlib Figure.
@@ -55,9 +61,41 @@ class Result:
         """
         raise NotImplementedError(f"{type(self).__name__}.plot")
 
+    def view(self, **options):
+        """The result as an interactive plotly Figure, which displays inline in Jupyter (the interactive counterpart
+        of :meth:`plot`, what ROSS's ``plot`` returns: rotorred's ``plot(backend="plotly")``).
+
+        Parameters
+        ----------
+        **options
+            ``kind``, the figure's name (default the result's main figure: the Campbell diagram, the Bode plot, the
+            waveforms, the class map, the branch, the amplitude against speed), and the options of the type's view in
+            :mod:`rotorred.plots.interactive` (e.g. ``operating_speed`` (rad/s) of a Campbell diagram).
+
+        Returns
+        -------
+        plotly.graph_objects.Figure
+
+        Raises
+        ------
+        InputError
+            If the type has no interactive view (:data:`rotorred.plots.interactive.VIEWS`) or ``kind`` is unknown.
+        """
+        from rotorred.plots.interactive import view
+
+        return view(self, **options)
+
     def to_xarray(self):
         """The result as an :class:`xarray.Dataset` with named dimensions and ``units`` on every variable."""
         raise NotImplementedError(f"{type(self).__name__}.to_xarray")
+
+
+def _short_summary(result) -> list[str]:
+    """``result.summary()`` as text lines, cut to :data:`MAX_REPR_LINES` - 1."""
+    lines = [str(line) for line in result.summary()]
+    if len(lines) > MAX_REPR_LINES - 1:  # a bug of the type's summary: keep the repr short all the same
+        lines = lines[: MAX_REPR_LINES - 2] + [f"... ({len(lines) - MAX_REPR_LINES + 2} more lines)"]
+    return lines
 
 
 def label_coordinate(dim: str, labels: Sequence[str], long_name: str) -> tuple:

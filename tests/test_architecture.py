@@ -33,6 +33,8 @@ LAYERS = {
 }
 #: where matplotlib may be imported
 MATPLOTLIB_ALLOWED = ("rotorred.plots", "rotorred.cli")
+#: the plotting libraries confined there
+PLOTTING = ("matplotlib", "plotly")
 #: longest function allowed (lines of body, docstring excluded), and the compiled step loop's limit
 MAX_FUNCTION_LINES = 80
 MAX_KERNEL_LOOP_LINES = 150
@@ -55,8 +57,10 @@ MODULES = _modules()
 
 
 #: the one upward import allowed: a result's ``plot`` method imports its drawing from rotorred.plots when called
-#: (rotorred.results.Result), as xarray's ``.plot`` does, so that a result never loads matplotlib until it is drawn
+#: (rotorred.results.Result), as xarray's ``.plot`` does, so that a result never loads matplotlib until it is drawn;
+#: ``view``, its interactive (plotly) counterpart, likewise
 PLOT_METHOD = "plot"
+PLOT_METHODS = (PLOT_METHOD, "view")
 
 
 def _plot_method_imports(tree: ast.Module) -> set[int]:
@@ -64,7 +68,7 @@ def _plot_method_imports(tree: ast.Module) -> set[int]:
     out = set()
     for cls in (n for n in ast.walk(tree) if isinstance(n, ast.ClassDef)):
         for fn in cls.body:
-            if isinstance(fn, ast.FunctionDef) and fn.name == PLOT_METHOD:
+            if isinstance(fn, ast.FunctionDef) and fn.name in PLOT_METHODS:
                 out |= {id(n) for n in ast.walk(fn) if isinstance(n, ast.ImportFrom)
                         and (n.module or "").startswith("rotorred.plots")}
     return out
@@ -167,7 +171,7 @@ def test_cycle_finder_finds_a_cycle():
 
 def test_matplotlib_only_in_plots_and_cli():
     bad = [m for m, t in MODULES.items()
-           if any(i == "matplotlib" or i.startswith("matplotlib.") for i in _imports(m, t))
+           if any(i.split(".")[0] in PLOTTING for i in _imports(m, t))
            and not m.startswith(MATPLOTLIB_ALLOWED)]
     assert not bad, bad
 

@@ -55,7 +55,7 @@ def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
     assert 0.34 < npz["t"][-1] < 0.3486 and np.all(np.isfinite(npz["rub_18_x"]))
     assert len((out / "timeseries.csv").read_text().splitlines()) == len(npz["t"]) + 1
     assert sorted((out / ".rotorred-files").read_text().split()) == sorted(
-        ["INCOMPLETE", "result.npz", "scene.toml", "summary.txt", "timeseries.csv"])
+        ["INCOMPLETE", "report.html", "result.npz", "scene.toml", "summary.txt", "timeseries.csv"])
     assert_provenance(out, argv, "summary.txt", "scene", since)  # under the INCOMPLETE line, which stays first
 
 

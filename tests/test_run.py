@@ -189,8 +189,8 @@ def test_cli_run(tmp_path, capsys):
     assert "harmonic steady state" in out and "wall time" in out
     # the result's files, and the hidden manifest naming them (rotorred.writers.OutputFolder); no lock, no staging
     assert sorted(p.name for p in (tmp_path / "out").iterdir() if not p.name.startswith(".")) == [
-        "result.npz", "scene.toml", "spectra_node14.png", "summary.txt"]
-    assert (tmp_path / "out" / ".rotorred-files").read_text().split() == ["result.npz", "scene.toml",
+        "report.html", "result.npz", "scene.toml", "spectra_node14.png", "summary.txt"]
+    assert (tmp_path / "out" / ".rotorred-files").read_text().split() == ["report.html", "result.npz", "scene.toml",
                                                                           "spectra_node14.png", "summary.txt"]
     assert sorted(p.name for p in (tmp_path / "out").iterdir() if p.name.startswith(".")) == [".rotorred-files"]
 

@@ -6,7 +6,8 @@ its supports' stiffness in N/m, ``rub.K_nr``, ``rub.mu_d`` ...: ``scenes.branch.
 each point's stability (Floquet multipliers of the monodromy matrix). Writes ``branch.csv`` (a row a point: the key, the
 peak of each output DOF in µm, the largest multiplier, stable or not), ``branch_lines.csv`` (the amplitude of each
 harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xarray/NetCDF), ``branch.png`` (peak
-against the key: stable solid, unstable dashed, folds and corners marked) and ``branch.txt``.
+against the key: stable solid, unstable dashed, folds and corners marked), ``branch.txt`` and ``report.html`` (the
+same, interactive; ``--no-html``: none).
 
 SIGINT or SIGTERM while the branch is traced or its stability computed ends it there and keeps every point traced:
 the files are written with them all (those without their stability marked "unknown", the folder INCOMPLETE, the
@@ -21,6 +22,7 @@ from __future__ import annotations
 from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance
+from rotorred.cli.report import add_html_option, stage_report
 from rotorred.cli.run import interruptible
 
 
@@ -43,6 +45,7 @@ def add_parser(subparsers):
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true",
                    help="go on with a branch beyond the size limits (steps, memory, model size; see the message)")
+    add_html_option(p)
     return p
 
 
@@ -88,7 +91,7 @@ def run(args) -> int:
         branch = continue_scene(scene, model, key, start, stop, options,
                                 progress=tracing, interrupts=interrupts)
     report(format_branch(branch))
-    files, late = _write(branch, out, interrupts, record)
+    files, late = _write(branch, out, interrupts, record, args)
     for f in files:
         report(f"wrote {f}")
     if branch.interrupted:
@@ -100,7 +103,7 @@ def run(args) -> int:
     return 0
 
 
-def _write(branch, out, interrupts: dict, record=None) -> tuple[list, str]:
+def _write(branch, out, interrupts: dict, record=None, args=None) -> tuple[list, str]:
     """Stage and commit the branch's files into ``out`` with SIGINT and SIGTERM held back (``writers.signals_held``,
     as a commit is), so that a signal does not cut them (nor leave a file half made): the points an interrupt kept,
     or a complete branch, are written whole. A signal that came meanwhile is dropped once they are committed. The
@@ -111,6 +114,8 @@ def _write(branch, out, interrupts: dict, record=None) -> tuple[list, str]:
     try:
         with writers.signals_held(), folder:
             write_branch(branch, folder, record)
+            if args is not None:
+                stage_report(args, folder, branch)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except tuple(interrupts) as exc:
         if not folder.committed:

@@ -2,7 +2,9 @@
 
 Writes ``campbell.csv``, ``campbell.png``, ``critical_speeds.csv`` (with the API 684 / 617 amplification factors and
 separation margins, :mod:`rotorred.linear.margins`), ``campbell.txt`` (what it prints, under the
-rotorred version, command line and date) and ``rotor.toml`` (the rotor as read, a rotor file that gives it again).
+rotorred version, command line and date), ``rotor.toml`` (the rotor as read, a rotor file that gives it again) and
+``report.html`` (the interactive diagram: hover a point for its mode, whirl and damping, click it for its mode shape;
+``--no-html`` leaves it out: :mod:`rotorred.cli.report`).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 
 from rotorred import checks, writers
 from rotorred.cli.feedback import report
+from rotorred.cli.report import add_html_option, stage_report
 from rotorred.cli.options import (grid, number_list, options_named, out_dir, provenance, ratio_number,
                                   speed_line, spool_ratios, stage_summary)
 
@@ -94,6 +97,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         "operating_range_rpm of that spool; without either, amplification factors only)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
+    add_html_option(p)
     return p
 
 
@@ -150,8 +154,8 @@ def run(args) -> int:
         files = [result.to_csv(folder.staged("campbell.csv"))]
         ref_nominal = rotor.speeds[result.reference]
         api = []
+        operating_speed = ref_nominal if ref_nominal > 0 else None
         if len(result.speeds) > 1:  # one speed is a table, not a diagram
-            operating_speed = ref_nominal if ref_nominal > 0 else None
             files.append(save_figure(result.plot(operating_speed=operating_speed), folder.staged("campbell.png")))
             rng = operating_range(given_range, rotor, result.reference)
             margins = separation_margins(model, result, rng)
@@ -160,6 +164,7 @@ def run(args) -> int:
         text = "\n".join([format_critical_speeds(result) if len(result.speeds) > 1 else format_whirl_table(result),
                           format_mode_count(result)] + api + ([comparison] if comparison else []))
         files += stage_summary(folder, "campbell.txt", text, record)
+        files += stage_report(args, folder, result, model=model, operating_speed=operating_speed)
         folder.commit()
     report(text)
     report("wrote " + " and ".join(str(out / f.name) for f in files))

@@ -8,7 +8,8 @@ model ("full" or "reduced", with its mode count, cutoff, boundary nodes and rub 
 Writes ``response.csv`` (speeds in rpm, amplitudes in µm, phases in deg), ``bode.png`` and
 ``polar.png`` into ``--out``; with ``--frf`` also ``frf.csv`` and ``frf.png``; and ``harmonic.txt`` (what it prints,
 under the rotorred version, command line and date) with the resolved input: ``rotor.toml`` (the rotor as read) or,
-for a scene, ``scene.toml`` (:mod:`rotorred.scenes.resolved`).
+for a scene, ``scene.toml`` (:mod:`rotorred.scenes.resolved`); and ``report.html``, the Bode and polar plots with
+hover (``--no-html`` leaves it out: :mod:`rotorred.cli.report`).
 
 Defaults (documented in ``--help``):
 
@@ -30,6 +31,7 @@ import numpy as np
 
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import report
+from rotorred.cli.report import add_html_option, stage_report
 from rotorred.cli.options import (dof_list, grid, node_list, options_named, out_dir, provenance,
                                   ratio_number, speed_line, spool_ratios, stage_summary)
 
@@ -81,6 +83,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help=f"FRF frequencies in Hz START:STOP:N (with --frf; default {FRF_FREQUENCIES})")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true", help="go on with a model beyond the size limits")
+    add_html_option(p)
     return p
 
 
@@ -258,6 +261,7 @@ def run(args) -> int:
         names = _write(folder, result, title, model, rotor, frf_pairs, frf_freqs)
         text = _report(args, rotor, scene, label, unbalances, elapsed, result)
         names += [f.name for f in stage_summary(folder, "harmonic.txt", text, record)]
+        names += [f.name for f in stage_report(args, folder, result, title=title)]
         folder.commit()
     report(text)
     for name in names:

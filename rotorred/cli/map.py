@@ -8,7 +8,8 @@ LocalCluster, one single-threaded worker per core, unless ``--scheduler`` names 
 0`` runs serially), each point from its neighbour's final state along the first key (``--cold``:
 from the scene's start), up, down or both ways, each until settled or ``--limit`` seconds. Writes
 ``map.nc`` (xarray/NetCDF), ``map.csv``, ``map_lines.csv``, ``map.txt``, the figures and ``scene.toml`` (the
-resolved base scene; the command line, with the varied keys, is at the top of ``map.txt`` and in ``map.nc``); the
+resolved base scene; the command line, with the varied keys, is at the top of ``map.txt`` and in ``map.nc``),
+``report.html`` (class map and bifurcation diagram, a point's orbit and spectrum on a click; ``--no-html``: none); the
 points are kept in ``DIR/points`` as they finish, and the same command resumes an interrupted map.
 """
 
@@ -17,6 +18,7 @@ from __future__ import annotations
 from rotorred import checks
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
+from rotorred.cli.report import add_html_option, write_report_to
 from rotorred.cli.run import interruptible
 
 
@@ -43,6 +45,7 @@ def add_parser(subparsers):
     p.add_argument("--out", required=True, help="output directory (its points/ are kept: the same command resumes)")
     p.add_argument("--force", action="store_true",
                    help="go on with maps beyond the size limits (steps, memory, model size; see the message)")
+    add_html_option(p)
     return p
 
 
@@ -122,7 +125,7 @@ def run(args) -> int:
     result = run_map(spec, out, workers=n_workers, scheduler=args.scheduler, provenance=record,
                      force=args.force, interrupts=interrupts())
     report(format_map(result.dataset, spec))
-    for f in result.files:
+    for f in list(result.files) + write_report_to(args, out, result):
         report(f"wrote {f}")
     report(f"{result.n_run} points run, {result.n_resumed} resumed from {out / 'points'}; "
            f"wall time {result.wall_time:.2f} s")

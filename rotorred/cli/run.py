@@ -9,7 +9,8 @@ and in the NPZ and .mat: :mod:`rotorred.provenance`), and prints the summary. A 
 built-in ``runup``, ``runup-rub``, ``coastdown-rub``) writes ``runup_amplitude.png``,
 ``order_tracks.png``, ``waterfall.png``, ``runup_orbits.png``, their CSV files
 (``runup_amplitude.csv``, ``order_tracks.csv``, ``rub_intervals.csv``, ``critical_speeds.csv``),
-the record and ``summary.txt``.
+the record and ``summary.txt``. Both write ``report.html``, the interactive figures (``--no-html`` leaves it out:
+:mod:`rotorred.cli.report`).
 
 Everything is checked before computing (the scene, ``--out``, the size estimate of
 :mod:`rotorred.scenes.budget`); the files are staged and moved into ``--out`` when complete
@@ -25,6 +26,7 @@ import time
 from rotorred import checks, progress, writers
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import add_settings, out_dir, provenance
+from rotorred.cli.report import REPORT, add_html_option, stage_report
 
 DEFAULT_SCENE = "paper-rub"
 
@@ -135,6 +137,7 @@ def add_parser(subparsers):
     p.add_argument("--no-normal", action="store_true", help="do not compute the scene without rub for comparison")
     p.add_argument("--force", action="store_true",
                    help="go on with a run beyond the size limits (steps, memory, model size; see the message)")
+    add_html_option(p)
     return p
 
 
@@ -192,7 +195,7 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
     from rotorred.cli import EXIT_DIVERGED
 
     if scene.runup is not None:
-        return _runup_and_write(scene, folder, out, record)
+        return _runup_and_write(scene, args, folder, out, record)
     from rotorred import SceneDiverged, format_summary, run_to_tolerance, submit_figures, write_outputs
 
     drawing = []  # the record's figures: drawn while the line fit, settling and class are computed
@@ -203,17 +206,19 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
         result = run_to_tolerance(scene, progress=None, on_record=on_record)
     except SceneDiverged as exc:
         write_outputs(exc.partial, folder.staging, shown=out, pool=pool, provenance=record)
+        stage_report(args, folder, exc.partial)
         files = folder.commit(incomplete=str(exc))
         report(format_summary(exc.partial, files))
         error(f"{exc}; partial results written to {out} (marked {writers.INCOMPLETE})")
         return EXIT_DIVERGED
     files = write_outputs(result, folder.staging, shown=out, pool=pool, drawing=drawing, provenance=record)
+    files += [out / REPORT for _ in stage_report(args, folder, result)]
     folder.commit()
     report(format_summary(result, files))
     return 0
 
 
-def _runup_and_write(scene, folder, out, record) -> int:
+def _runup_and_write(scene, args, folder, out, record) -> int:
     """A run-up scene: the transient through its speed profile, its figures, data and summary; a diverged run
     writes what it computed up to then, analysed, marked INCOMPLETE (exit 3)."""
     from rotorred.cli import EXIT_DIVERGED
@@ -221,6 +226,7 @@ def _runup_and_write(scene, folder, out, record) -> int:
 
     result = run_runup(scene, progress=None)
     write_runup_outputs(result, folder.staging, shown=out, provenance=record)
+    stage_report(args, folder, result)
     committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:
