@@ -119,7 +119,7 @@ bad.write_text(ROTOR.replace("D_o = 0.060, D_i = 0.045", "D_o = 0.060, D_i = 0.0
 try:
     rr.load_rotor(bad)
 except rr.InputError as error:
-    print(error)
+    print(str(error).replace(str(folder), "<folder>"))
 
 # %%
 # The Campbell diagram

@@ -120,3 +120,7 @@ ax.set_ylabel("change of the whirl frequency (%)")
 ax.set_title("seed-rig: whirl frequencies with the shear term halved, against the element as derived")
 ax.grid(alpha=0.3)
 ax.legend(fontsize=7, ncol=2)
+
+# %%
+# The experiment is over: remove the copy.
+shutil.rmtree(work)
