@@ -52,12 +52,15 @@ from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proport
 from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, harmonic_dataset, sampled_forces
 from rotorred.nonlinear.torus_krylov import RankJacobian, block_product
 from rotorred.results import Result
+from rotorred.signals.spectra import pyfftw
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
 
 #: the loosest and the tightest relative tolerance of GMRES on a Newton step (the inexact Newton's forcing term,
 #: :func:`solve_torus`)
 FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
+#: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
+COMPLIANCE_CHUNK = 256
 
 def alias_free_grid(H1: int, H2: int, degree: int) -> tuple[int, int]:
     """The least even grid ``(N_1, N_2)`` that transforms a degree-``degree`` polynomial of a box ``H_1 x H_2``
@@ -143,6 +146,27 @@ class TorusHarmonics:
         if among is None:
             self._lazy["pairs"] = maps
         return maps
+
+    def _transform(self, kind: str, p: int):
+        """The real 2-D FFT of p signals on the grid (``forward``: samples (N_1, N_2, p) -> half spectrum
+        (N_1 / 2 + 1, N_2, p), unnormalised) or its inverse (``inverse``: normalised by 1 / (N_1 N_2)), the real
+        transform along theta_1: a pyFFTW plan kept per kind and p (a copy of its output returned), or scipy's FFT
+        without pyFFTW."""
+        key = (kind, p)
+        if key not in self._lazy:
+            half, full = (self.N1 // 2 + 1, self.N2, p), (self.N1, self.N2, p)
+            if pyfftw is None:
+                self._lazy[key] = (lambda x: sfft.rfftn(x, axes=(1, 0))) if kind == "forward" else \
+                    (lambda x: sfft.irfftn(x, s=(self.N2, self.N1), axes=(1, 0)))
+            else:
+                if kind == "forward":
+                    plan = pyfftw.builders.rfftn(pyfftw.empty_aligned(full, float), axes=(1, 0),
+                                                 planner_effort="FFTW_ESTIMATE", threads=1)
+                else:
+                    plan = pyfftw.builders.irfftn(pyfftw.empty_aligned(half, complex), s=(self.N2, self.N1),
+                                                  axes=(1, 0), planner_effort="FFTW_ESTIMATE", threads=1)
+                self._lazy[key] = lambda x: plan(x).copy()
+        return self._lazy[key]
 
     # ----------------------------------------------------------------------------------------------- sizes
     @property
@@ -303,8 +327,8 @@ class TorusHarmonics:
         C[self._half[1:]] = 0.5 * Q[1:]
         C[self._half_conjugate] = 0.5 * Q[self._axis_orders].conj()
         C[0] = Q[0]
-        q = sfft.irfftn(C.reshape(self.N1 // 2 + 1, self.N2, p), s=(self.N2, self.N1), axes=(1, 0), norm="forward")
-        return q.reshape(self.n_samples, p)
+        q = self._transform("inverse", p)(C.reshape(self.N1 // 2 + 1, self.N2, p))
+        return q.reshape(self.n_samples, p) * self.n_samples
 
     def derivative(self, z: np.ndarray, n: int, w) -> np.ndarray:
         """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``.
@@ -386,7 +410,7 @@ class TorusHarmonics:
             In the units of ``f``.
         """
         n = f.shape[1]
-        S = sfft.rfftn(f.reshape(self.N1, self.N2, n), axes=(1, 0), norm="forward").reshape(-1, n)
+        S = self._transform("forward", n)(f.reshape(self.N1, self.N2, n)).reshape(-1, n) / self.n_samples
         c = S[self._half]
         z = np.empty((self.size, n))
         z[0] = c[0].real
@@ -610,12 +634,19 @@ class TorusProblem:
 
     # ----------------------------------------------------------------------------------------------- condensation
     def _compliance(self) -> _Compliance:
-        """Z_k^-1 at every order's frequency, by one batched solve (computed once: w is fixed)."""
+        """Z_k^-1 at every order's frequency, by batched solves of :data:`COMPLIANCE_CHUNK` orders at a time (the
+        dynamic stiffnesses of all the orders at once would be the largest array of the solve), computed once: w is
+        fixed."""
         if "compliance" in self._cache:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
-        Z = self.K[None] - (wk**2)[:, None, None] * self.M[None] + 1j * wk[:, None, None] * self.D[None]
-        X, Q_full = dynamic_compliance(Z, c, self.harmonics.phasors(self.forcing, n_all))
+        forcing = self.harmonics.phasors(self.forcing, n_all)
+        X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
+        for lo in range(0, len(wk), COMPLIANCE_CHUNK):
+            part = slice(lo, lo + COMPLIANCE_CHUNK)
+            w = wk[part][:, None, None]
+            Z = self.K[None] - w**2 * self.M[None] + 1j * w * self.D[None]
+            X[part], Q_full[part] = dynamic_compliance(Z, c, forcing[part])
         H = X[:, c, :]
         out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
         self._cache["compliance"] = out
@@ -673,7 +704,8 @@ class TorusProblem:
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         R = z - self.linear_response() + self.apply(h.coefficients(f))
         flat = np.hstack([dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)])
-        base, factor = proportional_columns(flat)
+        active = np.flatnonzero(np.any(flat != 0.0, axis=1))  # a contact's samples (zero rows are proportional)
+        base, factor = proportional_columns(flat[active]) if active.size else ([], np.full((2 * c * c, 2), -1.0))
         terms = []
         for b in range(len(base)):
             for kind in (0, 1):
