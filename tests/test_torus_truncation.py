@@ -12,6 +12,7 @@ from rotorred.checks import InputError
 from rotorred.nonlinear.forces import CubicSpring
 from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
 from rotorred.nonlinear.torus_truncation import TorusOrdersNotConverged, torus_change, torus_to_tolerance
+from results_checks import assert_shows_itself
 
 C, K3, F1, F2 = 0.2, 0.5, 0.15, 0.1
 W = (0.8, 0.8 * math.sqrt(2.0))
@@ -50,7 +51,7 @@ def test_orders_chosen_by_the_change_bound_the_error_against_a_finer_torus():
         torus_to_tolerance(build, ladder[:1], first.linear_response(), 1e-4, amplitudes)
 
 
-def test_torus_balance_with_a_tolerance_names_the_orders_it_chose():
+def test_torus_balance_with_a_tolerance_names_the_orders_it_chose(tmp_path):
     """torus_balance with options.tolerance on paper-rub out of contact (clearance 1 mm, the response linear): the
     ladder doubles (2, 4) to (4, 8), the change is round-off (the forced lines are in both), so (4, 8) is returned
     and the summary says so; a grid given with a tolerance is refused."""
@@ -66,5 +67,6 @@ def test_torus_balance_with_a_tolerance_names_the_orders_it_chose():
     assert result.truncation.orders == (4, 8) and result.truncation.estimate < 1e-12
     assert result.problem.problem.harmonics.H1 == 4
     assert any("orders |k1| <= 4, |k2| <= 8" in line for line in result.summary())
+    assert_shows_itself(result, tmp_path, of=rr.RubTorus)
     with pytest.raises(InputError, match="options.grid"):
         rr.TorusOptions(grid=(64, 1024), tolerance=1e-3)

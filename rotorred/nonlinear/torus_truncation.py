@@ -50,11 +50,11 @@ class TorusTruncation:
     steps: tuple
 
     def describe(self) -> str:
-        """One line: the orders chosen and the changes that chose them."""
-        tried = ", ".join(f"{H[0]} x {H[1]}: {change:.2g}" for H, change in self.steps)
-        return (f"tolerance {self.tolerance:g}: orders |k1| <= {self.orders[0]}, |k2| <= {self.orders[1]} (grid "
-                f"{self.grid[0]} x {self.grid[1]}), the response's change from the truncation before "
-                f"{self.estimate:.2g} (largest over the outputs of ||Q_coarse - Q_fine|| / ||Q_fine||; {tried})")
+        """One line (under 120 characters for a ladder of three): the orders chosen and the changes that chose
+        them."""
+        tried = ", ".join(f"{H[0]}x{H[1]} {change:.2g}" for H, change in self.steps)
+        return (f"tolerance {self.tolerance:g}: orders |k1| <= {self.orders[0]}, |k2| <= {self.orders[1]}, "
+                f"grid {self.grid[0]}x{self.grid[1]}; change to each box {tried}")
 
 
 class TorusOrdersNotConverged(NotConverged):

@@ -215,7 +215,7 @@ class RubTorus(Result):
                  f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}), grid {h.N1} x {h.N2}; "
                  f"{len(self.problem.problem.dofs)} unknowns",
                  f"{s.iterations} Newton iterations ({sum(s.krylov)} GMRES), relative residual {s.residual:.3g}; "
-                 f"started from {self.start}; {self.solve_time:.3g} s"]
+                 f"{self.solve_time:.3g} s", f"started from {self.start}"]
         if self.truncation is not None:
             lines.append(self.truncation.describe())
         where = [f"{f:.6g} Hz {tuple(int(v) for v in k)}" for f, k in zip(self.frequencies, self.orders)]
