@@ -29,8 +29,10 @@ The linear rest is condensed per order through the dynamic compliance, as in
 
 the sum over the distinct shapes of the sampled force derivatives (``T_t`` their Toeplitz matrices, times the
 derivative operator for a velocity derivative; ``A_t`` the DOF pattern). When the patterns span few directions (a
-rub's force is one direction times the normal force: rank 1), Newton's step is solved through the Woodbury identity
-on the orders times that rank, not on the orders times the contact DOFs (:meth:`TorusProblem.newton_step`).
+rub's force is one direction times the normal force: rank 1), Newton's step is an equation on the orders times that
+rank (Woodbury's identity), solved by preconditioned GMRES with the Jacobian's products through the grid, never
+formed (:meth:`TorusProblem.newton_step`, :mod:`rotorred.nonlinear.torus_krylov`, docs/model.md §25); the dense
+Jacobian (:meth:`TorusProblem.evaluate`) is the tests' reference for small sets.
 
 Both base frequencies must be forced or the solution has a continuous phase in each angle; with every base forced
 (the rig: unbalances at ``f_L`` and ``f_H = 3 w_2 / (2 pi)``) the solution is isolated and no phase condition is
