@@ -265,8 +265,9 @@ def test_rub_scene_out_of_contact_is_the_linear_unbalance_response_on_the_torus(
 def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced_lines():
     """paper-rub at outer 91.37 Hz, rubbing: a 3 s transient (its line fit on 2-3 s finds the torus (f_H/3, f_L)
     itself) starts the torus on a coarse set (|k1| <= 6, |k2| <= 30, grid 32 x 256; least squares on |k1| <= 4,
-    |k2| <= 30). Newton converges (measured 8 iterations, 152 GMRES iterations in all; the rub's Jacobian pattern is rank 1, so each step is GMRES
-    on 2K - 1 = 793 unknowns, matrix-free), and the three largest lines at node 14 Y equal the transient's (measured f_H
+    |k2| <= 30). Newton converges (measured 8 iterations, 152 GMRES iterations in all; the rub's Jacobian pattern is
+    rank 1, so each step is GMRES on 2K - 1 = 793 unknowns, matrix-free), and the three largest lines at node 14 Y
+    equal the transient's (measured f_H
     -0.15 %, 4f_H/3 -0.35 %, f_L -0.017 %); the impacts' combination lines need the larger sets of
     validation/hb_torus.py (here 2f_H/3 + f_L is 3.7 % off)."""
     from rotorred.scenes.harmonic_balance import unknown_records
