@@ -22,8 +22,8 @@ Prints:
 3. the evidence on what limits the comparison: the transient's own lines fitted on four 5 s windows (their scatter),
    the torus's strongest line next to each of them, and the change of the torus's lines between the last two
    truncations;
-4. the cold start (:func:`rotorred.torus_balance` from its own 1 s record of a 3 s transient): its time and its
-   distance from the warm solve;
+4. the cold start (:func:`rotorred.torus_balance` from its own 1 s record of a 3 s transient, the bases its line
+   fit finds there): its time and its distance from the warm solve;
 5. the table of the issue's measure: transient time, torus time (start, Newton at every truncation), their ratio,
    the worst of the 10 lines, and the process's peak resident memory (transient, record and torus together: an upper
    bound of the torus's).
@@ -126,20 +126,20 @@ def torus_memory(scene, sm, torus, result, largest, records) -> float:
 
 def cold(scene, sm, torus, rp, z):
     """The cold start: :func:`rotorred.torus_balance` from its own short transient (2-3 s from the settled linear
-    state, least squares on |k1| <= 4, |k2| <= 30 of its last second), on the same bases and truncation as the warm
-    solve ``z`` of ``rp``. Returns its time (transient and torus, s) and the largest difference of the two tori's
+    state), the bases the line fit's torus search finds in its last second, least squares on |k1| <= 4, |k2| <= 30
+    there, and Newton on the same truncation as the warm solve ``z`` of ``rp``. Returns its time (transient and torus, s) and the largest difference of the two tori's
     complex amplitudes at node 14 Y over every order, relative to the largest."""
     import rotorred as rr
 
     H1, H2, N1, N2 = TRUNCATIONS[-1]
-    options = rr.TorusOptions(bases=(torus.f_L / torus.j, torus.f_H / torus.k), orders=(H1, H2), grid=(N1, N2),
-                              f_max=F_MAX, outputs=[OUTPUT])
+    options = rr.TorusOptions(orders=(H1, H2), grid=(N1, N2), f_max=F_MAX, outputs=[OUTPUT])  # bases: its line fit
     result = rr.torus_balance(sm.model, rr.Operating.point(dict(scene.speeds)), rr.Loads(scene.unbalances),
                               scene.plates, options)
     warm = rp.problem.recover(z)[:, :rp.n_model] @ sm.model.output_rows([OUTPUT]).T
     difference = np.max(np.abs(result.phasors - warm)) / np.max(np.abs(warm))
-    print(f"cold start (torus_balance: transient {options.start_window[0]:g}-{options.start_window[1]:g} s, least "
-          f"squares, Newton): {result.solution.iterations} Newton iterations ({sum(result.solution.krylov)} GMRES), "
+    assert result.bases_hz == rp.bases_hz, (result.bases_hz, rp.bases_hz)
+    print(f"cold start (torus_balance: transient {options.start_window[0]:g}-{options.start_window[1]:g} s, its torus "
+          f"{result.bases_hz[0]:.6g}, {result.bases_hz[1]:.6g} Hz, least squares, Newton): {result.solution.iterations} Newton iterations ({sum(result.solution.krylov)} GMRES), "
           f"{result.solve_time:.2f} s in all; its node 14 Y amplitudes against the warm solve's: {difference:.2g} of "
           "the largest")
     return result.solve_time, difference
