@@ -126,6 +126,8 @@ _EXPORTS = {
     "TorusProblem": "rotorred.nonlinear.torus",
     "TorusSolution": "rotorred.nonlinear.torus",
     "solve_torus": "rotorred.nonlinear.torus",
+    "TorusTruncation": "rotorred.nonlinear.torus_truncation",
+    "torus_to_tolerance": "rotorred.nonlinear.torus_truncation",
     "ContinuationOptions": "rotorred.nonlinear.continuation",
     "continue_branch": "rotorred.nonlinear.continuation",
     "Branch": "rotorred.nonlinear.continuation",

@@ -29,8 +29,10 @@ The linear rest is condensed per order through the dynamic compliance, as in
 
 the sum over the distinct shapes of the sampled force derivatives (``T_t`` their Toeplitz matrices, times the
 derivative operator for a velocity derivative; ``A_t`` the DOF pattern). When the patterns span few directions (a
-rub's force is one direction times the normal force: rank 1), Newton's step is solved through the Woodbury identity
-on the orders times that rank, not on the orders times the contact DOFs (:meth:`TorusProblem.newton_step`).
+rub's force is one direction times the normal force: rank 1), Newton's step is an equation on the orders times that
+rank (Woodbury's identity), solved by preconditioned GMRES with the Jacobian's products through the grid, never
+formed (:meth:`TorusProblem.newton_step`, :mod:`rotorred.nonlinear.torus_krylov`, docs/model.md §25); the dense
+Jacobian (:meth:`TorusProblem.evaluate`) is the tests' reference for small sets.
 
 Both base frequencies must be forced or the solution has a continuous phase in each angle; with every base forced
 (the rig: unbalances at ``f_L`` and ``f_H = 3 w_2 / (2 pi)``) the solution is isolated and no phase condition is
@@ -43,19 +45,24 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.fft as sfft
 import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.condensed import dynamic_compliance, real_form
 from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
 from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, harmonic_dataset, sampled_forces
+from rotorred.nonlinear.torus_krylov import RankJacobian, block_product
 from rotorred.results import Result
+from rotorred.signals.spectra import pyfftw
 
 __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
 
-#: singular values of the stacked DOF patterns below this share of the largest count as zero (their rank)
-RANK_RTOL = 1e-12
-
+#: the loosest and the tightest relative tolerance of GMRES on a Newton step (the inexact Newton's forcing term,
+#: :func:`solve_torus`)
+FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
+#: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
+COMPLIANCE_CHUNK = 256
 
 def alias_free_grid(H1: int, H2: int, degree: int) -> tuple[int, int]:
     """The least even grid ``(N_1, N_2)`` that transforms a degree-``degree`` polynomial of a box ``H_1 x H_2``
@@ -115,17 +122,53 @@ class TorusHarmonics:
         self._index_maps()
 
     def _index_maps(self) -> None:
-        """Where each order, its negative, and each difference and sum of two orders sit on the flattened FFT grid."""
+        """Where each order sits on the half spectrum of the real 2-D FFT (``_half``; ``_half_conjugate``: the
+        negatives of the orders with ``k_1 = 0``, which that spectrum holds too). The K x K maps of differences and
+        sums of two orders are built only when a dense Toeplitz matrix is asked (:meth:`_pair_maps`)."""
         k1, k2 = self.orders[:, 0], self.orders[:, 1]
+        object.__setattr__(self, "_half", (k1 * self.N2 + k2 % self.N2).astype(np.intp))
+        axis = np.flatnonzero(k1 == 0)[1:]  # the orders (0, k2 > 0)
+        object.__setattr__(self, "_axis_orders", axis)
+        object.__setattr__(self, "_half_conjugate", ((-k2[axis]) % self.N2).astype(np.intp))
+        object.__setattr__(self, "_lazy", {})
 
-        index_type = np.int32 if self.n_samples < 2**31 else np.intp  # K x K of them: 100 MB at K = 5000
+    def _pair_maps(self, among: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Where the difference and the sum of each two orders (of the positions ``among``, default all, kept then)
+        sit on the flattened full grid, (L, L) each: only for dense Toeplitz matrices (:meth:`toeplitz_blocks`)."""
+        if among is None and "pairs" in self._lazy:
+            return self._lazy["pairs"]
+        orders = self.orders if among is None else self.orders[among]
+        k1, k2 = orders[:, 0], orders[:, 1]
+        index_type = np.int32 if self.n_samples < 2**31 else np.intp
 
         def flat(m1, m2):
             return ((m1 % self.N1) * self.N2 + (m2 % self.N2)).astype(index_type)
-        object.__setattr__(self, "_plus", flat(k1, k2))
-        object.__setattr__(self, "_minus", flat(-k1, -k2))
-        object.__setattr__(self, "_difference", flat(k1[:, None] - k1[None, :], k2[:, None] - k2[None, :]))
-        object.__setattr__(self, "_sum", flat(k1[:, None] + k1[None, :], k2[:, None] + k2[None, :]))
+        maps = (flat(k1[:, None] - k1[None, :], k2[:, None] - k2[None, :]),
+                flat(k1[:, None] + k1[None, :], k2[:, None] + k2[None, :]))
+        if among is None:
+            self._lazy["pairs"] = maps
+        return maps
+
+    def _transform(self, kind: str, p: int):
+        """The real 2-D FFT of p signals on the grid (``forward``: samples (N_1, N_2, p) -> half spectrum
+        (N_1 / 2 + 1, N_2, p), unnormalised) or its inverse (``inverse``: normalised by 1 / (N_1 N_2)), the real
+        transform along theta_1: a pyFFTW plan kept per kind and p (a copy of its output returned), or scipy's FFT
+        without pyFFTW."""
+        key = (kind, p)
+        if key not in self._lazy:
+            half, full = (self.N1 // 2 + 1, self.N2, p), (self.N1, self.N2, p)
+            if pyfftw is None:
+                self._lazy[key] = (lambda x: sfft.rfftn(x, axes=(1, 0))) if kind == "forward" else \
+                    (lambda x: sfft.irfftn(x, s=(self.N2, self.N1), axes=(1, 0)))
+            else:
+                if kind == "forward":
+                    plan = pyfftw.builders.rfftn(pyfftw.empty_aligned(full, float), axes=(1, 0),
+                                                 planner_effort="FFTW_ESTIMATE", threads=1)
+                else:
+                    plan = pyfftw.builders.irfftn(pyfftw.empty_aligned(half, complex), s=(self.N2, self.N1),
+                                                  axes=(1, 0), planner_effort="FFTW_ESTIMATE", threads=1)
+                self._lazy[key] = lambda x: plan(x).copy()
+        return self._lazy[key]
 
     # ----------------------------------------------------------------------------------------------- sizes
     @property
@@ -265,13 +308,29 @@ class TorusHarmonics:
         ndarray, shape (N_1 N_2, n)
             In the units of ``z``, theta_1 major (:meth:`angles`).
         """
-        Q = self.phasors(z, n)
-        C = np.zeros((self.n_samples, n), complex)
-        C[self._plus[1:]] = 0.5 * Q[1:]
-        C[self._minus[1:]] = 0.5 * Q[1:].conj()
+        return self.synthesised(self.phasors(z, n))
+
+    def synthesised(self, Q: np.ndarray) -> np.ndarray:
+        """The real signals of complex amplitudes ``Q`` (K, p) on the grid: ``Re sum_k Q_k exp(i k . theta)``, by one
+        inverse real 2-D FFT of the half spectrum (the real transform along theta_1, whose orders are k_1 >= 0).
+
+        Parameters
+        ----------
+        Q : ndarray, shape (K, p), complex
+            Amplitudes of each order, any units.
+
+        Returns
+        -------
+        ndarray, shape (N_1 N_2, p)
+            In the units of ``Q``, theta_1 major.
+        """
+        p = Q.shape[1]
+        C = np.zeros(((self.N1 // 2 + 1) * self.N2, p), complex)
+        C[self._half[1:]] = 0.5 * Q[1:]
+        C[self._half_conjugate] = 0.5 * Q[self._axis_orders].conj()
         C[0] = Q[0]
-        q = np.fft.ifft2(C.reshape(self.N1, self.N2, n), axes=(0, 1)).real * self.n_samples
-        return q.reshape(self.n_samples, n)
+        q = self._transform("inverse", p)(C.reshape(self.N1 // 2 + 1, self.N2, p))
+        return q.reshape(self.n_samples, p) * self.n_samples
 
     def derivative(self, z: np.ndarray, n: int, w) -> np.ndarray:
         """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``.
@@ -353,8 +412,8 @@ class TorusHarmonics:
             In the units of ``f``.
         """
         n = f.shape[1]
-        S = np.fft.fft2(f.reshape(self.N1, self.N2, n), axes=(0, 1)).reshape(self.n_samples, n) / self.n_samples
-        c = S[self._plus]
+        S = self._transform("forward", n)(f.reshape(self.N1, self.N2, n)).reshape(-1, n) / self.n_samples
+        c = S[self._half]
         z = np.empty((self.size, n))
         z[0] = c[0].real
         z[1::2], z[2::2] = 2.0 * c[1:].real, -2.0 * c[1:].imag
@@ -369,27 +428,32 @@ class TorusHarmonics:
         E[:, 1::2], E[:, 2::2] = np.cos(phase), np.sin(phase)
         return E
 
-    def toeplitz_blocks(self, columns: np.ndarray) -> np.ndarray:
-        """``T(d)`` of each sampled column ``d`` of ``columns``, from its 2-D spectrum (module docstring). Written in
-        place, a real part at a time (the blocks are large: 2K - 1 = 7000).
+    def toeplitz_blocks(self, columns: np.ndarray, among: np.ndarray | None = None) -> np.ndarray:
+        """``T(d)`` of each sampled column ``d`` of ``columns``, from its 2-D spectrum (module docstring), between all
+        the orders or only those at the positions ``among`` (ascending, 0 first: the rows and columns of those
+        orders). Written in place, a real part at a time.
 
         Parameters
         ----------
         columns : ndarray, shape (N_1 N_2, p)
             p sampled Jacobian entries on the grid (e.g. df/dq (N/m)).
+        among : ndarray of int, shape (L,), optional
+            Positions of orders in :attr:`orders`, starting with 0 (the mean); default all (L = K).
 
         Returns
         -------
-        ndarray, shape (p, 2K - 1, 2K - 1)
+        ndarray, shape (p, 2L - 1, 2L - 1)
             In the units of ``columns``.
         """
-        p, K = columns.shape[1], self.n_orders
+        p = columns.shape[1]
+        K = self.n_orders if among is None else len(among)
         S = np.fft.fft2(columns.reshape(self.N1, self.N2, p), axes=(0, 1)).reshape(self.n_samples, p) / self.n_samples
         real, imag = np.ascontiguousarray(S.real.T), np.ascontiguousarray(S.imag.T)
-        out = np.empty((p, self.size, self.size))
+        difference, total = self._pair_maps(among)
+        out = np.empty((p, 2 * K - 1, 2 * K - 1))
         for i in range(p):
-            rm, rp = real[i][self._difference], real[i][self._sum]  # Re D_{k-j}, Re D_{k+j}
-            im, ip = imag[i][self._difference], imag[i][self._sum]
+            rm, rp = real[i][difference], real[i][total]  # Re D_{k-j}, Re D_{k+j}
+            im, ip = imag[i][difference], imag[i][total]
             inner = out[i, 1:, 1:].reshape(K - 1, 2, K - 1, 2)  # (order, a or b) x (order, a or b), a view
             np.add(rm[1:, 1:], rp[1:, 1:], out=inner[:, 0, :, 0])
             np.subtract(im[1:, 1:], ip[1:, 1:], out=inner[:, 0, :, 1])
@@ -495,14 +559,6 @@ class _Compliance:
 
 
 @dataclass(frozen=True)
-class _Linearisation:
-    """The residual at z and its Jacobian as terms: dR/dz = I + G sum_t kron(T_t, A_t)."""
-
-    R: np.ndarray
-    terms: tuple  # of (T_t (m, m), A_t (c, c))
-
-
-@dataclass(frozen=True)
 class TorusProblem:
     """A system forced at two incommensurate base frequencies with nonlinear forces on a few DOFs: its quasi-periodic
     response by harmonic balance on the torus, condensed onto those DOFs.
@@ -580,12 +636,19 @@ class TorusProblem:
 
     # ----------------------------------------------------------------------------------------------- condensation
     def _compliance(self) -> _Compliance:
-        """Z_k^-1 at every order's frequency, by one batched solve (computed once: w is fixed)."""
+        """Z_k^-1 at every order's frequency, by batched solves of :data:`COMPLIANCE_CHUNK` orders at a time (the
+        dynamic stiffnesses of all the orders at once would be the largest array of the solve), computed once: w is
+        fixed."""
         if "compliance" in self._cache:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
-        Z = self.K[None] - (wk**2)[:, None, None] * self.M[None] + 1j * wk[:, None, None] * self.D[None]
-        X, Q_full = dynamic_compliance(Z, c, self.harmonics.phasors(self.forcing, n_all))
+        forcing = self.harmonics.phasors(self.forcing, n_all)
+        X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
+        for lo in range(0, len(wk), COMPLIANCE_CHUNK):
+            part = slice(lo, lo + COMPLIANCE_CHUNK)
+            w = wk[part][:, None, None]
+            Z = self.K[None] - w**2 * self.M[None] + 1j * w * self.D[None]
+            X[part], Q_full[part] = dynamic_compliance(Z, c, forcing[part])
         H = X[:, c, :]
         out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
         self._cache["compliance"] = out
@@ -610,7 +673,7 @@ class TorusProblem:
             (m).
         """
         g = self._compliance()
-        return _block_product(g.G0, g.Gk, X.reshape(self.size, -1), self.n).reshape(X.shape)
+        return block_product(g.G0, g.Gk, X.reshape(self.size, -1), self.n).reshape(X.shape)
 
     @property
     def scale(self) -> float:
@@ -634,29 +697,30 @@ class TorusProblem:
         f = sampled_forces(self._local_forces, q, v)[0]
         return z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
 
-    def _linearise(self, z: np.ndarray) -> _Linearisation:
-        """R and the Jacobian's terms: the sampled force derivatives grouped by shape (a shape shared by several DOF
-        pairs, e.g. a rub's rank-1 Jacobian, gets one Toeplitz block), velocity shapes times the derivative."""
+    def _sampled_terms(self, z: np.ndarray):
+        """R and the Jacobian's terms at z: the distinct shapes of the sampled force derivatives (N_1 N_2, b) (a shape
+        shared by several DOF pairs, e.g. a rub's rank-1 Jacobian, counts once) and the terms ``(b, kind, A)``: shape
+        b on the DOF pattern A, of a derivative by q (kind 0) or by dq/dt (kind 1)."""
         h, c = self.harmonics, self.n
         q, v = self.samples(z)
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         R = z - self.linear_response() + self.apply(h.coefficients(f))
         flat = np.hstack([dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)])
-        base, factor = proportional_columns(flat)
-        blocks = h.toeplitz_blocks(flat[:, base]) if base else np.zeros((0, h.size, h.size))
+        active = np.flatnonzero(np.any(flat != 0.0, axis=1))  # a contact's samples (zero rows are proportional)
+        base, factor = proportional_columns(flat[active]) if active.size else ([], np.full((2 * c * c, 2), -1.0))
         terms = []
         for b in range(len(base)):
-            for kind in (0, 1):  # 0: a derivative by q, 1: by dq/dt
+            for kind in (0, 1):
                 pairs = factor[kind * c * c:(kind + 1) * c * c]
                 A = np.where(pairs[:, 1] == b, pairs[:, 0], 0.0).reshape(c, c)
                 if A.any():
-                    T = blocks[b] if kind == 0 else h.times_derivative(blocks[b], 1, self.w)
-                    terms.append((T, A))
-        return _Linearisation(R, tuple(terms))
+                    terms.append((b, kind, A))
+        return R, flat[:, base], tuple(terms)
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
-        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve_periodic` takes the problem).
+        (:class:`Evaluation`, so :func:`rotorred.nonlinear.hb.solve_periodic` takes the problem). A reference for
+        small sets (tests): its memory is size^2; :func:`solve_torus` never builds it (:meth:`jacobian`).
 
         Parameters
         ----------
@@ -670,39 +734,66 @@ class TorusProblem:
         Evaluation
         """
         def jacobian():
-            lin = self._linearise(z)
-            T = sum((np.kron(Tt, At) for Tt, At in lin.terms), np.zeros((self.size, self.size)))
+            _, columns, terms = self._sampled_terms(z)
+            blocks = self.harmonics.toeplitz_blocks(columns) if terms else np.zeros((0, 1, 1))
+            T = np.zeros((self.size, self.size))
+            for b, kind, A in terms:
+                Tb = blocks[b] if kind == 0 else self.harmonics.times_derivative(blocks[b], 1, self.w)
+                T += np.kron(Tb, A)
             return np.eye(self.size) + self.apply(T)
         return Evaluation(self.residual(z), self.scale, jacobian, lambda: np.full(self.size, np.nan))
 
-    def newton_step(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The residual at ``z`` and Newton's step ``-J^-1 R``, through the Woodbury identity on the rank r of the DOF
-        patterns: ``J = I + X Y``, ``X = G (I (x) U)``, ``Y = sum_t kron(T_t, U^T A_t V) (I (x) V^T)``, so that
-        ``J^-1 = I - X (I + Y X)^-1 Y`` needs one dense solve of size (2K - 1) r (r = 1 for a rub).
+    def jacobian(self, z: np.ndarray, reuse: RankJacobian | None = None) -> tuple[np.ndarray, RankJacobian]:
+        """The residual at ``z`` and the Jacobian there, held by its sampled fields on the contact's rank (never a
+        matrix: :class:`rotorred.nonlinear.torus_krylov.RankJacobian`).
 
         Parameters
         ----------
         z : ndarray, shape (size,)
             Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+        reuse : RankJacobian, optional
+            An earlier Jacobian whose preconditioner this one may keep.
+
+        Returns
+        -------
+        R : ndarray, shape (size,)
+            The residual (m).
+        J : RankJacobian or None
+            None where no force has a derivative (out of contact: J = I).
+        """
+        R, columns, terms = self._sampled_terms(z)
+        if not terms:
+            return R, None
+        g = self._compliance()
+        return R, RankJacobian(self.harmonics, self.w, (g.G0, g.Gk), columns, terms, reuse)
+
+    def newton_step(self, z: np.ndarray, rtol: float = 1e-12, reuse: RankJacobian | None = None):
+        """The residual at ``z`` and Newton's step ``-J^-1 R``, by Woodbury's identity on the contact's rank and
+        preconditioned GMRES to ``rtol`` (:class:`rotorred.nonlinear.torus_krylov.RankJacobian`).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+        rtol : float
+            Relative residual of GMRES on the reduced equation.
+        reuse : RankJacobian, optional
+            An earlier Jacobian whose preconditioner this step may keep (:meth:`jacobian`).
 
         Returns
         -------
         R, step : ndarray, shape (size,)
             The residual and the step (m).
+        stats : KrylovStats or None
+            GMRES's iterations and the residual it reached (None out of contact: the step is -R).
+        J : RankJacobian or None
+            The Jacobian at ``z`` (its preconditioner for the next step).
         """
-        lin = self._linearise(z)
-        if not lin.terms:
-            return lin.R, -lin.R
-        U, V = _pattern_bases([A for _, A in lin.terms])
-        m, c, r, s = self.harmonics.size, self.n, U.shape[1], V.shape[1]
-        core = sum((np.kron(T, U.T @ A @ V) for T, A in lin.terms), np.zeros((m * r, m * s)))
-        g = self._compliance()
-        G0, Gk = V.T @ g.G0 @ U, _projected_blocks(g.Gk, V, U)
-        YX = _block_product_right(core, G0, Gk, s, r)
-        YR = core @ (lin.R.reshape(m, c) @ V).reshape(-1)
-        y = sla.solve(np.eye(m * r) + YX, YR)
-        X_y = self.apply((y.reshape(m, r) @ U.T).reshape(-1))
-        return lin.R, -lin.R + X_y
+        R, J = self.jacobian(z, reuse)
+        if J is None:
+            return R, -R, None, None
+        step, stats = J.solve(-R, rtol)
+        return R, step, stats, J
 
     # ----------------------------------------------------------------------------------------------- recovery
     def recover(self, z: np.ndarray) -> np.ndarray:
@@ -726,38 +817,6 @@ class TorusProblem:
         return g.Q_full - np.einsum("kac,kc->ka", g.X, F)
 
 
-def _block_product(G0: np.ndarray, Gk: np.ndarray, X: np.ndarray, c: int) -> np.ndarray:
-    """``G X`` for block-diagonal G: G0 (c, c) on the first c rows, Gk[k] (2c, 2c) on each next 2c rows."""
-    out = np.empty_like(X)
-    out[:c] = G0 @ X[:c]
-    out[c:] = np.matmul(Gk, X[c:].reshape(len(Gk), 2 * c, -1)).reshape(-1, X.shape[1])
-    return out
-
-
-def _block_product_right(P: np.ndarray, B0: np.ndarray, Bk: np.ndarray, s: int, r: int) -> np.ndarray:
-    """``P B`` for block-diagonal B: B0 (s, r) on the first s columns of P, Bk[k] (2s, 2r) on each next 2s."""
-    p = P.shape[0]
-    Pk, Ok = P[:, s:].reshape(p, len(Bk), 2 * s), np.zeros((p, len(Bk), 2 * r))
-    for j in range(2 * s):  # the blocks are small: a sum of 4 s r scaled columns, not a batched product
-        for i in range(2 * r):
-            Ok[:, :, i] += Pk[:, :, j] * Bk[None, :, j, i]
-    return np.hstack([P[:, :s] @ B0, Ok.reshape(p, -1)])
-
-
-def _projected_blocks(Gk: np.ndarray, V: np.ndarray, U: np.ndarray) -> np.ndarray:
-    """``(I_2 (x) V^T) Gk[k] (I_2 (x) U)`` for every order: shape (K - 1, 2s, 2r)."""
-    V2, U2 = np.kron(np.eye(2), V), np.kron(np.eye(2), U)
-    return V2.T @ Gk @ U2
-
-
-def _pattern_bases(patterns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal bases U (c, r) of the patterns' column spaces and V (c, s) of their row spaces."""
-    def basis(stack):
-        u, sv, _ = np.linalg.svd(stack, full_matrices=False)
-        return u[:, sv > RANK_RTOL * sv[0]]
-    return basis(np.hstack(patterns)), basis(np.hstack([A.T for A in patterns]))
-
-
 @dataclass(frozen=True, repr=False)
 class TorusSolution(Result):
     """A converged torus: its coefficients and how Newton got there.
@@ -778,6 +837,8 @@ class TorusSolution(Result):
         The base frequencies (rad/s).
     dofs : tuple of int
         The DOFs of the unknowns (the problem's ``dofs``).
+    krylov : tuple of int
+        GMRES iterations of each Newton step (0 for a step out of contact).
     """
 
     z: np.ndarray
@@ -787,6 +848,7 @@ class TorusSolution(Result):
     harmonics: TorusHarmonics
     w: tuple[float, float]
     dofs: tuple[int, ...]
+    krylov: tuple[int, ...] = ()
 
     def __post_init__(self):
         object.__setattr__(self, "z", checks.array("z", self.z, (self.harmonics.size * len(self.dofs),)))
@@ -820,7 +882,8 @@ class TorusSolution(Result):
                 f"({f[0]:.6g}, {f[1]:.6g} Hz): {len(self.dofs)} DOFs",
                 f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}"
                 + (f", |k . w| <= {h.w_max:.6g} rad/s" if h.w_max is not None else "") + f"), grid {h.N1} x {h.N2}",
-                f"converged in {self.iterations} Newton iterations, relative residual {self.residual:.3g}",
+                f"converged in {self.iterations} Newton iterations ({sum(self.krylov)} GMRES iterations), relative "
+                f"residual {self.residual:.3g}",
                 f"strongest lines (k1, k2): {top}"]
 
     def plot(self, ax=None, *, dofs=None, title: str | None = None):
@@ -862,8 +925,13 @@ class TorusSolution(Result):
 
 def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, max_iter: int = 40,
                 max_halvings: int = 30) -> TorusSolution:
-    """The torus near ``z0`` by Newton's method (steps by :meth:`TorusProblem.newton_step`) with a backtracking line
-    search on ``||R||`` (trial points by their residual alone).
+    """The torus near ``z0`` by Newton's method with matrix-free steps (:meth:`TorusProblem.newton_step`: GMRES on
+    the contact's rank, never a dense Jacobian) and a backtracking line search on ``||R||`` (trial points by their
+    residual alone).
+
+    Each step is solved only as far as it serves (an inexact Newton method): GMRES's relative tolerance is
+    ``min(1e-2, rho)`` with ``rho`` the relative residual of the iterate, so the steps tighten as Newton converges
+    and the last ones are nearly exact (docs/model.md §25), never tighter than 1e-3 of what is left to reach ``tol``.
 
     Parameters
     ----------
@@ -887,19 +955,22 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
         lowers it.
     """
     z = checks.array("z0", z0, (problem.size,)).copy()
-    scale, history = problem.scale, []
+    scale, history, krylov, J = problem.scale, [], [], None
     R = problem.residual(z)
     for it in range(max_iter + 1):
         norm = float(np.linalg.norm(R))
         history.append(norm / scale)
         if history[-1] <= tol:
-            return TorusSolution(z, it, history[-1], tuple(history), problem.harmonics, problem.w, problem.dofs)
+            return TorusSolution(z, it, history[-1], tuple(history), problem.harmonics, problem.w, problem.dofs,
+                                 tuple(krylov))
         if it == max_iter:
             break
+        rtol = max(min(FORCING_MAX, history[-1]), 1e-3 * tol / history[-1], KRYLOV_FLOOR)
         try:
-            step = problem.newton_step(z)[1]
+            _, step, stats, J = problem.newton_step(z, rtol, J)
         except (sla.LinAlgError, ValueError):
             raise NotConverged(problem.w[0], history[-1], tol, it, "singular Jacobian") from None
+        krylov.append(0 if stats is None else stats.iterations)
         a = 1.0
         for _ in range(max_halvings):  # the residual alone (no Jacobian) for each trial
             trial = z + a * step

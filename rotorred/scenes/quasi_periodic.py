@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -29,6 +29,7 @@ from rotorred.checks import InputError
 from rotorred.model.operating import Operating, checked as checked_operating
 from rotorred.nonlinear.hb import coefficient_variables
 from rotorred.nonlinear.torus import TorusSolution, solve_torus
+from rotorred.nonlinear.torus_truncation import TorusTruncation, torus_to_tolerance
 from rotorred.results import Result, dof_coordinates, strongest_lines
 from rotorred.scenes.built import balance_loads, built_scene, plates_on, rotor_model
 from rotorred.scenes.harmonic_balance import unknown_records
@@ -41,6 +42,8 @@ from rotorred.transient.options import Initial, Loads, Recording, StepControl
 
 __all__ = ["TorusOptions", "RubTorus", "torus_balance", "default_grid"]
 
+#: how often a tolerance may double the orders (:attr:`TorusOptions.ladder`)
+DOUBLINGS = 2
 #: how the solution was started
 FROM_RECORD, FROM_LINEAR = "the transient's record (least squares)", "the linear response"
 
@@ -79,6 +82,11 @@ class TorusOptions:
         Relative residual Newton must reach (-).
     outputs : sequence of (int, str)
         Model DOFs (node, direction) reported; default x and y of every rub node.
+    tolerance : float, optional
+        Choose the orders by the convergence of the outputs' response (docs/model.md §25): ``orders`` is the first
+        truncation, each next doubles both bounds (at most :data:`DOUBLINGS` times, the grid
+        :func:`default_grid` of each), and the first whose response changes from the one before by at most
+        ``tolerance`` (relative, the largest over the outputs) is returned; ``grid`` must then not be given.
     """
 
     bases: tuple[float, float] | None = None
@@ -90,6 +98,7 @@ class TorusOptions:
     dt: float = 2e-5
     tol: float = 1e-10
     outputs: Sequence[tuple[int, str]] = ()
+    tolerance: float | None = None
 
     def __post_init__(self):
         if self.bases is not None:
@@ -113,6 +122,16 @@ class TorusOptions:
         checks.positive("options.dt", self.dt, "s")
         checks.number("options.tol", self.tol, gt=0.0, lt=1.0)
         object.__setattr__(self, "outputs", tuple(tuple(o) for o in self.outputs))
+        if self.tolerance is not None:
+            checks.number("options.tolerance", self.tolerance, gt=0.0, lt=1.0)
+            if self.grid is not None:
+                checks.fail("options.grid", self.grid, "must not be given with options.tolerance (each truncation "
+                            "takes default_grid of its orders)")
+
+    @property
+    def ladder(self) -> tuple[tuple[int, int], ...]:
+        """The truncations tried with a tolerance: ``orders`` doubled :data:`DOUBLINGS` times."""
+        return tuple((self.orders[0] << j, self.orders[1] << j) for j in range(DOUBLINGS + 1))
 
     @property
     def n_grid(self) -> tuple[int, int]:
@@ -145,6 +164,8 @@ class RubTorus(Result):
         Speed of every spool there (rad/s).
     solve_time : float
         Wall time of the start's transient and Newton's solve (s).
+    truncation : TorusTruncation, optional
+        What ``options.tolerance`` chose (None without one).
     """
 
     problem: TorusRubProblem
@@ -154,6 +175,7 @@ class RubTorus(Result):
     operating: Operating
     speeds: Mapping[str, float]
     solve_time: float
+    truncation: TorusTruncation | None = None
 
     @property
     def bases_hz(self) -> tuple[float, float]:
@@ -192,8 +214,10 @@ class RubTorus(Result):
                  + ", ".join(f"{sp} {k}" for sp, k in self.problem.spool_orders.items()),
                  f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}), grid {h.N1} x {h.N2}; "
                  f"{len(self.problem.problem.dofs)} unknowns",
-                 f"{s.iterations} Newton iterations, relative residual {s.residual:.3g}; started from {self.start}; "
-                 f"{self.solve_time:.3g} s"]
+                 f"{s.iterations} Newton iterations ({sum(s.krylov)} GMRES), relative residual {s.residual:.3g}; "
+                 f"{self.solve_time:.3g} s", f"started from {self.start}"]
+        if self.truncation is not None:
+            lines.append(self.truncation.describe())
         where = [f"{f:.6g} Hz {tuple(int(v) for v in k)}" for f, k in zip(self.frequencies, self.orders)]
         return lines + strongest_lines(self.outputs, self.amplitudes, where)
 
@@ -301,8 +325,22 @@ def torus_balance(model, operating: Operating, loads: Loads, contacts: Sequence[
             checks.fail("options.start_orders", options.start_orders, "must give lines the start window "
                         f"{options.start_window} s resolves: their frequencies {exc.requirement}", exc.unit)
         start = FROM_RECORD
-    solution = solve_torus(rp.problem, z0, tol=options.tol)
-    return RubTorus(rp, solution, start, outputs, operating, dict(speeds), time.perf_counter() - t0)
+    if options.tolerance is None:
+        solution, choice = solve_torus(rp.problem, z0, tol=options.tol), None
+    else:
+        problems = {options.orders: rp}
+
+        def build(H1, H2):
+            if (H1, H2) not in problems:
+                problems[(H1, H2)] = _problem(scene, system, rp.bases_hz,
+                                              replace(options, orders=(H1, H2), tolerance=None))
+            return problems[(H1, H2)].problem
+        rows = rp.model.output_rows(list(outputs))
+        _, solution, choice = torus_to_tolerance(
+            build, options.ladder, z0, options.tolerance,
+            lambda problem, z: problem.recover(z)[:, :rp.n_model] @ rows.T, newton_tol=options.tol)
+        rp = problems[choice.orders]
+    return RubTorus(rp, solution, start, outputs, operating, dict(speeds), time.perf_counter() - t0, choice)
 
 
 def _problem(scene, system, bases, options: TorusOptions) -> TorusRubProblem:

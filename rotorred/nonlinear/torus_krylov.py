@@ -1,0 +1,222 @@
+"""Newton's step on a torus without its Jacobian: GMRES on the contact's rank, preconditioned on the orders of largest
+compliance (docs/model.md §25).
+
+The condensed torus Jacobian (:class:`rotorred.nonlinear.torus.TorusProblem`) is ``J = I + G sum_t T_t (x) A_t``: G the
+dynamic compliance of the unknown DOFs, block diagonal over the orders, and ``T_t`` the multiplication by a sampled
+force derivative ``d_t(theta)`` (times the derivative ``w . nabla`` for a velocity derivative), acting on the DOF
+pattern ``A_t``. The patterns span few directions: ``A_t = U B_t V^T`` with U (c, r) and V (c, s) orthonormal (a rub:
+r = s = 1, the force along one direction, driven by the penetration along one). With ``X = G (I (x) U)`` and
+``Y = C (I (x) V^T)``, ``C = sum_t T_t (x) B_t``, Woodbury's identity gives Newton's step
+
+    -J^-1 R = -R + X y,   (I + C G_VU) y = C (R V),   G_VU = (I (x) V^T) G (I (x) U),
+
+an equation in the coefficients of r signals on the torus. ``C`` is never formed: its product with p, the
+coefficients of s signals, is their samples and rates on the grid by one inverse real 2-D FFT, multiplied there by
+the fields ``Mq(theta) = sum d_t B_t`` (position terms) and ``Mv(theta)`` (velocity terms), r x s at each sample, and
+returned by one forward FFT: O(N_1 N_2 log(N_1 N_2) (r + 2 s)) a product, memory O(N_1 N_2 r s + K (r + s)^2).
+GMRES (scipy) solves it, preconditioned by the exact inverse of its block between the orders of largest compliance
+(:data:`COARSE_ORDERS`: the orders where ``C G_VU`` is large, whose eigenvalues would otherwise be GMRES's outliers)
+and the identity elsewhere; the block is the fields' Toeplitz matrices between those orders only (built from their
+2-D spectrum), inverted once and reused by the following Newton steps until GMRES needs more than
+:data:`REFRESH_ITERATIONS`. *Choice* (docs/model.md §25): the block diagonal over the orders (each order's 2 x 2
+block with the contact's mean stiffness) stalls on the rig: its impacts couple the orders far from the diagonal
+(at |k1| <= 6, |k2| <= 30, GMRES stalled at 4.5e-2 after 2000 iterations, against 4.5e-5 after 43 without a
+preconditioner).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.sparse.linalg import LinearOperator, gmres
+
+__all__ = ["RankJacobian", "pattern_bases"]
+
+#: singular values of the stacked DOF patterns below this share of the largest count as zero (their rank)
+RANK_RTOL = 1e-12
+#: the orders of largest compliance whose block of the reduced equation the preconditioner inverts exactly
+COARSE_ORDERS = 1000
+#: GMRES iterations past which a reused preconditioner is built afresh from the current fields
+REFRESH_ITERATIONS = 60
+
+
+def pattern_bases(patterns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal bases U (c, r) of the patterns' column spaces and V (c, s) of their row spaces."""
+    def basis(stack):
+        u, sv, _ = np.linalg.svd(stack, full_matrices=False)
+        return u[:, sv > RANK_RTOL * sv[0]]
+    return basis(np.hstack(patterns)), basis(np.hstack([A.T for A in patterns]))
+
+
+def projected_blocks(G0: np.ndarray, Gk: np.ndarray, V: np.ndarray, U: np.ndarray):
+    """``V^T G0 U`` and ``(I_2 (x) V^T) Gk[k] (I_2 (x) U)`` of every order: shapes (s, r) and (K - 1, 2s, 2r)."""
+    V2, U2 = np.kron(np.eye(2), V), np.kron(np.eye(2), U)
+    return V.T @ G0 @ U, V2.T @ Gk @ U2
+
+
+@dataclass
+class KrylovStats:
+    """What a Krylov solve took: GMRES iterations and the true relative residual of the reduced equation."""
+
+    iterations: int
+    residual: float
+
+
+class RankJacobian:
+    """The torus Jacobian at a point, held by its sampled fields on the contact's rank (module docstring).
+
+    Parameters
+    ----------
+    harmonics : TorusHarmonics
+        The orders and grid.
+    w : (float, float)
+        The base frequencies (rad/s).
+    G : (ndarray (c, c), ndarray (K - 1, 2c, 2c))
+        The compliance blocks of the unknowns (m/N): order 0 and each other order's real form.
+    columns : ndarray, shape (N_1 N_2, b)
+        The distinct sampled derivative shapes d_b(theta) (N/m or N s/m).
+    terms : sequence of (int, int, ndarray (c, c))
+        ``(b, kind, A)``: shape b times the DOF pattern A, of a position (kind 0) or a velocity (kind 1) derivative.
+    reuse : RankJacobian, optional
+        An earlier Jacobian of the same problem whose preconditioner (built from its own fields) serves this one, if
+        its patterns span the same directions (:meth:`solve` builds a fresh one where it serves badly).
+    """
+
+    def __init__(self, harmonics, w, G, columns: np.ndarray, terms, reuse: RankJacobian | None = None):
+        self.h, self.w = harmonics, tuple(w)
+        self.G0, self.Gk = G
+        self.c = self.G0.shape[0]
+        self.U, self.V = pattern_bases([A for _, _, A in terms])
+        self.r, self.s = self.U.shape[1], self.V.shape[1]
+        N = harmonics.n_samples
+        self.Mq, self.Mv = np.zeros((N, self.r, self.s)), np.zeros((N, self.r, self.s))
+        for b, kind, A in terms:
+            B = self.U.T @ A @ self.V
+            (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * B[None]
+        self.has_velocity = bool(np.any(self.Mv))
+        self.P0, self.Pk = projected_blocks(self.G0, self.Gk, self.V, self.U)
+        same = reuse is not None and reuse.U.shape == self.U.shape and reuse.V.shape == self.V.shape and \
+            np.allclose(np.abs(reuse.U.T @ self.U), np.eye(self.r)) and \
+            np.allclose(np.abs(reuse.V.T @ self.V), np.eye(self.s))
+        self._preconditioner = reuse._preconditioner if same else None
+        if same:  # the bases' signs may differ: the reused factors act in the earlier bases
+            self.U, self.V = reuse.U, reuse.V
+            self.Mq, self.Mv = np.zeros_like(self.Mq), np.zeros_like(self.Mv)
+            for b, kind, A in terms:
+                (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * (self.U.T @ A @ self.V)[None]
+            self.P0, self.Pk = reuse.P0, reuse.Pk
+        self.reused = same
+
+    @property
+    def inner_size(self) -> int:
+        """Unknowns of the reduced equation: (2K - 1) r."""
+        return self.h.size * self.r
+
+    # ------------------------------------------------------------------------------------------ products
+    def core(self, p: np.ndarray) -> np.ndarray:
+        """``C p``: the coefficients (m, r) of ``Mq p(theta) + Mv (w . nabla) p(theta)`` for the coefficients
+        ``p`` (m, s) of s signals, through the grid."""
+        h, s = self.h, self.s
+        if self.has_velocity:
+            both = np.hstack([p, h.derivative(p.reshape(-1), s, self.w).reshape(-1, s)])
+            samples = h.synthesised(_phasors(both))
+            out = (np.einsum("nrs,ns->nr", self.Mq, samples[:, :s])
+                   + np.einsum("nrs,ns->nr", self.Mv, samples[:, s:]))
+        else:
+            out = np.einsum("nrs,ns->nr", self.Mq, h.synthesised(_phasors(p)))
+        return h.coefficients(out).reshape(-1, self.r)
+
+    def compliance(self, y: np.ndarray) -> np.ndarray:
+        """``G_VU y`` for y (m, r): (m, s)."""
+        return block_product(self.P0, self.Pk, y.reshape(-1, 1), self.r).reshape(-1, self.s)
+
+    def inner(self, y: np.ndarray) -> np.ndarray:
+        """``(I + C G_VU) y`` for y of shape ((2K - 1) r,)."""
+        y = y.reshape(-1, self.r)
+        return (y + self.core(self.compliance(y))).reshape(-1)
+
+    def times(self, v: np.ndarray) -> np.ndarray:
+        """``J v`` for v of shape ((2K - 1) c,): ``v + G (I (x) U) C (I (x) V^T) v``."""
+        Cv = self.core(v.reshape(-1, self.c) @ self.V)
+        return v + block_product(self.G0, self.Gk, (Cv @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
+
+    # ------------------------------------------------------------------------------------------ preconditioner
+    def _coarse_block(self):
+        """The orders where the compliance is largest (:data:`COARSE_ORDERS` of them, the mean among them): their
+        positions in the reduced vector and the inverse of the reduced equation's dense block between them,
+        ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
+        h, r, s, N = self.h, self.r, self.s, self.h.n_samples
+        weight = np.concatenate([[np.linalg.norm(self.P0)], np.linalg.norm(self.Pk, axis=(1, 2))])
+        among = np.union1d([0], np.argsort(-weight)[:COARSE_ORDERS])
+        m = 2 * len(among) - 1
+
+        def assembled(blocks):
+            return blocks.reshape(r, s, m, m).transpose(2, 0, 3, 1).reshape(m * r, m * s)
+        C = assembled(h.toeplitz_blocks(self.Mq.reshape(N, r * s), among))
+        if self.has_velocity:  # times the derivative on the right: columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k)
+            Tv = assembled(h.toeplitz_blocks(self.Mv.reshape(N, r * s), among)).reshape(m * r, m, s)
+            wk = h.frequencies(self.w)[among[1:]][None, :, None]
+            C3 = C.reshape(m * r, m, s)  # a view
+            C3[:, 1::2] -= wk * Tv[:, 2::2]
+            C3[:, 2::2] += wk * Tv[:, 1::2]
+        GT = block_product(self.P0.T, self.Pk[among[1:] - 1].transpose(0, 2, 1), C.T, s)  # (G_L^T C^T)
+        rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
+        rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
+        # inverted once (in double precision: its condition reaches 2e7 on the rig), its product a GMRES iteration:
+        # faster than an LU's two triangular solves
+        return rows, sla.inv(np.eye(m * r) + GT.T, check_finite=False)
+
+    def precondition(self, y: np.ndarray) -> np.ndarray:
+        """An approximate inverse of ``I + C G_VU`` applied to y ((2K - 1) r,): exact on the block between the orders
+        of largest compliance (:meth:`_coarse_block`), the identity elsewhere (where ``C G_VU`` is small)."""
+        if self._preconditioner is None:
+            self._preconditioner = self._coarse_block()
+        rows, inverse = self._preconditioner
+        out = y.copy()
+        out[rows] = inverse @ y[rows]
+        return out
+
+    # ------------------------------------------------------------------------------------------ the step
+    def solve(self, b: np.ndarray, rtol: float, maxiter: int = 300, restart: int = 100):
+        """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``;
+        returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced residual reached)."""
+        rhs = self.core(b.reshape(-1, self.c) @ self.V).reshape(-1)
+        n = self.inner_size
+        A = LinearOperator((n, n), matvec=self.inner, dtype=float)
+        M = LinearOperator((n, n), matvec=self.precondition, dtype=float)
+        count = [0]
+
+        def counted(_):
+            count[0] += 1
+        y, info = gmres(A, rhs, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
+                        callback=counted, callback_type="pr_norm")
+        if self.reused and (info != 0 or count[0] > REFRESH_ITERATIONS):  # the earlier factors serve badly: fresh
+            self._preconditioner, self.reused = None, False
+            y, info = gmres(A, rhs, x0=y, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
+                            callback=counted, callback_type="pr_norm")
+        norm = float(np.linalg.norm(rhs)) or 1.0
+        achieved = float(np.linalg.norm(self.inner(y) - rhs)) / norm
+        if not np.all(np.isfinite(y)):
+            raise sla.LinAlgError("GMRES gave a non-finite solution")
+        X_y = block_product(self.G0, self.Gk, (y.reshape(-1, self.r) @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
+        return b - X_y, KrylovStats(count[0], achieved)
+
+
+def _phasors(p: np.ndarray) -> np.ndarray:
+    """Complex amplitudes (K, p) of harmonic-major coefficient rows (m, p)."""
+    out = np.empty(((p.shape[0] + 1) // 2, p.shape[1]), complex)
+    out[0] = p[0]
+    out[1:] = p[1::2] - 1j * p[2::2]
+    return out
+
+
+def block_product(B0: np.ndarray, Bk: np.ndarray, X: np.ndarray, c: int) -> np.ndarray:
+    """``B X`` for block-diagonal B: B0 (a, c) on the first c rows of X (m c, p), Bk[k] (2a, 2c) on each next 2c:
+    shape (m a, p)."""
+    a = B0.shape[0]
+    out = np.empty((a + 2 * a * len(Bk), X.shape[1]))
+    out[:a] = B0 @ X[:c]
+    out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
+    return out
