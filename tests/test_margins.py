@@ -65,6 +65,23 @@ def test_half_power_points_of_a_single_dof_system(zeta):
     assert half_power(lambda r: r, W, 1.0) is None  # no peak
 
 
+@pytest.mark.parametrize("offset", [0.3, 0.5])
+def test_half_power_of_a_peak_sharper_than_the_grid(offset):
+    """A peak narrower than the sampling (zeta = 1e-3: half-power band 2e-3 wide, samples 2e-2 apart, the peak
+    ``offset`` of a step from the nearest): every sample lies below peak / sqrt(2), so the half-power points lie
+    between the refined peak and its neighbouring samples. Before, the brackets were taken from the samples alone and
+    Brent's method failed ("f(a) and f(b) must have different signs"; a rotor of the gallery's tutorial met it). The
+    points against the closed form (as in the test above) to 1e-12."""
+    zeta = 1e-3
+    W = 1 + (np.arange(-10, 11) + offset) * 2e-2
+    amplitude = (lambda r: 1 / np.abs(1 - r * r + 2j * zeta * r))
+    assert amplitude(W).max() < amplitude(np.array([1.0]))[0] / math.sqrt(2)  # the grid misses the band
+    hp = half_power(amplitude, W, 1.0)
+    root = 2 * zeta * math.sqrt(1 - zeta * zeta)
+    exact = (math.sqrt(1 - 2 * zeta ** 2 - root), math.sqrt(1 - 2 * zeta ** 2 + root))
+    np.testing.assert_allclose((hp.lower, hp.upper), exact, rtol=1e-12)
+
+
 @pytest.mark.parametrize("zeta", [0.01, 0.02, 0.04])
 def test_amplification_factor_of_a_rotor_that_behaves_as_one_dof(zeta):
     """The rigid disk on isotropic damped bearings (disk_rotor): the AF of its forward critical speed from

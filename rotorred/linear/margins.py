@@ -250,17 +250,18 @@ def half_power(amplitude: Callable[[np.ndarray], np.ndarray], speeds: np.ndarray
     if peak < A[i]:  # the bounded search stopped short of the grid's best: keep the sample
         Wp, peak = float(speeds[i]), float(A[i])
     level = peak / math.sqrt(2.0)
-    left = next((j for j in range(i, -1, -1) if A[j] < level), None)
-    right = next((j for j in range(i, len(A)) if A[j] < level), None)
+    # the nearest samples below the level on each side of the refined peak; every sample between them and the peak
+    # is at or above it (a peak sharper than the grid may leave even the best sample below the level)
+    left = next((j for j in range(len(A) - 1, -1, -1) if speeds[j] < Wp and A[j] < level), None)
+    right = next((j for j in range(len(A)) if speeds[j] > Wp and A[j] < level), None)
     if left is None or right is None:
         return None
 
     def gap(W):
         return one(W) - level
 
-    # samples left + 1 ... right - 1 are at or above the level (left, right: the first below it from the peak out)
-    lower = brentq(gap, speeds[left], speeds[left + 1], xtol=1e-12 * Wp)
-    upper = brentq(gap, speeds[right - 1], speeds[right], xtol=1e-12 * Wp)
+    lower = brentq(gap, speeds[left], min(float(speeds[left + 1]), Wp), xtol=1e-12 * Wp)
+    upper = brentq(gap, max(float(speeds[right - 1]), Wp), speeds[right], xtol=1e-12 * Wp)
     return HalfPower(Wp, peak, float(lower), float(upper))
 
 
