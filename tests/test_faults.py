@@ -445,12 +445,13 @@ def test_run_ups_say_what_a_steady_run_says_of_a_long_step_and_a_large_orbit(tmp
         in capsys.readouterr().err
 
 
-def test_an_error_raised_from_an_interrupt_is_the_interrupt():
+def test_an_error_raised_from_an_interrupt_is_the_interrupt(monkeypatch, tmp_path, capsys):
     """A signal that comes as a module is imported or a class made is raised again as another error, its cause the
     interrupt (seen at random moments: ``ImportError: initialization failed``, ``RuntimeError: Error calling
-    __set_name__``, each an internal error, exit 1, before): the commands raise the interrupt itself."""
+    __set_name__``, each an internal error, exit 1, before): every command (here `convert`, through the one wrapper of
+    rotorred.cli.main) reports the interrupt itself, and another error stays what it is."""
+    import rotorred.cli.convert as convert
     from rotorred.cli import Terminated
-    from rotorred.cli.run import interruptible
 
     def importing(args):
         try:
@@ -458,10 +459,13 @@ def test_an_error_raised_from_an_interrupt_is_the_interrupt():
         except Terminated as exc:
             raise ImportError("initialization failed") from exc
 
-    with pytest.raises(Terminated):
-        interruptible(importing)(None)
-    with pytest.raises(ValueError):
-        interruptible(lambda args: int("x"))(None)
+    monkeypatch.setattr(convert, "run", importing)
+    assert main(["convert", "a.toml", str(tmp_path / "b.toml")]) == 143
+    err = capsys.readouterr().err
+    assert err == "rotorred convert: error: terminated (SIGTERM); the output folder keeps its earlier result\n", err
+    monkeypatch.setattr(convert, "run", lambda args: int("x"))
+    assert main(["convert", "a.toml", str(tmp_path / "b.toml")]) == 1  # an internal error: no interrupt in its chain
+    assert "internal error (ValueError" in capsys.readouterr().err
 
 
 def test_the_readme_states_the_number_of_fault_kinds():

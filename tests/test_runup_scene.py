@@ -176,3 +176,41 @@ def test_reduced_run_up_equals_full():
         if ta.order == 1.0:
             worst = max(worst, np.max(np.abs(tb.amplitude - ta.amplitude)) / ta.amplitude.max())
     assert worst < 8.6e-5
+
+
+@pytest.mark.parametrize("signal_name, status", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_an_interrupted_run_up_writes_the_record_up_to_the_signal(tmp_path, monkeypatch, capsys, signal_name, status):
+    """Issue 41: SIGINT or SIGTERM as a run-up stepped kept the earlier result, nothing of the run (on main: exit 130,
+    the folder as before). Now the signal's exception, raised between two compiled calls (here as the 5th speed
+    interval is set up), ends the stepping there: the record up to the last step taken is analysed and written,
+    the folder marked INCOMPLETE with the signal and the time, exit 130 or 143, one line, no traceback; the record
+    is the uninterrupted run's, bit for bit, up to there."""
+    import rotorred.transient.ramp as ramp
+    from rotorred.cli import Terminated, interrupts, main
+
+    args = ["run", "runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3", "--set", "runup.orbits_hz=[]",
+            "--set", "output.plots=[]", "--set", "output.formats=['npz']"]
+    assert main([*args, "--out", str(tmp_path / "whole"), "-q"]) == 0
+    real, calls = ramp.interval_state, []
+
+    def interrupted(*a, **k):
+        calls.append(1)
+        if len(calls) == 5:
+            raise {"SIGINT": KeyboardInterrupt, "SIGTERM": Terminated}[signal_name]()
+        return real(*a, **k)
+
+    monkeypatch.setattr(ramp, "interval_state", interrupted)
+    capsys.readouterr()
+    out = tmp_path / "cut"
+    assert main([*args, "--out", str(out), "-q"]) == status
+    err = capsys.readouterr().err
+    assert err.startswith(f"rotorred run: error: interrupted ({signal_name}) at t = 0.") and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and "partial results written to" in err, err
+    assert (out / "INCOMPLETE").read_text().startswith(f"interrupted ({signal_name}) at t = ")
+    assert f"INCOMPLETE: interrupted ({signal_name})" in (out / "summary.txt").read_text()
+    whole, cut = np.load(tmp_path / "whole" / "result.npz"), np.load(out / "result.npz")
+    n = len(cut["t"])
+    assert 10 < n < len(whole["t"]) and not (out / ".rotorred-staging").exists()
+    for key in ("t", "node18_x", "speed_inner"):
+        np.testing.assert_array_equal(cut[key], whole[key][:n])
+    assert set(interrupts()) == {KeyboardInterrupt, Terminated}

@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -29,7 +30,7 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.model.operating import Operating, checked as checked_operating
-from rotorred.progress import stage
+from rotorred.progress import INTERRUPTS, interrupt_name, stage
 from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
 from rotorred.scenes.built import built_scene, checked_loads, load_nodes, plates_on, recorded_nodes, rotor_model
@@ -129,7 +130,9 @@ class RunupResult(Result):
     build_time, solve_time, analysis_time : float
         Wall times (s).
     incomplete : str or None
-        Why the run stops early (a diverged transient); the analyses cover the record up to then.
+        Why the run stops early (a diverged or interrupted transient); the analyses cover the record up to then.
+    interrupt : str
+        The signal that ended the transient ("SIGINT", "SIGTERM": :func:`run_runup`'s ``interrupts``), or "".
     """
 
     scene: Scene
@@ -153,6 +156,7 @@ class RunupResult(Result):
     solve_time: float
     analysis_time: float
     incomplete: str | None = None
+    interrupt: str = ""
 
     @property
     def reference(self) -> str:
@@ -420,11 +424,14 @@ def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
 
 
 # --------------------------------------------------------------------------- the run
-def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | None = None) -> RunupResult:
+def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | None = None,
+              interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> RunupResult:
     """Step the scene through its speed profile and analyse the record (see the module docstring).
 
     A diverged transient does not raise: the result holds the record up to the failure, analysed,
-    with ``incomplete`` saying when, where and why it stopped.
+    with ``incomplete`` saying when, where and why it stopped. Nor does an interrupt while the transient steps
+    (``interrupts``): the result holds the record up to the last step taken, analysed, with ``incomplete`` and
+    ``interrupt`` saying so; an interrupt before the stepping or in the analysis is raised as it came.
 
     Parameters
     ----------
@@ -435,6 +442,9 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     progress : bool, optional
         Progress bar on stderr; None (default): shown on a terminal once the run has taken 1 s
         (:class:`rotorred.transient.options.StepControl`).
+    interrupts : mapping of exception type to str
+        The exceptions that end the transient where it is, and the signal each stands for (default SIGINT's
+        ``KeyboardInterrupt``; empty: none, they propagate).
 
     Returns
     -------
@@ -446,6 +456,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
         If the scene has no ``[runup]``.
     """
     from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
+    from rotorred.transient.ramp import interrupted_record
     from rotorred.transient.results import SimulationDiverged
 
     if scene.runup is None:
@@ -455,7 +466,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     at_t0 = dataclasses.replace(scene, operating=Operating.point(profile.speeds_at(0.0)))
     start = Initial(*settled_state(at_t0, model.model)) if s.start == "settled" else None
     t0 = time.perf_counter()
-    incomplete = None
+    incomplete, interrupt = None, ""
     stage("stepping %s through its speed profile: %d steps of %g s to %g s", scene.name, round(s.duration / s.dt),
           s.dt, s.duration)
     try:
@@ -465,9 +476,16 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
                        start=start, control=StepControl(progress=progress))
     except SimulationDiverged as exc:
         res, incomplete = exc.result, explain_divergence(scene, exc)
+    except tuple(interrupts) as exc:
+        res = interrupted_record(exc)
+        if res is None:  # before the first step: nothing to keep
+            raise
+        interrupt = interrupt_name(exc, interrupts)
+        incomplete = (f"interrupted ({interrupt}) at t = {res.final.t:.6g} s of solver.duration = {s.duration:g} s; "
+                      f"the record up to there is kept")
     solve_time = time.perf_counter() - t0
     stage("analysing %s: order tracks, critical speeds, rub intervals", scene.name)
-    return analyse(scene, model, res, solve_time, incomplete)
+    return dataclasses.replace(analyse(scene, model, res, solve_time, incomplete), interrupt=interrupt)
 
 
 @dataclass(frozen=True)

@@ -163,6 +163,8 @@ def format_runup_summary(result: RunupResult, files=()) -> str:
     if result.overall:
         rows = []
         for node, (speed, radius) in sorted(result.overall.items()):
+            if not len(radius):  # a record shorter than two revolutions (an early divergence or interrupt)
+                continue
             k = int(np.argmax(radius))
             rows.append([str(node), f"{1e6 * radius[k]:.2f}", f"{speed[k] * HZ:.2f}", f"{60 * speed[k] * HZ:.0f}"])
         lines += ["", f"largest orbit radius against {ref} speed:",
