@@ -225,7 +225,7 @@ def _consistent_partial(kind: str, out: Path) -> str:
     from rotorred import writers
 
     if not (out / writers.MANIFEST).exists():
-        return f"{said}; {len(points)} finished points without a dataset"
+        return "no manifest"
     listed = (out / writers.MANIFEST).read_text().split()
     if writers.INCOMPLETE not in listed or not all((out / name).exists() for name in listed):
         return f"manifest {listed} against {sorted(p.name for p in out.iterdir())}"
@@ -287,7 +287,7 @@ def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) 
     from rotorred import writers
 
     if not (out / writers.MANIFEST).exists():
-        return f"{said}; {len(points)} finished points without a dataset"
+        return "no manifest"
     listed = (out / writers.MANIFEST).read_text().split()
     if writers.INCOMPLETE not in listed and all((out / name).exists() for name in listed) \
             and _complete(kind, out, before):

@@ -214,9 +214,9 @@ def main(argv: list[str] | None = None) -> int:
             feedback.configure(args.command, feedback.level(args))
             status = int(args._run(args) or 0)
         except BaseException as exc:  # noqa: BLE001 -- the one place every error is turned into a message
-            from rotorred.progress import interrupt_in
+            from rotorred import progress
 
-            status = _report(args, interrupt_in(exc, tuple(interrupts())) or exc)
+            status = _report(args, progress.interrupt_in(exc, tuple(interrupts())) or exc)
     if noted and status not in (interrupted_status(n) for n in noted):
         _error(args, f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to its "
                      "end: its result is written whole")
