@@ -468,6 +468,50 @@ def test_an_error_raised_from_an_interrupt_is_the_interrupt(monkeypatch, tmp_pat
     assert "internal error (ValueError" in capsys.readouterr().err
 
 
+#: a child that sends itself ``SIG`` as it first imports ``MODULE`` (an import hook), then runs the console script
+SELF_SIGNAL = """
+import os, signal, sys
+MODULE, SIG = sys.argv[1], getattr(signal, sys.argv[2])
+class Hook:
+    def find_spec(self, name, path=None, target=None):
+        if name == MODULE:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), SIG)
+        return None
+sys.meta_path.insert(0, Hook())
+sys.argv = ["rotorred", *sys.argv[3:]]
+from rotorred.cli import entry
+sys.exit(entry())
+"""
+
+
+@pytest.mark.parametrize("module, sig, command", [
+    ("numpy", "SIGINT", ["--version"]),                               # parsing: the parser's imports
+    ("rotorred.cli.map", "SIGTERM", ["run", "paper-rub"]),            # a command module, as the parser is built
+    ("scipy", "SIGINT", ["campbell", "seed-rig", "--speeds", "0:6000:5"]),  # inside a command (not run, map, continue)
+    ("scipy", "SIGTERM", ["campbell", "seed-rig", "--speeds", "0:6000:5"]),
+    ("rotorred.model.rotor_file", "SIGTERM", ["convert", "a.toml", "b.toml"]),
+])
+def test_a_signal_during_the_first_imports_is_one_line_and_its_status(tmp_path, module, sig, command):
+    """Issue 41: a signal in the first ~0.6 s of a command, as rotorred's modules were imported and before its handlers
+    existed, gave Python's KeyboardInterrupt traceback (exit -2) or a silent death by SIGTERM (exit -15) (on main: the
+    first two cases below; SIGINT at the import of numpy as the parser is built: a traceback). The console script
+    now sets the handlers first: a signal from then on, at the import of any module, in parsing or inside `campbell`
+    or `convert` (commands without work to keep: these cases held on main too), exits 130 or 143 with one line, no
+    traceback, nothing written."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", SELF_SIGNAL, module, sig, *command,
+                           *(["--out", str(tmp_path / "o")] if command[0] in ("run", "campbell") else [])],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == SIGNALS[sig][0], (done.returncode, done.stderr)
+    err = done.stderr.strip()
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert err.startswith("rotorred") and ("interrupted (SIGINT)" if sig == "SIGINT" else "terminated (SIGTERM)") in err
+    assert not (tmp_path / "o").exists() and not (tmp_path / "b.toml").exists()
+
+
 def test_the_readme_states_the_number_of_fault_kinds():
     """The README's sentence on the faults tested gives the number of FAULT_KINDS, each named once."""
     text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
