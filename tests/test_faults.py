@@ -187,24 +187,131 @@ INTERRUPTED = {
                "--set", "runup.orbits_hz=[10.0, 20.0]", "--set", "output.plots=[]"], ["--set", "runup.to=0.31"]),
 }
 #: a signal's exit statuses: the command's (it caught the signal), or the signal's own (-2, -15: it came after the
-#: command had returned, while the interpreter shut down; its result is then complete)
+#: command had returned, while the process ended; its result is then complete)
 SIGNALS = {"SIGINT": (130, -2), "SIGTERM": (143, -15)}
-#: the earliest moment of an interrupt (s): once the command's own handlers are set, past Python's start and the import
-#: of rotorred.cli (0.5 s: `rotorred --version` takes 0.47 s here), where SIGINT is Python's own KeyboardInterrupt
-#: traceback (exit -2), before rotorred runs
-START = 0.6
+#: the earliest moment of an interrupt (s) after the fork of the command's process: once the console script's handlers
+#: are set (they are its first statement). The moments before, in Python's start and rotorred's first imports, are
+#: test_a_signal_during_the_first_imports_is_one_line_and_its_status's
+START = 0.005
+#: how long a forked command's process lives on after the command has returned (s), as a Python process's end takes
+#: (0.2-0.5 s with numba's modules loaded): a signal sent as the parent saw it running then ends it by the signal's
+#: action (-2, -15), as in a real process, not after it has exited (a signal lost, exit 0)
+LINGER = 0.2
 
 
-def _command(*args: str):
+class _Forked:
+    """``rotorred ARGS -q`` (the console script, :func:`rotorred.cli.entry`) in a child forked from this process, its
+    stdout and stderr into files: a process start-up without Python's start and the imports, and with the compiled
+    kernels this process has loaded (:func:`_warm`). SIGINT as in a terminal (Python's KeyboardInterrupt)."""
+
+    def __init__(self, *args: str):
+        import os
+        import tempfile
+
+        self.files = [tempfile.TemporaryFile() for _ in range(2)]
+        self.pid = os.fork()
+        if self.pid == 0:
+            self._child(args)
+        self.returncode = None
+
+    def _child(self, args):
+        import io
+        import os
+        import signal
+        import sys
+        import time
+        import traceback
+
+        status = 1
+        try:
+            for fd, f in zip((1, 2), self.files):
+                os.dup2(f.fileno(), fd)
+            sys.stdout, sys.stderr = (io.TextIOWrapper(io.FileIO(fd, "w", closefd=False), line_buffering=True)
+                                      for fd in (1, 2))
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            sys.argv = ["rotorred", *args, "-q"]
+            from rotorred.cli import entry
+
+            status = entry()
+        except BaseException:  # noqa: BLE001 -- what a real process would print
+            traceback.print_exc()
+        finally:
+            for stream in (sys.stdout, sys.stderr):
+                stream.flush()
+            time.sleep(LINGER)  # as an interpreter's end: a signal now has its own action (entry's)
+            os._exit(status)
+
+    def ended(self) -> bool:
+        """Whether the child has exited (without reaping it: a signal sent after a check that says no reaches it)."""
+        import os
+
+        return os.waitid(os.P_PID, self.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
+
+    def send_signal(self, sig) -> None:
+        import os
+
+        os.kill(self.pid, sig)
+
+    def communicate(self, timeout: float = 120.0) -> tuple[str, str]:
+        """Wait for the child (killed after ``timeout`` s): (stdout, stderr); its status in ``returncode``."""
+        import os
+        import signal
+        import time
+
+        t_end = time.monotonic() + timeout
+        while not self.ended() and time.monotonic() < t_end:
+            time.sleep(0.01)
+        if not self.ended():
+            os.kill(self.pid, signal.SIGKILL)
+        self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
+        texts = []
+        for f in self.files:
+            f.seek(0)
+            texts.append(f.read().decode("utf-8", "replace"))
+            f.close()
+        return texts[0], texts[1]
+
+
+#: the kinds whose command this process has run (its modules imported, its kernels loaded)
+_WARMED: set = set()
+
+
+def _warm(kind: str, scratch: Path) -> None:
+    """Run ``kind``'s command once in this process (its imports and compiled kernels then serve every child forked from
+    it and from the pool processes forked from it)."""
     import os
-    import signal
-    import subprocess
-    import sys
 
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONUNBUFFERED="1")
-    return subprocess.Popen([sys.executable, "-c", "import sys; from rotorred.cli import main; sys.exit(main())",
-                             *args, "-q"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # as in a terminal
+    if kind not in _WARMED:
+        assert main([*INTERRUPTED[kind][0], "--out", str(scratch / f"warm-{kind}-{os.getpid()}"), "-q"]) == 0
+        _WARMED.add(kind)
+
+
+@pytest.fixture()
+def no_tqdm_monitor():
+    """No tqdm monitor thread in this process while the test forks (a thread holding a lock at a fork leaves it held
+    in the child)."""
+    import tqdm
+
+    interval = tqdm.tqdm.monitor_interval
+    tqdm.tqdm.monitor_interval = 0
+    if tqdm.tqdm.monitor is not None:
+        tqdm.tqdm.monitor.exit()
+        tqdm.tqdm.monitor = None
+    yield
+    tqdm.tqdm.monitor_interval = interval
+
+
+def _earlier(kind: str, out: Path) -> float:
+    """The earlier result of ``kind`` into ``out`` (a forked child of a warm process) and the seconds it took."""
+    import time
+
+    _warm(kind, out.parent)
+    t0 = time.perf_counter()
+    proc = _Forked(*INTERRUPTED[kind][0], "--out", str(out))
+    _, err = proc.communicate()
+    assert proc.returncode == 0, err
+    return time.perf_counter() - t0
 
 
 def _snapshot(folder: Path) -> dict:
@@ -244,13 +351,6 @@ def _consistent_partial(kind: str, out: Path) -> str:
     return "" if (out / "summary.txt").read_text().count("INCOMPLETE") else "summary.txt not marked"
 
 
-def _ended(proc) -> bool:
-    """Whether ``proc`` has exited (without reaping it: a signal sent after a check that says no reaches it)."""
-    import os
-
-    return os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
-
-
 def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) -> str:
     """Run ``kind`` into ``out`` (a copy of ``earlier``, or new for a map), send ``sig`` after ``delay`` s; what went
     wrong ("" if nothing)."""
@@ -258,21 +358,22 @@ def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) 
     import time
 
     args, changed = INTERRUPTED[kind]
+    _warm(kind, out.parent)
     while True:  # a moment after the command ended (a machine less busy than when it was measured): earlier
         shutil.rmtree(out, ignore_errors=True)
         if kind != "map":
             shutil.copytree(earlier, out)
         before = _snapshot(out)
-        proc = _command(*args, *changed, "--out", str(out))
+        proc = _Forked(*args, *changed, "--out", str(out))
         time.sleep(delay)
-        if not _ended(proc):
+        if not proc.ended():
             proc.send_signal(getattr(signal, sig))  # microseconds after the check: it was running
             break
         proc.communicate()
         if proc.returncode != 0:
             return f"{kind} without a signal: exit {proc.returncode}"
         delay = START + 0.6 * (delay - START)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate()
     said = f"{kind} {sig} at {delay:.2f} s: exit {proc.returncode}, {err.strip()[-300:]!r}"
     if proc.returncode not in SIGNALS[sig] or "Traceback" in err:
         return said
@@ -302,31 +403,31 @@ def _complete(kind: str, out: Path, before: dict) -> bool:
     return set(before) <= set(now) and all(now[k] != v for k, v in before.items() if k.endswith(".txt"))
 
 
-def test_sigint_and_sigterm_at_random_moments_leave_the_earlier_or_a_partial_result(tmp_path):
+def test_sigint_and_sigterm_at_random_moments_leave_the_earlier_or_a_partial_result(tmp_path, no_tqdm_monitor):
     """Issue 41: SIGINT and SIGTERM at 10 random moments (seed 41) of a short map, continue and run-up, two at a time:
     every exit 130 (SIGINT) or 143 (SIGTERM) (or the signal's own, -2 or -15, when it came after the command had
     returned), no traceback, no staging folder or lock left, and every folder its earlier result, a consistent partial
-    one marked INCOMPLETE, or (the signal after the commit) the complete new one; a map's finished point is never
-    left without its dataset. On main a SIGTERM, or a SIGINT as the map was written, left the finished point without
-    map.nc. Moments from START s on: see START."""
+    one marked INCOMPLETE (a run-up's: its record up to the signal), or (the signal after the commit) the complete new
+    one; a map's finished point is never left without its dataset. On main a SIGTERM, or a SIGINT as the map was
+    written, left the finished point without map.nc, and a run-up interrupted as it stepped kept nothing of its run.
+
+    Each command runs in a child forked from a pool process forked from this one, which has run each command once
+    (its imports done, its kernels loaded): the moments fall in the command's own work, from START s on (the first
+    imports: test_a_signal_during_the_first_imports_is_one_line_and_its_status); this took 115-130 s with a fresh
+    Python process for each moment, most of it in imports."""
+    import multiprocessing
     import random
-    import time
-    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+    from concurrent.futures import ProcessPoolExecutor
 
-    def earlier(kind):
-        t0 = time.perf_counter()
-        proc = _command(*INTERRUPTED[kind][0], "--out", str(tmp_path / f"{kind}-earlier"))
-        _, err = proc.communicate(timeout=120)
-        assert proc.returncode == 0, err
-        return time.perf_counter() - t0
-
-    with ThreadPoolExecutor(2) as pool:
-        took = dict(zip(INTERRUPTED, pool.map(earlier, INTERRUPTED)))
-    rng = random.Random(41)
-    cases = [(kind, tmp_path / f"{kind}-earlier", tmp_path / f"{kind}-{i}", rng.choice(list(SIGNALS)),
-              rng.uniform(START, 0.9 * took[kind])) for kind in INTERRUPTED for i in range(10)]
-    with ProcessPoolExecutor(2) as pool:  # not threads: a thread waiting for the GIL between the check that the
-        # command runs and the signal could send it after the command ended
+    for kind in INTERRUPTED:
+        _warm(kind, tmp_path)
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:  # not threads: a thread
+        # waiting for the GIL between the check that the command runs and the signal could send it after it ended
+        took = dict(zip(INTERRUPTED, pool.map(_earlier, INTERRUPTED,
+                                              [tmp_path / f"{kind}-earlier" for kind in INTERRUPTED])))
+        rng = random.Random(41)
+        cases = [(kind, tmp_path / f"{kind}-earlier", tmp_path / f"{kind}-{i}", rng.choice(list(SIGNALS)),
+                  rng.uniform(START, 0.9 * took[kind])) for kind in INTERRUPTED for i in range(10)]
         wrong = [w for w in pool.map(_one_interrupt, *zip(*cases)) if w]
     assert not wrong, "\n".join(wrong)
 
@@ -339,7 +440,6 @@ def dask_cluster():
     import socket
     import subprocess
     import sys
-    import time
 
     from distributed import Client
 

@@ -175,16 +175,17 @@ def entry() -> int:
     5). Files are closed and exit handlers run as before; only the collection at exit is skipped.
 
     :func:`main` sets the handlers of SIGINT and SIGTERM first, before it imports anything, so that a signal at any
-    moment of a command, its imports included, ends it with 130 or 143 and one line; once it has returned (its result
-    complete) a signal is answered with its status, without a traceback, however late it comes."""
-    late: list[str] = []
-    for signum in (signal.SIGINT, signal.SIGTERM):  # outside main's handlers (restored as it returns): noted only
+    moment of a command, its imports included, ends it with 130 or 143 and one line. Outside them (the instant
+    before, and once main has returned, its result complete, as the interpreter ends) each signal has the operating
+    system's own action: the process ends by it (exit -2 or -15, a shell's 130 or 143), without Python's
+    KeyboardInterrupt traceback."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
         if signal.getsignal(signum) is not signal.SIG_IGN:
-            signal.signal(signum, lambda n, frame: late.append(signal.Signals(n).name))
+            signal.signal(signum, signal.SIG_DFL)
     gc.set_threshold(*GC_THRESHOLDS)
     status = main()
     gc.freeze()
-    return interrupted_status(late[0]) if late and status == EXIT_OK else status
+    return status
 
 
 def main(argv: list[str] | None = None) -> int:
