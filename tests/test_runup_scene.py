@@ -214,3 +214,26 @@ def test_an_interrupted_run_up_writes_the_record_up_to_the_signal(tmp_path, monk
     for key in ("t", "node18_x", "speed_inner"):
         np.testing.assert_array_equal(cut[key], whole[key][:n])
     assert set(interrupts()) == {KeyboardInterrupt, Terminated}
+
+
+def test_runup_critical_speeds_csv_is_campbells_with_the_api_columns(short_runup, tmp_path, capsys):
+    """Issue 38: a run-up's critical_speeds.csv lacked the API 684 columns of `rotorred campbell`'s (on main: six
+    columns, `inner speed (Hz)` ... `log dec`). Now it is written by the same writer
+    (CampbellResult.critical_speeds_to_csv) from the run-up's Campbell diagram of the swept range and its separation
+    margins: campbell's header, the amplification factor of each unbalance-excited (forward) critical speed."""
+    from rotorred.cli import main
+
+    result, out, _ = short_runup
+    with open(out / "critical_speeds.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    assert main(["campbell", "seed-rig", "--speeds", "0:3000:5", "--out", str(tmp_path / "c"), "-q"]) == 0
+    with open(tmp_path / "c" / "critical_speeds.csv", newline="") as f:
+        assert rows[0] == next(csv.reader(f))
+    assert rows[0][-4:] == ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
+    assert len(rows) - 1 == len(result.critical_speeds) == len(result.margins) >= 4
+    speed, whirl, af = (rows[0].index(k) for k in ("inner speed (rpm)", "whirl", "amplification_factor"))
+    for row, c, m in zip(rows[1:], result.critical_speeds, result.margins):
+        assert float(row[speed]) == pytest.approx(c.speed_rpm, rel=1e-6)
+        if row[whirl] == "forward":
+            assert float(row[af]) == pytest.approx(m.amplification_factor, rel=1e-4) and m.amplification_factor > 1
+    assert result.campbell.critical_speeds == result.critical_speeds

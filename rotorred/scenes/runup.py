@@ -124,6 +124,12 @@ class RunupResult(Result):
         Critical speeds in the swept range of the reference spool (``speed`` in rad/s of the reference).
     campbell_ratio : dict of str to float
         Speed ratios of the Campbell diagram (the profile's final ones).
+    campbell : CampbellResult
+        The Campbell diagram of the swept range (:data:`CAMPBELL_SPEEDS` speeds of the reference spool).
+    margins : tuple of SeparationMargin
+        The API 684 amplification factor and separation margin of each critical speed
+        (:func:`rotorred.linear.margins.separation_margins`; against the rotor file's operating range of the reference
+        spool, without a verdict when it gives none).
     model_label : str
     n_steps : int
     counters : dict
@@ -149,6 +155,8 @@ class RunupResult(Result):
     rubs: tuple
     critical_speeds: tuple
     campbell_ratio: dict
+    campbell: object
+    margins: tuple
     model_label: str
     n_steps: int
     counters: dict
@@ -408,19 +416,24 @@ def orbit_snapshots(scene: Scene, t: np.ndarray, speeds: dict, outputs: dict) ->
     return tuple(out)
 
 
-def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
-    """Campbell critical speeds of the reference spool within the swept range, at the profile's final ratios."""
+def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple:
+    """The Campbell diagram of the reference spool over the swept range (its lowest to its highest speed), at the
+    profile's final ratios: (its critical speeds, the ratios, the diagram, their API 684 separation margins
+    (:func:`rotorred.linear.margins.separation_margins`, against the rotor file's operating range of the reference
+    spool when it gives one))."""
     from rotorred.linear.campbell import campbell
+    from rotorred.linear.margins import OperatingRange, separation_margins
 
     ref = scene.runup.reference
     final = {s: float(v[-1]) for s, v in speeds.items()}
     if final[ref] <= 0:
         final = {s: float(np.max(v)) for s, v in speeds.items()}
     ratio = {s: w / final[ref] for s, w in final.items() if s != ref}
-    top = float(np.max(speeds[ref]))
-    cd = campbell(scene.rotor, Operating.line(np.linspace(0.0, top, CAMPBELL_SPEEDS), ref, ratios=ratio))
-    low = float(np.min(speeds[ref]))
-    return tuple(c for c in cd.critical_speeds if low <= c.speed <= top), {ref: 1.0, **ratio}
+    low, top = float(np.min(speeds[ref])), float(np.max(speeds[ref]))
+    cd = campbell(scene.rotor, Operating.line(np.linspace(low, top, CAMPBELL_SPEEDS), ref, ratios=ratio))
+    given = scene.rotor.defaults.operating_range(ref)
+    margins = separation_margins(scene.rotor, cd, None if given is None else OperatingRange(*given))
+    return tuple(cd.critical_speeds), {ref: 1.0, **ratio}, cd, margins
 
 
 # --------------------------------------------------------------------------- the run
@@ -596,7 +609,7 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
     f_max = scene.output.f_max_hz or 4.0 * f_top
     segment = min(0.25, 0.5 * (res.t[-1] - res.t[0])) if len(res.t) > 16 else 0.0
     fall = waterfall(res.t, res.outputs[dof], segment, f_max) if segment > 0 and len(res.t) >= 32 else None
-    criticals, ratio = critical_speeds_in_range(scene, speeds)
+    criticals, ratio, diagram, margins = critical_speeds_in_range(scene, speeds)
     counters = {"us_per_step": res.us_per_step, "n_passes": res.n_passes, "n_factorizations": res.n_factorizations,
                 "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
                 "kernel_load_time": res.kernel_load_time, "kernel_compiled": res.kernel_compiled}
@@ -604,7 +617,7 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
                        track_dofs=track_dofs, overall=overall, waterfall=fall, waterfall_dof=dof,
                        orbits=orbit_snapshots(scene, res.t, speeds, res.outputs),
                        rubs=rub_intervals(scene, res.t, speeds, res.contacts), critical_speeds=criticals,
-                       campbell_ratio=ratio, model_label=model.label, n_steps=res.n_steps, counters=counters,
+                       campbell_ratio=ratio, campbell=diagram, margins=margins, model_label=model.label, n_steps=res.n_steps, counters=counters,
                        build_time=model.build_time, solve_time=solve_time, analysis_time=time.perf_counter() - t0,
                        incomplete=incomplete)
 
