@@ -45,7 +45,7 @@ EXIT_STATUSES = {
     EXIT_INPUT: "bad input (a file, a key, an option, --out, a size beyond the limits): nothing computed, "
                 "nothing written",
     EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `map` (and `sweep`) keeps "
-                   "the other points and names the failed ones in map.csv and map.txt",
+                   "the other points and names the failed ones in map.csv and map.txt; `compare` writes nothing",
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written (a "
                       "full disk, a quota, the file-size limit, a folder removed, a non-regular file at its path: one "
                       "line naming the file, the earlier result intact), memory that cannot be allocated (the size), "

@@ -10,7 +10,8 @@ printed table) and ``scene.toml`` (the scene as set, the comparison's options in
 ``compare.txt``).
 
 SIGINT or SIGTERM after the reference run keeps the runs done: they are written, the folder marked INCOMPLETE, exit
-130 or 143; before it, the folder keeps its earlier result, as in every command.
+130 or 143; before it, the folder keeps its earlier result, as in every command. A run that diverges ends the
+comparison with exit 3 and one line saying when, where and why; nothing is written.
 """
 
 from __future__ import annotations
@@ -74,9 +75,9 @@ def run(args) -> int:
     """Check everything, then compare into ``--out`` (exit 130 or 143 when interrupted, the runs done kept)."""
     import dataclasses
 
-    from rotorred.cli import interrupted_status, interrupts
+    from rotorred.cli import EXIT_DIVERGED, interrupted_status, interrupts
     from rotorred.cli.run import _settings
-    from rotorred import (InputError, check_comparison, compare_models, format_comparison, load_scene,
+    from rotorred import (InputError, SceneDiverged, check_comparison, compare_models, format_comparison, load_scene,
                           scene_estimate, scene_toml)
 
     t0 = time.perf_counter()
@@ -92,7 +93,11 @@ def run(args) -> int:
     scene_estimate(dataclasses.replace(checked, solver=dataclasses.replace(checked.solver, dt=finest,
                                                                            model="full"))).check(force=args.force)
     record = provenance(args, "scene", scene_toml(scene))
-    comparison = compare_models(scene, options, interrupts=interrupts())
+    try:
+        comparison = compare_models(scene, options, interrupts=interrupts())
+    except SceneDiverged as exc:  # the scene's message, less its promise of a record kept: a comparison writes none
+        error(f"{str(exc).split('; the record up to')[0]}; nothing is written (a comparison needs every run)")
+        return EXIT_DIVERGED
     report(format_comparison(comparison))
     for f in _write(comparison, out, tuple(interrupts()), record):
         report(f"wrote {f}")
