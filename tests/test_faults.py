@@ -2,7 +2,7 @@
 run-ups, sizes before work, and inputs a command cannot honour. Each test first reproduced its example on main
 (named in its docstring) and passes now.
 
-Fault kinds tested here: :data:`FAULT_KINDS` (29; the README states their number)."""
+Fault kinds tested here: :data:`FAULT_KINDS` (30; the README states their number)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ FAULT_KINDS = (
     # 2. interrupts: SIGINT and SIGTERM at random moments of map, continue, run-up; a worker or the scheduler lost;
     # an error raised from an interrupt
     "SIGINT map", "SIGTERM map", "SIGINT continue", "SIGTERM continue", "SIGINT run-up", "SIGTERM run-up",
-    "Dask worker killed", "Dask scheduler killed", "interrupt inside an import",
+    "Dask worker killed", "Dask scheduler killed", "--scheduler not Dask", "interrupt inside an import",
     # ... and at the first imports, before a command runs; in every other command (campbell, harmonic, modes)
     "signal at the first imports", "SIGINT or SIGTERM campbell", "SIGINT or SIGTERM harmonic",
     "SIGINT or SIGTERM modes",
@@ -529,6 +529,41 @@ def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplet
     assert (out / "INCOMPLETE").read_text().startswith("the Dask cluster was lost")
     with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
         assert list(ds["status"].values.ravel()) == ["ok", "", ""]
+
+
+def test_a_scheduler_address_where_no_dask_answers_is_refused_naming_it(tmp_path, capsys):
+    """Issue 41: a --scheduler that is not Dask gave an internal error (on main: a web server's reply read as a Dask
+    frame, "out of memory: Unable to allocate 3.01 EiB", exit 4). Now refused (exit 2), one line naming --scheduler
+    and what answered; nothing written."""
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+
+    def answer():
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.sendall(b"HTTP/1.0 200 OK\r\nContent-Type: text/plain\r\n\r\nhello")
+
+    threading.Thread(target=answer, daemon=True).start()
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    out = tmp_path / "o"
+    try:
+        status = main(["map", "paper-rub", "--vary", "rub.clearance=20e-6,30e-6", "--scheduler", address, *SHORT,
+                       "--out", str(out), "-q"])
+    finally:
+        server.close()
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert err.startswith(f"rotorred map: error: --scheduler = {address!r}: must be a Dask scheduler's address "
+                          "(tcp://host:port); what answered there does not speak Dask's protocol ("), err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
 
 
 # --------------------------------------------------------------------------- 4. inputs a command cannot honour
