@@ -2,7 +2,7 @@
 run-ups, sizes before work, and inputs a command cannot honour. Each test first reproduced its example on main
 (named in its docstring) and passes now.
 
-Fault kinds tested here: :data:`FAULT_KINDS` (30; the README states their number)."""
+Fault kinds tested here: :data:`FAULT_KINDS` (31; the README states their number)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ FAULT_KINDS = (
     # 2. interrupts: SIGINT and SIGTERM at random moments of map, continue, run-up; a worker or the scheduler lost;
     # an error raised from an interrupt
     "SIGINT map", "SIGTERM map", "SIGINT continue", "SIGTERM continue", "SIGINT run-up", "SIGTERM run-up",
-    "Dask worker killed", "Dask scheduler killed", "--scheduler not Dask", "interrupt inside an import",
+    "Dask worker killed", "Dask scheduler killed", "--scheduler not Dask", "SIGINT Dask map", "interrupt inside an import",
     # ... and at the first imports, before a command runs; in every other command (campbell, harmonic, modes)
     "signal at the first imports", "SIGINT or SIGTERM campbell", "SIGINT or SIGTERM harmonic",
     "SIGINT or SIGTERM modes",
@@ -529,6 +529,35 @@ def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplet
     assert (out / "INCOMPLETE").read_text().startswith("the Dask cluster was lost")
     with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
         assert list(ds["status"].values.ravel()) == ["ok", "", ""]
+
+
+def test_ctrl_c_on_a_dask_map_writes_the_points_done_marked_incomplete(dask_cluster, tmp_path, monkeypatch, capsys):
+    """Issue 41: Ctrl-C on a Dask map gave internal errors, worker tracebacks, no dataset and no INCOMPLETE marker.
+    Now SIGINT's KeyboardInterrupt after the first point (raised as its result comes back from the worker) ends the
+    map there: exit 130, one line, map.nc holding the point done, the folder INCOMPLETE, the cluster left running."""
+    import xarray as xr
+
+    import rotorred.maps.run as map_run
+
+    real = map_run.run_points
+
+    def interrupted(spec, store, client, on_point):
+        def stop(*args):
+            on_point(*args)
+            raise KeyboardInterrupt
+        return real(spec, store, client, on_point=stop)
+
+    monkeypatch.setattr(map_run, "run_points", interrupted)
+    out = tmp_path / "out"
+    status = main(["map", "paper-rub", "--vary", "rub.clearance=20e-6,30e-6,40e-6", "--scheduler",
+                   dask_cluster["address"], *SHORT, "--out", str(out), "-q"])
+    err = capsys.readouterr().err
+    assert status == 130, err
+    assert err.startswith("rotorred map: error: interrupted (SIGINT)") and len(err.strip().splitlines()) == 1, err
+    assert (out / "INCOMPLETE").read_text().startswith("interrupted (SIGINT)")
+    with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
+        assert list(ds["status"].values.ravel()) == ["ok", "", ""]
+    assert dask_cluster["scheduler"].poll() is None and dask_cluster["worker"].poll() is None
 
 
 def test_a_scheduler_address_where_no_dask_answers_is_refused_naming_it(tmp_path, capsys):
