@@ -495,13 +495,15 @@ def dask_cluster():
         p.wait()
 
 
-@pytest.mark.parametrize("victim", ["worker", "scheduler"])
+@pytest.mark.parametrize("victim", ["worker", "scheduler", "Ctrl-C"])
 def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplete(dask_cluster, tmp_path, monkeypatch,
                                                                                   capsys, victim):
     """Issue 41: killing the only worker or the scheduler gave internal errors and no dataset (on main: the map with
-    its only worker killed waited for ever; with its scheduler killed, an internal error, exit 1, no map.nc). Now the
-    map ends there with exit 3, one line saying the Dask cluster was lost, and map.nc holds the point done, the folder
-    INCOMPLETE; the same command resumes it."""
+    its only worker killed waited for ever; with its scheduler killed, an internal error, exit 1, no map.nc), and so
+    did Ctrl-C on a Dask map (worker tracebacks, no INCOMPLETE marker). Now the map ends there with exit 3 (130 for
+    SIGINT's KeyboardInterrupt, raised as the first point's result comes back from the worker), one line saying the
+    Dask cluster was lost (or the signal), and map.nc holds the point done, the folder INCOMPLETE; the same command
+    resumes it."""
     import signal
 
     import xarray as xr
@@ -515,6 +517,8 @@ def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplet
     def killing(spec, store, client, on_point):
         def kill(*args):
             on_point(*args)
+            if victim == "Ctrl-C":
+                raise KeyboardInterrupt
             dask_cluster[victim].send_signal(signal.SIGKILL)
         return real(spec, store, client, on_point=kill)
 
@@ -523,41 +527,13 @@ def test_a_dask_cluster_lost_under_a_map_writes_the_points_done_marked_incomplet
     status = main(["map", "paper-rub", "--vary", "rub.clearance=20e-6,30e-6,40e-6", "--scheduler",
                    dask_cluster["address"], *SHORT, "--out", str(out), "-q"])
     err = capsys.readouterr().err
-    assert status == 3, err
-    assert err.startswith("rotorred map: error: the Dask cluster was lost (") and "after 1 of 3 points" in err, err
+    said = "interrupted (SIGINT)" if victim == "Ctrl-C" else "the Dask cluster was lost"
+    assert status == (130 if victim == "Ctrl-C" else 3), err
+    assert err.startswith(f"rotorred map: error: {said}") and "after 1 of 3 points" in err, err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
-    assert (out / "INCOMPLETE").read_text().startswith("the Dask cluster was lost")
+    assert (out / "INCOMPLETE").read_text().startswith(said)
     with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
         assert list(ds["status"].values.ravel()) == ["ok", "", ""]
-
-
-def test_ctrl_c_on_a_dask_map_writes_the_points_done_marked_incomplete(dask_cluster, tmp_path, monkeypatch, capsys):
-    """Issue 41: Ctrl-C on a Dask map gave internal errors, worker tracebacks, no dataset and no INCOMPLETE marker.
-    Now SIGINT's KeyboardInterrupt after the first point (raised as its result comes back from the worker) ends the
-    map there: exit 130, one line, map.nc holding the point done, the folder INCOMPLETE, the cluster left running."""
-    import xarray as xr
-
-    import rotorred.maps.run as map_run
-
-    real = map_run.run_points
-
-    def interrupted(spec, store, client, on_point):
-        def stop(*args):
-            on_point(*args)
-            raise KeyboardInterrupt
-        return real(spec, store, client, on_point=stop)
-
-    monkeypatch.setattr(map_run, "run_points", interrupted)
-    out = tmp_path / "out"
-    status = main(["map", "paper-rub", "--vary", "rub.clearance=20e-6,30e-6,40e-6", "--scheduler",
-                   dask_cluster["address"], *SHORT, "--out", str(out), "-q"])
-    err = capsys.readouterr().err
-    assert status == 130, err
-    assert err.startswith("rotorred map: error: interrupted (SIGINT)") and len(err.strip().splitlines()) == 1, err
-    assert (out / "INCOMPLETE").read_text().startswith("interrupted (SIGINT)")
-    with xr.open_dataset(out / "map.nc", engine="h5netcdf") as ds:
-        assert list(ds["status"].values.ravel()) == ["ok", "", ""]
-    assert dask_cluster["scheduler"].poll() is None and dask_cluster["worker"].poll() is None
 
 
 def test_a_scheduler_address_where_no_dask_answers_is_refused_naming_it(tmp_path, capsys):
