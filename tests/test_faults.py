@@ -204,33 +204,39 @@ SIGNALS = {"SIGINT": (130, -2), "SIGTERM": (143, -15)}
 #: are set (they are its first statement). The moments before, in Python's start and rotorred's first imports, are
 #: test_a_signal_during_the_first_imports_is_one_line_and_its_status's
 START = 0.005
-#: how long a forked command's process lives on after the command has returned (s), as a Python process's end takes
-#: (0.2-0.5 s with numba's modules loaded): a signal sent as the parent saw it running then ends it by the signal's
-#: action (-2, -15), as in a real process, not after it has exited (a signal lost, exit 0)
-LINGER = 0.2
 
 
 class _Forked:
     """``rotorred ARGS -q`` (the console script, :func:`rotorred.cli.entry`) in a child forked from this process, its
     stdout and stderr into files: a process start-up without Python's start and the imports, and with the compiled
-    kernels this process has loaded (:func:`_warm`). SIGINT as in a terminal (Python's KeyboardInterrupt)."""
+    kernels this process has loaded (:func:`_warm`). SIGINT as in a terminal (Python's KeyboardInterrupt).
+
+    Once the command has returned, the child says so and waits until :meth:`communicate` lets it exit, as a Python
+    process's end takes its time: a signal then has the action entry leaves it (the process ends by it, -2 or -15),
+    and none is sent to a process that has already exited (a parent descheduled between its check and the signal
+    would lose it, and see exit 0)."""
 
     def __init__(self, *args: str):
         import os
         import tempfile
 
         self.files = [tempfile.TemporaryFile() for _ in range(2)]
+        returned, self._go = os.pipe(), os.pipe()
         self.pid = os.fork()
         if self.pid == 0:
-            self._child(args)
+            os.close(returned[0])
+            os.close(self._go[1])
+            self._child(args, returned[1], self._go[0])
+        os.close(returned[1])
+        os.close(self._go[0])
+        self._returned = returned[0]
         self.returncode = None
 
-    def _child(self, args):
+    def _child(self, args, returned: int, go: int):
         import io
         import os
         import signal
         import sys
-        import time
         import traceback
 
         status = 1
@@ -250,14 +256,15 @@ class _Forked:
         finally:
             for stream in (sys.stdout, sys.stderr):
                 stream.flush()
-            time.sleep(LINGER)  # as an interpreter's end: a signal now has its own action (entry's)
+            os.write(returned, b"r")
+            os.read(go, 1)  # as an interpreter's end: a signal now has its own action (entry's)
             os._exit(status)
 
     def ended(self) -> bool:
-        """Whether the child has exited (without reaping it: a signal sent after a check that says no reaches it)."""
-        import os
+        """Whether the command has returned (its process then waits for :meth:`communicate`)."""
+        import select
 
-        return os.waitid(os.P_PID, self.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
+        return bool(select.select([self._returned], [], [], 0)[0])
 
     def send_signal(self, sig) -> None:
         import os
@@ -265,16 +272,20 @@ class _Forked:
         os.kill(self.pid, sig)
 
     def communicate(self, timeout: float = 120.0) -> tuple[str, str]:
-        """Wait for the child (killed after ``timeout`` s): (stdout, stderr); its status in ``returncode``."""
+        """Wait for the command (its process killed after ``timeout`` s), let its process exit: (stdout, stderr); its
+        status in ``returncode``."""
         import os
+        import select
         import signal
-        import time
 
-        t_end = time.monotonic() + timeout
-        while not self.ended() and time.monotonic() < t_end:
-            time.sleep(0.01)
-        if not self.ended():
+        if not select.select([self._returned], [], [], timeout)[0]:
             os.kill(self.pid, signal.SIGKILL)
+        try:
+            os.write(self._go[1], b"g")
+        except BrokenPipeError:  # ended by a signal after it returned
+            pass
+        for fd in (self._returned, self._go[1]):
+            os.close(fd)
         self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
         texts = []
         for f in self.files:
@@ -386,7 +397,7 @@ def _one_interrupt(kind: str, earlier: Path, out: Path, sig: str, delay: float) 
         delay = START + 0.6 * (delay - START)
     _, err = proc.communicate()
     said = f"{kind} {sig} at {delay:.2f} s: exit {proc.returncode}, {err.strip()[-300:]!r}"
-    if proc.returncode not in SIGNALS[sig] or "Traceback" in err:
+    if proc.returncode not in SIGNALS[sig] or "Traceback" in err or "internal error" in err:
         return said
     leftovers = [p.name for p in out.glob(".rotorred*") if p.name != ".rotorred-files"] if out.exists() else []
     if leftovers:

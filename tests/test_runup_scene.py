@@ -237,3 +237,22 @@ def test_runup_critical_speeds_csv_is_campbells_with_the_api_columns(short_runup
         if row[whirl] == "forward":
             assert float(row[af]) == pytest.approx(m.amplification_factor, rel=1e-4) and m.amplification_factor > 1
     assert result.campbell.critical_speeds == result.critical_speeds
+
+
+def test_a_run_up_interrupted_before_its_second_sample_keeps_the_earlier_result(tmp_path, monkeypatch, capsys):
+    """A signal as the first speed interval is set up leaves a record of one sample, nothing to analyse (seen at a
+    random moment: an internal error, "zero-size array to reduction operation maximum", then exit 130): the interrupt
+    is raised as it came, and the folder keeps its earlier result (here none), exit 130, one line."""
+    import rotorred.transient.ramp as ramp
+    from rotorred.cli import main
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ramp, "interval_state", interrupted)
+    out = tmp_path / "cut"
+    assert main(["run", "runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3", "--set",
+                 "runup.orbits_hz=[]", "--set", "output.plots=[]", "--out", str(out), "-q"]) == 130
+    err = capsys.readouterr().err
+    assert err == "rotorred run: error: interrupted (SIGINT); the output folder keeps its earlier result\n", err
+    assert not out.exists()

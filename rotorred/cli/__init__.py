@@ -7,7 +7,9 @@ Each command lives in its own module ``rotorred/cli/<command>.py`` exposing
 (``rotorred <command>: error: ...``), without a traceback, and the exit status says which kind
 it was (:data:`EXIT_STATUSES`, also printed by ``rotorred --help``). An unexpected error
 ("internal error") has its traceback written to a log file in the output folder (or the
-temporary folder when ``--out`` is unusable), and the message says where.
+temporary folder when ``--out`` is unusable), and the message says where. It is the one interrupt path too: SIGINT
+and SIGTERM end any command, from its first import on, with one line and exit 130 or 143 (:func:`main`); the long
+commands keep what they have through :func:`interrupts`.
 """
 
 from __future__ import annotations
@@ -219,8 +221,9 @@ def main(argv: list[str] | None = None) -> int:
 
             status = _report(args, progress.interrupt_in(exc, tuple(interrupts())) or exc)
     if noted and status not in (interrupted_status(n) for n in noted):
-        _error(args, f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to its "
-                     "end: its result is written whole")
+        if status == EXIT_OK:  # an error's status: its message is said
+            _error(args, f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to "
+                         "its end: its result is written whole")
         return interrupted_status(noted[0])
     return status
 

@@ -444,7 +444,8 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     A diverged transient does not raise: the result holds the record up to the failure, analysed,
     with ``incomplete`` saying when, where and why it stopped. Nor does an interrupt while the transient steps
     (``interrupts``): the result holds the record up to the last step taken, analysed, with ``incomplete`` and
-    ``interrupt`` saying so; an interrupt before the stepping or in the analysis is raised as it came.
+    ``interrupt`` saying so; an interrupt before the stepping, before the record's second sample or in the analysis
+    is raised as it came.
 
     Parameters
     ----------
@@ -491,7 +492,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
         res, incomplete = exc.result, explain_divergence(scene, exc)
     except tuple(interrupts) as exc:
         res = interrupted_record(exc)
-        if res is None:  # before the first step: nothing to keep
+        if res is None or len(res.t) < 2:  # before the second recorded sample: nothing to keep
             raise
         interrupt = interrupt_name(exc, interrupts)
         incomplete = (f"interrupted ({interrupt}) at t = {res.final.t:.6g} s of solver.duration = {s.duration:g} s; "
