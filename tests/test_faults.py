@@ -1,5 +1,6 @@
 """Faults of the long commands (issue 41): a map resumed after its scene changed, interrupts of map, continue and
-run-ups, sizes before work, and inputs a command cannot honour. Each test first reproduced its example on main
+run-ups (and of every other command, from its first imports on), a Dask cluster lost or not Dask, sizes before work,
+and inputs a command cannot honour. Each test first reproduced its example on main
 (named in its docstring) and passes now.
 
 Fault kinds tested here: :data:`FAULT_KINDS` (31; the README states their number)."""
