@@ -460,7 +460,7 @@ def test_the_other_commands_interrupted_at_random_moments_keep_the_earlier_or_wr
     """Issue 41: `harmonic`, `campbell` (and `modes`, `convert`) were not under the interrupt wrapper of map, continue
     and run: a signal raised again from an import became an internal error there (exit 1; reproduced on main by
     test_an_error_raised_from_an_interrupt_is_the_interrupt through `convert`), and one lost in a library an exit 0.
-    Now every command is, in rotorred.cli.main. SIGINT or SIGTERM at 3 random moments (seed 41) of each exits 130 or
+    Now every command is, in rotorred.cli.main. SIGINT or SIGTERM at 2 random moments (seed 41) of each exits 130 or
     143 (or -2, -15 after it returned), no traceback, and its folder keeps its earlier result or holds the complete
     new one (these moments held on main too: this guards the wrapper's place)."""
     import multiprocessing
@@ -473,7 +473,7 @@ def test_the_other_commands_interrupted_at_random_moments_keep_the_earlier_or_wr
         took = dict(zip(OTHERS, pool.map(_earlier, OTHERS, [tmp_path / f"{kind}-earlier" for kind in OTHERS])))
         rng = random.Random(41)
         cases = [(kind, tmp_path / f"{kind}-earlier", tmp_path / f"{kind}-{i}", rng.choice(list(SIGNALS)),
-                  rng.uniform(START, 0.9 * took[kind])) for kind in OTHERS for i in range(3)]
+                  rng.uniform(START, 0.9 * took[kind])) for kind in OTHERS for i in range(2)]
         wrong = [w for w in pool.map(_one_interrupt, *zip(*cases)) if w]
     assert not wrong, "\n".join(wrong)
 
