@@ -52,9 +52,10 @@ EXIT_STATUSES = {
                       "full disk, a quota, the file-size limit, a folder removed, a non-regular file at its path: one "
                       "line naming the file, the earlier result intact), memory that cannot be allocated (the size), "
                       "or an optional library is missing (the message gives its install command)",
-    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
-                 "marked INCOMPLETE; `compare`: the runs done, marked INCOMPLETE; `map`: the points done, resumed by "
-                 "the same command)",
+    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT), in any command, from its first imports on: --out keeps its "
+                 "earlier result (`continue`: the points traced, marked INCOMPLETE; `compare`: the runs done, marked "
+                 "INCOMPLETE; `map`: the points done, resumed by the same command; a run-up: its record up to the "
+                 "signal, analysed, marked INCOMPLETE)",
     EXIT_SIGTERM: "terminated (SIGTERM): as 130",
 }
 
