@@ -327,7 +327,8 @@ def keys(field: str, data: Mapping, allowed: Iterable[str], required: Iterable[s
 # --------------------------------------------------------------------------- physical bounds
 @dataclass(frozen=True)
 class Bound:
-    """The largest magnitude an input may have, in the unit the user gives it, and why (docs/model.md).
+    """The largest magnitude an input may have (and for some the smallest), in the unit the user gives it, and why
+    (docs/model.md).
 
     Attributes
     ----------
@@ -336,11 +337,15 @@ class Bound:
     unit : str
     why : str
         What the bound stands for, for the message.
+    least : float
+        The smallest magnitude allowed (in ``unit``; 0: none), for an input whose small values mean nothing too (a
+        tolerance below round-off, a step of a femtosecond).
     """
 
     limit: float
     unit: str
     why: str
+    least: float = 0.0
 
 
 #: the physical bounds of command inputs, each in the unit the user types (docs/model.md, "Physical bounds of command
@@ -355,6 +360,14 @@ BOUNDS = {
     "harmonic": Bound(1e3, "", "excitation orders stay below 1000: the highest, blade-passing orders, are blade "
                                "counts"),
     "frequency": Bound(1e6, "Hz", "far beyond the bending modes a beam model describes"),
+    "clearance": Bound(0.1, "m", "rub clearances are micrometres to millimetres: a gap of 10 cm never closes on a "
+                                 "rotor's orbit"),
+    "tolerance": Bound(1e-2, "", "a relative residual of 1 % already is no solution; below 1e-14 it is round-off, "
+                                 "never reached", least=1e-14),
+    "step": Bound(1e-2, "s", "a 10 ms step samples a 50 Hz whirl twice a period; a step below 1 ns gives a billion "
+                             "steps a simulated second", least=1e-9),
+    "refine": Bound(100.0, "", "a shaft element split 100 times is far finer than a beam model needs: more only "
+                               "multiplies the model's size"),
 }
 
 _PER_RPM = {"rpm": 1.0, "Hz": 60.0, "rad/s": 30.0 / math.pi}
@@ -372,7 +385,8 @@ def bounded(field: str, value, values, kind: str, unit: str = "") -> np.ndarray:
     values : float or array_like
         The values, in ``unit``.
     kind : str
-        A key of :data:`BOUNDS`: ``"speed"``, ``"ratio"``, ``"unbalance"``, ``"harmonic"``, ``"frequency"``.
+        A key of :data:`BOUNDS`: ``"speed"``, ``"ratio"``, ``"unbalance"``, ``"harmonic"``, ``"frequency"``,
+        ``"clearance"``, ``"tolerance"``, ``"step"``, ``"refine"``.
     unit : str
         The unit of ``values`` (default the bound's; a speed may be in ``"rpm"``, ``"Hz"`` or ``"rad/s"``).
 
@@ -389,16 +403,19 @@ def bounded(field: str, value, values, kind: str, unit: str = "") -> np.ndarray:
     limit = bound.limit / _PER_RPM[unit] if kind == "speed" else bound.limit
     if arr.size and float(np.max(np.abs(arr))) > limit:
         fail(field, value, f"must be at most {bound_text(kind, unit)}")
+    if arr.size and float(np.min(np.abs(arr))) < bound.least:
+        fail(field, value, f"must be at least {bound_text(kind, unit, least=True)}")
     return arr
 
 
-def bound_text(kind: str, unit: str = "") -> str:
+def bound_text(kind: str, unit: str = "", least: bool = False) -> str:
     """``"1e+06 rpm (twice the fastest machine rotors: ...)"``: the bound of :data:`BOUNDS` ``[kind]`` in ``unit``
-    (default the bound's) and why."""
+    (default the bound's) and why; with ``least``, its smallest magnitude instead of its largest."""
     bound = BOUNDS[kind]
     unit = unit or bound.unit
-    limit = bound.limit / _PER_RPM[unit] if kind == "speed" else bound.limit
-    shown = f"{limit:.6g}" + (f" {unit}" if unit else "") + (f" = {bound.limit:g} {bound.unit}" if unit != bound.unit
+    value = bound.least if least else bound.limit
+    limit = value / _PER_RPM[unit] if kind == "speed" else value
+    shown = f"{limit:.6g}" + (f" {unit}" if unit else "") + (f" = {value:g} {bound.unit}" if unit != bound.unit
                                                              else "")
     return f"{shown} ({bound.why})"
 

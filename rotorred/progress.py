@@ -27,9 +27,12 @@ import io
 import logging
 import sys
 import unicodedata
+from collections.abc import Mapping
 from contextlib import contextmanager
+from types import MappingProxyType
 
-__all__ = ["LOG", "stage", "bar", "shown", "muted", "interrupt_in", "ascii_text", "ascii_fallback", "ASCII_FORMS"]
+__all__ = ["LOG", "stage", "bar", "shown", "muted", "INTERRUPTS", "interrupt_name", "interrupt_in", "ascii_text",
+           "ascii_fallback", "ASCII_FORMS"]
 
 #: the package's logger: the parent of every module's logger
 LOG = logging.getLogger("rotorred")
@@ -91,6 +94,28 @@ def muted():
         yield
     finally:
         LOG.setLevel(level)
+
+
+#: the interrupts of long work outside the command line, and the signal each stands for: SIGINT's ``KeyboardInterrupt``
+#: (the command line adds its SIGTERM exception: ``rotorred.cli.interrupts``)
+INTERRUPTS = MappingProxyType({KeyboardInterrupt: "SIGINT"})
+
+
+def interrupt_name(exc: BaseException, interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> str:
+    """The signal ``exc`` stands for in ``interrupts`` ("SIGINT", "SIGTERM").
+
+    Parameters
+    ----------
+    exc : BaseException
+        An exception of one of ``interrupts``' types.
+    interrupts : mapping of exception type to str
+        The interrupts and their signals (default :data:`INTERRUPTS`).
+
+    Returns
+    -------
+    str
+    """
+    return next(name for kind, name in interrupts.items() if isinstance(exc, kind))
 
 
 def interrupt_in(exc: BaseException, kinds: tuple) -> BaseException | None:

@@ -165,10 +165,10 @@ def atomic_path(path: str | Path, suffix: str = ""):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{suffix}", dir=path.parent)
     except OSError as exc:
         raise _write_fault(exc, path) from exc
-    if hasattr(os, "fchmod"):  # POSIX: mkstemp's 0600 -> what open() would give; Windows has only a read-only flag
-        os.fchmod(fd, 0o666 & ~_UMASK)
-    os.close(fd)
-    try:
+    try:  # from here on an interrupt (or any error) removes the temporary file
+        if hasattr(os, "fchmod"):  # POSIX: mkstemp's 0600 -> what open() would give; Windows has a read-only flag
+            os.fchmod(fd, 0o666 & ~_UMASK)
+        os.close(fd)
         yield Path(tmp)
         check_target(path)  # nothing put there meanwhile
         os.replace(tmp, path)

@@ -155,7 +155,10 @@ CASES = [
     *[([*cmd, "--out", out], ["--out", token]) for cmd in (["run", "paper-rub"],
                                                           ["sweep", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6"],
                                                           ["campbell", "seed-rig", "--speeds", "0:6000:3"],
-                                                          ["harmonic", "seed-rig"])
+                                                          ["harmonic", "seed-rig"],
+                                                          ["map", "paper-rub", "--vary", "rub.clearance=1e-6,2e-6"],
+                                                          ["continue", "paper-rub", "--param", "rub.clearance=45e-6:4e-5"],
+                                                          ["compare", "paper-rub"], ["modes", "seed-rig", "--speed", "3000"])
       for out, token in (("{d}/afile", "afile"), ("{d}/afile/sub", "afile"), ("", "''"), ("{ro}/sub", "ro"))],
 ]
 

@@ -59,6 +59,19 @@ def test_diverging_run_keeps_its_partial_record(tmp_path, capsys):
     assert_provenance(out, argv, "summary.txt", "scene", since)  # under the INCOMPLETE line, which stays first
 
 
+def test_a_diverging_comparison_is_exit_3_in_one_line_and_writes_nothing(tmp_path, capsys):
+    """Reliability finding 2 in `compare`: a run that diverged was an internal error (on main: "internal error
+    (SceneDiverged: ...)", exit 1, a traceback log). Now exit 3, one line saying when, where and why, not promising a
+    record kept: a comparison needs every run, and writes nothing."""
+    out = tmp_path / "cmp"
+    assert main(["compare", "paper-rub", "--modes", "8", "--out", str(out), "--set", "unbalance[1].m_e=4.0",
+                 *DIVERGE, "-q"]) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("rotorred compare: error: the transient diverged at t = 0.3486 s at rub[0] (node 18, x)")
+    assert err.strip().endswith("nothing is written (a comparison needs every run)") and "is kept" not in err, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err and not out.exists()
+
+
 def test_diverging_sweep_point_is_recorded_and_the_others_kept(tmp_path, capsys):
     """A one-key sweep (a map) with a value whose transient diverges: that point is recorded with the reason, the
     other is kept, exit 3."""

@@ -100,6 +100,11 @@ def test_the_bounds_hold_at_the_bound_and_convert_units():
             checks.bounded("x", value, value, "speed", unit)
     with pytest.raises(checks.InputError, match="must be finite"):
         checks.bounded("x", "nan", [1.0, np.nan], "ratio")
+    for kind, bound in checks.BOUNDS.items():  # a least magnitude: at it accepted, just below refused
+        if bound.least:
+            assert checks.bounded("x", bound.least, bound.least, kind)[()] == bound.least
+            with pytest.raises(checks.InputError, match="must be at least"):
+                checks.bounded("x", bound.least * 0.999999, bound.least * 0.999999, kind)
 
 
 def test_the_bounds_are_the_documented_ones():
@@ -107,11 +112,42 @@ def test_the_bounds_are_the_documented_ones():
     text = (Path(__file__).resolve().parents[1] / "docs" / "model.md").read_text(encoding="utf-8")
     section = text[text.index("## 23. Physical bounds of command inputs"):]
     rows = {"speed": "| 1e6 rpm", "ratio": "| 100 |", "unbalance": "| 1000 kg m |", "harmonic": "| 1000 |",
-            "frequency": "| 1e6 Hz |"}
+            "frequency": "| 1e6 Hz |", "clearance": "| 0.1 m |", "tolerance": "| 0.01, and at least 1e-14 |",
+            "step": "| 0.01 s, and at least 1e-9 s |", "refine": "| 100 |"}
     assert set(rows) == set(checks.BOUNDS)
     for kind, cell in rows.items():
         assert cell in section, kind
-        assert float(cell.strip("| ").split()[0]) == checks.BOUNDS[kind].limit
+        assert float(cell.strip("| ").split()[0].rstrip(",")) == checks.BOUNDS[kind].limit
+        if checks.BOUNDS[kind].least:
+            assert float(cell.split("at least ")[1].split()[0]) == checks.BOUNDS[kind].least
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["continue", "paper-rub", "--param", "speeds.outer=90:1e300"],
+     "--param = 'speeds.outer=90:1e300': must be at most 16666.7 Hz = 1e+06 rpm (" + checks.BOUNDS["speed"].why),
+    (["continue", "paper-rub", "--param", "rub.clearance=45e-6:1e300"],
+     "--param = 'rub.clearance=45e-6:1e300': must be at most 0.1 m (" + checks.BOUNDS["clearance"].why),
+    (["continue", "paper-rub", "--param", "rub.clearance=45e-6:40e-6", "--tol", "1e300"],
+     "--tol = 1e+300: must be at most 0.01 (" + checks.BOUNDS["tolerance"].why),
+    (["continue", "paper-rub", "--param", "rub.clearance=45e-6:40e-6", "--tol", "1e-300"],
+     "--tol = 1e-300: must be at least 1e-14 (" + checks.BOUNDS["tolerance"].why),
+    (["compare", "paper-rub", "--refine", "1000000000"],
+     "--refine = 1000000000: must be at most 100 (" + checks.BOUNDS["refine"].why),
+    (["compare", "paper-rub", "--dt", "2e-5,1e300"], "--dt = '2e-5,1e300': must be at most 0.01 s ("),
+    (["compare", "paper-rub", "--dt", "1e-300"], "--dt = '1e-300': must be at least 1e-09 s ("),
+])
+def test_continue_and_compare_refuse_absurd_option_values_naming_the_bound(tmp_path, capsys, args, expected):
+    """Issue 41: `continue` and `compare` had no bounds on their options' magnitudes (on main: `continue --param
+    speeds.outer=90:1e300` an internal error (OverflowError), `--param rub.clearance=45e-6:1e300` and `--tol 1e300`
+    exit 0 with overflow warnings, `--tol 1e-300` "the matrix is singular", `compare --refine 1e9` killed for its
+    memory (exit 137), `--dt 1e300` an internal error (SceneDiverged)). Now each is refused before any work (exit 2, one
+    line naming the option, its value, the bound and why; no traceback, no --out). `run` has no number of its own: its
+    values are scene keys (`--set`), the scene loader's."""
+    out = tmp_path / "o"
+    assert main([*args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rotorred {args[0]}: error: {expected}") and len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err and not out.exists()
 
 
 def test_a_non_finite_response_is_refused_before_writing(tmp_path, capsys, monkeypatch):

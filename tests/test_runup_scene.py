@@ -176,3 +176,83 @@ def test_reduced_run_up_equals_full():
         if ta.order == 1.0:
             worst = max(worst, np.max(np.abs(tb.amplitude - ta.amplitude)) / ta.amplitude.max())
     assert worst < 8.6e-5
+
+
+@pytest.mark.parametrize("signal_name, status", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_an_interrupted_run_up_writes_the_record_up_to_the_signal(tmp_path, monkeypatch, capsys, signal_name, status):
+    """Issue 41: SIGINT or SIGTERM as a run-up stepped kept the earlier result, nothing of the run (on main: exit 130,
+    the folder as before). Now the signal's exception, raised between two compiled calls (here as the 5th speed
+    interval is set up), ends the stepping there: the record up to the last step taken is analysed and written,
+    the folder marked INCOMPLETE with the signal and the time, exit 130 or 143, one line, no traceback; the record
+    is the uninterrupted run's, bit for bit, up to there."""
+    import rotorred.transient.ramp as ramp
+    from rotorred.cli import Terminated, interrupts, main
+
+    args = ["run", "runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3", "--set", "runup.orbits_hz=[]",
+            "--set", "output.plots=[]", "--set", "output.formats=['npz']"]
+    assert main([*args, "--out", str(tmp_path / "whole"), "-q"]) == 0
+    real, calls = ramp.interval_state, []
+
+    def interrupted(*a, **k):
+        calls.append(1)
+        if len(calls) == 5:
+            raise {"SIGINT": KeyboardInterrupt, "SIGTERM": Terminated}[signal_name]()
+        return real(*a, **k)
+
+    monkeypatch.setattr(ramp, "interval_state", interrupted)
+    capsys.readouterr()
+    out = tmp_path / "cut"
+    assert main([*args, "--out", str(out), "-q"]) == status
+    err = capsys.readouterr().err
+    assert err.startswith(f"rotorred run: error: interrupted ({signal_name}) at t = 0.") and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and "partial results written to" in err, err
+    assert (out / "INCOMPLETE").read_text().startswith(f"interrupted ({signal_name}) at t = ")
+    assert f"INCOMPLETE: interrupted ({signal_name})" in (out / "summary.txt").read_text()
+    whole, cut = np.load(tmp_path / "whole" / "result.npz"), np.load(out / "result.npz")
+    n = len(cut["t"])
+    assert 10 < n < len(whole["t"]) and not (out / ".rotorred-staging").exists()
+    for key in ("t", "node18_x", "speed_inner"):
+        np.testing.assert_array_equal(cut[key], whole[key][:n])
+    assert set(interrupts()) == {KeyboardInterrupt, Terminated}
+
+
+def test_runup_critical_speeds_csv_is_campbells_with_the_api_columns(short_runup, tmp_path, capsys):
+    """Issue 38: a run-up's critical_speeds.csv lacked the API 684 columns of `rotorred campbell`'s (on main: six
+    columns, `inner speed (Hz)` ... `log dec`). Now it is written by the same writer
+    (CampbellResult.critical_speeds_to_csv) from the run-up's Campbell diagram of the swept range and its separation
+    margins: campbell's header, the amplification factor of each unbalance-excited (forward) critical speed."""
+    from rotorred.cli import main
+
+    result, out, _ = short_runup
+    with open(out / "critical_speeds.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    assert main(["campbell", "seed-rig", "--speeds", "0:3000:5", "--out", str(tmp_path / "c"), "-q"]) == 0
+    with open(tmp_path / "c" / "critical_speeds.csv", newline="") as f:
+        assert rows[0] == next(csv.reader(f))
+    assert rows[0][-4:] == ["amplification_factor", "required_margin_pct", "actual_margin_pct", "meets_api"]
+    assert len(rows) - 1 == len(result.critical_speeds) == len(result.margins) >= 4
+    speed, whirl, af = (rows[0].index(k) for k in ("inner speed (rpm)", "whirl", "amplification_factor"))
+    for row, c, m in zip(rows[1:], result.critical_speeds, result.margins):
+        assert float(row[speed]) == pytest.approx(c.speed_rpm, rel=1e-6)
+        if row[whirl] == "forward":
+            assert float(row[af]) == pytest.approx(m.amplification_factor, rel=1e-4) and m.amplification_factor > 1
+    assert result.campbell.critical_speeds == result.critical_speeds
+
+
+def test_a_run_up_interrupted_before_its_second_sample_keeps_the_earlier_result(tmp_path, monkeypatch, capsys):
+    """A signal as the first speed interval is set up leaves a record of one sample, nothing to analyse (seen at a
+    random moment: an internal error, "zero-size array to reduction operation maximum", then exit 130): the interrupt
+    is raised as it came, and the folder keeps its earlier result (here none), exit 130, one line."""
+    import rotorred.transient.ramp as ramp
+    from rotorred.cli import main
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ramp, "interval_state", interrupted)
+    out = tmp_path / "cut"
+    assert main(["run", "runup", "--set", "runup.duration=1.0", "--set", "runup.to=0.3", "--set",
+                 "runup.orbits_hz=[]", "--set", "output.plots=[]", "--out", str(out), "-q"]) == 130
+    err = capsys.readouterr().err
+    assert err == "rotorred run: error: interrupted (SIGINT); the output folder keeps its earlier result\n", err
+    assert not out.exists()

@@ -7,7 +7,9 @@ Each command lives in its own module ``rotorred/cli/<command>.py`` exposing
 (``rotorred <command>: error: ...``), without a traceback, and the exit status says which kind
 it was (:data:`EXIT_STATUSES`, also printed by ``rotorred --help``). An unexpected error
 ("internal error") has its traceback written to a log file in the output folder (or the
-temporary folder when ``--out`` is unusable), and the message says where.
+temporary folder when ``--out`` is unusable), and the message says where. It is the one interrupt path too: SIGINT
+and SIGTERM end any command, from its first import on, with one line and exit 130 or 143 (:func:`main`); the long
+commands keep what they have through :func:`interrupts`.
 """
 
 from __future__ import annotations
@@ -45,14 +47,15 @@ EXIT_STATUSES = {
     EXIT_INPUT: "bad input (a file, a key, an option, --out, a size beyond the limits): nothing computed, "
                 "nothing written",
     EXIT_DIVERGED: "a run diverged: `run` writes the partial record marked INCOMPLETE; `map` (and `sweep`) keeps "
-                   "the other points and names the failed ones in map.csv and map.txt",
+                   "the other points and names the failed ones in map.csv and map.txt; `compare` writes nothing",
     EXIT_ENVIRONMENT: "the environment: --out is used by another run (lock), an output could not be written (a "
                       "full disk, a quota, the file-size limit, a folder removed, a non-regular file at its path: one "
                       "line naming the file, the earlier result intact), memory that cannot be allocated (the size), "
                       "or an optional library is missing (the message gives its install command)",
-    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT): --out keeps its earlier result (`continue`: the points traced, "
-                 "marked INCOMPLETE; `compare`: the runs done, marked INCOMPLETE; `map`: the points done, resumed by "
-                 "the same command)",
+    EXIT_SIGINT: "interrupted (Ctrl-C, SIGINT), in any command, from its first imports on: --out keeps its "
+                 "earlier result (`continue`: the points traced, marked INCOMPLETE; `compare`: the runs done, marked "
+                 "INCOMPLETE; `map`: the points done, resumed by the same command; a run-up: its record up to the "
+                 "signal, analysed, marked INCOMPLETE)",
     EXIT_SIGTERM: "terminated (SIGTERM): as 130",
 }
 
@@ -172,7 +175,16 @@ def entry() -> int:
     """The ``rotorred`` console script: :func:`main` with the collector's :data:`GC_THRESHOLDS`, then every object it
     leaves frozen for the garbage collector, so that the interpreter's exit does not walk them (numba's and scipy's
     hundreds of thousands: a warm ``rotorred run`` of paper-rub ended 0.23 s sooner, 2.47 against 2.70 s, medians of
-    5). Files are closed and exit handlers run as before; only the collection at exit is skipped."""
+    5). Files are closed and exit handlers run as before; only the collection at exit is skipped.
+
+    :func:`main` sets the handlers of SIGINT and SIGTERM first, before it imports anything, so that a signal at any
+    moment of a command, its imports included, ends it with 130 or 143 and one line. Outside them (the instant
+    before, and once main has returned, its result complete, as the interpreter ends) each signal has the operating
+    system's own action: the process ends by it (exit -2 or -15, a shell's 130 or 143), without Python's
+    KeyboardInterrupt traceback."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(signum) is not signal.SIG_IGN:
+            signal.signal(signum, signal.SIG_DFL)
     gc.set_threshold(*GC_THRESHOLDS)
     status = main()
     gc.freeze()
@@ -180,49 +192,92 @@ def entry() -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run one command; returns its exit status (:data:`EXIT_STATUSES`)."""
-    for name in ONE_THREAD:
-        os.environ.setdefault(name, "1")
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the outputs' provenance
-    if not getattr(args, "_run", None):
-        parser.print_help()
-        return EXIT_INPUT
-    from rotorred.cli import feedback
+    """Run one command; returns its exit status (:data:`EXIT_STATUSES`).
 
-    feedback.configure(args.command, feedback.level(args))
-    with _sigterm_raises():
+    The one place where every command is interruptible: SIGINT and SIGTERM raise their exceptions (:func:`interrupts`)
+    from the first line on, imports and parsing included, and end the command with one line and 130 or 143, never a
+    traceback (:func:`_noting`). An error raised from an interrupt (:func:`rotorred.progress.interrupt_in`: a signal
+    that came as a module was imported or a class made) is reported as that interrupt. A signal that a library
+    swallowed (raised in a ctypes callback of llvmlite as numba loads the step kernel, where Python prints "Exception
+    ignored" and goes on) leaves the command to run to its end, which then exits 130 or 143 saying so, its result
+    written whole: a command never exits 0 when a signal came."""
+    noted: list[str] = []
+    args = None
+    with _noting(noted):
         try:
-            return int(args._run(args) or 0)
+            for name in ONE_THREAD:
+                os.environ.setdefault(name, "1")
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the outputs' provenance
+            if not getattr(args, "_run", None):
+                parser.print_help()
+                return EXIT_INPUT
+            from rotorred.cli import feedback
+
+            feedback.configure(args.command, feedback.level(args))
+            status = int(args._run(args) or 0)
         except BaseException as exc:  # noqa: BLE001 -- the one place every error is turned into a message
-            return _report(args, exc)
+            from rotorred import progress
+
+            status = _report(args, progress.interrupt_in(exc, tuple(interrupts())) or exc)
+    if noted and status not in (interrupted_status(n) for n in noted):
+        if status == EXIT_OK:  # an error's status: its message is said
+            _error(args, f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to "
+                         "its end: its result is written whole")
+        return interrupted_status(noted[0])
+    return status
+
+
+def interrupts() -> dict:
+    """The exceptions of SIGINT and SIGTERM in a command (``KeyboardInterrupt``; :class:`Terminated`, raised by
+    :func:`main`'s handler) and the signal each stands for: the one mapping every command ends its work on (``map``,
+    ``continue``, ``compare`` and the run-ups keeping what they have: ``interrupts`` of :func:`rotorred.run_map`,
+    :func:`rotorred.continue_scene`, :func:`rotorred.compare_models`, :func:`rotorred.run_runup`)."""
+    return {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
+
+
+def interrupted_status(signal_name: str) -> int:
+    """The exit status of a command its signal ended: 130 (SIGINT) or 143 (SIGTERM)."""
+    return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[signal_name]
 
 
 @contextlib.contextmanager
-def _sigterm_raises():
-    """Within the block, SIGTERM raises :class:`Terminated` (main thread only; restored afterwards)."""
+def _noting(noted: list):
+    """SIGINT and SIGTERM raise their exceptions (:func:`interrupts`) and are noted in ``noted``; unraisable
+    interrupts (raised where Python can only ignore them), and any unraisable error once a signal came, are not
+    printed (the command's message says what happened). Restored on exit; in the main thread only, and SIGINT only
+    where it is not ignored."""
+    kinds = {name: kind for kind, name in interrupts().items()}
+
     def handler(signum, frame):
-        raise Terminated()
+        name = signal.Signals(signum).name
+        noted.append(name)
+        raise kinds[name]()
+
+    previous, hook = {}, sys.unraisablehook
     try:
-        old = signal.signal(signal.SIGTERM, handler)
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(signum) is not signal.SIG_IGN:
+                previous[signum] = signal.signal(signum, handler)
     except ValueError:  # not the main thread
-        old = None
+        pass
+    sys.unraisablehook = lambda u: None if noted or isinstance(u.exc_value, tuple(interrupts())) else hook(u)
     try:
         yield
     finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        sys.unraisablehook = hook
+        for signum, old in previous.items():
+            signal.signal(signum, old)
 
 
 def _error(args, text: str) -> None:
-    print(f"rotorred {args.command}: error: {text}", file=sys.stderr)
+    command = f"rotorred {args.command}" if getattr(args, "command", None) else "rotorred"
+    print(f"{command}: error: {text}", file=sys.stderr)
 
 
 def _report(args, exc: BaseException) -> int:
     """One message for ``exc`` on stderr; returns the exit status."""
-    from rotorred import InputError, writers
-
     if isinstance(exc, KeyboardInterrupt):
         _error(args, "interrupted (SIGINT); the output folder keeps its earlier result")
         return EXIT_SIGINT
@@ -231,6 +286,8 @@ def _report(args, exc: BaseException) -> int:
         return EXIT_SIGTERM
     if isinstance(exc, SystemExit):
         raise exc
+    from rotorred import InputError, writers
+
     if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] in INSTALL:
         name = exc.name.split(".")[0]
         _error(args, f"the optional library {name!r} is needed here and is not installed: {INSTALL[name]}")
@@ -264,9 +321,11 @@ def _is_internal(exc: BaseException) -> bool:
 
 
 def _is_diverged(exc: BaseException) -> bool:
-    """A transient that diverged, or a harmonic balance that did not converge (each says where and why)."""
+    """A transient that diverged (a scene's, in its key names), or a harmonic balance that did not converge (each
+    says where and why)."""
     kinds = [getattr(sys.modules.get(name), kind, None) for name, kind in
-             (("rotorred.transient.results", "SimulationDiverged"), ("rotorred.nonlinear.hb", "NotConverged"))]
+             (("rotorred.transient.results", "SimulationDiverged"), ("rotorred.scenes.run", "SceneDiverged"),
+              ("rotorred.nonlinear.hb", "NotConverged"))]
     return any(k is not None and isinstance(exc, k) for k in kinds)
 
 
@@ -293,6 +352,8 @@ def _usable_out(args) -> Path | None:
     from rotorred import InputError
     from rotorred.cli.options import out_dir
 
+    if getattr(args, "out", None) is None:
+        return None
     try:
         return out_dir("--out", getattr(args, "out", None))
     except InputError:
@@ -300,4 +361,4 @@ def _usable_out(args) -> Path | None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(entry())

@@ -23,7 +23,6 @@ from rotorred import checks, progress
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance
 from rotorred.cli.report import add_html_option, stage_report
-from rotorred.cli.run import interruptible
 
 
 def add_parser(subparsers):
@@ -62,13 +61,17 @@ def _param(text: str) -> tuple[str, float, float]:
         checks.fail("--param", text, "must have numbers START and STOP")
     if not (start > 0 and stop > 0) or start == stop:
         checks.fail("--param", text, "must have START and STOP > 0 and different")
-    return key.strip(), start, stop
+    key = key.strip()
+    if key.startswith("speeds.") or key == "rub.clearance":  # the keys with a physical bound (checks.BOUNDS)
+        checks.bounded("--param", text, (start, stop), "speed" if key.startswith("speeds.") else "clearance",
+                       "Hz" if key.startswith("speeds.") else "m")
+    return key, start, stop
 
 
-@interruptible
 def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
-    from rotorred.cli.run import _settings, interrupted_status, interrupts as signals
+    from rotorred.cli import interrupted_status, interrupts as signals
+    from rotorred.cli.run import _settings
     from rotorred import BranchOptions, build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
@@ -77,7 +80,7 @@ def run(args) -> int:
     N = checks.integer("--samples", args.samples, ge=2 * H + 2)
     if N % 2:
         checks.fail("--samples", N, "must be even")
-    tol = checks.positive("--tol", args.tol)
+    tol = float(checks.bounded("--tol", args.tol, checks.positive("--tol", args.tol), "tolerance"))
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
     options = BranchOptions(H, N, tol, not args.no_stability)

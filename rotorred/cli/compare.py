@@ -10,7 +10,8 @@ printed table) and ``scene.toml`` (the scene as set, the comparison's options in
 ``compare.txt``).
 
 SIGINT or SIGTERM after the reference run keeps the runs done: they are written, the folder marked INCOMPLETE, exit
-130 or 143; before it, the folder keeps its earlier result, as in every command.
+130 or 143; before it, the folder keeps its earlier result, as in every command. A run that diverges ends the
+comparison with exit 3 and one line saying when, where and why; nothing is written.
 """
 
 from __future__ import annotations
@@ -63,18 +64,20 @@ def _options(args):
     by ``check_comparison``)."""
     from rotorred import CompareOptions
 
-    dts = () if args.dt is None else number_list("--dt", args.dt, "s", gt=0)
-    return CompareOptions(modes=_modes(args.modes), dts=dts, refine=checks.integer("--refine", args.refine, ge=1),
-                          progress=None)
+    dts = () if args.dt is None else tuple(checks.bounded("--dt", args.dt, number_list("--dt", args.dt, "s", gt=0),
+                                                          "step"))
+    refine = checks.integer("--refine", args.refine, ge=1)
+    checks.bounded("--refine", args.refine, refine, "refine")
+    return CompareOptions(modes=_modes(args.modes), dts=dts, refine=refine, progress=None)
 
 
 def run(args) -> int:
     """Check everything, then compare into ``--out`` (exit 130 or 143 when interrupted, the runs done kept)."""
     import dataclasses
 
-    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM, Terminated
+    from rotorred.cli import EXIT_DIVERGED, interrupted_status, interrupts
     from rotorred.cli.run import _settings
-    from rotorred import (InputError, check_comparison, compare_models, format_comparison, load_scene,
+    from rotorred import (InputError, SceneDiverged, check_comparison, compare_models, format_comparison, load_scene,
                           scene_estimate, scene_toml)
 
     t0 = time.perf_counter()
@@ -90,16 +93,19 @@ def run(args) -> int:
     scene_estimate(dataclasses.replace(checked, solver=dataclasses.replace(checked.solver, dt=finest,
                                                                            model="full"))).check(force=args.force)
     record = provenance(args, "scene", scene_toml(scene))
-    interrupts = {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
-    comparison = compare_models(scene, options, interrupts=interrupts)
+    try:
+        comparison = compare_models(scene, options, interrupts=interrupts())
+    except SceneDiverged as exc:  # the scene's message, less its promise of a record kept: a comparison writes none
+        error(f"{str(exc).split('; the record up to')[0]}; nothing is written (a comparison needs every run)")
+        return EXIT_DIVERGED
     report(format_comparison(comparison))
-    for f in _write(comparison, out, tuple(interrupts), record):
+    for f in _write(comparison, out, tuple(interrupts()), record):
         report(f"wrote {f}")
     report(f"wall time {time.perf_counter() - t0:.2f} s")
     if comparison.interrupted:
         error(f"interrupted ({comparison.interrupted}) after {len(comparison.runs)} runs; the runs done are written, "
               f"the folder marked INCOMPLETE")
-        return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[comparison.interrupted]
+        return interrupted_status(comparison.interrupted)
     return 0
 
 

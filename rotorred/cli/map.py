@@ -19,7 +19,6 @@ from rotorred import checks
 from rotorred.cli.feedback import error, report
 from rotorred.cli.options import SCENE_UNITS, add_settings, out_dir, provenance, spool_ratios
 from rotorred.cli.report import add_html_option, write_report_to
-from rotorred.cli.run import interruptible
 
 
 def add_parser(subparsers):
@@ -107,12 +106,10 @@ def _values(parsed, item: str) -> tuple[str, tuple]:
     return key, tuple(float(v) for v in values)
 
 
-@interruptible
 def run(args) -> int:
     """Check everything, then run the map into ``--out`` (exit 3 when points failed or the Dask cluster was lost, 130
     or 143 when SIGINT or SIGTERM ended it: the points done written, the folder marked INCOMPLETE)."""
-    from rotorred.cli import EXIT_DIVERGED
-    from rotorred.cli.run import interrupted_status, interrupts
+    from rotorred.cli import EXIT_DIVERGED, interrupted_status, interrupts
     from rotorred import format_map, run_map
 
     out = out_dir("--out", args.out)

@@ -39,88 +39,6 @@ def warn(texts) -> None:
         logging.getLogger(__name__).warning(text)
 
 
-def interrupts() -> dict:
-    """The exceptions of SIGINT and SIGTERM in a command (``KeyboardInterrupt``; :class:`rotorred.cli.Terminated`,
-    raised by :func:`rotorred.cli.main`'s handler) and the signal each stands for: the one mapping ``map``,
-    ``continue`` and the run-ups end their work on, keeping what they have (``interrupts`` of
-    :func:`rotorred.run_map` and :func:`rotorred.continue_scene`)."""
-    from rotorred.cli import Terminated
-
-    return {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
-
-
-def interruptible(command):
-    """``command`` (a command's ``run(args)``) that never ends with exit 0 when SIGINT or SIGTERM came.
-
-    * An error raised from an interrupt (:func:`interrupts`) is raised as that interrupt
-      (:func:`rotorred.progress.interrupt_in`: a signal that came as a module was imported or a class made), so that
-      :func:`rotorred.cli.main` reports the signal, not an internal error.
-    * Each signal is noted as its exception is raised: one that a library swallowed (raised in a ctypes callback
-      of llvmlite as numba loads the step kernel, where Python prints "Exception ignored" and goes on) leaves the
-      command to run to its end, and it then exits 130 or 143 saying so, its result written whole. Python's reports
-      of an ignored interrupt, and once a signal came of the errors of objects it left half made (their destructors,
-      llvmlite's), are not printed: the command's message says what happened.
-    """
-    import functools
-
-    @functools.wraps(command)
-    def run_interruptible(args):
-        noted: list[str] = []
-        with _noting(noted):
-            try:
-                status = command(args)
-            except Exception as exc:  # noqa: BLE001 -- an interrupt's error is the interrupt; any other is raised
-                cause = progress.interrupt_in(exc, tuple(interrupts()))
-                if cause is None:
-                    raise
-                raise cause from None
-        if noted and status not in (interrupted_status(n) for n in noted):
-            error(f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to its "
-                  "end: its result is written whole")
-            return interrupted_status(noted[0])
-        return status
-    return run_interruptible
-
-
-@contextlib.contextmanager
-def _noting(noted: list):
-    """SIGINT and SIGTERM raise their exceptions (:func:`interrupts`) and are noted in ``noted``; unraisable
-    interrupts (raised where Python can only ignore them), and any unraisable error once a signal came, are not
-    printed. Restored on exit; in the main thread only,
-    and SIGINT only where it is not ignored."""
-    import signal
-    import sys
-
-    kinds = {name: kind for kind, name in interrupts().items()}
-
-    def handler(signum, frame):
-        name = signal.Signals(signum).name
-        noted.append(name)
-        raise kinds[name]()
-
-    previous, hook = {}, sys.unraisablehook
-    try:
-        for signum in (signal.SIGINT, signal.SIGTERM):
-            if signal.getsignal(signum) is not signal.SIG_IGN:
-                previous[signum] = signal.signal(signum, handler)
-    except ValueError:  # not the main thread
-        pass
-    sys.unraisablehook = lambda u: None if noted or isinstance(u.exc_value, tuple(interrupts())) else hook(u)
-    try:
-        yield
-    finally:
-        sys.unraisablehook = hook
-        for signum, old in previous.items():
-            signal.signal(signum, old)
-
-
-def interrupted_status(signal_name: str) -> int:
-    """The exit status of a command its signal ended, its partial result written: 130 (SIGINT) or 143 (SIGTERM)."""
-    from rotorred.cli import EXIT_SIGINT, EXIT_SIGTERM
-
-    return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[signal_name]
-
-
 def add_parser(subparsers):
     from rotorred import builtin_scenes  # light: the scene schema is imported when a scene is read
     p = subparsers.add_parser(
@@ -141,7 +59,6 @@ def add_parser(subparsers):
     return p
 
 
-@interruptible
 def run(args) -> int:
     """Check everything, then compute into a locked, staged ``--out`` (exit statuses: :mod:`rotorred.cli`)."""
     from rotorred import load_scene, scene_estimate, scene_toml
@@ -220,16 +137,18 @@ def _compute_and_write(scene, args, folder, out, pool, record) -> int:
 
 def _runup_and_write(scene, args, folder, out, record) -> int:
     """A run-up scene: the transient through its speed profile, its figures, data and summary; a diverged run
-    writes what it computed up to then, analysed, marked INCOMPLETE (exit 3)."""
-    from rotorred.cli import EXIT_DIVERGED
+    writes what it computed up to then, analysed, marked INCOMPLETE (exit 3), and so does one that SIGINT or SIGTERM
+    ended as it stepped (exit 130 or 143; its files written with the signals held back)."""
+    from rotorred.cli import EXIT_DIVERGED, interrupted_status, interrupts
     from rotorred import format_runup_summary, run_runup, write_runup_outputs
 
-    result = run_runup(scene, progress=None)
-    write_runup_outputs(result, folder.staging, shown=out, provenance=record)
-    stage_report(args, folder, result)
-    committed = folder.commit(incomplete=result.incomplete)
+    result = run_runup(scene, progress=None, interrupts=interrupts())
+    with writers.signals_held() if result.interrupt else contextlib.nullcontext():
+        write_runup_outputs(result, folder.staging, shown=out, provenance=record)
+        stage_report(args, folder, result)
+        committed = folder.commit(incomplete=result.incomplete)
     report(format_runup_summary(result, committed))
     if result.incomplete:
         error(f"{result.incomplete}; partial results written to {out} (marked {writers.INCOMPLETE})")
-        return EXIT_DIVERGED
+        return interrupted_status(result.interrupt) if result.interrupt else EXIT_DIVERGED
     return 0

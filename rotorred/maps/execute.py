@@ -206,7 +206,9 @@ def local_cluster(n_workers: int | None = None):
 
 
 def connect(address: str, timeout: float = 10.0):
-    """A client of the scheduler at ``address``; a clear error after ``timeout`` s when it cannot be reached."""
+    """A client of the scheduler at ``address``; a clear error after ``timeout`` s when it cannot be reached, and at
+    once when what answers there is not a Dask scheduler (a web server's bytes, read as a Dask frame, once asked for
+    3 EiB: an "out of memory" error before)."""
     from distributed import Client
 
     from rotorred import checks
@@ -216,6 +218,9 @@ def connect(address: str, timeout: float = 10.0):
     except (OSError, TimeoutError) as exc:
         checks.fail("--scheduler", address, f"must be a reachable Dask scheduler address (tcp://host:port); "
                     f"none answered within {timeout:g} s ({type(exc).__name__})")
+    except Exception as exc:  # noqa: BLE001 -- whatever a server that is not Dask's makes the protocol raise
+        checks.fail("--scheduler", address, "must be a Dask scheduler's address (tcp://host:port); what answered "
+                    f"there does not speak Dask's protocol ({type(exc).__name__})")
 
 
 def is_lost(exc: BaseException) -> bool:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -29,7 +30,7 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.model.operating import Operating, checked as checked_operating
-from rotorred.progress import stage
+from rotorred.progress import INTERRUPTS, interrupt_name, stage
 from rotorred.results import Result
 from rotorred.scenes.run import SceneModel, build_model, explain_divergence, settled_state, table_dof
 from rotorred.scenes.built import built_scene, checked_loads, load_nodes, plates_on, recorded_nodes, rotor_model
@@ -123,13 +124,21 @@ class RunupResult(Result):
         Critical speeds in the swept range of the reference spool (``speed`` in rad/s of the reference).
     campbell_ratio : dict of str to float
         Speed ratios of the Campbell diagram (the profile's final ones).
+    campbell : CampbellResult
+        The Campbell diagram of the swept range (:data:`CAMPBELL_SPEEDS` speeds of the reference spool).
+    margins : tuple of SeparationMargin
+        The API 684 amplification factor and separation margin of each critical speed
+        (:func:`rotorred.linear.margins.separation_margins`; against the rotor file's operating range of the reference
+        spool, without a verdict when it gives none).
     model_label : str
     n_steps : int
     counters : dict
     build_time, solve_time, analysis_time : float
         Wall times (s).
     incomplete : str or None
-        Why the run stops early (a diverged transient); the analyses cover the record up to then.
+        Why the run stops early (a diverged or interrupted transient); the analyses cover the record up to then.
+    interrupt : str
+        The signal that ended the transient ("SIGINT", "SIGTERM": :func:`run_runup`'s ``interrupts``), or "".
     """
 
     scene: Scene
@@ -146,6 +155,8 @@ class RunupResult(Result):
     rubs: tuple
     critical_speeds: tuple
     campbell_ratio: dict
+    campbell: object
+    margins: tuple
     model_label: str
     n_steps: int
     counters: dict
@@ -153,6 +164,7 @@ class RunupResult(Result):
     solve_time: float
     analysis_time: float
     incomplete: str | None = None
+    interrupt: str = ""
 
     @property
     def reference(self) -> str:
@@ -404,27 +416,36 @@ def orbit_snapshots(scene: Scene, t: np.ndarray, speeds: dict, outputs: dict) ->
     return tuple(out)
 
 
-def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple[tuple, dict]:
-    """Campbell critical speeds of the reference spool within the swept range, at the profile's final ratios."""
+def critical_speeds_in_range(scene: Scene, speeds: dict) -> tuple:
+    """The Campbell diagram of the reference spool over the swept range (its lowest to its highest speed), at the
+    profile's final ratios: (its critical speeds, the ratios, the diagram, their API 684 separation margins
+    (:func:`rotorred.linear.margins.separation_margins`, against the rotor file's operating range of the reference
+    spool when it gives one))."""
     from rotorred.linear.campbell import campbell
+    from rotorred.linear.margins import OperatingRange, separation_margins
 
     ref = scene.runup.reference
     final = {s: float(v[-1]) for s, v in speeds.items()}
     if final[ref] <= 0:
         final = {s: float(np.max(v)) for s, v in speeds.items()}
     ratio = {s: w / final[ref] for s, w in final.items() if s != ref}
-    top = float(np.max(speeds[ref]))
-    cd = campbell(scene.rotor, Operating.line(np.linspace(0.0, top, CAMPBELL_SPEEDS), ref, ratios=ratio))
-    low = float(np.min(speeds[ref]))
-    return tuple(c for c in cd.critical_speeds if low <= c.speed <= top), {ref: 1.0, **ratio}
+    low, top = float(np.min(speeds[ref])), float(np.max(speeds[ref]))
+    cd = campbell(scene.rotor, Operating.line(np.linspace(low, top, CAMPBELL_SPEEDS), ref, ratios=ratio))
+    given = scene.rotor.defaults.operating_range(ref)
+    margins = separation_margins(scene.rotor, cd, None if given is None else OperatingRange(*given))
+    return tuple(cd.critical_speeds), {ref: 1.0, **ratio}, cd, margins
 
 
 # --------------------------------------------------------------------------- the run
-def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | None = None) -> RunupResult:
+def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | None = None,
+              interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> RunupResult:
     """Step the scene through its speed profile and analyse the record (see the module docstring).
 
     A diverged transient does not raise: the result holds the record up to the failure, analysed,
-    with ``incomplete`` saying when, where and why it stopped.
+    with ``incomplete`` saying when, where and why it stopped. Nor does an interrupt while the transient steps
+    (``interrupts``): the result holds the record up to the last step taken, analysed, with ``incomplete`` and
+    ``interrupt`` saying so; an interrupt before the stepping, before the record's second sample or in the analysis
+    is raised as it came.
 
     Parameters
     ----------
@@ -435,6 +456,9 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     progress : bool, optional
         Progress bar on stderr; None (default): shown on a terminal once the run has taken 1 s
         (:class:`rotorred.transient.options.StepControl`).
+    interrupts : mapping of exception type to str
+        The exceptions that end the transient where it is, and the signal each stands for (default SIGINT's
+        ``KeyboardInterrupt``; empty: none, they propagate).
 
     Returns
     -------
@@ -446,6 +470,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
         If the scene has no ``[runup]``.
     """
     from rotorred.transient.newmark import Initial, Loads, Recording, StepControl, simulate
+    from rotorred.transient.ramp import interrupted_record
     from rotorred.transient.results import SimulationDiverged
 
     if scene.runup is None:
@@ -455,7 +480,7 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
     at_t0 = dataclasses.replace(scene, operating=Operating.point(profile.speeds_at(0.0)))
     start = Initial(*settled_state(at_t0, model.model)) if s.start == "settled" else None
     t0 = time.perf_counter()
-    incomplete = None
+    incomplete, interrupt = None, ""
     stage("stepping %s through its speed profile: %d steps of %g s to %g s", scene.name, round(s.duration / s.dt),
           s.dt, s.duration)
     try:
@@ -465,9 +490,16 @@ def run_runup(scene: Scene, model: SceneModel | None = None, progress: bool | No
                        start=start, control=StepControl(progress=progress))
     except SimulationDiverged as exc:
         res, incomplete = exc.result, explain_divergence(scene, exc)
+    except tuple(interrupts) as exc:
+        res = interrupted_record(exc)
+        if res is None or len(res.t) < 2:  # before the second recorded sample: nothing to keep
+            raise
+        interrupt = interrupt_name(exc, interrupts)
+        incomplete = (f"interrupted ({interrupt}) at t = {res.final.t:.6g} s of solver.duration = {s.duration:g} s; "
+                      f"the record up to there is kept")
     solve_time = time.perf_counter() - t0
     stage("analysing %s: order tracks, critical speeds, rub intervals", scene.name)
-    return analyse(scene, model, res, solve_time, incomplete)
+    return dataclasses.replace(analyse(scene, model, res, solve_time, incomplete), interrupt=interrupt)
 
 
 @dataclass(frozen=True)
@@ -578,7 +610,7 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
     f_max = scene.output.f_max_hz or 4.0 * f_top
     segment = min(0.25, 0.5 * (res.t[-1] - res.t[0])) if len(res.t) > 16 else 0.0
     fall = waterfall(res.t, res.outputs[dof], segment, f_max) if segment > 0 and len(res.t) >= 32 else None
-    criticals, ratio = critical_speeds_in_range(scene, speeds)
+    criticals, ratio, diagram, margins = critical_speeds_in_range(scene, speeds)
     counters = {"us_per_step": res.us_per_step, "n_passes": res.n_passes, "n_factorizations": res.n_factorizations,
                 "n_contact_steps": res.n_contact_steps, "n_substeps": res.n_substeps,
                 "kernel_load_time": res.kernel_load_time, "kernel_compiled": res.kernel_compiled}
@@ -586,7 +618,7 @@ def analyse(scene: Scene, model: SceneModel, res, solve_time: float, incomplete:
                        track_dofs=track_dofs, overall=overall, waterfall=fall, waterfall_dof=dof,
                        orbits=orbit_snapshots(scene, res.t, speeds, res.outputs),
                        rubs=rub_intervals(scene, res.t, speeds, res.contacts), critical_speeds=criticals,
-                       campbell_ratio=ratio, model_label=model.label, n_steps=res.n_steps, counters=counters,
+                       campbell_ratio=ratio, campbell=diagram, margins=margins, model_label=model.label, n_steps=res.n_steps, counters=counters,
                        build_time=model.build_time, solve_time=solve_time, analysis_time=time.perf_counter() - t0,
                        incomplete=incomplete)
 

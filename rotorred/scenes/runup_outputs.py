@@ -74,12 +74,11 @@ def _rubs_csv(result: RunupResult, path: Path) -> Path:
 
 
 def _criticals_csv(result: RunupResult, path: Path) -> Path:
-    header = [f"{result.reference} speed (Hz)", f"{result.reference} speed (rpm)", "line", "whirl",
-              "frequency (Hz)", "log dec"]
-    cs = result.critical_speeds
-    return write_csv(path, header, [[c.speed * HZ for c in cs], [60 * c.speed * HZ for c in cs],
-                                    [f"1x {c.spool}" for c in cs], [c.whirl for c in cs],
-                                    [c.frequency * HZ for c in cs], [c.log_dec for c in cs]])
+    """The critical speeds in the swept range as ``rotorred campbell`` writes them, through the same writer
+    (:meth:`rotorred.linear.campbell.CampbellResult.critical_speeds_to_csv`): with the margin to the rotor's operating
+    speed of the reference spool and the API 684 columns of :attr:`RunupResult.margins`."""
+    nominal = result.scene.rotor.speeds.get(result.reference, 0.0)
+    return result.campbell.critical_speeds_to_csv(path, nominal if nominal > 0 else None, result.margins)
 
 
 def write_runup_outputs(result: RunupResult, out: str | Path, shown: str | Path | None = None,
@@ -163,6 +162,8 @@ def format_runup_summary(result: RunupResult, files=()) -> str:
     if result.overall:
         rows = []
         for node, (speed, radius) in sorted(result.overall.items()):
+            if not len(radius):  # a record shorter than two revolutions (an early divergence or interrupt)
+                continue
             k = int(np.argmax(radius))
             rows.append([str(node), f"{1e6 * radius[k]:.2f}", f"{speed[k] * HZ:.2f}", f"{60 * speed[k] * HZ:.0f}"])
         lines += ["", f"largest orbit radius against {ref} speed:",

@@ -265,17 +265,63 @@ def run_profile(run: stepping.Run, rho_target: float = RHO_TARGET, pass_tol: flo
     settings = kernel.Settings(t0=0.0, dt=run.dt, n_halvings=control.max_halvings, newton_tol=control.newton_tol,
                                max_newton=control.max_newton, limit=control.displacement_limit)
     diag = kernel.Diagnostics(counters=np.zeros(kernel.N_COUNTERS, dtype=np.int64), err=np.zeros(4))
-    status, times = _run_intervals(ops, B, constant, run.plates, intervals, tables, contact, state, record,
-                                   settings, diag, plan.n_steps, n_levels, control.chunk_steps, control.progress)
+    status, times, interrupt = _run_intervals(ops, B, constant, run.plates, intervals, tables, contact, state,
+                                              record, settings, diag, plan.n_steps, n_levels, control.chunk_steps,
+                                              control.progress)
     # 5. package (the state-recording rows after the outputs)
-    return stepping.package_result(run, plan, record, state, diag, status, (setup_time + times[0], *times[1:]),
-                                   n_factorizations=len(intervals) * n_levels)
+    result = stepping.package_result(run, plan, record, state, diag, status, (setup_time + times[0], *times[1:]),
+                                     n_factorizations=len(intervals) * n_levels)
+    if interrupt is not None:
+        raise _with_record(interrupt, result, plan.n_steps * run.dt)
+    return result
+
+
+#: the attribute of a signal's exception that ended a run at varying speeds: the record up to there
+#: (:func:`interrupted_record`)
+RECORD_ATTRIBUTE = "record_until_interrupt"
+
+
+def interrupted_record(exc: BaseException):
+    """The record up to the signal whose exception ``exc`` ended a run at varying speeds (raised again by
+    :func:`run_profile` with it), or None.
+
+    Parameters
+    ----------
+    exc : BaseException
+        SIGINT's ``KeyboardInterrupt``, or a caller's SIGTERM exception.
+
+    Returns
+    -------
+    TransientResult or None
+        ``success`` False, ``status`` 0, ``message`` saying when it stopped, the record and ``final`` at the last step
+        taken (``n_steps`` of them).
+    """
+    return getattr(exc, RECORD_ATTRIBUTE, None)
+
+
+def _with_record(interrupt: BaseException, result, t_end: float) -> BaseException:
+    """``interrupt`` carrying ``result`` (finished up to its last step) marked as interrupted there."""
+    import dataclasses
+
+    message = (f"interrupted ({type(interrupt).__name__}) at t = {result.final.t:.9g} s of {t_end:.9g} s; results "
+               f"kept up to there")
+    setattr(interrupt, RECORD_ATTRIBUTE, dataclasses.replace(result, success=False, message=message))
+    return interrupt
+
+
+def _interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` is a signal's exception: a ``BaseException`` that is neither an error nor an exit (SIGINT's
+    ``KeyboardInterrupt``, the command line's SIGTERM exception)."""
+    return not isinstance(exc, (Exception, SystemExit, GeneratorExit))
 
 
 def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, record, settings, diag, n_steps,
                    n_levels, chunk_steps, progress):
     """The compiled loop over every interval, in chunks, with a progress bar; (status, (build, wall, cpu, load,
-    compiled)): the intervals' set-up, the loop's wall and CPU time, the kernel's load (s), whether it compiled."""
+    compiled), interrupt): the intervals' set-up, the loop's wall and CPU time, the kernel's load (s), whether it
+    compiled, and the signal's exception (:func:`_interrupt`) that stopped the loop between two compiled calls (the
+    record and state then hold every step taken), or None. A signal is answered in Python between chunks: at most one
+    chunk after it came."""
     spare = kernel.spare_state(state)
     n, n_s = len(ops.M), len(ops.G)
     work = kernel.work_arrays(n, len(plates), len(forces.kind))
@@ -283,27 +329,39 @@ def _run_intervals(ops, B, forces, plates, intervals, tables, contact, state, re
     chunk = chunk_steps or max(2000, min(n_steps, 100_000))
     status, build, load, compiled = RUNNING, 0.0, 0.0, False
     wall = cpu = 0.0
+    interrupt = None
     with stepping.step_bar(n_steps, settings.dt, progress) as shown:
         for interval in intervals:
             t_build = time.perf_counter()
-            levels, R, rho = interval_state(ops, B, forces, plates, interval, settings.dt, n_levels)
-            var = ramp_kernel.Varying(R=R, rho=rho, ref=np.ascontiguousarray(interval.ref), **tables)
-            build += time.perf_counter() - t_build
-            args = (0, 0, levels, var, contact, state, spare, work, rwork, record, settings, diag)
-            seconds, new = stepping.load_kernel(args, ramp_kernel.run_ramp_steps)
+            try:
+                levels, R, rho = interval_state(ops, B, forces, plates, interval, settings.dt, n_levels)
+                var = ramp_kernel.Varying(R=R, rho=rho, ref=np.ascontiguousarray(interval.ref), **tables)
+                build += time.perf_counter() - t_build
+                args = (0, 0, levels, var, contact, state, spare, work, rwork, record, settings, diag)
+                seconds, new = stepping.load_kernel(args, ramp_kernel.run_ramp_steps)
+            except BaseException as exc:  # noqa: BLE001 -- a signal's exception ends the run here; others are raised
+                if not _interrupt(exc):
+                    raise
+                interrupt = exc
+                break
             load, compiled = load + seconds, compiled or new
             t_run, cpu_run = time.perf_counter(), time.process_time()
             i = interval.begin
-            while i < interval.end:
-                i_next = min(interval.end, i + chunk)
-                status = ramp_kernel.run_ramp_steps(i, i_next, levels, var, contact, state, spare, work, rwork,
-                                                    record, settings, diag)
-                if status != RUNNING:
-                    break
-                shown.update((i_next - i) * settings.dt)
-                i = i_next
+            try:
+                while i < interval.end:
+                    i_next = min(interval.end, i + chunk)
+                    status = ramp_kernel.run_ramp_steps(i, i_next, levels, var, contact, state, spare, work, rwork,
+                                                        record, settings, diag)
+                    if status != RUNNING:
+                        break
+                    shown.update((i_next - i) * settings.dt)
+                    i = i_next
+            except BaseException as exc:  # noqa: BLE001 -- as above: the steps taken are in record and state
+                if not _interrupt(exc):
+                    raise
+                interrupt = exc
             wall += time.perf_counter() - t_run
             cpu += time.process_time() - cpu_run
-            if status != RUNNING:
+            if status != RUNNING or interrupt is not None:
                 break
-    return status, (build, wall, cpu, load, compiled)
+    return status, (build, wall, cpu, load, compiled), interrupt
