@@ -41,7 +41,7 @@ from rotorred.progress import interrupt_in, stage
 from rotorred.provenance import Provenance
 from rotorred.results import Result
 from rotorred.scenes.run import table_dof
-from rotorred.nonlinear.continuation import INTERRUPTS, interrupt_name
+from rotorred.progress import INTERRUPTS, interrupt_name
 from rotorred.writers import OutputFolder, render_table, signals_held, write_netcdf, write_text
 
 __all__ = ["MapRun", "run_map", "format_map"]

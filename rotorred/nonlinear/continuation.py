@@ -30,18 +30,15 @@ import scipy.linalg as sla
 from scipy.optimize import brentq
 
 from rotorred import checks
+from rotorred.progress import INTERRUPTS, interrupt_name
 from rotorred.nonlinear.fourier import to_phasors
 from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, coefficient_variables, solve_periodic
 from rotorred.nonlinear.lowrank import bordered
 from rotorred.nonlinear.stability import floquet
 from rotorred.results import Result
 
-__all__ = ["Fold", "Branch", "ContinuationOptions", "INTERRUPTS", "STABILITY_FLAGS", "continue_branch", "interrupt_name", "parameter_of",
+__all__ = ["Fold", "Branch", "ContinuationOptions", "STABILITY_FLAGS", "continue_branch", "parameter_of",
            "stability_variable"]
-
-#: the exceptions that end a branch where it is, its points kept, and the signal each stands for (a caller may name
-#: others: ``rotorred continue`` adds the command line's SIGTERM)
-INTERRUPTS = MappingProxyType({KeyboardInterrupt: "SIGINT"})
 
 #: a point's stability as a NetCDF flag (CF flag_values, flag_meanings: the variable ``stable``,
 #: :func:`stability_variable`)
@@ -342,11 +339,6 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
         interrupt = interrupt_name(exc, interrupts)
         stopped = f"interrupted ({interrupt}) at {_at(problem, points[-1].y[-1])}, after {len(points)} points"
     return _branch(problem, points, folds, stopped, stability, interrupt)
-
-
-def interrupt_name(exc: BaseException, interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> str:
-    """The signal ``exc`` stands for in ``interrupts`` (:data:`INTERRUPTS`)."""
-    return next(name for kind, name in interrupts.items() if isinstance(exc, kind))
 
 
 def _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max, max_points,

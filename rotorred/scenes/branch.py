@@ -43,10 +43,10 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.model.operating import Operating
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import (INTERRUPTS, ContinuationOptions, continue_branch, interrupt_name,
-                                             stability_variable)
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch, stability_variable
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve_periodic
 from rotorred.nonlinear.stability import floquet_by_monodromy
+from rotorred.progress import INTERRUPTS, interrupt_name
 from rotorred.results import Result
 from rotorred.scenes.harmonic_balance import RubProblem, base_frequency, rub_problem
 from rotorred.scenes.keys import cf_units, netcdf_name

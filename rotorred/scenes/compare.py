@@ -44,8 +44,6 @@ LOG = logging.getLogger(__name__)
 
 #: fixed-interface mode counts compared by default (bench_pareto's 8, 16 and 24: docs/benchmarks.md)
 DEFAULT_MODES = (8, 16, 24)
-#: interrupts ending the comparison with the runs done (the command line adds SIGTERM's)
-INTERRUPTS = {KeyboardInterrupt: "SIGINT"}
 
 
 @dataclass(frozen=True)
@@ -361,7 +359,7 @@ def _check_dts(scene: Scene, dts: tuple[float, ...]) -> None:
 
 # --------------------------------------------------------------------------- runs
 def compare_models(scene: Scene, options: CompareOptions = CompareOptions(),
-                   interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> ModelComparison:
+                   interrupts: Mapping[type[BaseException], str] = progress.INTERRUPTS) -> ModelComparison:
     """Run ``scene`` on its full model and on each reduced model, at each step, and measure each against the full
     model at the finest step (module docstring).
 
