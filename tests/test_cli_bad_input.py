@@ -209,3 +209,10 @@ def test_bad_input_is_refused_cleanly(argv, tokens, inputs, tmp_path, monkeypatc
 
 def test_there_are_at_least_60_kinds():
     assert len(CASES) >= 60
+
+
+def test_the_readme_states_the_number_of_bad_inputs():
+    """The README's sentence on bad input gives the number of :data:`CASES`, each a distinct case."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    assert len({(tuple(argv), tuple(tokens)) for argv, tokens in CASES}) == len(CASES)
+    assert re.search(rf"`tests/test_cli_bad_input.py` gives the commands {len(CASES)} bad\s+inputs", text)

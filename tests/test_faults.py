@@ -699,7 +699,9 @@ def test_a_signal_during_the_first_imports_is_one_line_and_its_status(tmp_path, 
 
 
 def test_the_readme_states_the_number_of_fault_kinds():
-    """docs/commands.md's sentence on the faults tested gives the number of FAULT_KINDS, each named once."""
+    """docs/commands.md's sentence on the faults tested, and the README's, give the number of FAULT_KINDS, each named once."""
     text = (Path(__file__).resolve().parents[1] / "docs" / "commands.md").read_text(encoding="utf-8")
     assert len(set(FAULT_KINDS)) == len(FAULT_KINDS)
     assert f"`tests/test_faults.py` tries\n{len(FAULT_KINDS)} kinds of fault" in text
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    assert f"`tests/test_faults.py` tries {len(FAULT_KINDS)} kinds of fault (its `FAULT_KINDS`" in readme
