@@ -77,7 +77,7 @@ def test_size_decides_the_form_and_the_path(request):
     its sparse twin (system_of); refined(32), 2312 DOFs, dense too; refined(64) sparse."""
     from rotorred.model.assembly import system_of
 
-    if request.config.getoption("--sparse-from") is not None or request.config.getoption("--solve-sparse-from") is not None:
+    if any(request.config.getoption(o) is not None for o in ("--sparse-from", "--solve-sparse-from")):
         pytest.skip("--sparse-from or --solve-sparse-from replaces the sizes this test checks")
 
     rig = rr.load_rotor("seed-rig")

@@ -21,8 +21,9 @@ the 61-speed Campbell 0-12 000 rpm with critical speeds (default mode count), th
 speeds, the automatic Craig-Bampton reduction, and the rub transient's µs per step against the unrefined rig's
 (median of three alternating runs). The last check (``--scene`` runs it alone) is the user's way: ``rotorred run`` of
 the paper-rub scene whose ``[rotor] file`` is the rig refined(128) written by ``Rotor.to_toml``, against
-``rotorred run paper-rub`` (the unrefined rig), alternating, three runs each: the µs per step, the model's build time
-(both from the run's summary.txt), the command's wall time and its peak resident set (its own ``ru_maxrss``).
+``rotorred run paper-rub`` (the unrefined rig), and the first with ``--set solver.modes=auto``, alternating, three
+runs each: the µs per step, the model's build time (both from the run's summary.txt), the command's wall time and its
+peak resident set (its own ``ru_maxrss``).
 
 Run ``python validation/bench_sparse.py [--quick] [--checks] [--scene] [--dense-up-to N] [--plot PATH]``.
 """
@@ -187,8 +188,9 @@ def check(name: str) -> dict:
 
 def cli_scene_runs(repeats: int = 3) -> dict:
     """``rotorred run`` of the paper-rub scene on the rig refined(128) (a rotor file written by ``Rotor.to_toml``,
-    9224 DOFs) and of the built-in paper-rub (80 DOFs), alternating ``repeats`` times after one warm-up run: the
-    medians of the µs per step and the build time (summary.txt), of the wall time (s) and the peak RSS (MB) of each."""
+    9224 DOFs), of the built-in paper-rub (80 DOFs), and of the first with ``solver.modes = "auto"``, alternating
+    ``repeats`` times after one warm-up run: the medians of the µs per step and the build time (summary.txt), of the
+    wall time (s) and the peak RSS (MB) of each."""
     import re
     import shutil
     import tempfile
@@ -197,22 +199,23 @@ def cli_scene_runs(repeats: int = 3) -> dict:
     import rotorred as rr
 
     command = shutil.which("rotorred", path=str(Path(sys.executable).parent)) or shutil.which("rotorred")
-    runs = {"rig": [], "refined128": []}
+    runs = {"rig": [], "refined128": [], "refined128_auto": []}
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         rr.load_rotor("seed-rig").refined(128).to_toml(tmp / "rig128.toml")
         text = resources.files("rotorred.scenes.builtin").joinpath("paper-rub.toml").read_text(encoding="utf-8")
         (tmp / "big.toml").write_text(text.replace('preset = "seed-rig"', 'file = "rig128.toml"'), encoding="utf-8")
-        scenes = {"rig": "paper-rub", "refined128": str(tmp / "big.toml")}
+        scenes = {"rig": ["paper-rub"], "refined128": [str(tmp / "big.toml")],
+                  "refined128_auto": [str(tmp / "big.toml"), "--set", "solver.modes=auto"]}
 
         def run(key: str, k: int) -> dict:
             out = tmp / f"{key}{k}"
             t0 = time.perf_counter()
-            child = subprocess.Popen([command, "run", scenes[key], "--out", str(out), "-q"])
+            child = subprocess.Popen([command, "run", *scenes[key], "--out", str(out), "-q"])
             _, status, usage = os.wait4(child.pid, 0)
             wall = time.perf_counter() - t0
             if os.waitstatus_to_exitcode(status) != 0:
-                raise RuntimeError(f"rotorred run {scenes[key]} failed with exit {os.waitstatus_to_exitcode(status)}")
+                raise RuntimeError(f"rotorred run {scenes[key]} failed: exit {os.waitstatus_to_exitcode(status)}")
             summary = (out / "summary.txt").read_text(encoding="utf-8")
             return {"us_step": float(re.search(r"\(([0-9.]+) us/step", summary).group(1)),
                     "build_s": float(re.search(r"built in ([0-9.]+) s", summary).group(1)),
@@ -289,9 +292,10 @@ def format_table(rows: list[dict], checks: list[dict] | None = None) -> str:
 def format_scene(c: dict) -> str:
     """The ``cli_scene`` check as a table: ``rotorred run`` of paper-rub on the rig and on refined(128)."""
     lines = ["rotorred run paper-rub (median of 3 alternating runs, one thread)",
-             f"{'rotor':<24}{'DOF':>6}{'µs/step':>9}{'build s':>9}{'wall s':>8}{'peak RSS MB':>13}"]
-    for key, label, n in (("rig", "seed-rig (preset)", 80), ("refined128", "refined(128) rotor file", 9224)):
-        lines.append(f"{label:<24}{n:>6}{c[key + '_us_step']:>9.3g}{c[key + '_build_s']:>9.3g}"
+             f"{'rotor':<26}{'DOF':>6}{'µs/step':>9}{'build s':>9}{'wall s':>8}{'peak RSS MB':>13}"]
+    for key, label, n in (("rig", "seed-rig (preset)", 80), ("refined128", "refined(128) rotor file", 9224),
+                          ("refined128_auto", "refined(128), modes auto", 9224)):
+        lines.append(f"{label:<26}{n:>6}{c[key + '_us_step']:>9.3g}{c[key + '_build_s']:>9.3g}"
                      f"{c[key + '_wall_s']:>8.3g}{c[key + '_rss_mb']:>13.0f}")
     lines.append(f"µs/step refined(128) / rig: {c['us_step_ratio']:.2f}x (the same run)")
     return "\n".join(lines)

@@ -213,7 +213,8 @@ def main(argv=None):
     parser.add_argument("--damping-scan", action="store_true", help="only the shipped rotors' modes beyond zeta = 0.6")
     args = parser.parse_args(argv)
     if args.damping_scan:
-        print("lowest whirl frequency with 0.6 <= damping ratio < 0.99 at 0 to 1.5 x the nominal speeds (none: 12000 rpm)")
+        print("lowest whirl frequency with 0.6 <= damping ratio < 0.99 at 0 to 1.5 x the nominal speeds "
+              "(none: 12000 rpm)")
         for name, n_dof, lowest, band in damping_scan():
             print(f"  {name:36s} {n_dof:5d} DOFs  {lowest:8.1f} Hz   (Campbell band top {band:.1f} Hz)")
         return
@@ -241,7 +242,8 @@ def main(argv=None):
 
 def _print_mesh(refines: tuple[int, ...], element: str) -> None:
     f, change, order = mesh_study(refines, element)
-    print(f"mesh study ({element} elements): lowest whirl frequencies (Hz) and the largest change from the previous mesh")
+    print(f"mesh study ({element} elements): lowest whirl frequencies (Hz) and the largest change from the "
+          "previous mesh")
     for r, row, c in zip(refines, f, [None, *change]):
         text = "" if c is None else f"  max change {c:.2e}"
         print(f"  refined({r:3d}) " + " ".join(f"{x / (2 * np.pi):10.6f}" for x in row[:6]) + " ..." + text)
