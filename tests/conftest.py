@@ -17,14 +17,21 @@ def pytest_addoption(parser):
     parser.addoption("--sparse-from", type=int, default=None,
                      help="assemble and solve models of at least this many DOFs sparse (rotorred.model.sparse."
                           "SPARSE_FROM, SOLVE_SPARSE_FROM); 0 runs every test on the sparse path")
+    parser.addoption("--solve-sparse-from", type=int, default=None,
+                     help="solve models of at least this many DOFs sparse (rotorred.model.sparse.SOLVE_SPARSE_FROM), "
+                          "assembled as the size says; 0 runs every analysis with a sparse path on it")
 
 
 @pytest.fixture(autouse=True)
 def _sparse_from(request, monkeypatch):
-    """``--sparse-from N``: the size from which models are assembled sparse, for this run."""
+    """``--sparse-from N``: the size from which models are assembled and solved sparse, for this run;
+    ``--solve-sparse-from N``: the size from which they are solved sparse."""
+    from rotorred.model import sparse
+
     value = request.config.getoption("--sparse-from")
     if value is not None:
-        from rotorred.model import sparse
-
         monkeypatch.setattr(sparse, "SPARSE_FROM", value)
         monkeypatch.setattr(sparse, "SOLVE_SPARSE_FROM", value)
+    solve = request.config.getoption("--solve-sparse-from")
+    if solve is not None:
+        monkeypatch.setattr(sparse, "SOLVE_SPARSE_FROM", solve)

@@ -49,9 +49,11 @@ ROTORS = {"seed-rig": lambda: rr.load_rotor("seed-rig"), "nelson-mcvaugh": lambd
 
 @pytest.mark.parametrize("name", ROTORS)
 def test_sparse_assembly_is_the_dense_one(name):
-    """Every matrix equal to round-off (1e-14 of the largest entry), the loss frequency (first natural frequency,
-    sparse Lanczos against dense LAPACK) within 1e-9 (measured 5e-12), so the speed-dependent matrices, whose
-    hysteretic damping is taken at it, within 1e-11 (measured 6e-13); the rigid-body test agrees."""
+    """Every assembled matrix equal to the bit (each entry's terms summed in the same order: a round-off difference
+    split a free spool's zero eigenvalues otherwise, tests/test_supports.py failed with --sparse-from 0), the loss
+    frequency (first natural frequency, sparse Lanczos against dense LAPACK) within 1e-9 (measured 5e-12), so the
+    speed-dependent matrices, whose hysteretic damping is taken at it, within 1e-11 (measured 6e-13); the rigid-body
+    test agrees."""
     rotor = ROTORS[name]()
     d, s = assemble(rotor, as_sparse=False), assemble(rotor, as_sparse=True)
     assert s.is_sparse and not d.is_sparse and sp.issparse(s.K) and s.dense().M.shape == d.M.shape
@@ -59,8 +61,9 @@ def test_sparse_assembly_is_the_dense_one(name):
     def close(a, b, rtol=1e-14):
         return np.max(np.abs(sparse.dense(a) - b)) <= rtol * max(np.max(np.abs(b)), 1e-300)
 
-    assert close(s.M, d.M) and close(s.K, d.K) and close(s.C, d.C)
-    assert all(close(s.G[k], d.G[k]) and close(s.K_G[k], d.K_G[k]) for k in d.G)
+    assert all(np.array_equal(sparse.dense(a), b) for a, b in ((s.M, d.M), (s.K, d.K), (s.C, d.C)))
+    assert all(np.array_equal(sparse.dense(s.G[k]), d.G[k]) and np.array_equal(sparse.dense(s.K_G[k]), d.K_G[k])
+               for k in d.G)
     for factor in (0.3, 1.7):
         speeds = {k: factor * w for k, w in rotor.speeds.items()}
         assert close(s.stiffness(speeds), d.stiffness(speeds), 1e-11) and close(s.damping(speeds), d.damping(speeds),
@@ -74,8 +77,8 @@ def test_size_decides_the_form_and_the_path(request):
     its sparse twin (system_of); refined(32), 2312 DOFs, dense too; refined(64) sparse."""
     from rotorred.model.assembly import system_of
 
-    if request.config.getoption("--sparse-from") is not None:
-        pytest.skip("--sparse-from replaces the sizes this test checks")
+    if any(request.config.getoption(o) is not None for o in ("--sparse-from", "--solve-sparse-from")):
+        pytest.skip("--sparse-from or --solve-sparse-from replaces the sizes this test checks")
 
     rig = rr.load_rotor("seed-rig")
     small, mid = assemble(rig), assemble(rig.refined(16))
@@ -147,3 +150,55 @@ def test_sparse_reduction_refuses_a_free_interior():
     loose = assemble(dataclasses.replace(rig, intershaft_bearings=()), as_sparse=True)
     with pytest.raises(InputError, match=r"^boundary_nodes = \[1\]: must restrain the interior part"):
         reduce(loose, (1,), n_modes=2)
+
+
+class _BranchSolver:
+    """A stand-in for campbell's solver along one tracked curve: ``curve(W)`` its eigenvalue at speed W (rad/s),
+    one fixed shape."""
+
+    def __init__(self, curve):
+        self.curve = curve
+        self.x_rows = self.y_rows = np.eye(2)
+
+    def local(self, W, lam0, v0):
+        return self.curve(W), np.array([1.0, 1j]) / np.sqrt(2)
+
+    def solve(self, W):
+        return np.array([self.curve(W)]), (np.array([1.0, 1j]) / np.sqrt(2))[:, None]
+
+
+def test_a_jump_of_the_tracked_curve_is_no_critical_speed():
+    """A Campbell crossing is refined by Brent's method on a sign change of Im(lambda) - line; where the tracked curve
+    jumps between two modes (as it did under --sparse-from 0 in tests/test_supports.py, before the two assemblies were
+    equal to the bit: round-off split a free spool's zero eigenvalues into three tiny whirl frequencies instead of two),
+    Brent's method converges on the jump, and the 'crossing' was reported at a speed whose line is 14 Hz off its
+    frequency. Now it is none; a true crossing is found to round-off."""
+    from rotorred.linear.campbell import _refine
+
+    Omega = np.array([60.0, 80.0])
+    shapes = [np.array([[1.0], [1j]]) / np.sqrt(2)] * 2
+    whirl = np.array([["forward"], ["forward"]])
+    line = ("s", 1.0, 1.0, 0.0)  # frequency = W
+    for curve, crossing in ((lambda W: -1.0 + (100.0 if W < 70.0 else 50.0) * 1j, False),
+                            (lambda W: -1.0 + (0.5 * W + 35.0) * 1j, True)):
+        lam_grid = np.array([[curve(60.0)], [curve(80.0)]])
+        found = _refine(_BranchSolver(curve), Omega, lam_grid, shapes, whirl, (0, 0), line)
+        assert (found is not None) == crossing
+        if crossing:
+            assert found.speed == pytest.approx(70.0, rel=1e-10) and found.frequency == pytest.approx(70.0, rel=1e-10)
+
+
+def test_every_mode_below_a_frequency_alone_is_certified():
+    """``eigen(..., below=w)`` with no mode count (the band of a scene's automatic mode count, linear/accuracy.py): on
+    a sparse model every whirl mode below w, as the dense solve gives them (within 1e-7). Before, with no count the
+    sparse solve never certified its eigenvalues, doubled its Arnoldi vectors to a quarter of the model's and fell back
+    to a dense solve (for the rig refined(128) hours and 10 GB)."""
+    rotor = rr.load_rotor("seed-rig").refined(4)
+    d, s = assemble(rotor, as_sparse=False), assemble(rotor, as_sparse=True)
+    w = 2 * np.pi * 650.0
+    dense = eigen(d.M, d.damping(rotor.speeds), d.K, below=w).eigenvalues
+    found = eigen(s.M, s.damping(rotor.speeds), s.K, below=w).eigenvalues
+    assert found.shape[0] < 0.25 * 2 * s.n_dof  # the sparse solve, not its dense fallback
+    lower = np.sort(found.imag[found.imag < w])
+    assert len(lower) == np.sum(dense.imag < w) > 10
+    np.testing.assert_allclose(lower, np.sort(dense.imag[dense.imag < w]), rtol=1e-7)

@@ -19,9 +19,13 @@ libraries included. The growth exponent of each task is the slope of log(cost) a
 rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
 the 61-speed Campbell 0-12 000 rpm with critical speeds (default mode count), the unbalance response at 200
 speeds, the automatic Craig-Bampton reduction, and the rub transient's µs per step against the unrefined rig's
-(median of three alternating runs).
+(median of three alternating runs). The last check (``--scene`` runs it alone) is the user's way: ``rotorred run`` of
+the paper-rub scene whose ``[rotor] file`` is the rig refined(128) written by ``Rotor.to_toml``, against
+``rotorred run paper-rub`` (the unrefined rig), and the first with ``--set solver.modes=auto``, alternating, three
+runs each: the µs per step, the model's build time (both from the run's summary.txt), the command's wall time and its
+peak resident set (its own ``ru_maxrss``).
 
-Run ``python validation/bench_sparse.py [--quick] [--checks] [--dense-up-to N] [--plot PATH]``.
+Run ``python validation/bench_sparse.py [--quick] [--checks] [--scene] [--dense-up-to N] [--plot PATH]``.
 """
 
 from __future__ import annotations
@@ -175,8 +179,55 @@ def check(name: str) -> dict:
             for refine, model in models.items():
                 runs[refine].append(rub_us_per_step(refine, model))
         out.update({f"us_step_{refine}": statistics.median(v) for refine, v in runs.items()})
+    elif name == "cli_scene":
+        out.update(cli_scene_runs())
     out["seconds"] = time.perf_counter() - t0
     out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return out
+
+
+def cli_scene_runs(repeats: int = 3) -> dict:
+    """``rotorred run`` of the paper-rub scene on the rig refined(128) (a rotor file written by ``Rotor.to_toml``,
+    9224 DOFs), of the built-in paper-rub (80 DOFs), and of the first with ``solver.modes = "auto"``, alternating
+    ``repeats`` times after one warm-up run: the medians of the µs per step and the build time (summary.txt), of the
+    wall time (s) and the peak RSS (MB) of each."""
+    import re
+    import shutil
+    import tempfile
+    from importlib import resources
+
+    import rotorred as rr
+
+    command = shutil.which("rotorred", path=str(Path(sys.executable).parent)) or shutil.which("rotorred")
+    runs = {"rig": [], "refined128": [], "refined128_auto": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        rr.load_rotor("seed-rig").refined(128).to_toml(tmp / "rig128.toml")
+        text = resources.files("rotorred.scenes.builtin").joinpath("paper-rub.toml").read_text(encoding="utf-8")
+        (tmp / "big.toml").write_text(text.replace('preset = "seed-rig"', 'file = "rig128.toml"'), encoding="utf-8")
+        scenes = {"rig": ["paper-rub"], "refined128": [str(tmp / "big.toml")],
+                  "refined128_auto": [str(tmp / "big.toml"), "--set", "solver.modes=auto"]}
+
+        def run(key: str, k: int) -> dict:
+            out = tmp / f"{key}{k}"
+            t0 = time.perf_counter()
+            child = subprocess.Popen([command, "run", *scenes[key], "--out", str(out), "-q"])
+            _, status, usage = os.wait4(child.pid, 0)
+            wall = time.perf_counter() - t0
+            if os.waitstatus_to_exitcode(status) != 0:
+                raise RuntimeError(f"rotorred run {scenes[key]} failed: exit {os.waitstatus_to_exitcode(status)}")
+            summary = (out / "summary.txt").read_text(encoding="utf-8")
+            return {"us_step": float(re.search(r"\(([0-9.]+) us/step", summary).group(1)),
+                    "build_s": float(re.search(r"built in ([0-9.]+) s", summary).group(1)),
+                    "wall_s": wall, "rss_mb": usage.ru_maxrss / 1024}
+
+        run("rig", 0)  # the step kernel compiled and cached once: not measured
+        for k in range(repeats):
+            for key in runs:
+                runs[key].append(run(key, k + 1))
+    out = {f"{key}_{m}": round(statistics.median(r[m] for r in v), 3) for key, v in runs.items()
+           for m in ("us_step", "build_s", "wall_s", "rss_mb")}
+    out["us_step_ratio"] = round(out["refined128_us_step"] / out["rig_us_step"], 3)
     return out
 
 
@@ -230,8 +281,23 @@ def format_table(rows: list[dict], checks: list[dict] | None = None) -> str:
     lines.append("growth exponent (sparse, >= 1000 DOFs): " + ", ".join(
         f"{LABELS[t].split(' (')[0]} n^{p:.2f}" for t, p in exponents(rows).items()))
     for c in checks or ():
+        if c["check"] == "cli_scene":
+            lines.append(format_scene(c))
+            continue
         lines.append("refined(128) check: " + ", ".join(f"{k} {v}" for k, v in c.items() if k != "check")
                      + f"  [{c['check']}]")
+    return "\n".join(lines)
+
+
+def format_scene(c: dict) -> str:
+    """The ``cli_scene`` check as a table: ``rotorred run`` of paper-rub on the rig and on refined(128)."""
+    lines = ["rotorred run paper-rub (median of 3 alternating runs, one thread)",
+             f"{'rotor':<26}{'DOF':>6}{'µs/step':>9}{'build s':>9}{'wall s':>8}{'peak RSS MB':>13}"]
+    for key, label, n in (("rig", "seed-rig (preset)", 80), ("refined128", "refined(128) rotor file", 9224),
+                          ("refined128_auto", "refined(128), modes auto", 9224)):
+        lines.append(f"{label:<26}{n:>6}{c[key + '_us_step']:>9.3g}{c[key + '_build_s']:>9.3g}"
+                     f"{c[key + '_wall_s']:>8.3g}{c[key + '_rss_mb']:>13.0f}")
+    lines.append(f"µs/step refined(128) / rig: {c['us_step_ratio']:.2f}x (the same run)")
     return "\n".join(lines)
 
 
@@ -265,6 +331,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help=f"refined{QUICK} only")
     parser.add_argument("--checks", action="store_true", help="also the issue's checks on refined(128)")
+    parser.add_argument("--scene", action="store_true", help="only `rotorred run` on refined(128) against the rig")
     parser.add_argument("--dense-up-to", type=int, default=16, help="largest refinement solved dense too")
     parser.add_argument("--plot", metavar="PATH")
     parser.add_argument("--worker", help=argparse.SUPPRESS)
@@ -276,8 +343,11 @@ def main(argv=None) -> int:
     if args.check:
         print(json.dumps(check(args.check)))
         return 0
+    if args.scene:
+        print(format_scene(_subprocess(["--check", "cli_scene"])))
+        return 0
     rows = measure(QUICK if args.quick else REFINES, args.dense_up_to)
-    checks = [_subprocess(["--check", c]) for c in ("campbell61", "unbalance200", "reduction", "rub")] \
+    checks = [_subprocess(["--check", c]) for c in ("campbell61", "unbalance200", "reduction", "rub", "cli_scene")] \
         if args.checks else []
     print(format_table(rows, checks))
     if args.plot:

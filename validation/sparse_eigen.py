@@ -15,12 +15,26 @@ long-double one). The same matrices (doubles) are solved by all four: the refere
 The mesh study gives the lowest 12 whirl frequencies at refined(8, 16, ..., 128) (sparse path) and the observed
 order of convergence p = log2(|f_h - f_h/2| / |f_h/2 - f_h/4|).
 
-Run ``python validation/sparse_eigen.py [--refine N] [--mesh]``.
+The damping-ratio study (``--damping``) is tests/test_campbell.py's identity check on the unrefined rig at 3000 rpm
+(the lowest 6 whirl modes): the damping ratios of the dense solve a Campbell of 6 modes makes (2 x 6 + 4 candidates,
+more than a quarter of the 80-DOF rig's eigenvalues: dense even on a sparse model) and of the test's own
+``eigen(..., n_modes=6)`` on the sparse matrices (shift-invert Arnoldi), each against the extended-precision one.
+
+The damping scan (``--damping-scan``) lists, for each preset rotor and the built-in scenes' rotor (its Rayleigh
+damping), unrefined and refined(8), the lowest whirl frequency with a damping ratio in [0.6, 0.99) at 0 to 1.5 times
+the nominal speeds (every spool 0 to 12 000 rpm where the rotor has none; dense, every mode): the modes the sparse
+path does not certify (docs/model.md §24).
+
+``--hierarchical`` runs the mesh study of the rig with every shaft element ``hierarchical`` (h^4), refined(1 .. 32):
+the rig's order 2 is its Nelson element's (docs/model.md §24, "Mesh convergence").
+
+Run ``python validation/sparse_eigen.py [--refine N] [--mesh] [--hierarchical] [--damping] [--damping-scan]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import time
 from dataclasses import dataclass
@@ -58,8 +72,13 @@ class Comparison:
     dense_time: float
 
 
-def _matrices(refine: int):
-    rotor = load_rotor("seed-rig").refined(refine)
+def _matrices(refine: int, element: str = "nelson"):
+    rotor = load_rotor("seed-rig")
+    if element != "nelson":  # every shaft element of the rig in the given formulation
+        spools = tuple(dataclasses.replace(s, elements=tuple(dataclasses.replace(e, element=element)
+                                                             for e in s.elements)) for s in rotor.spools)
+        rotor = dataclasses.replace(rotor, spools=spools)
+    rotor = rotor.refined(refine)
     model = assemble(rotor, as_sparse=True)
     speeds = {s: SPEED_FACTOR * w for s, w in rotor.speeds.items()}
     return tuple(sp.csc_array(X) for X in (model.M, model.damping(speeds), model.stiffness(speeds)))
@@ -126,21 +145,89 @@ def compare(refine: int = 16) -> Comparison:
                       sparse_time=t_sparse, dense_time=t_dense)
 
 
-def mesh_study(refines=(8, 16, 32, 64, 128)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def mesh_study(refines=(8, 16, 32, 64, 128), element: str = "nelson") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The lowest ``N_MODES`` whirl frequencies (rad/s) at each refinement (rows, each mesh halving the last), the
     largest relative change between consecutive meshes, and the observed order log2 of the ratio of consecutive
-    changes."""
-    f = np.array([eigen(*_matrices(r), n_modes=N_MODES, max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).frequencies
-                  for r in refines])
+    changes; every shaft element of the rig ``element`` (the rig's own: ``"nelson"``)."""
+    f = np.array([eigen(*_matrices(r, element), n_modes=N_MODES,
+                        max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).frequencies for r in refines])
     change = np.max(np.abs(f[1:] / f[:-1] - 1), axis=1)
     return f, change, np.log2(change[:-1] / change[1:])
+
+
+def damping_ratios() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Relative errors of the lowest 6 whirl modes' damping ratios -Re(lambda)/|lambda| of the unrefined rig at
+    3000 rpm (tests/test_campbell.py's identity check) against the extended-precision reference: the dense solve a
+    Campbell makes, the sparse one the test's ``eigen(..., n_modes=6)`` makes, and the two against each other."""
+    rig = load_rotor("seed-rig")
+    model = assemble(rig, as_sparse=True)
+    omega = 3000 * np.pi / 30
+    ratios = {s: w / rig.speeds["inner"] for s, w in rig.speeds.items()}
+    M, D, K = (sp.csc_array(X) for X in (model.M, model.C + omega * model.gyroscopic(ratios), model.K))
+    sparse_solution = eigen(M, D, K, n_modes=6)
+    dense = eigen(M.toarray(), D.toarray(), K.toarray(), n_modes=2 * 6 + 4).eigenvalues[:6]
+    reference = np.array([complex(extended(M, D, K, lam, v)) for lam, v in zip(sparse_solution.eigenvalues,
+                                                                                sparse_solution.modes.T)])
+
+    def zeta(lam):
+        return -lam.real / np.abs(lam)
+
+    return (np.abs(zeta(dense) / zeta(reference) - 1), np.abs(zeta(sparse_solution.eigenvalues) / zeta(reference) - 1),
+            np.abs(zeta(sparse_solution.eigenvalues) / zeta(dense) - 1))
+
+
+def damping_scan() -> list[tuple[str, int, float, float]]:
+    """(rotor, DOFs, lowest whirl frequency (Hz) with 0.6 <= zeta < 0.99 at 0, 0.25, ..., 1.5 x the nominal speeds (a
+    rotor without them: every spool 0 to 12 000 rpm) or inf, the top of a Campbell band 1.25 x the fastest spool's
+    highest speed (Hz)) of each shipped rotor."""
+    from rotorred.linear.modal import SPARSE_COMPLETE_DAMPING_RATIO
+    from rotorred.scenes.schema import load_scene
+
+    scene_rotor = load_scene("paper-rub").rotor
+    cases = [(name, load_rotor(name)) for name in ("seed-rig", "nelson-mcvaugh", "ross-coaxial")]
+    cases += [("built-in scenes' rotor", scene_rotor), ("built-in scenes' rotor refined(8)", scene_rotor.refined(8))]
+    out = []
+    for name, rotor in cases:
+        model = assemble(rotor, as_sparse=False)
+        top = {s: 1.5 * w for s, w in rotor.speeds.items()}
+        if not any(top.values()):  # no nominal speed: every spool to 12 000 rpm
+            top = {s: 12000 * np.pi / 30 for s in top}
+        lowest = np.inf
+        for factor in np.linspace(0.0, 1.0, 7):
+            speeds = {s: factor * w for s, w in top.items()}
+            lam = eigen(model.M, model.damping(speeds), model.stiffness(speeds),
+                        max_damping_ratio=WHIRL_MAX_DAMPING_RATIO).eigenvalues
+            damped = -lam.real / np.abs(lam) >= SPARSE_COMPLETE_DAMPING_RATIO
+            lowest = min(lowest, float(np.min(lam.imag[damped], initial=np.inf)))
+        out.append((name, model.n_dof, lowest / (2 * np.pi), 1.25 * max(top.values()) / (2 * np.pi)))
+    return out
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--refine", type=int, default=16)
     parser.add_argument("--mesh", action="store_true", help="also the mesh study, refined(8 .. 128)")
+    parser.add_argument("--hierarchical", action="store_true",
+                        help="only the mesh study of the rig with hierarchical elements, refined(1 .. 32)")
+    parser.add_argument("--damping", action="store_true", help="only the damping-ratio study of the unrefined rig")
+    parser.add_argument("--damping-scan", action="store_true", help="only the shipped rotors' modes beyond zeta = 0.6")
     args = parser.parse_args(argv)
+    if args.damping_scan:
+        print("lowest whirl frequency with 0.6 <= damping ratio < 0.99 at 0 to 1.5 x the nominal speeds "
+              "(none: 12000 rpm)")
+        for name, n_dof, lowest, band in damping_scan():
+            print(f"  {name:36s} {n_dof:5d} DOFs  {lowest:8.1f} Hz   (Campbell band top {band:.1f} Hz)")
+        return
+    if args.damping:
+        dense, sparse, between = damping_ratios()
+        print("unrefined rig at 3000 rpm, lowest 6 whirl modes: damping ratios against the extended-precision ones")
+        print("  dense (a Campbell's solve)   " + " ".join(f"{e:.1e}" for e in dense))
+        print("  sparse eigen(n_modes=6)      " + " ".join(f"{e:.1e}" for e in sparse))
+        print(f"  sparse against dense: {between.max():.2e} (largest)")
+        return
+    if args.hierarchical:
+        _print_mesh((1, 2, 4, 8, 16, 32), "hierarchical")
+        return
     c = compare(args.refine)
     print(f"seed rig refined({args.refine}), {c.n_dof} DOFs, lowest {N_MODES} whirl frequencies at the nominal speeds")
     print("relative error against the extended-precision reference (max over the modes):")
@@ -150,13 +237,17 @@ def main(argv=None):
     print(f"sparse against dense M^-1 form {c.sparse_vs_inverse:.2e}, against the dense pencil {c.sparse_vs_pencil:.2e}")
     print(f"one solve: sparse {c.sparse_time:.3f} s, dense {c.dense_time:.2f} s ({c.dense_time / c.sparse_time:.0f}x)")
     if args.mesh:
-        refines = (8, 16, 32, 64, 128)
-        f, change, order = mesh_study(refines)
-        print("mesh study: lowest whirl frequencies (Hz) and the largest change from the previous mesh")
-        for r, row, c in zip(refines, f, [None, *change]):
-            text = "" if c is None else f"  max change {c:.2e}"
-            print(f"  refined({r:3d}) " + " ".join(f"{x / (2 * np.pi):8.3f}" for x in row[:6]) + " ..." + text)
-        print("observed order (log2 of consecutive changes): " + " ".join(f"{p:.2f}" for p in order))
+        _print_mesh((8, 16, 32, 64, 128), "nelson")
+
+
+def _print_mesh(refines: tuple[int, ...], element: str) -> None:
+    f, change, order = mesh_study(refines, element)
+    print(f"mesh study ({element} elements): lowest whirl frequencies (Hz) and the largest change from the "
+          "previous mesh")
+    for r, row, c in zip(refines, f, [None, *change]):
+        text = "" if c is None else f"  max change {c:.2e}"
+        print(f"  refined({r:3d}) " + " ".join(f"{x / (2 * np.pi):10.6f}" for x in row[:6]) + " ..." + text)
+    print("observed order (log2 of consecutive changes): " + " ".join(f"{p:.2f}" for p in order))
 
 
 if __name__ == "__main__":

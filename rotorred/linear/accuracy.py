@@ -26,6 +26,8 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.linear.modal import eigen
+from rotorred.model import sparse
+from rotorred.model.assembly import system_of
 
 __all__ = ["ReceptanceError", "band_frequencies", "receptance", "warped", "receptance_error", "N_GRID"]
 
@@ -63,8 +65,9 @@ def band_frequencies(model, speeds: Mapping[str, float], f_max_hz: float, n_grid
     """
     f_max_hz = checks.positive("f_max_hz", f_max_hz, "Hz")
     w_max = 2 * math.pi * f_max_hz
-    if eigenvalues is None:
-        eigenvalues = eigen(model.M, model.damping(speeds), model.stiffness(speeds)).eigenvalues
+    if eigenvalues is None:  # a large model: its modes below the band's top only (sparse, docs/model.md §24)
+        model = system_of(model, "model", sparse_ok=True)
+        eigenvalues = eigen(model.M, model.damping(speeds), model.stiffness(speeds), below=w_max).eigenvalues
     natural = eigenvalues.imag[eigenvalues.imag <= w_max]
     spools = [w for w in speeds.values() if 0 < w <= w_max]
     return np.unique(np.concatenate([np.linspace(0.0, w_max, n_grid), natural, spools]))
@@ -97,11 +100,14 @@ def receptance(model, speeds: Mapping[str, float], omega: np.ndarray, outputs: S
     dt : float, optional
         Time step of the average-acceleration Newmark step: its steady-state receptance (:func:`warped`).
     """
+    model = system_of(model, "model", sparse_ok=True)  # a large full model: one sparse LU a frequency
     R = model.output_rows(list(outputs))
     B = model.output_rows(list(inputs)).T
     s = 1j * warped(omega, dt)
-    D = model.damping(speeds)
-    A = s[:, None, None] ** 2 * model.M + s[:, None, None] * D + model.stiffness(speeds)
+    D, K = model.damping(speeds), model.stiffness(speeds)
+    if sparse.is_sparse(model.M):
+        return np.array([R @ sparse.solve(sk * sk * model.M + sk * D + K, B.astype(complex)) for sk in s])
+    A = s[:, None, None] ** 2 * model.M + s[:, None, None] * D + K
     return R @ np.linalg.solve(A, np.broadcast_to(B, (len(s),) + B.shape))
 
 

@@ -906,9 +906,9 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
                     continue  # counted as the right end of interval i - 1
                 if g[i, j] * g[i + 1, j] > 0:
                     continue
-                crit.append(replace(
-                    _refine(solver, Omega, lam_all, shapes, whirl, (i, j), (spool, hh, slope, offset)),
-                    same_line=same))
+                found = _refine(solver, Omega, lam_all, shapes, whirl, (i, j), (spool, hh, slope, offset))
+                if found is not None:
+                    crit.append(replace(found, same_line=same))
     crit.sort(key=lambda c: (c.speed, c.mode))
     changes = _stability_changes(solver, Omega, lam_all, shapes, whirl, log_dec, is_rigid)
     return CampbellResult(speeds=Omega, frequencies=freq, log_dec=log_dec, whirl=whirl, tracking_mac=tracking,
@@ -1137,11 +1137,21 @@ def _stability_changes(solver: _Solver, Omega, lam_grid, shapes, whirl, log_dec,
     return tuple(sorted(out, key=lambda c: (c.speed, c.mode)))
 
 
-def _refine(solver: _Solver, Omega, lam_grid, shapes, whirl, at: tuple[int, int], line) -> CriticalSpeed:
+#: a refined crossing whose whirl frequency is off its excitation line by more than this share of |lambda| is none:
+#: the sign change that bracketed it was a jump of the tracked curve between two modes (Brent's method then converges
+#: on the jump), seen where round-off splits a free spool's zero eigenvalues into a varying count of tiny whirl
+#: frequencies (docs/model.md §24)
+_CROSSING_TOL = 1e-6
+
+
+def _refine(solver: _Solver, Omega, lam_grid, shapes, whirl, at: tuple[int, int], line) -> CriticalSpeed | None:
     """The crossing of whirl curve j with the excitation line ``line`` = (spool, harmonic, slope, offset), frequency
-    slope x Omega + offset, in [Omega_i, Omega_i+1], ``at`` = (i, j) (:func:`_root`)."""
+    slope x Omega + offset, in [Omega_i, Omega_i+1], ``at`` = (i, j) (:func:`_root`); None where the root found is
+    not on the line (a jump of the tracked curve, :data:`_CROSSING_TOL`)."""
     (i, j), (spool, harmonic, slope, offset) = at, line
     root, lam, shape = _root(solver, Omega, lam_grid, shapes, i, j, lambda lam, W: lam.imag - (slope * W + offset))
+    if abs(lam.imag - (slope * root + offset)) > _CROSSING_TOL * abs(lam):
+        return None
     if whirl[i, j] == whirl[i + 1, j]:
         label = str(whirl[i, j])  # also right inside a multiple eigenvalue, where the shape is any basis vector
     else:

@@ -42,13 +42,10 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from rotorred import checks, writers
 from rotorred.model.assembly import system_of
-from rotorred.model.sparse import is_sparse
+from rotorred.model import sparse
 from rotorred.model.loads import Unbalance
 from rotorred.results import Result, dof_coordinates, label_coordinate
 from rotorred.model.operating import Operating
@@ -539,10 +536,7 @@ class _Matrices:
     def solve(self, w: float, rhs: np.ndarray) -> np.ndarray:
         """``dynamic_stiffness(w)^-1 rhs``, ``rhs`` shape (n,) or (n, k): a dense LU, or a sparse one (SuperLU, a
         fill-reducing order of A + A^T: a beam model's banded matrix factorises in O(n)) for a sparse model."""
-        A = self.dynamic_stiffness(w)
-        if is_sparse(A):
-            return spla.splu(sp.csc_array(A), permc_spec="MMD_AT_PLUS_A").solve(np.asarray(rhs, complex))
-        return sla.solve(A, rhs, check_finite=False)
+        return sparse.solve(self.dynamic_stiffness(w), np.asarray(rhs, complex))
 
 
 def unbalance_forces(model, unbalances: Sequence[Unbalance]) -> dict[str, np.ndarray]:

@@ -155,7 +155,9 @@ def _sparse_eigen(M, D, K, wanted: tuple[int, float], min_frequency: float,
         if max_damping_ratio is not None:
             keep &= -lam.real < max_damping_ratio * np.abs(lam)
         order = np.flatnonzero(keep)[np.argsort(lam.imag[keep], kind="stable")]
-        top = max(w_wanted, lam.imag[order[n_wanted - 1]] if 0 < n_wanted <= len(order) else np.inf)
+        # the highest frequency to certify: the n-th lowest found (not yet found: go on), and w
+        top = max(w_wanted, 0.0 if n_wanted == 0 else lam.imag[order[n_wanted - 1]] if n_wanted <= len(order)
+                  else np.inf)
         if cover * top + abs(sigma) <= radius:
             break
         k *= 2

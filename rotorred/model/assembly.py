@@ -374,12 +374,20 @@ class _Triplets:
         self.vals.append(np.asarray(block, dtype=float).ravel())
 
     def matrix(self, n: int, as_sparse: bool):
-        """The sum of the blocks, shape (n, n): a CSR array if ``as_sparse``, else a dense ndarray."""
+        """The sum of the blocks, shape (n, n): a CSR array if ``as_sparse``, else a dense ndarray; the two equal to
+        the bit: each entry summed in the order the blocks were added (``np.add.at``, as ``toarray`` sums), where
+        ``tocsr`` would sum an entry's terms in the order of an unstable sort, and a round-off difference split a
+        free spool's zero eigenvalues otherwise (its count of near-zero whirl frequencies, and with it the mode
+        tracking, then differed: docs/model.md §24)."""
         if not self.vals:
             return coo_array((n, n)).tocsr() if as_sparse else np.zeros((n, n))
         rows, cols, vals = (np.concatenate(x) for x in (self.rows, self.cols, self.vals))
-        X = coo_array((vals, (rows, cols)), shape=(n, n))
-        return X.tocsr() if as_sparse else X.toarray()
+        if not as_sparse:
+            return coo_array((vals, (rows, cols)), shape=(n, n)).toarray()
+        keys, at = np.unique(rows.astype(np.int64) * n + cols, return_inverse=True)
+        sums = np.zeros(len(keys))
+        np.add.at(sums, at.ravel(), vals)
+        return coo_array((sums, (keys // n, keys % n)), shape=(n, n)).tocsr()
 
 
 def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):

@@ -14,7 +14,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["SPARSE_FROM", "SOLVE_SPARSE_FROM", "is_sparse", "dense", "csr", "zeros_like", "nonzero", "cut", "lowest_w2"]
+__all__ = ["SPARSE_FROM", "SOLVE_SPARSE_FROM", "is_sparse", "dense", "csr", "zeros_like", "nonzero", "cut", "solve",
+           "lowest_w2"]
 
 #: models of at least this many DOFs are assembled sparse: their dense matrices would take 50 MB each, seven of
 #: them at least (M, K, C and a G and K_G per spool); a smaller model's can be read as arrays
@@ -55,6 +56,28 @@ def cut(X, rows: np.ndarray, cols: np.ndarray):
     if sp.issparse(X):
         return sp.csr_array(X)[rows][:, cols]
     return X[np.ix_(rows, cols)]
+
+
+def solve(A, rhs: np.ndarray) -> np.ndarray:
+    """``A^-1 rhs`` of a square matrix ``A``, sparse or dense: a sparse one by SuperLU with the minimum-degree order of
+    A + A^T (``permc_spec="MMD_AT_PLUS_A"``: a beam model is banded up to its node numbering, which a fill-reducing
+    order undoes; a banded matrix factorises in O(n)), a dense one by LAPACK.
+
+    Parameters
+    ----------
+    A : ndarray or sparse matrix, shape (n, n)
+        Regular matrix (real or complex).
+    rhs : ndarray, shape (n,) or (n, k)
+        Right-hand side(s).
+
+    Returns
+    -------
+    ndarray, shape of ``rhs``
+    """
+    if sp.issparse(A):
+        dtype = np.result_type(A.dtype, np.asarray(rhs).dtype)
+        return spla.splu(sp.csc_array(A, dtype=dtype), permc_spec="MMD_AT_PLUS_A").solve(np.asarray(rhs, dtype))
+    return sla.solve(A, rhs, check_finite=False)
 
 
 def lowest_w2(K, M, k: int) -> tuple[np.ndarray, np.ndarray]:

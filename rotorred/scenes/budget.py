@@ -31,6 +31,10 @@ MEMORY_FRACTION = 0.5
 _CSV_BYTES = 17
 #: dense n x n float matrices held at once by the linear analyses (M, K, C, G per spool, factors, state space)
 _DENSE_MATRICES = 24
+#: bytes a DOF of a model solved sparse (docs/model.md §24): its sparse matrices, LU factors and Arnoldi bases
+#: (measured: a 61-speed Campbell of the rig refined(128), 9224 DOFs, peaks at 460 MB traced, 50 KB a DOF;
+#: validation/bench_sparse.py --checks)
+_SPARSE_BYTES_PER_DOF = 64 * 1024
 
 
 def format_bytes(n: float) -> str:
@@ -91,7 +95,7 @@ class Estimate:
         """One line: the steps, the recorded samples and their memory, the model's DOFs and its matrices' memory."""
         parts = [f"{self.steps:.3g} steps" if self.steps else "",
                  f"{self.samples:.3g} {self.held} ({format_bytes(self.record_bytes)})" if self.samples else "",
-                 f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of dense matrices)"]
+                 f"a {self.n_dof}-DOF model ({format_bytes(self.model_bytes)} of model matrices)"]
         return "estimate: " + ", ".join(p for p in parts if p)
 
     def check(self, force: bool = False, memory: int | None = None) -> Estimate:
@@ -134,22 +138,30 @@ class Estimate:
         return self
 
 
-def model_estimate(rotor) -> tuple[int, int]:
-    """(DOFs, bytes of the dense matrices) of ``rotor``'s finite-element model (4 DOFs per node).
+def model_estimate(rotor, dense: bool = False) -> tuple[int, int]:
+    """(DOFs, bytes of the matrices) of ``rotor``'s finite-element model (4 DOFs per node).
 
     Parameters
     ----------
     rotor : Rotor
-        The rotor; a hierarchical element adds 4 internal DOFs.
+        The rotor; a hierarchical element adds 6 internal DOFs.
+    dense : bool
+        Whether the run reads the full model dense (a full-model transient); else a model of at least
+        :data:`rotorred.model.sparse.SOLVE_SPARSE_FROM` DOFs is solved sparse (docs/model.md §24).
 
     Returns
     -------
     n_dof : int
         Degrees of freedom of the full model.
     bytes : int
-        Memory of the dense n x n matrices the linear analyses hold at once (bytes).
+        Memory of the matrices the linear analyses hold at once (bytes): dense n x n ones, or a sparse model's
+        matrices, factors and bases, linear in n.
     """
-    n = 4 * len(rotor.nodes) + 4 * sum(1 for e in _elements(rotor) if getattr(e, "element", "") == "hierarchical")
+    from rotorred.model import sparse
+
+    n = 4 * len(rotor.nodes) + 6 * sum(1 for e in _elements(rotor) if getattr(e, "element", "") == "hierarchical")
+    if not dense and n >= sparse.SOLVE_SPARSE_FROM:
+        return n, _SPARSE_BYTES_PER_DOF * n
     return n, _DENSE_MATRICES * 8 * n * n
 
 
@@ -180,7 +192,7 @@ def scene_estimate(scene) -> Estimate:
     cases = 2 if scene.plates and scene.output.compare_normal and runup is None else 1
     columns = 1 + cases * len(scene.output.dofs) + 8 * len(scene.plates)
     record = samples * columns * (8 * 4 + _CSV_BYTES)  # record, result, NPZ/.mat copies; CSV text
-    n_dof, model_bytes = model_estimate(scene.rotor)
+    n_dof, model_bytes = model_estimate(scene.rotor, dense=s.model == "full")
     model = ("rotor", scene.rotor_source)
     fields = {"steps": ("solver.duration", s.duration), "dofs": model,
               "memory": ("solver.record_start", s.record_start) if record >= model_bytes else model}
