@@ -86,7 +86,7 @@ def torus_to_tolerance(build: Callable[[int, int], TorusProblem], ladder, z0: np
     ladder : sequence of (int, int)
         The boxes ``(H_1, H_2)`` tried in order, at least two.
     z0 : ndarray
-        The start of the first truncation's Newton, shape (build(*ladder[0]).size,).
+        The start of the first truncation's Newton, shape ``(build(*ladder[0]).size,)``.
     tolerance : float
         The change to reach, in (0, 1).
     outputs : callable
