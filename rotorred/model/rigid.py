@@ -56,13 +56,13 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rigid : ndarray of bool, shape (n,), or (k,)
         Whether each is a rigid-body motion.
     """
+    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     if sparse.is_sparse(model.M):
-        w2, phi, largest = _lowest_of_sparse(model)
+        w2, phi, largest = _lowest_of_sparse(model, own)
     else:
         w2, phi = sla.eigh(model.K, model.M)
         largest = float(np.max(np.abs(w2)))
     limit = np.full(len(w2), NULL_RTOL * max(largest, 1e-300))
-    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     if own:
         candidates = np.flatnonzero(w2 <= RIGID_RTOL * max(own.values()))
         shares = _spool_shares(model, phi[:, candidates])  # (n_spools, candidates)
@@ -71,14 +71,14 @@ def null_space(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return w2, phi, w2 <= limit
 
 
-def _lowest_of_sparse(model) -> tuple[np.ndarray, np.ndarray, float]:
+def _lowest_of_sparse(model, own: dict[str, float]) -> tuple[np.ndarray, np.ndarray, float]:
     """The lowest eigenpairs of a sparse model, enough to hold every rigid-body motion (4 per spool and 2 per pedestal
     at most, with margin; more while the highest found is still rigid), and a bound of its largest w^2 (the largest
     ratio of K's and M's diagonal entries, Rayleigh quotients of unit vectors: at most the largest w^2, so the
-    round-off rule compares with a smaller value; it matters only for a model built by hand)."""
+    round-off rule compares with a smaller value; it matters only for a model built by hand). ``own``: each spool's
+    :func:`elastic_scale_w2` (empty for a model built by hand), computed once by :func:`null_space`."""
     K = 0.5 * (model.K + model.K.T)
     largest = float(np.max(np.abs(K.diagonal()) / np.maximum(model.M.diagonal(), 1e-300)))
-    own = elastic_scale_w2(model.rotor) if model.rotor is not None else {}
     top = max(RIGID_RTOL * max(own.values()) if own else 0.0, NULL_RTOL * largest)
     k = 4 * len(model.spools) + 2 * len(model.full_dofs.translational) + 4
     while True:
