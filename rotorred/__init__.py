@@ -138,6 +138,10 @@ _EXPORTS = {
     "floquet": "rotorred.nonlinear.stability",
     "floquet_by_monodromy": "rotorred.nonlinear.stability",
     "Floquet": "rotorred.nonlinear.stability",
+    "torus_lyapunov": "rotorred.nonlinear.torus_stability",
+    "torus_trajectory": "rotorred.nonlinear.torus_stability",
+    "LyapunovOptions": "rotorred.nonlinear.torus_stability",
+    "TorusStability": "rotorred.nonlinear.torus_stability",
     # scenes
     "load_scene": "rotorred.scenes.schema",
     "builtin_scenes": "rotorred.scenes.builtin",

@@ -230,17 +230,33 @@ def torus_trajectory(problem, z: np.ndarray, t: np.ndarray, dofs: str = "unknown
         checks.fail("dofs", dofs, "must be 'unknowns' or 'all'")
     h = problem.harmonics
     Q = h.phasors(z, problem.n) if dofs == "unknowns" else problem.recover(z)
-    return _synthesised(Q, problem.frequencies, np.atleast_1d(np.asarray(t, float)))
+    return _Series(h, Q, problem.w)(np.atleast_1d(np.asarray(t, float)))
 
 
-def _synthesised(Q: np.ndarray, wk: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``Re sum_k Q_k e^{i wk t}`` and its time derivative at the times t, a chunk of times at a time."""
-    q, v = np.empty((t.size, Q.shape[1])), np.empty((t.size, Q.shape[1]))
-    for lo in range(0, t.size, CHUNK):
-        e = np.exp(1j * np.outer(t[lo:lo + CHUNK], wk))
-        q[lo:lo + CHUNK] = (e @ Q).real
-        v[lo:lo + CHUNK] = (e @ (1j * wk[:, None] * Q)).real
-    return q, v
+class _Series:
+    """The torus's amplitudes laid out by order, ``(k_1, k_2 + H_2)``, for a sum along ``theta = w t`` that costs
+    products, not exponentials: ``sum_k Q_k e^{i k.w t} = sum_{k_1} e^{i k_1 w_1 t} (sum_{k_2} Q_{k_1 k_2}
+    e^{i k_2 w_2 t})``, the inner sums one matrix product for all ``k_1``."""
+
+    def __init__(self, harmonics, Q: np.ndarray, w):
+        H1, H2 = harmonics.H1, harmonics.H2
+        k1, k2 = harmonics.orders[:, 0], harmonics.orders[:, 1]
+        wk = harmonics.frequencies(w)[:, None]
+        self.w, self.H2 = w, H2
+        self.Q = np.zeros((2, H1 + 1, 2 * H2 + 1, Q.shape[1]), complex)  # the series of q and of dq/dt
+        self.Q[0, k1, k2 + H2], self.Q[1, k1, k2 + H2] = Q, 1j * wk * Q
+
+    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """q and dq/dt at the times t, shape (len(t), p) each."""
+        _, H1p, H2p, p = self.Q.shape
+        out = np.empty((2, t.size, p))
+        for lo in range(0, t.size, CHUNK):
+            tt = t[lo:lo + CHUNK]
+            E1 = np.exp(1j * np.outer(tt, self.w[0] * np.arange(H1p)))  # (m, H1 + 1)
+            E2 = np.exp(1j * np.outer(tt, self.w[1] * np.arange(-self.H2, self.H2 + 1)))  # (m, 2 H2 + 1)
+            inner = np.einsum("tj,sijc->stic", E2, self.Q, optimize=True)  # (2, m, H1 + 1, p)
+            out[:, lo:lo + CHUNK] = np.einsum("ti,stic->stc", E1, inner).real
+        return out[0], out[1]
 
 
 def _step(problem, options: LyapunovOptions) -> float:
@@ -293,7 +309,7 @@ def torus_lyapunov(problem, z: np.ndarray, options: LyapunovOptions = LyapunovOp
     dt = _step(problem, options)
     per_block = 2 * max(1, math.ceil(options.periods * math.pi / min(problem.w) / dt / options.blocks))  # even
     Y0 = np.linalg.qr(np.random.default_rng(options.seed).standard_normal((m, options.count)))[0]
-    torus = (A0, lower, problem.harmonics.phasors(z, problem.n), problem.frequencies,
+    torus = (A0, lower, _Series(problem.harmonics, problem.harmonics.phasors(z, problem.n), problem.w),
              local_forces(problem.forces, problem.dofs))
     T_block = per_block * dt
     means, logs, contact_steps = _integrate(problem, torus, Y0, dt, per_block, options.blocks)
@@ -309,13 +325,13 @@ def _integrate(problem, torus, Y, dt, per_block: int, blocks: int):
     """Carry the perturbations ``Y`` through ``blocks`` blocks of ``per_block`` steps of ``dt`` (s), a QR after each
     product (a step, or a stretch of steps without a force derivative: :func:`_products`). Returns the time average over each block of the summed logarithms of R's diagonal, their growth in each
     block, shape (blocks, p) each, and the count of steps with a force derivative."""
-    A0, lower, Q, wk, forces = torus
+    A0, lower, series, forces = torus
     p = Y.shape[1]
     S, means, logs, contact_steps = np.zeros(p), np.zeros((blocks, p)), np.zeros((blocks, p)), 0
     free, n_steps = {}, per_block * blocks
     longest = max(1, int(2 * math.pi / (SAMPLES * max(problem.w) * dt)))
     for lo in range(0, n_steps, CHUNK):
-        products, active = _products(problem, A0, lower, (Q, wk, forces), dt,
+        products, active = _products(problem, A0, lower, (series, forces), dt,
                                      (lo, min(n_steps, lo + CHUNK), per_block), longest, free)
         contact_steps += active
         for block, Phi, steps in products:
@@ -333,9 +349,9 @@ def _products(problem, A0, lower, torus, dt, steps, longest: int, free):
     (batched), and one exponential of the linear state matrix for each stretch of steps without (cached by its length
     in ``free``), a stretch cut at the blocks' ends and after ``longest`` steps. Returns the list of
     ``(block, Phi, steps)`` and the count of steps with a derivative."""
-    (Q, wk, forces), (lo, hi, per_block) = torus, steps
+    (series, forces), (lo, hi, per_block) = torus, steps
     n, c = problem.M.shape[0], list(problem.dofs)
-    q, v = _synthesised(Q, wk, (np.arange(lo, hi) + 0.5) * dt)
+    q, v = series((np.arange(lo, hi) + 0.5) * dt)
     _, dq, dv = sampled_forces(forces, q, v)
     k = hi - lo
     active = np.any(dq.reshape(k, -1) != 0.0, axis=1) | np.any(dv.reshape(k, -1) != 0.0, axis=1)
