@@ -18,15 +18,15 @@ exponential (second order in ``dt``, as :func:`rotorred.nonlinear.stability.floq
 period); a stretch of steps where every derivative vanishes (out of contact) is one exponential of the linear state
 matrix. ``p`` perturbations (the columns of an orthonormal ``Y``, started at random with a fixed seed) are carried
 step by step and re-orthonormalised by a QR factorisation after every product (Benettin et al. 1980): the logarithms
-of R's diagonal, summed over a block of time and divided by it, are the block's exponents. The first block, where
+of R's diagonal, summed over a block of time and divided by it, are the block's exponents (a stretch without force
+derivatives is at most 1/32 of the faster base's period, so that S below is sampled finely). The first block, where
 the columns turn into the leading directions, is discarded. The summed logarithms S(t) grow as the exponents times t
 plus a bounded quasi-periodic wobble; S averaged over each block (the wobble mostly averaged out) is fitted by a
 line against the blocks' centres, and the slope is the exponent. Its error is the range of the fit's residuals over
 the centres' span (the steepest slope what the line leaves could fake) plus the change of the exponent when the
 whole integration is repeated at ``2 dt`` (the step's error, for any order >= 1: second order where the derivatives
-are smooth, first at a contact's crossings). The torus is
-called stable when the largest exponent is below ``-margin`` times its error, unstable when above ``+margin``
-times it, and undecided between.
+are smooth, first at a contact's crossings). The torus is called stable when the largest exponent is below
+``-margin`` times its error, unstable when above ``+margin`` times it, and undecided between.
 
 **A piecewise-smooth force** (the rig's plate law, docs/model.md §4): the derivatives are the solver's own
 (``force.evaluate``, the law's analytic tangent, zero out of contact). The plate's force is continuous across the
@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from rotorred import checks
+from rotorred import checks, progress as feedback
 from rotorred.nonlinear.hb import local_forces, sampled_forces
 from rotorred.results import Result
 
@@ -82,6 +82,8 @@ class LyapunovOptions:
         Errors by which the largest exponent must clear zero for a verdict, > 0.
     seed : int
         Seed of the random start of the perturbations.
+    progress : bool, optional
+        A progress bar of the steps (:func:`rotorred.progress.bar`: None, on a terminal when shown).
     """
 
     count: int = 2
@@ -91,6 +93,7 @@ class LyapunovOptions:
     blocks: int = 8
     margin: float = 3.0
     seed: int = 0
+    progress: bool | None = None
 
     def __post_init__(self):
         checks.integer("options.count", self.count, ge=1)
@@ -167,7 +170,7 @@ class TorusStability(Result):
                 f"forces' derivatives), {len(self.block_times)} blocks; {self.elapsed:.3g} s"]
 
     def plot(self, ax=None, *, title: str | None = None):
-        """Each block's exponents against the block's end time (1/s), the mean and zero dashed.
+        """Each block's exponents against the block's end time (1/s), the fitted exponents dashed, zero solid.
 
         Parameters
         ----------
@@ -312,19 +315,23 @@ def torus_lyapunov(problem, z: np.ndarray, options: LyapunovOptions = LyapunovOp
     torus = (A0, lower, _Series(problem.harmonics, problem.harmonics.phasors(z, problem.n), problem.w),
              local_forces(problem.forces, problem.dofs))
     T_block = per_block * dt
-    means, logs, contact_steps = _integrate(problem, torus, Y0, dt, per_block, options.blocks)
-    exponents, bound = _slope(means, T_block)
-    coarse = _slope(_integrate(problem, torus, Y0, 2 * dt, per_block // 2, options.blocks)[0], T_block)[0]
+    with feedback.bar(1.5 * per_block * options.blocks, "torus stability", "step", progress=options.progress,
+                      delay=1.0) as bar:
+        means, logs, contact_steps = _integrate(problem, torus, Y0, dt, (per_block, options.blocks), bar)
+        exponents, bound = _slope(means, T_block)
+        coarse = _slope(_integrate(problem, torus, Y0, 2 * dt, (per_block // 2, options.blocks), bar)[0], T_block)[0]
     errors = bound + np.abs(exponents - coarse)
     return TorusStability(exponents, errors, logs / T_block, T_block * np.arange(1, options.blocks + 1),
                           _verdict(exponents[0], errors[0], options.margin), options.margin, dt,
                           per_block * options.blocks, contact_steps, time.perf_counter() - started)
 
 
-def _integrate(problem, torus, Y, dt, per_block: int, blocks: int):
-    """Carry the perturbations ``Y`` through ``blocks`` blocks of ``per_block`` steps of ``dt`` (s), a QR after each
-    product (a step, or a stretch of steps without a force derivative: :func:`_products`). Returns the time average over each block of the summed logarithms of R's diagonal, their growth in each
-    block, shape (blocks, p) each, and the count of steps with a force derivative."""
+def _integrate(problem, torus, Y, dt, layout: tuple[int, int], bar):
+    """Carry the perturbations ``Y`` through ``blocks`` blocks of ``per_block`` steps (``layout``) of ``dt`` (s), a
+    QR after each product (a step, or a stretch of steps without a force derivative: :func:`_products`), the steps
+    counted on ``bar``. Returns the time average over each block of the summed logarithms of R's diagonal, their
+    growth in each block, shape (blocks, p) each, and the count of steps with a force derivative."""
+    per_block, blocks = layout
     A0, lower, series, forces = torus
     p = Y.shape[1]
     S, means, logs, contact_steps = np.zeros(p), np.zeros((blocks, p)), np.zeros((blocks, p)), 0
@@ -340,6 +347,7 @@ def _integrate(problem, torus, Y, dt, per_block: int, blocks: int):
             means[block] += (S + 0.5 * growth) * (steps / per_block)
             S += growth
             logs[block] += growth
+        bar.update(min(n_steps, lo + CHUNK) - lo)
     return means, logs, contact_steps
 
 
