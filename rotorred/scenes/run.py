@@ -661,18 +661,30 @@ def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None
     if scene.is_linear and (scene.solver.start == "settled" or balance) and initial is None:
         return _harmonic_response(scene, model.model)
     if balance:
-        return _balance_response(scene, model.model)
+        return _balance_response(scene, model.model) if _periodic(scene) else _torus_response(scene, model.model)
     f_L, f_H = spool_frequencies(scene)
     return _transient_response(scene, model, progress, f_L, f_H, initial)
 
 
 def _harmonic_response(scene: Scene, model) -> Response:
     """The settled linear response at the record times (no time stepping)."""
+    t = _record_times(scene)
+    stage("solving %s: the settled harmonic response at %d record times", scene.name, len(t), logger=LOG)
+    return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+
+
+def _record_times(scene: Scene) -> np.ndarray:
+    """The record times ``record_start .. duration`` at the scene's step (s)."""
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
-    t = s.record_start + s.dt * np.arange(n + 1)
-    stage("solving %s: the settled harmonic response at %d record times", scene.name, n + 1, logger=LOG)
-    return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+    return s.record_start + s.dt * np.arange(n + 1)
+
+
+def _periodic(scene: Scene) -> bool:
+    """Whether the scene's speeds have a periodic response (:func:`rotorred.scenes.harmonic_balance.common_frequency`)."""
+    from rotorred.scenes.harmonic_balance import common_frequency
+
+    return common_frequency(tuple(scene.frequencies_hz.values())) is not None
 
 
 def _balance_response(scene: Scene, model) -> Response:
@@ -682,9 +694,7 @@ def _balance_response(scene: Scene, model) -> Response:
     ``solver.tolerance``."""
     from rotorred.scenes.balance_harmonics import LADDER_START, balance_to_tolerance, cold_solution
 
-    s = scene.solver
-    n = int(round((s.duration - s.record_start) / s.dt))
-    t = s.record_start + s.dt * np.arange(n + 1)
+    s, t = scene.solver, _record_times(scene)
     stage("solving %s by harmonic balance: a short transient to start from, then Newton", scene.name, logger=LOG)
     record = start_record(scene, model)
     if s.tolerance is not None:
@@ -696,6 +706,20 @@ def _balance_response(scene: Scene, model) -> Response:
     counters = {"f0": rp.f0, "harmonics": rp.problem.harmonics.H, "samples": rp.problem.harmonics.N,
                 "choice": choice, "start": start}
     return Response(t, outputs, contacts, "harmonic-balance", 0, counters)
+
+
+def _torus_response(scene: Scene, model) -> Response:
+    """The quasi-periodic rub response by harmonic balance on a torus (``solver.method = "harmonic-balance"`` at
+    incommensurate speeds, :mod:`rotorred.scenes.torus_response`) at the record times, as a transient's record; the
+    torus (:class:`rotorred.scenes.quasi_periodic.RubTorus`) is the counters' ``"torus"``."""
+    from rotorred.scenes.torus_response import solve_scene_torus, torus_record
+
+    t = _record_times(scene)
+    stage("solving %s by harmonic balance on a torus (the speeds share no period of at most 10 s): a short transient "
+          "to find its bases and start from, then Newton-Krylov", scene.name, logger=LOG)
+    torus = solve_scene_torus(scene, model)
+    outputs, contacts = torus_record(torus, t, scene.output.dofs)
+    return Response(t, outputs, contacts, "harmonic-balance", 0, {"torus": torus})
 
 
 #: periods of the base frequency f0 of the transient a scene's harmonic balance starts from (docs/model.md §15)

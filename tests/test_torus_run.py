@@ -1,0 +1,108 @@
+"""``rotorred run SCENE --set solver.method=harmonic-balance`` at an incommensurate speed ratio solves the torus
+(:mod:`rotorred.scenes.torus_response`): the command and the Python ``torus_balance`` give one answer, the summary
+names the torus and its truncation, a commensurate ratio still goes the periodic way, a box too small for the
+spools' orders is refused in the scene's key names.
+
+paper-rub at outer 91.37 Hz (inner 70 Hz): the impacts lock to f_H/3, the torus is (f_L, f_H/3); a small box
+(|k1| <= 4, |k2| <= 20) keeps each run near a second.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import rotorred as rr
+from rotorred.cli import main
+from rotorred.scenes.torus_response import torus_record
+
+OUTER = "speeds.outer=91.37"
+SMALL = ["--set", "solver.harmonics=[4,20]"]
+TORUS = ["--set", "solver.method=harmonic-balance", "--set", OUTER] + SMALL
+#: the summary's torus lines are printed to 6 significant digits
+PRINTED = 1e-5
+
+
+@pytest.fixture(scope="module")
+def command(tmp_path_factory):
+    """The command at 91.37 Hz with a small box, no figures: its exit status and summary."""
+    out = tmp_path_factory.mktemp("torus") / "o"
+    status = main(["run", "paper-rub", *TORUS, "--set", "output.plots=[]", "--no-html", "--no-normal", "--out",
+                       str(out), "-q"])
+    return status, (out / "summary.txt").read_text(encoding="utf-8") if status == 0 else ""
+
+
+@pytest.fixture(scope="module")
+def python_torus():
+    """The same scene's torus from Python: ``torus_balance`` on the scene's model, loads, plates and settings."""
+    scene = rr.load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = rr.build_model(scene).model
+    options = rr.TorusOptions(orders=(4, 20), dt=scene.solver.dt, outputs=scene.output.dofs)
+    return rr.torus_balance(model, scene.operating, rr.Loads(scene.unbalances), scene.plates, options)
+
+
+def test_the_command_solves_the_torus_and_names_it(command):
+    status, summary = command
+    assert status == 0
+    assert "harmonic balance on a torus (f_L = 70 Hz, f_H/3 = 30.4567 Hz; spool orders inner (1, 0), outer (0, 3))" \
+        in summary
+    assert "orders |k1| <= 4 x |k2| <= 20 (185 orders in the band <= 1500 Hz), grid 16 x 256, 1476 unknowns" in summary
+    assert re.search(r"\d+ Newton iterations \(\d+ GMRES\), relative residual [0-9.e-]+", summary)
+    assert "Torus lines of node 14 Y" in summary
+
+
+def _printed_lines(summary: str) -> dict:
+    """The summary's torus lines of node 14 Y: {(k1, k2): amplitude (m)}."""
+    block = summary.split("Torus lines of node 14 Y")[1].split("\n\n")[0]
+    rows = re.findall(r"^\s*[0-9.e+-]+\s*\|\s*\((-?\d+), (-?\d+)\)\s*\|[^|]*\|\s*([0-9.e+-]+)\s*$", block, re.M)
+    return {(int(k1), int(k2)): 1e-6 * float(a) for k1, k2, a in rows}
+
+
+def test_the_command_and_torus_balance_give_one_answer(command, python_torus):
+    """The node 14 Y lines the command prints are those of the Python call on the same scene (measured: equal to
+    the printed 6 digits)."""
+    printed = _printed_lines(command[1])
+    assert len(printed) == 10
+    j = python_torus.outputs.index((14, "y"))
+    for order, amplitude in printed.items():
+        k = next(i for i, o in enumerate(python_torus.orders) if tuple(o) == order)
+        assert amplitude == pytest.approx(python_torus.amplitudes[k, j], rel=PRINTED)
+    largest = np.sort(python_torus.amplitudes[:, j])[::-1][:10]
+    assert sorted(printed.values(), reverse=True) == pytest.approx(largest, rel=PRINTED)
+
+
+def test_the_record_is_the_torus_series(python_torus):
+    """At t = 0 (the grid's first point, both angles 0) the record is the inverse 2-D FFT's sample of the torus, an
+    independent synthesis of the same series (the rub disk's x and y, the plate's u_n, u_t)."""
+    rp = python_torus.problem
+    h, n = rp.problem.harmonics, len(rp.problem.dofs)
+    grid = h.samples(python_torus.solution.z, n)[0]
+    outputs, contacts = torus_record(python_torus, np.array([0.0, 0.5]), [(18, "x"), (18, "y")])
+    assert outputs[(18, "x")][0] == pytest.approx(grid[0], rel=1e-12, abs=1e-15)
+    assert outputs[(18, "y")][0] == pytest.approx(grid[1], rel=1e-12, abs=1e-15)
+    assert contacts[0].u_n[0] == pytest.approx(grid[2], rel=1e-12, abs=1e-15)
+    assert contacts[0].u_t[0] == pytest.approx(grid[3], rel=1e-12, abs=1e-15)
+
+
+def test_a_commensurate_ratio_goes_the_periodic_way():
+    scene = rr.load_scene("paper-rub", {"solver.method": "harmonic-balance", "solver.harmonics": 30,
+                                        "solver.samples": 128})
+    result = rr.run_scene(scene, compare_normal=False, analyse=False)
+    assert "torus" not in result.counters and result.counters["f0"] == 10.0
+    assert result.method == "harmonic-balance"
+
+
+def test_a_box_without_the_spools_orders_is_refused(tmp_path, capsys):
+    """The torus found (f_L, f_H/3) has the outer spool at order (0, 3): a box |k2| <= 2 cannot hold it; refused after
+    the start's transient (the bases are found there) as solver.harmonics, exit 2, one line, nothing written."""
+    out = tmp_path / "o"
+    argv = ["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", OUTER, "--set",
+            "solver.harmonics=[4,2]", "--set", "output.plots=[]", "--no-html", "--no-normal", "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("rotorred run: error: ") and "Traceback" not in err
+    for token in ("solver.harmonics = [4, 2]", "must hold each spool's order", "30.4567", "91.37"):
+        assert token in err, (token, err)
+    assert not out.exists() or not any(out.iterdir())
