@@ -46,16 +46,15 @@ import numpy as np
 from rotorred.model.assembly import assemble
 from rotorred.progress import stage
 from rotorred.results import Result
-from rotorred.linear.harmonic import SteadyState, steady_state
-from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
+from rotorred.scenes.settled import settled_response, settled_state
 from rotorred.signals.classify import Classification, classify
 from rotorred.signals.linefit import FitOptions, LineFit, fit_lines, fit_peaks
 from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
 __all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "fit_and_settling", "Response", "respond",
-           "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
+           "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene",
            "harmonic_outputs", "spool_frequencies"]
 
 LOG = logging.getLogger(__name__)
@@ -251,6 +250,10 @@ class SceneResult(Result):
                  shorten(f"{self.method} response at f_L = {self.f_L:.6g} Hz, f_H = {self.f_H:.6g} Hz; {span}; "
                          f"{self.n_steps} steps"),
                  self.model_label.split(" (")[0]]  # its boundary nodes are a list
+        if "torus" in self.counters:
+            from rotorred.scenes.torus_response import describe_torus
+
+            lines += [shorten(f"on a {text}") for text in describe_torus(self.counters["torus"], self.f_L, self.f_H)]
         if self.incomplete:
             lines.append(shorten(f"INCOMPLETE: {self.incomplete}"))
         if d in self.lines:
@@ -459,58 +462,6 @@ def _reduced_label(scene: Scene, model, extra: tuple, how: str, system) -> str:
 
 
 # --------------------------------------------------------------------------- harmonic solution
-def scene_steady_state(scene: Scene, model) -> SteadyState | None:
-    """Linear steady state of the scene's unbalances, per spool (None without unbalances)."""
-    if not scene.unbalances:
-        return None
-    return steady_state(model, scene.operating, scene.unbalances)
-
-
-def _static_deflection(scene: Scene, model) -> np.ndarray | None:
-    """Gravity's static deflection in model coordinates (None without gravity)."""
-    if not scene.solver.gravity:
-        return None
-    return np.linalg.solve(model.stiffness(scene.speeds), gravity_force(model, scene.solver.gravity))
-
-
-def settled_state(scene: Scene, model) -> tuple[np.ndarray, np.ndarray]:
-    """Linear steady state at t = 0: (q0, v0) in model coordinates.
-
-    Sum of the per-spool unbalance phasors (``K - Omega^2 M + i Omega (C + sum Omega_s G_s)``
-    solved per spool) and gravity's static deflection.
-    """
-    q0 = np.zeros(model.M.shape[0])
-    v0 = np.zeros_like(q0)
-    steady = scene_steady_state(scene, model)
-    if steady is not None:
-        q0 += steady.displacement(0.0)
-        v0 += steady.velocity(0.0)
-    static = _static_deflection(scene, model)
-    if static is not None:
-        q0 += static
-    return q0, v0
-
-
-def settled_response(scene: Scene, model, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Settled linear response ``rows @ q(t)`` (unbalances and gravity), shape (len(rows), len(t)).
-
-    Parameters
-    ----------
-    rows : ndarray, shape (k, n)
-        Output rows in model coordinates (``model.output_rows(...)``).
-    t : ndarray, shape (m,)
-        Times (s).
-    """
-    y = np.zeros((rows.shape[0], len(t)))
-    steady = scene_steady_state(scene, model)
-    for s, P in (steady.phasors.items() if steady is not None else ()):
-        y += np.real((rows @ P)[:, None] * np.exp(1j * steady.speeds[s] * t)[None, :])
-    static = _static_deflection(scene, model)
-    if static is not None:
-        y += (rows @ static)[:, None]
-    return y
-
-
 def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
     """Settled linear response of the recorded DOFs at times ``t`` (s): {(node, dir): ndarray}."""
     dofs = scene.output.dofs

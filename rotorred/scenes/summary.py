@@ -129,18 +129,13 @@ def _setup(result: SceneResult) -> str:
 def torus_setup(result: SceneResult) -> list[str]:
     """The lines of a torus's response (a harmonic balance at incommensurate speeds): its bases named in the spools'
     frequencies, its truncation (orders, grid, unknowns), Newton's convergence, what a tolerance chose, the record."""
-    from rotorred.scenes.torus_response import base_labels
+    from rotorred.scenes.torus_response import describe_torus
 
     s, torus = result.scene.solver, result.counters["torus"]
-    h, sol = torus.problem.problem.harmonics, torus.solution
-    names = base_labels(torus, result.f_L, result.f_H)
-    bases = ", ".join(f"{name} = {f:.6g} Hz" for name, f in zip(names, torus.bases_hz))
-    band = f" in the band <= {h.w_max / (2 * math.pi):g} Hz" if h.w_max is not None else ""
-    lines = [f"response: harmonic balance on a torus ({bases}; spool orders "
-             + ", ".join(f"{sp} {tuple(k)}" for sp, k in torus.problem.spool_orders.items()) + "): the speeds share "
-             "no period of at most 10 s",
-             f"truncation: orders |k1| <= {h.H1} x |k2| <= {h.H2} ({h.n_orders} orders{band}), grid {h.N1} x {h.N2}, "
-             f"{sol.z.size} unknowns (the Fourier coefficients of {len(sol.dofs)} rub DOFs)"]
+    sol = torus.solution
+    shape, truncation = describe_torus(torus, result.f_L, result.f_H)
+    lines = [f"response: harmonic balance on a {shape}: the speeds share no period of at most 10 s",
+             f"truncation: {truncation}"]
     if torus.truncation is not None:
         lines.append(torus.truncation.describe())
     lines.append(f"{sol.iterations} Newton iterations ({sum(sol.krylov)} GMRES), relative residual "

@@ -29,7 +29,8 @@ from rotorred.checks import InputError
 from rotorred.scenes.harmonic_balance import contact_history
 from rotorred.signals.lines import line_label
 
-__all__ = ["torus_options", "solve_scene_torus", "torus_record", "spool_bases", "base_labels", "order_label"]
+__all__ = ["torus_options", "solve_scene_torus", "torus_record", "spool_bases", "base_labels", "order_label",
+           "describe_torus"]
 
 #: record times synthesised at once (the (times x orders) phases of a block: 8 MB a 512 orders)
 BLOCK = 1024
@@ -163,3 +164,15 @@ def order_label(order, bases: tuple) -> str:
     if None in bases:
         return f"{k1} f_1 {'-' if k2 < 0 else '+'} {abs(k2)} f_2"
     return line_label(k1 * bases[0][0] + k2 * bases[1][0], k1 * bases[0][1] + k2 * bases[1][1])
+
+
+def describe_torus(torus, f_L: float, f_H: float) -> tuple[str, str]:
+    """Two phrases: the torus (its bases named in the spools' frequencies and the spools' orders) and its truncation
+    (orders, band, grid, unknowns)."""
+    h, z = torus.problem.problem.harmonics, torus.solution.z
+    bases = ", ".join(f"{name} = {f:.6g} Hz" for name, f in zip(base_labels(torus, f_L, f_H), torus.bases_hz))
+    band = f" in the band <= {h.w_max / (2 * np.pi):g} Hz" if h.w_max is not None else ""
+    return (f"torus ({bases}; spool orders "
+            + ", ".join(f"{sp} {tuple(k)}" for sp, k in torus.problem.spool_orders.items()) + ")",
+            f"orders |k1| <= {h.H1} x |k2| <= {h.H2} ({h.n_orders} orders{band}), grid {h.N1} x {h.N2}, {z.size} "
+            f"unknowns (the Fourier coefficients of {len(torus.solution.dofs)} rub DOFs)")
