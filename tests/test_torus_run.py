@@ -27,11 +27,11 @@ PRINTED = 1e-5
 
 @pytest.fixture(scope="module")
 def command(tmp_path_factory):
-    """The command at 91.37 Hz with a small box, no figures: its exit status and summary."""
+    """The command at 91.37 Hz with a small box, no figures: its exit status, summary and folder."""
     out = tmp_path_factory.mktemp("torus") / "o"
     status = main(["run", "paper-rub", *TORUS, "--set", "output.plots=[]", "--no-html", "--no-normal", "--out",
                        str(out), "-q"])
-    return status, (out / "summary.txt").read_text(encoding="utf-8") if status == 0 else ""
+    return status, (out / "summary.txt").read_text(encoding="utf-8") if status == 0 else "", out
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +44,7 @@ def python_torus():
 
 
 def test_the_command_solves_the_torus_and_names_it(command):
-    status, summary = command
+    status, summary, _ = command
     assert status == 0
     assert "harmonic balance on a torus (f_L = 70 Hz, f_H/3 = 30.4567 Hz; spool orders inner (1, 0), outer (0, 3))" \
         in summary
@@ -71,6 +71,33 @@ def test_the_command_and_torus_balance_give_one_answer(command, python_torus):
         assert amplitude == pytest.approx(python_torus.amplitudes[k, j], rel=PRINTED)
     largest = np.sort(python_torus.amplitudes[:, j])[::-1][:10]
     assert sorted(printed.values(), reverse=True) == pytest.approx(largest, rel=PRINTED)
+
+
+def _torus_csv(out) -> dict:
+    """``torus.csv``: {(k1, k2): row} with the row's columns by name."""
+    import csv
+
+    with open(out / "torus.csv", encoding="utf-8") as f:
+        return {(int(r["k1"]), int(r["k2"])): r for r in csv.DictReader(f)}
+
+
+def test_the_command_writes_every_line_of_the_torus(command, python_torus):
+    """``torus.csv`` holds every order's line at full precision: node 14 Y's amplitudes are the Python call's
+    (measured: within 2.2e-16 relative), and its phases put together the record (the series at t = 2.1 s: measured
+    3.2e-14 of the sum of the amplitudes)."""
+    rows = _torus_csv(command[2])
+    assert len(rows) == 185
+    j = python_torus.outputs.index((14, "y"))
+    for k, order in enumerate(python_torus.orders):
+        row = rows[tuple(int(v) for v in order)]
+        assert 1e-6 * float(row["node 14 y amplitude (um)"]) == pytest.approx(python_torus.amplitudes[k, j],
+                                                                              rel=1e-14, abs=1e-20)
+    t = 2.1
+    series = sum(1e-6 * float(r["node 14 y amplitude (um)"]) * np.cos(2 * np.pi * float(r["frequency (Hz)"]) * t
+                                                                      + float(r["node 14 y phase (rad)"]))
+                 for r in rows.values())
+    record, _ = torus_record(python_torus, np.array([t]), [(14, "y")])
+    assert series == pytest.approx(record[(14, "y")][0], abs=1e-12 * python_torus.amplitudes[:, j].sum())
 
 
 def test_the_record_is_the_torus_series(python_torus):
@@ -105,4 +132,18 @@ def test_a_box_without_the_spools_orders_is_refused(tmp_path, capsys):
     assert err.startswith("rotorred run: error: ") and "Traceback" not in err
     for token in ("solver.harmonics = [4, 2]", "must hold each spool's order", "30.4567", "91.37"):
         assert token in err, (token, err)
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_nearly_commensurate_speeds_are_refused(tmp_path, capsys):
+    """Outer 105.001 Hz against 70 Hz (3/2 within 1e-5) shares no period of at most 10 s, but the torus's lines are
+    closer than the start's 1 s record resolves: refused as speeds, exit 2, one line saying what to do instead."""
+    out = tmp_path / "o"
+    argv = ["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", "speeds.outer=105.001", *SMALL,
+            "--set", "output.plots=[]", "--no-html", "--no-normal", "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("rotorred run: error: speeds = {'inner': 70.0, 'outer': 105.001}: must give a torus whose "
+                          "lines a 1 s record resolves"), err
+    assert "share a period of at most 10 s" in err and 'solver.method = "newmark"' in err
     assert not out.exists() or not any(out.iterdir())

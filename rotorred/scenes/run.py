@@ -134,7 +134,8 @@ class SceneResult(Result):
     normal : SceneResult or None
         The same scene without rub plates, when ``output.compare_normal``.
     counters : dict
-        Integrator counters (Newton iterations, contact steps, µs per step).
+        Integrator counters (Newton iterations, contact steps, µs per step); a harmonic balance's truncation and
+        start, or at incommensurate speeds its torus (``"torus"``: :class:`rotorred.scenes.quasi_periodic.RubTorus`).
     incomplete : str or None
         Why the record stops early (a diverged transient, :class:`SceneDiverged`); None when complete.
         An incomplete result has no spectra, lines or normal comparison.
@@ -589,6 +590,7 @@ class Response:
     method : {"harmonic", "transient", "harmonic-balance"}
     n_steps : int
     counters : dict
+        As :attr:`SceneResult.counters`.
     final : FinalState or None
         End state of a transient (None for the harmonic solution).
     """
@@ -603,7 +605,8 @@ class Response:
 
 
 def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None = False) -> Response:
-    """The response in the recorded window: harmonic for a linear scene started settled, else stepped in time.
+    """The response in the recorded window: harmonic for a linear scene started settled, by harmonic balance (periodic,
+    or on a torus at incommensurate speeds) with ``solver.method = "harmonic-balance"``, else stepped in time.
 
     ``initial`` (a FinalState) continues another run (:func:`run_scene`). Raises
     :class:`SceneDiverged`, carrying the partial result, when the transient diverges.

@@ -49,7 +49,8 @@ def torus_options(scene):
 def solve_scene_torus(scene, model):
     """The torus of ``scene`` on its (reduced) ``model`` (:func:`rotorred.scenes.quasi_periodic.torus_balance`), a
     refusal in the scene's key names: no torus found in the start's transient (``speeds``), a box too small for the
-    spools' orders on the bases found (``solver.harmonics``).
+    spools' orders on the bases found (``solver.harmonics``), a torus whose lines the start's record cannot resolve
+    (``speeds``, nearly commensurate).
 
     Parameters
     ----------
@@ -69,15 +70,25 @@ def solve_scene_torus(scene, model):
     try:
         return torus_balance(model, scene.operating, Loads(scene.unbalances), scene.plates, options)
     except InputError as exc:
-        if exc.field != "options.bases":
-            raise
-        if "truncated set" in exc.requirement:  # the spools' orders on the bases found lie outside the box
+        frequencies = {name: round(f, 9) for name, f in scene.frequencies_hz.items()}
+        if exc.field == "options.bases" and "truncated set" in exc.requirement:  # the spools' orders outside the box
             checks.fail("solver.harmonics", list(options.orders), f"must hold each spool's order on the torus found "
                         f"(bases {_hz(exc.value)} Hz): {exc.requirement.removeprefix('must hold ')}")
-        frequencies = {name: round(f, 9) for name, f in scene.frequencies_hz.items()}
-        checks.fail("speeds", frequencies, "must have a quasi-periodic rub response for a harmonic balance on a torus "
-                    f"(the speeds share no period of at most 10 s), but {exc.requirement.removeprefix('must be given: ')}; "
-                    'run a transient (solver.method = "newmark") there', "Hz")
+        if exc.field == "options.bases":  # the start's line fit found no torus of two incommensurate bases
+            checks.fail("speeds", frequencies, "must have a quasi-periodic rub response for a harmonic balance on a "
+                        "torus (the speeds share no period of at most 10 s), but "
+                        f"{exc.requirement.removeprefix('must be given: ')}; {ADVICE}", "Hz")
+        if exc.field == "options.start_orders":  # the torus's lines closer than the start's record resolves
+            window = options.start_window[1] - options.start_window[0]
+            checks.fail("speeds", frequencies, f"must give a torus whose lines a {window:g} s record resolves (the "
+                        f"start's transient; {exc.requirement.split(': ', 1)[-1]}): nearly commensurate speeds; "
+                        f"{ADVICE}", "Hz")
+        raise
+
+
+#: what a scene whose speeds have no torus the start finds can do instead
+ADVICE = ('make the speeds share a period of at most 10 s (a periodic harmonic balance) or run a transient '
+          '(solver.method = "newmark")')
 
 
 def _hz(bases) -> str:
