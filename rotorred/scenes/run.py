@@ -254,7 +254,8 @@ class SceneResult(Result):
         if "torus" in self.counters:
             from rotorred.scenes.torus_response import describe_torus
 
-            lines += [shorten(f"on a {text}") for text in describe_torus(self.counters["torus"], self.f_L, self.f_H)]
+            shape, truncation = describe_torus(self.counters["torus"], self.f_L, self.f_H)
+            lines += [shorten(f"on a {shape}"), shorten(truncation)]
         if self.incomplete:
             lines.append(shorten(f"INCOMPLETE: {self.incomplete}"))
         if d in self.lines:
