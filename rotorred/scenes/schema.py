@@ -723,7 +723,7 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = Solve
         if method not in ("newmark", "harmonic-balance"):
             fail("solver.tolerance", tolerance, f'must go with solver.method = "newmark" (its error estimates are '
                  f'the average-acceleration step\'s) or "harmonic-balance" (it chooses the harmonics), not {method!r}')
-    harmonics, samples = _solver_balance(table, method, _periodic(speeds))
+    harmonics, samples = _solver_balance(table, method, speeds)
     return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
                       record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity,
                       tolerance=tolerance, harmonics=harmonics, samples=samples)
@@ -737,9 +737,9 @@ def _periodic(speeds: dict) -> bool:
     return common_frequency(tuple(w / (2 * math.pi) for w in speeds.values())) is not None
 
 
-def _solver_balance(table: dict, method: str, periodic: bool) -> tuple:
+def _solver_balance(table: dict, method: str, speeds: dict) -> tuple:
     """``solver.harmonics`` and ``solver.samples``: only with method "harmonic-balance" (then their defaults), a pair
-    each (the torus's orders and grid) at incommensurate speeds (``periodic`` False)."""
+    each (the torus's orders and grid) at incommensurate ``speeds`` (rad/s)."""
     if method != "harmonic-balance":
         for key in ("harmonics", "samples"):
             if key in table:
@@ -751,7 +751,7 @@ def _solver_balance(table: dict, method: str, periodic: bool) -> tuple:
                 fail(f"solver.{key}", table[key], "must not be given with solver.tolerance (the tolerance chooses "
                      "the harmonics and samples); give one or the other")
         return None, None
-    if not periodic:
+    if not _periodic(speeds):
         return _torus_truncation(table)
     H = table.get("harmonics", BALANCE_DEFAULTS[0])
     if isinstance(H, (list, tuple)):
