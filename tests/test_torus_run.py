@@ -84,7 +84,7 @@ def _torus_csv(out) -> dict:
 def test_the_command_writes_every_line_of_the_torus(command, python_torus):
     """``torus.csv`` holds every order's line at full precision: node 14 Y's amplitudes are the Python call's
     (measured: within 2.2e-16 relative), and its phases put together the record (the series at t = 2.1 s: measured
-    3.2e-14 of the sum of the amplitudes)."""
+    5.8e-14 of the sum of the amplitudes)."""
     rows = _torus_csv(command[2])
     assert len(rows) == 185
     j = python_torus.outputs.index((14, "y"))

@@ -101,7 +101,7 @@ def torus_record(torus, t: np.ndarray, dofs) -> tuple[dict, tuple]:
     (:func:`rotorred.scenes.harmonic_balance.contact_history`).
 
     The series ``Re sum_k Q_k exp(i (k_1 w_1 + k_2 w_2) t)`` (phase origin t = 0, as the unbalance's) is summed in
-    blocks of :data:`BLOCK` times, its phases the products of each base's powers.
+    blocks of :data:`BLOCK` times (:func:`_synthesised`).
 
     Parameters
     ----------
@@ -132,14 +132,18 @@ def torus_record(torus, t: np.ndarray, dofs) -> tuple[dict, tuple]:
 
 
 def _synthesised(Q: np.ndarray, orders: np.ndarray, w, t: np.ndarray) -> np.ndarray:
-    """``Re sum_k Q_k exp(i (k . w) t)`` at the times ``t``, shape (n, p), for the amplitudes ``Q`` (K, p)."""
-    k1, k2 = orders[:, 0], orders[:, 1]
-    out = np.empty((len(t), Q.shape[1]))
+    """``Re sum_k Q_k exp(i (k . w) t)`` at the times ``t``, shape (n, p), for the amplitudes ``Q`` (K, p): by blocks of
+    :data:`BLOCK` times, ``exp(i (k . w) t) = exp(i (k . w) t_b) exp(i (k . w) (t - t_b))`` with ``t_b`` the block's
+    first time, the second factor's table computed once for times at a constant step (a record's)."""
+    wk = orders @ np.asarray(w, float)
+    step = np.diff(t)
+    uniform = len(t) > 1 and np.ptp(step) <= 1e-9 * abs(step[0])
+    out, table = np.empty((len(t), Q.shape[1])), None
     for start in range(0, len(t), BLOCK):
-        tb = t[start:start + BLOCK, None]
-        e1 = np.exp(1j * w[0] * tb * np.arange(k1.min(), k1.max() + 1))
-        e2 = np.exp(1j * w[1] * tb * np.arange(k2.min(), k2.max() + 1))
-        out[start:start + BLOCK] = ((e1[:, k1 - k1.min()] * e2[:, k2 - k2.min()]) @ Q).real
+        tb = t[start:start + BLOCK]
+        if table is None or not uniform:
+            table = np.exp(1j * np.outer(tb - tb[0], wk))
+        out[start:start + len(tb)] = (table[:len(tb)] @ (Q * np.exp(1j * wk * tb[0])[:, None])).real
     return out
 
 
