@@ -147,3 +147,14 @@ def test_nearly_commensurate_speeds_are_refused(tmp_path, capsys):
                           "lines a 1 s record resolves"), err
     assert "share a period of at most 10 s" in err and 'solver.method = "newmark"' in err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_tolerance_the_boxes_do_not_meet_is_said(tmp_path, capsys):
+    """solver.tolerance on a torus doubles the box from solver.harmonics: from [4, 20] the response still changes by
+    more than 0.05 at [16, 80] (measured 0.11), which the command says in one line, exit 3 (not converged)."""
+    argv = ["run", "paper-rub", "--set", "solver.method=harmonic-balance", "--set", OUTER, *SMALL, "--set",
+            "solver.tolerance=0.05", "--set", "output.plots=[]", "--no-html", "--no-normal", "--out", str(tmp_path / "o")]
+    assert main(argv) == 3
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("rotorred run: error: the torus did not meet the tolerance 0.05") and "Traceback" not in err
+    assert "|k1| <= 16, |k2| <= 80" in err, err

@@ -146,7 +146,7 @@ class SolverSpec:
         Harmonics of the base frequency and AFT samples a period (only with method "harmonic-balance"; default
         :data:`BALANCE_DEFAULTS`; None when ``tolerance`` chooses them). At incommensurate speeds, the torus's box of
         orders ``(H1, H2)`` and AFT grid ``(N1, N2)`` (default None: those of
-        :class:`rotorred.scenes.quasi_periodic.TorusOptions`).
+        :class:`rotorred.scenes.quasi_periodic.TorusOptions`); with ``tolerance``, the box it starts from.
     gravity : float
         Gravity along -y (m/s^2); 0 for none.
     tolerance : float or None
@@ -745,13 +745,15 @@ def _solver_balance(table: dict, method: str, speeds: dict) -> tuple:
             if key in table:
                 fail(f"solver.{key}", table[key], 'must not be given unless solver.method = "harmonic-balance"')
         return None, None
+    periodic = _periodic(speeds)
     if table.get("tolerance") is not None:  # the harmonics are chosen (rotorred.scenes.balance_harmonics)
-        for key in ("harmonics", "samples"):
+        for key in ("harmonics", "samples") if periodic else ("samples",):
             if key in table:
                 fail(f"solver.{key}", table[key], "must not be given with solver.tolerance (the tolerance chooses "
-                     "the harmonics and samples); give one or the other")
-        return None, None
-    if not _periodic(speeds):
+                     "the harmonics and samples); give one or the other" if periodic else "must not be given with "
+                     "solver.tolerance (each box of orders it tries takes its default grid)")
+        return (None, None) if periodic else _torus_truncation(table)
+    if not periodic:
         return _torus_truncation(table)
     H = table.get("harmonics", BALANCE_DEFAULTS[0])
     if isinstance(H, (list, tuple)):

@@ -9,8 +9,8 @@ by :func:`rotorred.scenes.quasi_periodic.torus_balance` (docs/model.md §15, §2
   (default :class:`~rotorred.scenes.quasi_periodic.TorusOptions`' (16, 70));
 * ``solver.samples = [N1, N2]``: the AFT grid (default :func:`~rotorred.scenes.quasi_periodic.default_grid` of the
   orders);
-* ``solver.tolerance``: the orders chosen by the convergence of the output DOFs' response, from the default box
-  doubled (``TorusOptions.tolerance``);
+* ``solver.tolerance``: the orders chosen by the convergence of the output DOFs' response, from ``solver.harmonics``
+  (or the default box) doubled, each box with its default grid (``TorusOptions.tolerance``);
 * ``solver.dt``: the step of the short transient the bases are found in and the solution started from.
 
 The bases are those the line fit finds in that transient (``f_L`` and ``f_H / 3`` on ``paper-rub`` near 91 Hz). The
