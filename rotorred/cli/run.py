@@ -9,7 +9,9 @@ and in the NPZ and .mat: :mod:`rotorred.provenance`), and prints the summary. A 
 built-in ``runup``, ``runup-rub``, ``coastdown-rub``) writes ``runup_amplitude.png``,
 ``order_tracks.png``, ``waterfall.png``, ``runup_orbits.png``, their CSV files
 (``runup_amplitude.csv``, ``order_tracks.csv``, ``rub_intervals.csv``, ``critical_speeds.csv``),
-the record and ``summary.txt``. Both write ``report.html``, the interactive figures (``--no-html`` leaves it out:
+the record and ``summary.txt``. ``--set solver.method=harmonic-balance`` writes the steady rub response by harmonic
+balance as the record, periodic or, at incommensurate speeds, on a torus (:mod:`rotorred.scenes.torus_response`). Both
+write ``report.html``, the interactive figures (``--no-html`` leaves it out:
 :mod:`rotorred.cli.report`).
 
 Everything is checked before computing (the scene, ``--out``, the size estimate of
@@ -46,7 +48,9 @@ def add_parser(subparsers):
         description="Run a scene file or built-in scene and write the paper's figures (time waveforms, spectra, "
                     "orbits; rub against normal), the data as NPZ, CSV and MATLAB .mat, and a summary (peak "
                     "amplitudes, contact fraction, impacts, labelled spectral lines in the form of the paper's "
-                    "Table 1). Scene keys: docs/scenes.md.")
+                    "Table 1). With --set solver.method=harmonic-balance a rub scene's steady response is solved by "
+                    "harmonic balance: periodic at commensurate speeds, on a torus at incommensurate ones (its bases, "
+                    "truncation and lines in the summary). Scene keys: docs/scenes.md.")
     p.add_argument("scene", nargs="?", default=DEFAULT_SCENE, metavar="SCENE",
                    help=f"built-in scene ({', '.join(builtin_scenes())}) or scene TOML file (default {DEFAULT_SCENE})")
     p.add_argument("--out", default=None, help="output directory (default ./rotorred-<scene name>); locked while "

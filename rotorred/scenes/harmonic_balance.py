@@ -7,6 +7,9 @@ scene's model (M, K at the speeds, C + sum_s Omega_s G_s) with two DOFs per plat
 ``c_n``, ``c_t``, ``k_n``, ``k_t``); the unknowns are the Fourier coefficients of each rub disk's x, y and its plate's
 u_n, u_t (:class:`rotorred.nonlinear.condensed.CondensedProblem`), the forces the paper's law
 (:class:`rotorred.nonlinear.forces.PlateRub`). Every DOF's response is recovered from the solution.
+
+Speeds without such an f_0 (no common period of at most 10 s: :func:`common_frequency`, the one rule) have a
+quasi-periodic response: a scene's harmonic balance there solves the torus (:mod:`rotorred.scenes.torus_response`).
 """
 
 from __future__ import annotations
@@ -23,22 +26,43 @@ from rotorred.nonlinear.condensed import CondensedProblem
 from rotorred.nonlinear.forces import PlateRub
 from rotorred.nonlinear.fourier import Harmonics, basis
 
-__all__ = ["RubProblem", "rub_problem", "base_frequency", "augmented_matrices", "own_coordinate", "plate_rubs",
+__all__ = ["RubProblem", "rub_problem", "base_frequency", "common_frequency", "contact_history", "augmented_matrices", "own_coordinate", "plate_rubs",
            "unknown_records"]
 
 
-def base_frequency(frequencies_hz) -> float:
-    """The greatest common divisor f_0 of the spool frequencies (Hz): each read as a fraction with a denominator of at
-    most 1000 (within 1e-9 relative), f_0 at least 0.1 Hz (a common period of at most 10 s); else refused."""
+#: the longest common period of the spool speeds a periodic harmonic balance solves (s): f_0 >= 1 / 10 s
+LONGEST_PERIOD = 10.0
+
+
+def _fraction_gcd(frequencies_hz) -> float | None:
+    """The greatest common divisor (Hz) of the frequencies, each read as a fraction with a denominator of at most 1000
+    (within 1e-9 relative); None if one is no such fraction."""
     fractions = [Fraction(f).limit_denominator(1000) for f in frequencies_hz]
     if any(abs(float(fr) - f) > 1e-9 * abs(f) for f, fr in zip(frequencies_hz, fractions)):
-        checks.fail("speeds", tuple(frequencies_hz), "must be commensurate for a periodic harmonic balance (a "
-                    "quasi-periodic response: rotorred.scenes.torus_balance.torus_rub_problem)", "Hz")
+        return None
     common = math.lcm(*(fr.denominator for fr in fractions))
-    f0 = math.gcd(*(int(fr * common) for fr in fractions)) / common
-    if f0 < 0.1:
-        checks.fail("speeds", tuple(frequencies_hz), f"must share a period of at most 10 s (their greatest common "
-                    f"divisor is {f0:.6g} Hz)", "Hz")
+    return math.gcd(*(int(fr * common) for fr in fractions)) / common
+
+
+def common_frequency(frequencies_hz) -> float | None:
+    """The base frequency f_0 (Hz) of a periodic response at the spool frequencies ``frequencies_hz`` (Hz): their
+    greatest common divisor, each read as a fraction with a denominator of at most 1000 (within 1e-9 relative), if it
+    is at least 1 / :data:`LONGEST_PERIOD` (a common period of at most 10 s); None otherwise (the speeds are
+    incommensurate for harmonic balance: the response is quasi-periodic, on a torus,
+    :func:`rotorred.scenes.quasi_periodic.torus_balance`)."""
+    f0 = _fraction_gcd(frequencies_hz)
+    return f0 if f0 is not None and f0 >= 1.0 / LONGEST_PERIOD else None
+
+
+def base_frequency(frequencies_hz) -> float:
+    """The base frequency f_0 (Hz) of :func:`common_frequency`; speeds without one are refused."""
+    f0 = common_frequency(frequencies_hz)
+    if f0 is None:
+        gcd = _fraction_gcd(frequencies_hz)
+        why = ("must be commensurate for a periodic harmonic balance" if gcd is None else
+               f"must share a period of at most {LONGEST_PERIOD:g} s (their greatest common divisor is {gcd:.6g} Hz)")
+        checks.fail("speeds", tuple(frequencies_hz), f"{why} (a quasi-periodic response: "
+                    "rotorred.scenes.torus_balance.torus_rub_problem)", "Hz")
     return f0
 
 
@@ -86,25 +110,13 @@ class RubProblem:
         """The solution as a transient's record at the times ``t`` (s): each model DOF of ``dofs`` (m or rad), and a
         :class:`rotorred.transient.results.ContactHistory` per plate from the law at those instants (slip where the
         plate pushes, open elsewhere; stick is not modelled here, docs/model.md §15)."""
-        from rotorred.transient.contact import sliding_velocity
-        from rotorred.transient.results import ContactHistory
-
         h = self.problem.harmonics
         E = h.rows_at(self.omega * np.asarray(t, float))
         c = self.problem.recover(z, self.omega).reshape(h.size, -1)
         outputs = {d: E @ (c[:, :self.n_model] @ row) for d, row in zip(dofs, self.model.output_rows(list(dofs)))}
         v_c = self.omega * (h.nabla @ c)  # the coefficients of the velocities (d/dt)
-        contacts = []
-        for rub in self.problem.forces:
-            q, v = E @ c[:, list(rub.dofs)], E @ v_c[:, list(rub.dofs)]
-            f, _, _ = rub.evaluate(q, v)
-            P, T = -f[:, 2], f[:, 3]  # the force on (u_n, u_t) is (-P, T)
-            plate = rub.plate
-            contacts.append(ContactHistory(
-                plate, P, T, np.where(P > 0.0, 1, 0).astype(np.int8), q[:, 2], q[:, 3],
-                sliding_velocity(plate, rub.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]),
-                plate.clearance - q @ rub.gradient))
-        return outputs, tuple(contacts)
+        return outputs, tuple(contact_history(rub, E @ c[:, list(rub.dofs)], E @ v_c[:, list(rub.dofs)])
+                              for rub in self.problem.forces)
 
     def final_state(self, z: np.ndarray):
         """The solution's state at t = 0 as a transient's start (:class:`rotorred.transient.results.FinalState`): the
@@ -198,6 +210,21 @@ def rub_problem(scene, model, H: int, N: int, f0: float | None = None) -> RubPro
     forcing = _forcing(h, n + 2 * len(scene.plates), phasors, orders)
     problem = CondensedProblem(M, D, K, h, dofs, forcing, forces)
     return RubProblem(problem, 2 * math.pi * f0, f0, n, model)
+
+
+def contact_history(rub: PlateRub, q: np.ndarray, v: np.ndarray):
+    """A balance's plate as a transient's :class:`rotorred.transient.results.ContactHistory`: the law of ``rub`` at
+    the displacements ``q`` and velocities ``v`` of its unknowns (disk x, y, plate u_n, u_t; shape (n, 4), m and m/s)
+    at n instants (slip where the plate pushes, open elsewhere; stick is not modelled here, docs/model.md §15)."""
+    from rotorred.transient.contact import sliding_velocity
+    from rotorred.transient.results import ContactHistory
+
+    f, _, _ = rub.evaluate(q, v)
+    P, T = -f[:, 2], f[:, 3]  # the force on (u_n, u_t) is (-P, T)
+    plate = rub.plate
+    return ContactHistory(plate, P, T, np.where(P > 0.0, 1, 0).astype(np.int8), q[:, 2], q[:, 3],
+                          sliding_velocity(plate, rub.surface_speed, 1.0, v[:, 0], v[:, 1], v[:, 3]),
+                          plate.clearance - q @ rub.gradient)
 
 
 def augmented_matrices(model, scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -113,6 +113,25 @@ def _linefit_csv(result: SceneResult, path: Path) -> Path:
     return write_csv(path, LINEFIT_HEADER, cols, digits=17)
 
 
+def _torus_csv(result: SceneResult, path: Path) -> Path:
+    """Every order's line of a torus (a harmonic balance at incommensurate speeds) at every recorded DOF, by frequency:
+    its order, label, and each DOF's amplitude and phase (of ``a cos(2 pi f t + phase)``, t the run's time)."""
+    from rotorred.scenes.torus_response import order_label, spool_bases
+
+    torus = result.counters["torus"]
+    bases = spool_bases(torus, result.f_L, result.f_H)
+    by_frequency = np.argsort(torus.frequencies, kind="stable")
+    header = ["frequency (Hz)", "k1", "k2", "label"]
+    cols = [torus.frequencies[by_frequency], torus.orders[by_frequency, 0], torus.orders[by_frequency, 1],
+            [order_label(torus.orders[k], bases) for k in by_frequency]]
+    signed = torus.problem.problem.harmonics.frequencies(torus.bases_hz)[by_frequency, None]
+    phasors = np.where(signed < 0, np.conj(torus.phasors[by_frequency]), torus.phasors[by_frequency])  # at +|f|
+    for j, d in enumerate(torus.outputs):
+        header += [f"node {d[0]} {d[1]} amplitude ({_unit(d)})", f"node {d[0]} {d[1]} phase (rad)"]
+        cols += [1e6 * np.abs(phasors[:, j]), np.angle(phasors[:, j])]
+    return write_csv(path, header, cols, digits=17)
+
+
 def _poincare_csv(result: SceneResult, path: Path) -> Path:
     p = result.analysis.classification.poincare
     return write_csv(path, POINCARE_HEADER, [p.times, 1e6 * p.x, 1e6 * p.velocity], digits=17)
@@ -134,6 +153,8 @@ def write_data(result: SceneResult, out: str | Path, provenance: Provenance | No
         files.append(_timeseries_csv(result, out / "timeseries.csv"))
         if result.spectra:
             files += [_spectra_csv(result, out / "spectra.csv"), _lines_csv(result, out / "lines.csv")]
+        if "torus" in result.counters:
+            files.append(_torus_csv(result, out / "torus.csv"))
         if result.analysis is not None:
             files += [_linefit_csv(result, out / "linefit.csv"), _poincare_csv(result, out / "poincare.csv")]
     return files

@@ -33,7 +33,7 @@ from rotorred.nonlinear.torus_truncation import TorusTruncation, torus_to_tolera
 from rotorred.results import Result, dof_coordinates, strongest_lines
 from rotorred.scenes.built import balance_loads, built_scene, plates_on, rotor_model
 from rotorred.scenes.harmonic_balance import unknown_records
-from rotorred.scenes.run import settled_state
+from rotorred.scenes.settled import settled_state
 from rotorred.scenes.schema import OutputSpec, SolverSpec
 from rotorred.scenes.torus_balance import TorusRubProblem, torus_bases, torus_rub_problem
 from rotorred.signals.linefit import fit_lines

@@ -46,16 +46,15 @@ import numpy as np
 from rotorred.model.assembly import assemble
 from rotorred.progress import stage
 from rotorred.results import Result
-from rotorred.linear.harmonic import SteadyState, steady_state
-from rotorred.model.loads import gravity_force
 from rotorred.scenes.schema import Scene
+from rotorred.scenes.settled import settled_response, settled_state
 from rotorred.signals.classify import Classification, classify
 from rotorred.signals.linefit import FitOptions, LineFit, fit_lines, fit_peaks
 from rotorred.signals.settling import Settling, settling_time
 from rotorred.signals.spectra import settled_spectrum
 
 __all__ = ["SceneModel", "SceneResult", "LineAnalysis", "analyse_lines", "fit_and_settling", "Response", "respond",
-           "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene", "settled_state", "settled_response",
+           "table_dof", "SceneDiverged", "explain_divergence", "build_model", "model_key", "run_scene",
            "harmonic_outputs", "spool_frequencies"]
 
 LOG = logging.getLogger(__name__)
@@ -135,7 +134,8 @@ class SceneResult(Result):
     normal : SceneResult or None
         The same scene without rub plates, when ``output.compare_normal``.
     counters : dict
-        Integrator counters (Newton iterations, contact steps, µs per step).
+        Integrator counters (Newton iterations, contact steps, µs per step); a harmonic balance's truncation and
+        start, or at incommensurate speeds its torus (``"torus"``: :class:`rotorred.scenes.quasi_periodic.RubTorus`).
     incomplete : str or None
         Why the record stops early (a diverged transient, :class:`SceneDiverged`); None when complete.
         An incomplete result has no spectra, lines or normal comparison.
@@ -251,6 +251,11 @@ class SceneResult(Result):
                  shorten(f"{self.method} response at f_L = {self.f_L:.6g} Hz, f_H = {self.f_H:.6g} Hz; {span}; "
                          f"{self.n_steps} steps"),
                  self.model_label.split(" (")[0]]  # its boundary nodes are a list
+        if "torus" in self.counters:
+            from rotorred.scenes.torus_response import describe_torus
+
+            shape, truncation = describe_torus(self.counters["torus"], self.f_L, self.f_H)
+            lines += [shorten(f"on a {shape}"), shorten(truncation)]
         if self.incomplete:
             lines.append(shorten(f"INCOMPLETE: {self.incomplete}"))
         if d in self.lines:
@@ -459,58 +464,6 @@ def _reduced_label(scene: Scene, model, extra: tuple, how: str, system) -> str:
 
 
 # --------------------------------------------------------------------------- harmonic solution
-def scene_steady_state(scene: Scene, model) -> SteadyState | None:
-    """Linear steady state of the scene's unbalances, per spool (None without unbalances)."""
-    if not scene.unbalances:
-        return None
-    return steady_state(model, scene.operating, scene.unbalances)
-
-
-def _static_deflection(scene: Scene, model) -> np.ndarray | None:
-    """Gravity's static deflection in model coordinates (None without gravity)."""
-    if not scene.solver.gravity:
-        return None
-    return np.linalg.solve(model.stiffness(scene.speeds), gravity_force(model, scene.solver.gravity))
-
-
-def settled_state(scene: Scene, model) -> tuple[np.ndarray, np.ndarray]:
-    """Linear steady state at t = 0: (q0, v0) in model coordinates.
-
-    Sum of the per-spool unbalance phasors (``K - Omega^2 M + i Omega (C + sum Omega_s G_s)``
-    solved per spool) and gravity's static deflection.
-    """
-    q0 = np.zeros(model.M.shape[0])
-    v0 = np.zeros_like(q0)
-    steady = scene_steady_state(scene, model)
-    if steady is not None:
-        q0 += steady.displacement(0.0)
-        v0 += steady.velocity(0.0)
-    static = _static_deflection(scene, model)
-    if static is not None:
-        q0 += static
-    return q0, v0
-
-
-def settled_response(scene: Scene, model, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Settled linear response ``rows @ q(t)`` (unbalances and gravity), shape (len(rows), len(t)).
-
-    Parameters
-    ----------
-    rows : ndarray, shape (k, n)
-        Output rows in model coordinates (``model.output_rows(...)``).
-    t : ndarray, shape (m,)
-        Times (s).
-    """
-    y = np.zeros((rows.shape[0], len(t)))
-    steady = scene_steady_state(scene, model)
-    for s, P in (steady.phasors.items() if steady is not None else ()):
-        y += np.real((rows @ P)[:, None] * np.exp(1j * steady.speeds[s] * t)[None, :])
-    static = _static_deflection(scene, model)
-    if static is not None:
-        y += (rows @ static)[:, None]
-    return y
-
-
 def harmonic_outputs(scene: Scene, model, t: np.ndarray) -> dict:
     """Settled linear response of the recorded DOFs at times ``t`` (s): {(node, dir): ndarray}."""
     dofs = scene.output.dofs
@@ -638,6 +591,7 @@ class Response:
     method : {"harmonic", "transient", "harmonic-balance"}
     n_steps : int
     counters : dict
+        As :attr:`SceneResult.counters`.
     final : FinalState or None
         End state of a transient (None for the harmonic solution).
     """
@@ -652,7 +606,8 @@ class Response:
 
 
 def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None = False) -> Response:
-    """The response in the recorded window: harmonic for a linear scene started settled, else stepped in time.
+    """The response in the recorded window: harmonic for a linear scene started settled, by harmonic balance (periodic,
+    or on a torus at incommensurate speeds) with ``solver.method = "harmonic-balance"``, else stepped in time.
 
     ``initial`` (a FinalState) continues another run (:func:`run_scene`). Raises
     :class:`SceneDiverged`, carrying the partial result, when the transient diverges.
@@ -661,18 +616,30 @@ def respond(scene: Scene, model: SceneModel, initial=None, progress: bool | None
     if scene.is_linear and (scene.solver.start == "settled" or balance) and initial is None:
         return _harmonic_response(scene, model.model)
     if balance:
-        return _balance_response(scene, model.model)
+        return _balance_response(scene, model.model) if _periodic(scene) else _torus_response(scene, model.model)
     f_L, f_H = spool_frequencies(scene)
     return _transient_response(scene, model, progress, f_L, f_H, initial)
 
 
 def _harmonic_response(scene: Scene, model) -> Response:
     """The settled linear response at the record times (no time stepping)."""
+    t = _record_times(scene)
+    stage("solving %s: the settled harmonic response at %d record times", scene.name, len(t), logger=LOG)
+    return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+
+
+def _record_times(scene: Scene) -> np.ndarray:
+    """The record times ``record_start .. duration`` at the scene's step (s)."""
     s = scene.solver
     n = int(round((s.duration - s.record_start) / s.dt))
-    t = s.record_start + s.dt * np.arange(n + 1)
-    stage("solving %s: the settled harmonic response at %d record times", scene.name, n + 1, logger=LOG)
-    return Response(t, harmonic_outputs(scene, model, t), (), "harmonic", 0, {})
+    return s.record_start + s.dt * np.arange(n + 1)
+
+
+def _periodic(scene: Scene) -> bool:
+    """Whether the scene's speeds have a periodic response (:func:`rotorred.scenes.harmonic_balance.common_frequency`)."""
+    from rotorred.scenes.harmonic_balance import common_frequency
+
+    return common_frequency(tuple(scene.frequencies_hz.values())) is not None
 
 
 def _balance_response(scene: Scene, model) -> Response:
@@ -682,9 +649,7 @@ def _balance_response(scene: Scene, model) -> Response:
     ``solver.tolerance``."""
     from rotorred.scenes.balance_harmonics import LADDER_START, balance_to_tolerance, cold_solution
 
-    s = scene.solver
-    n = int(round((s.duration - s.record_start) / s.dt))
-    t = s.record_start + s.dt * np.arange(n + 1)
+    s, t = scene.solver, _record_times(scene)
     stage("solving %s by harmonic balance: a short transient to start from, then Newton", scene.name, logger=LOG)
     record = start_record(scene, model)
     if s.tolerance is not None:
@@ -696,6 +661,20 @@ def _balance_response(scene: Scene, model) -> Response:
     counters = {"f0": rp.f0, "harmonics": rp.problem.harmonics.H, "samples": rp.problem.harmonics.N,
                 "choice": choice, "start": start}
     return Response(t, outputs, contacts, "harmonic-balance", 0, counters)
+
+
+def _torus_response(scene: Scene, model) -> Response:
+    """The quasi-periodic rub response by harmonic balance on a torus (``solver.method = "harmonic-balance"`` at
+    incommensurate speeds, :mod:`rotorred.scenes.torus_response`) at the record times, as a transient's record; the
+    torus (:class:`rotorred.scenes.quasi_periodic.RubTorus`) is the counters' ``"torus"``."""
+    from rotorred.scenes.torus_response import solve_scene_torus, torus_record
+
+    t = _record_times(scene)
+    stage("solving %s by harmonic balance on a torus (the speeds share no period of at most 10 s): a short transient "
+          "to find its bases and start from, then Newton-Krylov", scene.name, logger=LOG)
+    torus = solve_scene_torus(scene, model)
+    outputs, contacts = torus_record(torus, t, scene.output.dofs)
+    return Response(t, outputs, contacts, "harmonic-balance", 0, {"torus": torus})
 
 
 #: periods of the base frequency f0 of the transient a scene's harmonic balance starts from (docs/model.md §15)

@@ -137,13 +137,16 @@ class SolverSpec:
     start : {"settled", "rest"}
         Initial state: the linear steady state (unbalance and gravity) or rest (the start-up).
     method : {"newmark", "hht", "harmonic-balance"}
-        The time step, or the periodic response by harmonic balance (a rub scene at commensurate speeds: the
-        record is that periodic solution at the record times, :mod:`rotorred.scenes.harmonic_balance`).
+        The time step, or the steady response by harmonic balance (a rub scene; the record is that solution at the
+        record times): periodic at commensurate speeds (:mod:`rotorred.scenes.harmonic_balance`), on a torus at
+        incommensurate ones (:mod:`rotorred.scenes.torus_response`).
     alpha : float or None
         HHT-alpha parameter (only with method "hht").
-    harmonics, samples : int or None
+    harmonics, samples : int, (int, int) or None
         Harmonics of the base frequency and AFT samples a period (only with method "harmonic-balance"; default
-        :data:`BALANCE_DEFAULTS`; None when ``tolerance`` chooses them).
+        :data:`BALANCE_DEFAULTS`; None when ``tolerance`` chooses them). At incommensurate speeds, the torus's box of
+        orders ``(H1, H2)`` and AFT grid ``(N1, N2)`` (default None: those of
+        :class:`rotorred.scenes.quasi_periodic.TorusOptions`); with ``tolerance``, the box it starts from.
     gravity : float
         Gravity along -y (m/s^2); 0 for none.
     tolerance : float or None
@@ -164,8 +167,8 @@ class SolverSpec:
     alpha: float | None = None
     gravity: float = 0.0
     tolerance: float | None = None
-    harmonics: int | None = None
-    samples: int | None = None
+    harmonics: int | tuple[int, int] | None = None
+    samples: int | tuple[int, int] | None = None
 
 
 @dataclass(frozen=True)
@@ -720,29 +723,69 @@ def _solver(value, rotor: Rotor, speeds: dict[str, float], d: SolverSpec = Solve
         if method not in ("newmark", "harmonic-balance"):
             fail("solver.tolerance", tolerance, f'must go with solver.method = "newmark" (its error estimates are '
                  f'the average-acceleration step\'s) or "harmonic-balance" (it chooses the harmonics), not {method!r}')
-    harmonics, samples = _solver_balance(table, method)
+    harmonics, samples = _solver_balance(table, method, speeds)
     return SolverSpec(model=model, modes=modes, cutoff_hz=cutoff, boundary_nodes=boundary, dt=dt, duration=duration,
                       record_start=record_start, start=start, method=method, alpha=alpha, gravity=gravity,
                       tolerance=tolerance, harmonics=harmonics, samples=samples)
 
 
-def _solver_balance(table: dict, method: str) -> tuple[int | None, int | None]:
-    """``solver.harmonics`` and ``solver.samples``: only with method "harmonic-balance" (then their defaults)."""
+def _periodic(speeds: dict) -> bool:
+    """Whether the spool speeds (rad/s) have a periodic response (:func:`rotorred.scenes.harmonic_balance.common_frequency`);
+    else a harmonic balance is on a torus."""
+    from rotorred.scenes.harmonic_balance import common_frequency
+
+    return common_frequency(tuple(w / (2 * math.pi) for w in speeds.values())) is not None
+
+
+def _solver_balance(table: dict, method: str, speeds: dict) -> tuple:
+    """``solver.harmonics`` and ``solver.samples``: only with method "harmonic-balance" (then their defaults), a pair
+    each (the torus's orders and grid) at incommensurate ``speeds`` (rad/s)."""
     if method != "harmonic-balance":
         for key in ("harmonics", "samples"):
             if key in table:
                 fail(f"solver.{key}", table[key], 'must not be given unless solver.method = "harmonic-balance"')
         return None, None
+    periodic = _periodic(speeds)
     if table.get("tolerance") is not None:  # the harmonics are chosen (rotorred.scenes.balance_harmonics)
-        for key in ("harmonics", "samples"):
+        for key in ("harmonics", "samples") if periodic else ("samples",):
             if key in table:
                 fail(f"solver.{key}", table[key], "must not be given with solver.tolerance (the tolerance chooses "
-                     "the harmonics and samples); give one or the other")
-        return None, None
-    H = checks.integer("solver.harmonics", table.get("harmonics", BALANCE_DEFAULTS[0]), ge=1)
-    N = checks.integer("solver.samples", table.get("samples", BALANCE_DEFAULTS[1]), ge=2 * H + 2)
+                     "the harmonics and samples); give one or the other" if periodic else "must not be given with "
+                     "solver.tolerance (each box of orders it tries takes its default grid)")
+        return (None, None) if periodic else _torus_truncation(table)
+    if not periodic:
+        return _torus_truncation(table)
+    H = table.get("harmonics", BALANCE_DEFAULTS[0])
+    if isinstance(H, (list, tuple)):
+        fail("solver.harmonics", H, "must be one number of harmonics at speeds sharing a period of at most 10 s (a "
+             "pair [H1, H2] is a torus's, at incommensurate speeds)")
+    H = checks.integer("solver.harmonics", H, ge=1)
+    return H, _samples("solver.samples", table.get("samples", BALANCE_DEFAULTS[1]), H)
+
+
+def _samples(field: str, N, H: int) -> int:
+    """AFT samples for ``H`` harmonics: even and at least 2 H + 2."""
+    N = checks.integer(field, N, ge=2 * H + 2)
     if N % 2:
-        fail("solver.samples", N, "must be even")
+        fail(field, N, "must be even")
+    return N
+
+
+def _torus_truncation(table: dict) -> tuple:
+    """``solver.harmonics = [H1, H2]`` and ``solver.samples = [N1, N2]`` of a torus (each None unless given)."""
+    H = table.get("harmonics")
+    if H is not None:
+        if not isinstance(H, (list, tuple)):
+            fail("solver.harmonics", H, "must be a pair [H1, H2] at incommensurate speeds (the torus's orders |k1| <= "
+                 "H1, |k2| <= H2 of its two base frequencies), or left out (the default box)")
+        H = checks.sequence("solver.harmonics", H, lambda f, v: checks.integer(f, v, ge=1), min_len=2, max_len=2)
+    N = table.get("samples")
+    if N is not None:
+        if H is None or not isinstance(N, (list, tuple)):
+            fail("solver.samples", N, "must be a pair [N1, N2] with solver.harmonics = [H1, H2] at incommensurate "
+                 "speeds (the torus's AFT grid), or left out (the default grid of the orders)")
+        N = checks.sequence("solver.samples", N, min_len=2, max_len=2)
+        N = tuple(_samples(f"solver.samples[{i}]", v, H[i]) for i, v in enumerate(N))
     return H, N
 
 
@@ -859,7 +902,7 @@ def _build(data: dict, source: str, base: Path | None) -> Scene:
 
 
 def _check_balance(speeds: dict, plates, solver: SolverSpec) -> None:
-    """Harmonic balance here is of a rub response at commensurate speeds, without gravity."""
+    """Harmonic balance here is of a rub response without gravity (on a torus at incommensurate speeds)."""
     from rotorred.scenes.harmonic_balance import base_frequency
 
     if not plates:
@@ -868,6 +911,8 @@ def _check_balance(speeds: dict, plates, solver: SolverSpec) -> None:
     if solver.gravity:
         fail("solver.gravity", solver.gravity, 'must be 0 with solver.method = "harmonic-balance" (no static load in '
              "its forcing)", "m/s^2")
+    if not _periodic(speeds):
+        return  # a torus: its truncation was read in _solver_balance, the spools' orders are checked on its bases
     frequencies = tuple(w / (2 * math.pi) for w in speeds.values())
     f0 = base_frequency(frequencies)
     order = max(round(f / f0) for f in frequencies)

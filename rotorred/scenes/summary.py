@@ -44,7 +44,7 @@ def format_summary(result: SceneResult, files: list[Path] = ()) -> str:
         Blocks separated by blank lines; peaks in µm, speeds in rpm and Hz, line frequencies in Hz.
     """
     parts = [_incomplete(result), _setup(result), _peaks(result), range_warnings(result),
-             _contacts(result), _lines(result) if result.spectra else "", _line_fit(result)]
+             _contacts(result), _torus_lines(result), _lines(result) if result.spectra else "", _line_fit(result)]
     if files:
         parts.append("\n".join(f"wrote {f}" for f in files))
     return "\n\n".join(p for p in parts if p)
@@ -103,6 +103,8 @@ def _setup(result: SceneResult) -> str:
     if result.method == "harmonic":
         lines.append(f"response: harmonic steady state (linear scene, settled start), {len(result.t)} samples "
                      f"of {s.dt:g} s in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
+    elif result.method == "harmonic-balance" and "torus" in result.counters:
+        lines += torus_setup(result)
     elif result.method == "harmonic-balance":
         c = result.counters
         if c.get("choice") is not None:
@@ -122,6 +124,46 @@ def _setup(result: SceneResult) -> str:
             lines.append(f"step kernel compiled in {c['kernel_load_time']:.1f} s (once per install; not in the "
                          "us/step; cached on disk)")
     return "\n".join(lines)
+
+
+def torus_setup(result: SceneResult) -> list[str]:
+    """The lines of a torus's response (a harmonic balance at incommensurate speeds): its bases named in the spools'
+    frequencies, its truncation (orders, grid, unknowns), Newton's convergence, what a tolerance chose, the record."""
+    from rotorred.scenes.torus_response import describe_torus
+
+    s, torus = result.scene.solver, result.counters["torus"]
+    sol = torus.solution
+    shape, truncation = describe_torus(torus, result.f_L, result.f_H)
+    lines = [f"response: harmonic balance on a {shape}: the speeds share no period of at most 10 s",
+             f"truncation: {truncation}"]
+    if torus.truncation is not None:
+        lines.append(torus.truncation.describe())
+    lines.append(f"{sol.iterations} Newton iterations ({sum(sol.krylov)} GMRES), relative residual "
+                 f"{sol.residual:.3g}; started from {torus.start}; recorded at {len(result.t)} samples of {s.dt:g} s "
+                 f"in {s.record_start:g}-{s.duration:g} s; {result.solve_time:.2f} s")
+    return lines
+
+
+#: lines of the table DOF listed from a torus's series
+N_TORUS_LINES = 10
+
+
+def _torus_lines(result: SceneResult) -> str:
+    """The table DOF's :data:`N_TORUS_LINES` largest lines of a torus's series (exact: its coefficients, not a fit)."""
+    torus = result.counters.get("torus") if result.method == "harmonic-balance" else None
+    d = table_dof(result)
+    if torus is None or d not in torus.outputs:
+        return ""
+    from rotorred.scenes.torus_response import base_labels, order_label, spool_bases
+
+    names, bases = base_labels(torus, result.f_L, result.f_H), spool_bases(torus, result.f_L, result.f_H)
+    scale, unit = 1e6, ("urad" if d[1].startswith("theta") else "um")
+    a = torus.amplitudes[:, torus.outputs.index(d)]
+    rows = [[f"{torus.frequencies[k]:.6g}", f"({torus.orders[k, 0]}, {torus.orders[k, 1]})",
+             order_label(torus.orders[k], bases), f"{scale * a[k]:.6g}"] for k in np.argsort(-a)[:N_TORUS_LINES]]
+    return (f"Torus lines of node {d[0]} {direction_name(d[1])} (the {min(N_TORUS_LINES, len(a))} largest of the "
+            f"harmonic balance's {len(a)} orders k1 {names[0]} + k2 {names[1]}):\n"
+            + render_table(["frequency (Hz)", "order (k1, k2)", "line", f"amplitude ({unit})"], rows))
 
 
 def _peaks(result: SceneResult) -> str:
