@@ -81,7 +81,9 @@ EXAMPLES = {
     "run": ["rotorred run --out out                                  # the paper's rub scene (paper-rub)",
             "rotorred run paper-normal --out normal --set speeds.outer=95",
             "rotorred run out/scene.toml --out again                 # rerun a folder's resolved scene",
-            "rotorred run runup-rub --out runup -q                   # a run-up, printing errors only"],
+            "rotorred run runup-rub --out runup -q                   # a run-up, printing errors only",
+            "rotorred run paper-rub --set solver.method=harmonic-balance --set speeds.outer=91.37 --out torus"
+            "  # a quasi-periodic torus"],
     "campbell": ["rotorred campbell seed-rig --speeds 0:12000:61 --out campbell",
                  "rotorred campbell seed-rig --speeds 3000 --out whirl     # whirl frequencies at one speed",
                  "rotorred campbell my_rotor.toml --speeds 0:20000:81 --ratio 1.4 --harmonics 1,2 --out cd"],
