@@ -14,10 +14,10 @@ an equation in the coefficients of r signals on the torus. ``C`` is never formed
 coefficients of s signals, is their samples and rates on the grid by one inverse real 2-D FFT, multiplied there by
 the fields ``Mq(theta) = sum d_t B_t`` (position terms) and ``Mv(theta)`` (velocity terms), r x s at each sample, and
 returned by one forward FFT: O(N_1 N_2 log(N_1 N_2) (r + 2 s)) a product, memory O(N_1 N_2 r s + K (r + s)^2).
-GMRES (scipy) solves it, preconditioned by the exact inverse of its block between the orders of largest compliance
+GMRES (scipy) solves it, preconditioned by the inverse of its block between the orders of largest compliance
 (:data:`COARSE_ORDERS`: the orders where ``C G_VU`` is large, whose eigenvalues would otherwise be GMRES's outliers)
 and the identity elsewhere; the block is the fields' Toeplitz matrices between those orders only (built from their
-2-D spectrum), inverted once and reused by the following Newton steps until GMRES needs more than
+2-D spectrum), factorised once (LU, single precision) and reused by the following Newton steps until GMRES needs more than
 :data:`REFRESH_ITERATIONS`. *Choice* (docs/model.md §25): the block diagonal over the orders (each order's 2 x 2
 block with the contact's mean stiffness) stalls on the rig: its impacts couple the orders far from the diagonal
 (at |k1| <= 6, |k2| <= 30, GMRES stalled at 4.5e-2 after 2000 iterations, against 4.5e-5 after 43 without a
@@ -90,11 +90,7 @@ class RankJacobian:
         self.c = self.G0.shape[0]
         self.U, self.V = pattern_bases([A for _, _, A in terms])
         self.r, self.s = self.U.shape[1], self.V.shape[1]
-        N = harmonics.n_samples
-        self.Mq, self.Mv = np.zeros((N, self.r, self.s)), np.zeros((N, self.r, self.s))
-        for b, kind, A in terms:
-            B = self.U.T @ A @ self.V
-            (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * B[None]
+        self.Mq, self.Mv = self._fields(columns, terms)
         self.has_velocity = bool(np.any(self.Mv))
         self.P0, self.Pk = projected_blocks(self.G0, self.Gk, self.V, self.U)
         same = reuse is not None and reuse.U.shape == self.U.shape and reuse.V.shape == self.V.shape and \
@@ -103,11 +99,19 @@ class RankJacobian:
         self._preconditioner = reuse._preconditioner if same else None
         if same:  # the bases' signs may differ: the reused factors act in the earlier bases
             self.U, self.V = reuse.U, reuse.V
-            self.Mq, self.Mv = np.zeros_like(self.Mq), np.zeros_like(self.Mv)
-            for b, kind, A in terms:
-                (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * (self.U.T @ A @ self.V)[None]
+            self.Mq, self.Mv = self._fields(columns, terms)
             self.P0, self.Pk = reuse.P0, reuse.Pk
         self.reused = same
+
+    def _fields(self, columns: np.ndarray, terms) -> tuple[np.ndarray, np.ndarray]:
+        """The fields ``Mq = sum d_t B_t`` (position terms) and ``Mv`` (velocity terms), ``B_t = U^T A_t V``, on the
+        grid: shape (r, s, N_1 N_2) each, the samples contiguous (the layout of the FFT's signals)."""
+        N = self.h.n_samples
+        Mq, Mv = np.zeros((self.r, self.s, N)), np.zeros((self.r, self.s, N))
+        for b, kind, A in terms:
+            B = self.U.T @ A @ self.V
+            (Mq if kind == 0 else Mv)[...] += B[:, :, None] * columns[None, None, :, b]
+        return Mq, Mv
 
     @property
     def inner_size(self) -> int:
@@ -119,14 +123,15 @@ class RankJacobian:
         """``C p``: the coefficients (m, r) of ``Mq p(theta) + Mv (w . nabla) p(theta)`` for the coefficients
         ``p`` (m, s) of s signals, through the grid."""
         h, s = self.h, self.s
-        if self.has_velocity:
-            both = np.hstack([p, h.derivative(p.reshape(-1), s, self.w).reshape(-1, s)])
-            samples = h.synthesised(_phasors(both))
-            out = (np.einsum("nrs,ns->nr", self.Mq, samples[:, :s])
-                   + np.einsum("nrs,ns->nr", self.Mv, samples[:, s:]))
-        else:
-            out = np.einsum("nrs,ns->nr", self.Mq, h.synthesised(_phasors(p)))
-        return h.coefficients(out).reshape(-1, self.r)
+        Q = _phasors(p)
+        if not self.has_velocity:
+            return h.grid_product(Q, lambda x, out: _field_product(self.Mq, x, out), self.r)
+        rates = 1j * h.frequencies(self.w)[:, None] * Q  # (w . nabla): the phasor times i k . w
+
+        def product(x, out):
+            _field_product(self.Mq, x[:s], out)
+            out += _field_product(self.Mv, x[s:])
+        return h.grid_product(np.hstack([Q, rates]), product, self.r)
 
     def compliance(self, y: np.ndarray) -> np.ndarray:
         """``G_VU y`` for y (m, r): (m, s)."""
@@ -145,8 +150,8 @@ class RankJacobian:
     # ------------------------------------------------------------------------------------------ preconditioner
     def _coarse_block(self):
         """The orders where the compliance is largest (:data:`COARSE_ORDERS` of them, the mean among them): their
-        positions in the reduced vector and the inverse of the reduced equation's dense block between them,
-        ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
+        positions in the reduced vector and the LU factors (single precision) of the reduced equation's dense block
+        between them, ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
         h, r, s, N = self.h, self.r, self.s, self.h.n_samples
         weight = np.concatenate([[np.linalg.norm(self.P0)], np.linalg.norm(self.Pk, axis=(1, 2))])
         among = np.union1d([0], np.argsort(-weight)[:COARSE_ORDERS])
@@ -154,9 +159,9 @@ class RankJacobian:
 
         def assembled(blocks):
             return blocks.reshape(r, s, m, m).transpose(2, 0, 3, 1).reshape(m * r, m * s)
-        C = assembled(h.toeplitz_blocks(self.Mq.reshape(N, r * s), among))
+        C = assembled(h.toeplitz_blocks(self.Mq.reshape(r * s, N).T, among))
         if self.has_velocity:  # times the derivative on the right: columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k)
-            Tv = assembled(h.toeplitz_blocks(self.Mv.reshape(N, r * s), among)).reshape(m * r, m, s)
+            Tv = assembled(h.toeplitz_blocks(self.Mv.reshape(r * s, N).T, among)).reshape(m * r, m, s)
             wk = h.frequencies(self.w)[among[1:]][None, :, None]
             C3 = C.reshape(m * r, m, s)  # a view
             C3[:, 1::2] -= wk * Tv[:, 2::2]
@@ -164,18 +169,20 @@ class RankJacobian:
         GT = block_product(self.P0.T, self.Pk[among[1:] - 1].transpose(0, 2, 1), C.T, s)  # (G_L^T C^T)
         rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
         rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
-        # inverted once (in double precision: its condition reaches 2e7 on the rig), its product a GMRES iteration:
-        # faster than an LU's two triangular solves
-        return rows, sla.inv(np.eye(m * r) + GT.T, check_finite=False)
+        # factorised once. In single precision where the block is part of the equation (a preconditioner: on the rig's
+        # 1999 x 1999 block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product,
+        # GMRES's iterations unchanged, docs/model.md §25); in double where it is the whole (a direct solve)
+        precision = np.float64 if len(among) == h.n_orders else np.float32
+        return rows, sla.lu_factor((np.eye(m * r) + GT.T).astype(precision), check_finite=False, overwrite_a=True)
 
     def precondition(self, y: np.ndarray) -> np.ndarray:
         """An approximate inverse of ``I + C G_VU`` applied to y ((2K - 1) r,): exact on the block between the orders
         of largest compliance (:meth:`_coarse_block`), the identity elsewhere (where ``C G_VU`` is small)."""
         if self._preconditioner is None:
             self._preconditioner = self._coarse_block()
-        rows, inverse = self._preconditioner
+        rows, factors = self._preconditioner
         out = y.copy()
-        out[rows] = inverse @ y[rows]
+        out[rows] = sla.lu_solve(factors, y[rows].astype(factors[0].dtype), check_finite=False)
         return out
 
     # ------------------------------------------------------------------------------------------ the step
@@ -202,6 +209,13 @@ class RankJacobian:
             raise sla.LinAlgError("GMRES gave a non-finite solution")
         X_y = block_product(self.G0, self.Gk, (y.reshape(-1, self.r) @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
         return b - X_y, KrylovStats(count[0], achieved)
+
+
+def _field_product(M: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``M(theta) x(theta)`` at each sample: fields (r, s, N) times signals (s, N), shape (r, N) (into ``out``)."""
+    if M.shape[:2] == (1, 1):
+        return np.multiply(M[0], x, out=out)
+    return np.einsum("rsn,sn->rn", M, x, out=out)
 
 
 def _phasors(p: np.ndarray) -> np.ndarray:
