@@ -763,9 +763,10 @@ class TorusProblem:
         q, v = self.samples(z)
         f, dq, dv = sampled_forces(self._local_forces, q, v)
         R = z - self.linear_response() + self.apply(h.coefficients(f))
-        flat = np.hstack([dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)])
-        active = np.flatnonzero(np.any(flat != 0.0, axis=1))  # a contact's samples (zero rows are proportional)
-        base, factor = proportional_columns(flat[active]) if active.size else ([], np.full((2 * c * c, 2), -1.0))
+        dq, dv = dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)
+        active = np.flatnonzero(np.any(dq != 0.0, axis=1) | np.any(dv != 0.0, axis=1))  # a contact's samples (zero
+        flat = np.hstack([dq[active], dv[active]])  # rows are proportional to any: the shapes found on the others)
+        base, factor = proportional_columns(flat) if active.size else ([], np.full((2 * c * c, 2), -1.0))
         terms = []
         for b in range(len(base)):
             for kind in (0, 1):
@@ -773,7 +774,9 @@ class TorusProblem:
                 A = np.where(pairs[:, 1] == b, pairs[:, 0], 0.0).reshape(c, c)
                 if A.any():
                     terms.append((b, kind, A))
-        return R, flat[:, base], tuple(terms)
+        columns = np.zeros((h.n_samples, len(base)))
+        columns[active] = flat[:, base]
+        return R, columns, tuple(terms)
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``

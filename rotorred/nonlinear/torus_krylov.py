@@ -126,12 +126,14 @@ class RankJacobian:
         Q = _phasors(p)
         if not self.has_velocity:
             return h.grid_product(Q, lambda x, out: _field_product(self.Mq, x, out), self.r)
-        rates = 1j * h.frequencies(self.w)[:, None] * Q  # (w . nabla): the phasor times i k . w
+        both = np.empty((len(Q), 2 * s), complex)
+        both[:, :s] = Q
+        np.multiply(Q, 1j * h.frequencies(self.w)[:, None], out=both[:, s:])  # (w . nabla): the phasor times i k . w
 
         def product(x, out):
             _field_product(self.Mq, x[:s], out)
             out += _field_product(self.Mv, x[s:])
-        return h.grid_product(np.hstack([Q, rates]), product, self.r)
+        return h.grid_product(both, product, self.r)
 
     def compliance(self, y: np.ndarray) -> np.ndarray:
         """``G_VU y`` for y (m, r): (m, s)."""
@@ -232,5 +234,10 @@ def block_product(B0: np.ndarray, Bk: np.ndarray, X: np.ndarray, c: int) -> np.n
     a = B0.shape[0]
     out = np.empty((a + 2 * a * len(Bk), X.shape[1]))
     out[:a] = B0 @ X[:c]
-    out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
+    if Bk.shape[1:] == (2, 2):  # one signal (a rub's rank): the 2 x 2 products written out (matmul's are slow)
+        x, y = X[1::2], X[2::2]
+        out[1::2] = Bk[:, 0, 0, None] * x + Bk[:, 0, 1, None] * y
+        out[2::2] = Bk[:, 1, 0, None] * x + Bk[:, 1, 1, None] * y
+    else:
+        out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
     return out
