@@ -61,6 +61,8 @@ __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "al
 #: the loosest and the tightest relative tolerance of GMRES on a Newton step (the inexact Newton's forcing term,
 #: :func:`solve_torus`)
 FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
+#: the forcing term's power of the relative residual: min(1e-2, rho^1.5), the inexact Newton's order 1.5
+FORCING_ORDER = 1.5
 #: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
 COMPLIANCE_CHUNK = 256
 
@@ -1026,7 +1028,7 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
                                  tuple(krylov))
         if it == max_iter:
             break
-        rtol = max(min(FORCING_MAX, history[-1]), 1e-3 * tol / history[-1], KRYLOV_FLOOR)
+        rtol = max(min(FORCING_MAX, history[-1] ** FORCING_ORDER), 1e-3 * tol / history[-1], KRYLOV_FLOOR)
         try:
             _, step, stats, J = problem.newton_step(z, rtol, J)
         except (sla.LinAlgError, ValueError):

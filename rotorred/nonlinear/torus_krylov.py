@@ -26,11 +26,11 @@ preconditioner).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.sparse.linalg import LinearOperator, gmres
 
 __all__ = ["RankJacobian", "pattern_bases"]
 
@@ -189,28 +189,63 @@ class RankJacobian:
 
     # ------------------------------------------------------------------------------------------ the step
     def solve(self, b: np.ndarray, rtol: float, maxiter: int = 300, restart: int = 100):
-        """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``;
-        returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced residual reached)."""
+        """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``
+        (:func:`right_gmres`); returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced
+        residual reached)."""
         rhs = self.core(b.reshape(-1, self.c) @ self.V).reshape(-1)
-        n = self.inner_size
-        A = LinearOperator((n, n), matvec=self.inner, dtype=float)
-        M = LinearOperator((n, n), matvec=self.precondition, dtype=float)
-        count = [0]
-
-        def counted(_):
-            count[0] += 1
-        y, info = gmres(A, rhs, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
-                        callback=counted, callback_type="pr_norm")
-        if self.reused and (info != 0 or count[0] > REFRESH_ITERATIONS):  # the earlier factors serve badly: fresh
-            self._preconditioner, self.reused = None, False
-            y, info = gmres(A, rhs, x0=y, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
-                            callback=counted, callback_type="pr_norm")
-        norm = float(np.linalg.norm(rhs)) or 1.0
-        achieved = float(np.linalg.norm(self.inner(y) - rhs)) / norm
+        y, iterations, achieved = right_gmres(self.inner, self.precondition, rhs, None, rtol, restart, maxiter)
+        if self.reused and (achieved > rtol or iterations > REFRESH_ITERATIONS):  # the earlier factors serve badly:
+            self._preconditioner, self.reused = None, False  # fresh ones from the current fields
+            y, more, achieved = right_gmres(self.inner, self.precondition, rhs, y, rtol, restart, maxiter)
+            iterations += more
         if not np.all(np.isfinite(y)):
             raise sla.LinAlgError("GMRES gave a non-finite solution")
         X_y = block_product(self.G0, self.Gk, (y.reshape(-1, self.r) @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
-        return b - X_y, KrylovStats(count[0], achieved)
+        return b - X_y, KrylovStats(iterations, achieved)
+
+
+def right_gmres(A, M, b: np.ndarray, x0: np.ndarray | None, rtol: float, restart: int, maxiter: int):
+    """GMRES on ``A M u = b``, ``x = M u`` (preconditioned on the right, so its residual is the true one's: it stops
+    when ``||b - A x|| <= rtol ||b||``, where scipy's left-preconditioned GMRES stops on ``M``'s residual), restarted
+    every ``restart`` iterations, at most ``maxiter`` in all; Gram-Schmidt classical and repeated (two products with
+    the basis a step). Returns x, the iterations and the relative residual ``||b - A x|| / ||b||`` reached."""
+    norm = float(np.linalg.norm(b)) or 1.0
+    n, target = b.size, rtol * norm
+    x = np.zeros(n) if x0 is None else x0.copy()
+    r = b - A(x) if x0 is not None else b.copy()
+    beta, total = float(np.linalg.norm(r)), 0
+    while beta > target and total < maxiter:
+        m = min(restart, maxiter - total)
+        V, Z, H = np.empty((m + 1, n)), np.empty((m, n)), np.zeros((m + 1, m))
+        cs, sn, g = np.zeros(m), np.zeros(m), np.zeros(m + 1)
+        V[0], g[0] = r / beta, beta
+        for j in range(m):
+            Z[j] = M(V[j])
+            w = A(Z[j])
+            h = V[:j + 1] @ w
+            w -= h @ V[:j + 1]
+            again = V[:j + 1] @ w
+            w -= again @ V[:j + 1]
+            H[:j + 1, j], H[j + 1, j] = h + again, np.linalg.norm(w)
+            if H[j + 1, j] > 0.0:
+                V[j + 1] = w / H[j + 1, j]
+            for i in range(j):  # the earlier rotations on the new column
+                H[i, j], H[i + 1, j] = cs[i] * H[i, j] + sn[i] * H[i + 1, j], -sn[i] * H[i, j] + cs[i] * H[i + 1, j]
+            radius = math.hypot(H[j, j], H[j + 1, j])
+            cs[j], sn[j] = (1.0, 0.0) if radius == 0.0 else (H[j, j] / radius, H[j + 1, j] / radius)
+            H[j, j], H[j + 1, j] = radius, 0.0
+            g[j], g[j + 1] = cs[j] * g[j], -sn[j] * g[j]
+            total += 1
+            if abs(g[j + 1]) <= target or H[j, j] == 0.0:
+                break
+        k = j + 1
+        u = sla.solve_triangular(H[:k, :k], g[:k], check_finite=False)
+        x += u @ Z[:k]
+        r = b - A(x)
+        beta = float(np.linalg.norm(r))
+        if H[k - 1, k - 1] == 0.0:
+            break
+    return x, total, beta / norm
 
 
 def _field_product(M: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
