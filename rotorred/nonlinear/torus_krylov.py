@@ -161,9 +161,12 @@ class RankJacobian:
 
         def assembled(blocks):
             return blocks.reshape(r, s, m, m).transpose(2, 0, 3, 1).reshape(m * r, m * s)
-        C = assembled(h.toeplitz_blocks(self.Mq.reshape(r * s, N).T, among))
+        fields = np.vstack([self.Mq.reshape(r * s, N), self.Mv.reshape(r * s, N)]) if self.has_velocity else \
+            self.Mq.reshape(r * s, N)
+        blocks = h.toeplitz_blocks(fields.T, among)  # both fields at once: one spectrum, one map of order pairs
+        C = assembled(blocks[:r * s])
         if self.has_velocity:  # times the derivative on the right: columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k)
-            Tv = assembled(h.toeplitz_blocks(self.Mv.reshape(r * s, N).T, among)).reshape(m * r, m, s)
+            Tv = assembled(blocks[r * s:]).reshape(m * r, m, s)
             wk = h.frequencies(self.w)[among[1:]][None, :, None]
             C3 = C.reshape(m * r, m, s)  # a view
             C3[:, 1::2] -= wk * Tv[:, 2::2]
@@ -175,7 +178,9 @@ class RankJacobian:
         # 1999 x 1999 block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product,
         # GMRES's iterations unchanged, docs/model.md §25); in double where it is the whole (a direct solve)
         precision = np.float64 if len(among) == h.n_orders else np.float32
-        return rows, sla.lu_factor((np.eye(m * r) + GT.T).astype(precision), check_finite=False, overwrite_a=True)
+        block = GT.astype(precision).T  # Fortran order: LAPACK's, no copy
+        block[np.diag_indices(m * r)] += 1.0
+        return rows, sla.lu_factor(block, check_finite=False, overwrite_a=True)
 
     def precondition(self, y: np.ndarray) -> np.ndarray:
         """An approximate inverse of ``I + C G_VU`` applied to y ((2K - 1) r,): exact on the block between the orders
