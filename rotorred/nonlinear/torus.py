@@ -993,7 +993,7 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
     residual alone).
 
     Each step is solved only as far as it serves (an inexact Newton method): GMRES's relative tolerance is
-    ``min(1e-2, rho)`` with ``rho`` the relative residual of the iterate, so the steps tighten as Newton converges
+    ``min(1e-2, rho^1.5)`` with ``rho`` the relative residual of the iterate, so the steps tighten as Newton converges
     and the last ones are nearly exact (docs/model.md §25), never tighter than 1e-3 of what is left to reach ``tol``.
 
     Parameters
