@@ -126,9 +126,9 @@ class TorusHarmonics:
     def _index_maps(self) -> None:
         """Where each order sits on the half spectrum of the real 2-D FFT, the real transform along theta_2 (the
         contiguous axis): ``_half`` the flat position (row k_1 mod N_1, column |k_2|) of each order, its conjugate's
-        for k_2 < 0 (``_imaginary_sign``, ``_sine_sign``: the conjugate's signs), and ``_mirror``/``_mirrored``: the orders (k_1 > 0, 0), whose negative the
-        column k_2 = 0 holds too. The K x K maps of differences and sums of two orders are built only when a dense
-        Toeplitz matrix is asked (:meth:`_pair_maps`)."""
+        for k_2 < 0 (``_imaginary_sign``, ``_sine_sign``: the conjugate's signs), and ``_mirror``/``_mirrored``: the
+        orders (k_1 > 0, 0), whose negative the column k_2 = 0 holds too. The K x K maps of differences and sums of
+        two orders are built only when a dense Toeplitz matrix is asked (:meth:`_pair_maps`)."""
         k1, k2 = self.orders[:, 0], self.orders[:, 1]
         width = self.N2 // 2 + 1
         negative = k2 < 0
@@ -753,18 +753,26 @@ class TorusProblem:
         ndarray, shape (size,)
             (m).
         """
+        return self._evaluated(z)[0].copy()
+
+    def _evaluated(self, z: np.ndarray):
+        """R at z and the sampled force derivatives dq, dv (N_1 N_2, c, c), the last point's kept: Newton's step at
+        the point its line search has just evaluated needs no second pass through the grid."""
+        last = self._cache.get("evaluated")
+        if last is not None and np.array_equal(last[0], z):
+            return last[1:]
         q, v = self.samples(z)
-        f = sampled_forces(self._local_forces, q, v)[0]
-        return z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
+        f, dq, dv = sampled_forces(self._local_forces, q, v)
+        R = z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
+        self._cache["evaluated"] = (np.array(z, copy=True), R, dq, dv)
+        return R, dq, dv
 
     def _sampled_terms(self, z: np.ndarray):
         """R and the Jacobian's terms at z: the distinct shapes of the sampled force derivatives (N_1 N_2, b) (a shape
         shared by several DOF pairs, e.g. a rub's rank-1 Jacobian, counts once) and the terms ``(b, kind, A)``: shape
         b on the DOF pattern A, of a derivative by q (kind 0) or by dq/dt (kind 1)."""
         h, c = self.harmonics, self.n
-        q, v = self.samples(z)
-        f, dq, dv = sampled_forces(self._local_forces, q, v)
-        R = z - self.linear_response() + self.apply(h.coefficients(f))
+        R, dq, dv = self._evaluated(z)
         dq, dv = dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)
         active = np.flatnonzero(np.any(dq != 0.0, axis=1) | np.any(dv != 0.0, axis=1))  # a contact's samples (zero
         flat = np.hstack([dq[active], dv[active]])  # rows are proportional to any: the shapes found on the others)
@@ -778,7 +786,7 @@ class TorusProblem:
                     terms.append((b, kind, A))
         columns = np.zeros((h.n_samples, len(base)))
         columns[active] = flat[:, base]
-        return R, columns, tuple(terms)
+        return R.copy(), columns, tuple(terms)
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
