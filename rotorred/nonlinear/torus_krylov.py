@@ -39,6 +39,8 @@ __all__ = ["RankJacobian", "pattern_bases"]
 RANK_RTOL = 1e-12
 #: the orders of largest compliance whose block of the reduced equation the preconditioner inverts exactly
 COARSE_ORDERS = 1000
+#: the largest coarse block factorised in double precision (a larger one in single)
+DOUBLE_BLOCK = 1024
 #: GMRES iterations past which a reused preconditioner is built afresh from the current fields
 REFRESH_ITERATIONS = 60
 
@@ -175,10 +177,11 @@ class RankJacobian:
         GT = block_product(self.P0.T, self.Pk[among[1:] - 1].transpose(0, 2, 1), C.T, s)  # (G_L^T C^T)
         rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
         rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
-        # factorised once. In single precision where the block is part of the equation (a preconditioner: on the rig's
-        # 1999 x 1999 block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product,
-        # GMRES's iterations unchanged, docs/model.md §25); in double where it is the whole (a direct solve)
-        precision = np.float64 if len(among) == h.n_orders else np.float32
+        # factorised once, in single precision (a preconditioner only shapes GMRES's spectrum: on the rig's 1999 x 1999
+        # block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product, GMRES's
+        # iterations unchanged, docs/model.md §25); in double for a small block (cheap either way, and where it is
+        # the whole equation the step is then exact to round-off)
+        precision = np.float64 if m * r <= DOUBLE_BLOCK else np.float32
         block = GT.astype(precision).T  # Fortran order: LAPACK's, no copy
         block[np.diag_indices(m * r)] += 1.0
         return rows, sla.lu_factor(block, check_finite=False, overwrite_a=True)
