@@ -25,9 +25,10 @@ Prints:
    truncations;
 4. the cold start (:func:`rotorred.torus_balance` from its own 1 s record of a 3 s transient, the bases its line
    fit finds there): its time and its distance from the warm solve;
-5. the table of the issue's measure: transient time, torus time (start, Newton at every truncation), their ratio,
-   the worst of the 10 lines, and the process's peak resident memory (transient, record and torus together: an upper
-   bound of the torus's).
+5. the table of the issue's measure: transient time, torus time (everything after the transient that provides the
+   start: the start's least squares, every truncation's problem, compliance and Newton solve, the transfers between
+   them), their ratio, the worst of the 10 lines, the torus's peak memory (tracemalloc) and the process's peak
+   resident memory (transient, record and torus together: an upper bound of the torus's).
 
 The force kernel is compiled (numba) before the torus's clock starts, as the transient's is before its own.
 """
@@ -84,7 +85,7 @@ def transient(scene, sm):
 def refine(scene, sm, torus, result, largest, records):
     """The torus harmonic balance through :data:`TRUNCATIONS`; prints a row per truncation. Returns the last problem,
     its solution, the amplitudes of every truncation and the torus's time: the start's least squares and every
-    truncation's problem, compliance and Newton solve."""
+    truncation's problem, compliance and Newton solve, and the transfer from the one before."""
     frequencies = [ln.frequency_hz for ln in largest]
     reference = np.array([ln.amplitude for ln in largest])
     window = result.t >= result.t[-1] - START_SPAN
