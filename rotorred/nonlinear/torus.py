@@ -61,6 +61,8 @@ __all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "al
 #: the loosest and the tightest relative tolerance of GMRES on a Newton step (the inexact Newton's forcing term,
 #: :func:`solve_torus`)
 FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
+#: the forcing term's power of the relative residual: min(1e-2, rho^1.5), the inexact Newton's order 1.5
+FORCING_ORDER = 1.5
 #: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
 COMPLIANCE_CHUNK = 256
 
@@ -122,14 +124,21 @@ class TorusHarmonics:
         self._index_maps()
 
     def _index_maps(self) -> None:
-        """Where each order sits on the half spectrum of the real 2-D FFT (``_half``; ``_half_conjugate``: the
-        negatives of the orders with ``k_1 = 0``, which that spectrum holds too). The K x K maps of differences and
-        sums of two orders are built only when a dense Toeplitz matrix is asked (:meth:`_pair_maps`)."""
+        """Where each order sits on the half spectrum of the real 2-D FFT, the real transform along theta_2 (the
+        contiguous axis): ``_half`` the flat position (row k_1 mod N_1, column |k_2|) of each order, its conjugate's
+        for k_2 < 0 (``_imaginary_sign``, ``_sine_sign``: the conjugate's signs), and ``_mirror``/``_mirrored``: the
+        orders (k_1 > 0, 0), whose negative the column k_2 = 0 holds too. The K x K maps of differences and sums of
+        two orders are built only when a dense Toeplitz matrix is asked (:meth:`_pair_maps`)."""
         k1, k2 = self.orders[:, 0], self.orders[:, 1]
-        object.__setattr__(self, "_half", (k1 * self.N2 + k2 % self.N2).astype(np.intp))
-        axis = np.flatnonzero(k1 == 0)[1:]  # the orders (0, k2 > 0)
-        object.__setattr__(self, "_axis_orders", axis)
-        object.__setattr__(self, "_half_conjugate", ((-k2[axis]) % self.N2).astype(np.intp))
+        width = self.N2 // 2 + 1
+        negative = k2 < 0
+        row = np.where(negative, -k1, k1) % self.N1
+        object.__setattr__(self, "_half", (row * width + np.abs(k2)).astype(np.intp))
+        object.__setattr__(self, "_imaginary_sign", np.where(negative, -0.5, 0.5))
+        object.__setattr__(self, "_sine_sign", np.where(negative[1:], 2.0, -2.0)[:, None] / self.n_samples)
+        mirrored = np.flatnonzero((k2 == 0) & (k1 > 0))
+        object.__setattr__(self, "_mirrored", mirrored)
+        object.__setattr__(self, "_mirror", (((-k1[mirrored]) % self.N1) * width).astype(np.intp))
         object.__setattr__(self, "_lazy", {})
 
     def _pair_maps(self, among: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -149,25 +158,11 @@ class TorusHarmonics:
             self._lazy["pairs"] = maps
         return maps
 
-    def _transform(self, kind: str, p: int):
-        """The real 2-D FFT of p signals on the grid (``forward``: samples (N_1, N_2, p) -> half spectrum
-        (N_1 / 2 + 1, N_2, p), unnormalised) or its inverse (``inverse``: normalised by 1 / (N_1 N_2)), the real
-        transform along theta_1: a pyFFTW plan kept per kind and p (a copy of its output returned), or scipy's FFT
-        without pyFFTW."""
+    def _plan(self, kind: str, p: int) -> _GridTransform:
+        """The real 2-D FFT of p signals on this grid (:class:`_GridTransform`), kept per kind and p."""
         key = (kind, p)
         if key not in self._lazy:
-            half, full = (self.N1 // 2 + 1, self.N2, p), (self.N1, self.N2, p)
-            if pyfftw is None:
-                self._lazy[key] = (lambda x: sfft.rfftn(x, axes=(1, 0))) if kind == "forward" else \
-                    (lambda x: sfft.irfftn(x, s=(self.N2, self.N1), axes=(1, 0)))
-            else:
-                if kind == "forward":
-                    plan = pyfftw.builders.rfftn(pyfftw.empty_aligned(full, float), axes=(1, 0),
-                                                 planner_effort="FFTW_ESTIMATE", threads=1)
-                else:
-                    plan = pyfftw.builders.irfftn(pyfftw.empty_aligned(half, complex), s=(self.N2, self.N1),
-                                                  axes=(1, 0), planner_effort="FFTW_ESTIMATE", threads=1)
-                self._lazy[key] = lambda x: plan(x).copy()
+            self._lazy[key] = _GridTransform(kind, p, self.N1, self.N2)
         return self._lazy[key]
 
     # ----------------------------------------------------------------------------------------------- sizes
@@ -312,7 +307,7 @@ class TorusHarmonics:
 
     def synthesised(self, Q: np.ndarray) -> np.ndarray:
         """The real signals of complex amplitudes ``Q`` (K, p) on the grid: ``Re sum_k Q_k exp(i k . theta)``, by one
-        inverse real 2-D FFT of the half spectrum (the real transform along theta_1, whose orders are k_1 >= 0).
+        inverse real 2-D FFT of the half spectrum.
 
         Parameters
         ----------
@@ -324,13 +319,43 @@ class TorusHarmonics:
         ndarray, shape (N_1 N_2, p)
             In the units of ``Q``, theta_1 major.
         """
+        return self._synthesis(Q).T.copy()
+
+    def _synthesis(self, Q: np.ndarray) -> np.ndarray:
+        """:meth:`synthesised` with the signals leading (p, N_1 N_2), in the inverse plan's own output: valid until
+        that plan's next use. The half spectrum of the real transform along theta_2 (:meth:`_index_maps`)."""
         p = Q.shape[1]
-        C = np.zeros(((self.N1 // 2 + 1) * self.N2, p), complex)
-        C[self._half[1:]] = 0.5 * Q[1:]
-        C[self._half_conjugate] = 0.5 * Q[self._axis_orders].conj()
-        C[0] = Q[0]
-        q = self._transform("inverse", p)(C.reshape(self.N1 // 2 + 1, self.N2, p))
-        return q.reshape(self.n_samples, p) * self.n_samples
+        plan = self._plan("inverse", p)
+        C = plan.input.reshape(p, -1)
+        C.fill(0.0)
+        half = np.empty((p, self.n_orders), complex)
+        half.real, half.imag = 0.5 * Q.real.T, self._imaginary_sign * Q.imag.T  # k_2 < 0: the conjugate
+        C[:, self._half[1:]] = half[:, 1:]
+        C[:, self._mirror] = half[:, self._mirrored].conj()
+        C[:, 0] = Q[0]
+        return plan.execute().reshape(p, self.n_samples)
+
+    def grid_product(self, Q: np.ndarray, product, r: int) -> np.ndarray:
+        """The coefficients of ``product(x, out)`` for the signals ``x`` of complex amplitudes Q: one inverse and one
+        forward real 2-D FFT, ``product`` writing its r signals on the grid into ``out`` (no other copy).
+
+        Parameters
+        ----------
+        Q : ndarray, shape (K, p), complex
+            Amplitudes of each order of p signals, any units.
+        product : callable
+            ``product(x, out)``: x (p, N_1 N_2) the signals (read only), out (r, N_1 N_2) to fill.
+        r : int
+            Signals ``product`` returns.
+
+        Returns
+        -------
+        ndarray, shape (2K - 1, r)
+            Harmonic-major coefficients of the product's signals.
+        """
+        plan = self._plan("forward", r)
+        product(self._synthesis(Q), plan.input.reshape(r, self.n_samples))
+        return self._gathered(plan.execute().reshape(r, -1))
 
     def derivative(self, z: np.ndarray, n: int, w) -> np.ndarray:
         """Coefficients of ``dq/dt = (w . nabla) q``: ``(a_k, b_k) -> (k.w) (b_k, -a_k)``.
@@ -411,13 +436,19 @@ class TorusHarmonics:
         ndarray, shape ((2K - 1) n,)
             In the units of ``f``.
         """
-        n = f.shape[1]
-        S = self._transform("forward", n)(f.reshape(self.N1, self.N2, n)).reshape(-1, n) / self.n_samples
-        c = S[self._half]
-        z = np.empty((self.size, n))
-        z[0] = c[0].real
-        z[1::2], z[2::2] = 2.0 * c[1:].real, -2.0 * c[1:].imag
-        return z.reshape(-1)
+        p = f.shape[1]
+        plan = self._plan("forward", p)
+        plan.input[...] = f.T.reshape(p, self.N1, self.N2)
+        return self._gathered(plan.execute().reshape(p, -1)).reshape(-1)
+
+    def _gathered(self, S: np.ndarray) -> np.ndarray:
+        """Harmonic-major coefficients (2K - 1, p) of the unnormalised half spectra S (p, N_1 (N_2 / 2 + 1))."""
+        c = S[:, self._half].T
+        z = np.empty((self.size, S.shape[0]))
+        z[0] = c[0].real / self.n_samples
+        z[1::2] = c[1:].real * (2.0 / self.n_samples)
+        z[2::2] = c[1:].imag * self._sine_sign
+        return z
 
     # ----------------------------------------------------------------------------------------------- Jacobians
     def basis_matrix(self) -> np.ndarray:
@@ -538,6 +569,35 @@ class TorusHarmonics:
         Q[0] = fit.mean
         Q[used] = np.where(f[used] > 0, fit.coefficients, fit.coefficients.conj())
         return self.from_phasors(Q[:, None])
+
+
+class _GridTransform:
+    """The unnormalised real 2-D FFT of p signals on an N_1 x N_2 grid, signals leading, the real transform along
+    theta_2 (the contiguous axis: three times faster than along theta_1): ``forward`` samples (p, N_1, N_2) -> half
+    spectra (p, N_1, N_2 / 2 + 1), ``inverse`` back (``sum_k C_k exp(i k . theta)``, no 1 / (N_1 N_2)). Callers
+    write :attr:`input` and read what :meth:`execute` returns, the plan's own output (valid until its next call). A
+    pyFFTW plan (one thread) or scipy's FFT without pyFFTW."""
+
+    def __init__(self, kind: str, p: int, N1: int, N2: int):
+        half, full = (p, N1, N2 // 2 + 1), (p, N1, N2)
+        self.forward = kind == "forward"
+        if pyfftw is None:
+            self.input = np.zeros(full if self.forward else half, float if self.forward else complex)
+            self._fft = (lambda x: sfft.rfftn(x, axes=(1, 2))) if self.forward else \
+                (lambda x: sfft.irfftn(x, s=(N1, N2), axes=(1, 2), norm="forward"))
+            return
+        source = pyfftw.empty_aligned(full, float) if self.forward else pyfftw.empty_aligned(half, complex)
+        target = pyfftw.empty_aligned(half, complex) if self.forward else pyfftw.empty_aligned(full, float)
+        self._plan = pyfftw.FFTW(source, target, axes=(1, 2), direction="FFTW_FORWARD" if self.forward else
+                                 "FFTW_BACKWARD", flags=("FFTW_ESTIMATE", "FFTW_DESTROY_INPUT"), threads=1)
+        self.input = source
+
+    def execute(self) -> np.ndarray:
+        """The transform of :attr:`input` (which an inverse transform may overwrite)."""
+        if pyfftw is None:
+            return self._fft(self.input)
+        self._plan.execute()
+        return self._plan.output_array
 
 
 def _assembled(blocks: np.ndarray, n: int) -> np.ndarray:
@@ -693,21 +753,30 @@ class TorusProblem:
         ndarray, shape (size,)
             (m).
         """
+        return self._evaluated(z)[0].copy()
+
+    def _evaluated(self, z: np.ndarray):
+        """R at z and the sampled force derivatives dq, dv (N_1 N_2, c, c), the last point's kept: Newton's step at
+        the point its line search has just evaluated needs no second pass through the grid."""
+        last = self._cache.get("evaluated")
+        if last is not None and np.array_equal(last[0], z):
+            return last[1:]
         q, v = self.samples(z)
-        f = sampled_forces(self._local_forces, q, v)[0]
-        return z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
+        f, dq, dv = sampled_forces(self._local_forces, q, v)
+        R = z - self.linear_response() + self.apply(self.harmonics.coefficients(f))
+        self._cache["evaluated"] = (np.array(z, copy=True), R, dq, dv)
+        return R, dq, dv
 
     def _sampled_terms(self, z: np.ndarray):
         """R and the Jacobian's terms at z: the distinct shapes of the sampled force derivatives (N_1 N_2, b) (a shape
         shared by several DOF pairs, e.g. a rub's rank-1 Jacobian, counts once) and the terms ``(b, kind, A)``: shape
         b on the DOF pattern A, of a derivative by q (kind 0) or by dq/dt (kind 1)."""
         h, c = self.harmonics, self.n
-        q, v = self.samples(z)
-        f, dq, dv = sampled_forces(self._local_forces, q, v)
-        R = z - self.linear_response() + self.apply(h.coefficients(f))
-        flat = np.hstack([dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)])
-        active = np.flatnonzero(np.any(flat != 0.0, axis=1))  # a contact's samples (zero rows are proportional)
-        base, factor = proportional_columns(flat[active]) if active.size else ([], np.full((2 * c * c, 2), -1.0))
+        R, dq, dv = self._evaluated(z)
+        dq, dv = dq.reshape(h.n_samples, c * c), dv.reshape(h.n_samples, c * c)
+        active = np.flatnonzero(np.any(dq != 0.0, axis=1) | np.any(dv != 0.0, axis=1))  # a contact's samples (zero
+        flat = np.hstack([dq[active], dv[active]])  # rows are proportional to any: the shapes found on the others)
+        base, factor = proportional_columns(flat) if active.size else ([], np.full((2 * c * c, 2), -1.0))
         terms = []
         for b in range(len(base)):
             for kind in (0, 1):
@@ -715,7 +784,9 @@ class TorusProblem:
                 A = np.where(pairs[:, 1] == b, pairs[:, 0], 0.0).reshape(c, c)
                 if A.any():
                     terms.append((b, kind, A))
-        return R, flat[:, base], tuple(terms)
+        columns = np.zeros((h.n_samples, len(base)))
+        columns[active] = flat[:, base]
+        return R.copy(), columns, tuple(terms)
 
     def evaluate(self, z: np.ndarray, omega: float | None = None) -> Evaluation:
         """The residual, and on first use its dense analytic Jacobian ``I + G sum_t kron(T_t, A_t)``
@@ -930,7 +1001,7 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
     residual alone).
 
     Each step is solved only as far as it serves (an inexact Newton method): GMRES's relative tolerance is
-    ``min(1e-2, rho)`` with ``rho`` the relative residual of the iterate, so the steps tighten as Newton converges
+    ``min(1e-2, rho^1.5)`` with ``rho`` the relative residual of the iterate, so the steps tighten as Newton converges
     and the last ones are nearly exact (docs/model.md §25), never tighter than 1e-3 of what is left to reach ``tol``.
 
     Parameters
@@ -965,7 +1036,7 @@ def solve_torus(problem: TorusProblem, z0: np.ndarray, *, tol: float = 1e-10, ma
                                  tuple(krylov))
         if it == max_iter:
             break
-        rtol = max(min(FORCING_MAX, history[-1]), 1e-3 * tol / history[-1], KRYLOV_FLOOR)
+        rtol = max(min(FORCING_MAX, history[-1] ** FORCING_ORDER), 1e-3 * tol / history[-1], KRYLOV_FLOOR)
         try:
             _, step, stats, J = problem.newton_step(z, rtol, J)
         except (sla.LinAlgError, ValueError):

@@ -14,23 +14,24 @@ an equation in the coefficients of r signals on the torus. ``C`` is never formed
 coefficients of s signals, is their samples and rates on the grid by one inverse real 2-D FFT, multiplied there by
 the fields ``Mq(theta) = sum d_t B_t`` (position terms) and ``Mv(theta)`` (velocity terms), r x s at each sample, and
 returned by one forward FFT: O(N_1 N_2 log(N_1 N_2) (r + 2 s)) a product, memory O(N_1 N_2 r s + K (r + s)^2).
-GMRES (scipy) solves it, preconditioned by the exact inverse of its block between the orders of largest compliance
-(:data:`COARSE_ORDERS`: the orders where ``C G_VU`` is large, whose eigenvalues would otherwise be GMRES's outliers)
-and the identity elsewhere; the block is the fields' Toeplitz matrices between those orders only (built from their
-2-D spectrum), inverted once and reused by the following Newton steps until GMRES needs more than
-:data:`REFRESH_ITERATIONS`. *Choice* (docs/model.md §25): the block diagonal over the orders (each order's 2 x 2
-block with the contact's mean stiffness) stalls on the rig: its impacts couple the orders far from the diagonal
+GMRES preconditioned on the right (:func:`right_gmres`) solves it; the preconditioner is the inverse of its block
+between the orders of largest compliance (:data:`COARSE_ORDERS`: the orders where ``C G_VU`` is large, whose
+eigenvalues would otherwise be GMRES's outliers) and the identity elsewhere; the block is the fields' Toeplitz
+matrices between those orders only (built from their 2-D spectrum), factorised once (LU, single precision) and
+reused by the following Newton steps until GMRES needs more than :data:`REFRESH_ITERATIONS`. *Choice*
+(docs/model.md §25): the block diagonal over the orders (each order's 2 x 2 block with the contact's mean stiffness)
+stalls on the rig: its impacts couple the orders far from the diagonal
 (at |k1| <= 6, |k2| <= 30, GMRES stalled at 4.5e-2 after 2000 iterations, against 4.5e-5 after 43 without a
 preconditioner).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.sparse.linalg import LinearOperator, gmres
 
 __all__ = ["RankJacobian", "pattern_bases"]
 
@@ -38,6 +39,8 @@ __all__ = ["RankJacobian", "pattern_bases"]
 RANK_RTOL = 1e-12
 #: the orders of largest compliance whose block of the reduced equation the preconditioner inverts exactly
 COARSE_ORDERS = 1000
+#: the largest coarse block factorised in double precision (a larger one in single)
+DOUBLE_BLOCK = 1024
 #: GMRES iterations past which a reused preconditioner is built afresh from the current fields
 REFRESH_ITERATIONS = 60
 
@@ -90,11 +93,7 @@ class RankJacobian:
         self.c = self.G0.shape[0]
         self.U, self.V = pattern_bases([A for _, _, A in terms])
         self.r, self.s = self.U.shape[1], self.V.shape[1]
-        N = harmonics.n_samples
-        self.Mq, self.Mv = np.zeros((N, self.r, self.s)), np.zeros((N, self.r, self.s))
-        for b, kind, A in terms:
-            B = self.U.T @ A @ self.V
-            (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * B[None]
+        self.Mq, self.Mv = self._fields(columns, terms)
         self.has_velocity = bool(np.any(self.Mv))
         self.P0, self.Pk = projected_blocks(self.G0, self.Gk, self.V, self.U)
         same = reuse is not None and reuse.U.shape == self.U.shape and reuse.V.shape == self.V.shape and \
@@ -103,11 +102,19 @@ class RankJacobian:
         self._preconditioner = reuse._preconditioner if same else None
         if same:  # the bases' signs may differ: the reused factors act in the earlier bases
             self.U, self.V = reuse.U, reuse.V
-            self.Mq, self.Mv = np.zeros_like(self.Mq), np.zeros_like(self.Mv)
-            for b, kind, A in terms:
-                (self.Mq if kind == 0 else self.Mv)[...] += columns[:, b, None, None] * (self.U.T @ A @ self.V)[None]
+            self.Mq, self.Mv = self._fields(columns, terms)
             self.P0, self.Pk = reuse.P0, reuse.Pk
         self.reused = same
+
+    def _fields(self, columns: np.ndarray, terms) -> tuple[np.ndarray, np.ndarray]:
+        """The fields ``Mq = sum d_t B_t`` (position terms) and ``Mv`` (velocity terms), ``B_t = U^T A_t V``, on the
+        grid: shape (r, s, N_1 N_2) each, the samples contiguous (the layout of the FFT's signals)."""
+        N = self.h.n_samples
+        Mq, Mv = np.zeros((self.r, self.s, N)), np.zeros((self.r, self.s, N))
+        for b, kind, A in terms:
+            B = self.U.T @ A @ self.V
+            (Mq if kind == 0 else Mv)[...] += B[:, :, None] * columns[None, None, :, b]
+        return Mq, Mv
 
     @property
     def inner_size(self) -> int:
@@ -119,14 +126,17 @@ class RankJacobian:
         """``C p``: the coefficients (m, r) of ``Mq p(theta) + Mv (w . nabla) p(theta)`` for the coefficients
         ``p`` (m, s) of s signals, through the grid."""
         h, s = self.h, self.s
-        if self.has_velocity:
-            both = np.hstack([p, h.derivative(p.reshape(-1), s, self.w).reshape(-1, s)])
-            samples = h.synthesised(_phasors(both))
-            out = (np.einsum("nrs,ns->nr", self.Mq, samples[:, :s])
-                   + np.einsum("nrs,ns->nr", self.Mv, samples[:, s:]))
-        else:
-            out = np.einsum("nrs,ns->nr", self.Mq, h.synthesised(_phasors(p)))
-        return h.coefficients(out).reshape(-1, self.r)
+        Q = _phasors(p)
+        if not self.has_velocity:
+            return h.grid_product(Q, lambda x, out: _field_product(self.Mq, x, out), self.r)
+        both = np.empty((len(Q), 2 * s), complex)
+        both[:, :s] = Q
+        np.multiply(Q, 1j * h.frequencies(self.w)[:, None], out=both[:, s:])  # (w . nabla): the phasor times i k . w
+
+        def product(x, out):
+            _field_product(self.Mq, x[:s], out)
+            out += _field_product(self.Mv, x[s:])
+        return h.grid_product(both, product, self.r)
 
     def compliance(self, y: np.ndarray) -> np.ndarray:
         """``G_VU y`` for y (m, r): (m, s)."""
@@ -145,8 +155,8 @@ class RankJacobian:
     # ------------------------------------------------------------------------------------------ preconditioner
     def _coarse_block(self):
         """The orders where the compliance is largest (:data:`COARSE_ORDERS` of them, the mean among them): their
-        positions in the reduced vector and the inverse of the reduced equation's dense block between them,
-        ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
+        positions in the reduced vector and the LU factors (single precision) of the reduced equation's dense block
+        between them, ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
         h, r, s, N = self.h, self.r, self.s, self.h.n_samples
         weight = np.concatenate([[np.linalg.norm(self.P0)], np.linalg.norm(self.Pk, axis=(1, 2))])
         among = np.union1d([0], np.argsort(-weight)[:COARSE_ORDERS])
@@ -154,9 +164,12 @@ class RankJacobian:
 
         def assembled(blocks):
             return blocks.reshape(r, s, m, m).transpose(2, 0, 3, 1).reshape(m * r, m * s)
-        C = assembled(h.toeplitz_blocks(self.Mq.reshape(N, r * s), among))
+        fields = np.vstack([self.Mq.reshape(r * s, N), self.Mv.reshape(r * s, N)]) if self.has_velocity else \
+            self.Mq.reshape(r * s, N)
+        blocks = h.toeplitz_blocks(fields.T, among)  # both fields at once: one spectrum, one map of order pairs
+        C = assembled(blocks[:r * s])
         if self.has_velocity:  # times the derivative on the right: columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k)
-            Tv = assembled(h.toeplitz_blocks(self.Mv.reshape(N, r * s), among)).reshape(m * r, m, s)
+            Tv = assembled(blocks[r * s:]).reshape(m * r, m, s)
             wk = h.frequencies(self.w)[among[1:]][None, :, None]
             C3 = C.reshape(m * r, m, s)  # a view
             C3[:, 1::2] -= wk * Tv[:, 2::2]
@@ -164,44 +177,114 @@ class RankJacobian:
         GT = block_product(self.P0.T, self.Pk[among[1:] - 1].transpose(0, 2, 1), C.T, s)  # (G_L^T C^T)
         rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
         rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
-        # inverted once (in double precision: its condition reaches 2e7 on the rig), its product a GMRES iteration:
-        # faster than an LU's two triangular solves
-        return rows, sla.inv(np.eye(m * r) + GT.T, check_finite=False)
+        # factorised once, in single precision (a preconditioner only shapes GMRES's spectrum: on the rig's 1999 x 1999
+        # block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product, GMRES's
+        # iterations unchanged, docs/model.md §25); in double for a small block (cheap either way, and where it is
+        # the whole equation the step is then exact to round-off)
+        precision = np.float64 if m * r <= DOUBLE_BLOCK else np.float32
+        block = GT.astype(precision).T  # Fortran order: LAPACK's, no copy
+        block[np.diag_indices(m * r)] += 1.0
+        return rows, sla.lu_factor(block, check_finite=False, overwrite_a=True)
 
     def precondition(self, y: np.ndarray) -> np.ndarray:
         """An approximate inverse of ``I + C G_VU`` applied to y ((2K - 1) r,): exact on the block between the orders
         of largest compliance (:meth:`_coarse_block`), the identity elsewhere (where ``C G_VU`` is small)."""
         if self._preconditioner is None:
             self._preconditioner = self._coarse_block()
-        rows, inverse = self._preconditioner
+        rows, factors = self._preconditioner
         out = y.copy()
-        out[rows] = inverse @ y[rows]
+        out[rows] = sla.lu_solve(factors, y[rows].astype(factors[0].dtype), check_finite=False)
         return out
 
     # ------------------------------------------------------------------------------------------ the step
     def solve(self, b: np.ndarray, rtol: float, maxiter: int = 300, restart: int = 100):
-        """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``;
-        returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced residual reached)."""
+        """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``
+        (:func:`right_gmres`); returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced
+        residual reached)."""
         rhs = self.core(b.reshape(-1, self.c) @ self.V).reshape(-1)
-        n = self.inner_size
-        A = LinearOperator((n, n), matvec=self.inner, dtype=float)
-        M = LinearOperator((n, n), matvec=self.precondition, dtype=float)
-        count = [0]
-
-        def counted(_):
-            count[0] += 1
-        y, info = gmres(A, rhs, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
-                        callback=counted, callback_type="pr_norm")
-        if self.reused and (info != 0 or count[0] > REFRESH_ITERATIONS):  # the earlier factors serve badly: fresh
-            self._preconditioner, self.reused = None, False
-            y, info = gmres(A, rhs, x0=y, rtol=rtol, atol=0.0, restart=restart, maxiter=-(-maxiter // restart), M=M,
-                            callback=counted, callback_type="pr_norm")
-        norm = float(np.linalg.norm(rhs)) or 1.0
-        achieved = float(np.linalg.norm(self.inner(y) - rhs)) / norm
+        y, iterations, achieved = right_gmres(self.inner, self.precondition, rhs, None, rtol, restart, maxiter)
+        if self.reused and (achieved > rtol or iterations > REFRESH_ITERATIONS):  # the earlier factors serve badly:
+            self._preconditioner, self.reused = None, False  # fresh ones from the current fields
+            y, more, achieved = right_gmres(self.inner, self.precondition, rhs, y, rtol, restart, maxiter)
+            iterations += more
         if not np.all(np.isfinite(y)):
             raise sla.LinAlgError("GMRES gave a non-finite solution")
         X_y = block_product(self.G0, self.Gk, (y.reshape(-1, self.r) @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
-        return b - X_y, KrylovStats(count[0], achieved)
+        return b - X_y, KrylovStats(iterations, achieved)
+
+
+def right_gmres(A, M, b: np.ndarray, x0: np.ndarray | None, rtol: float, restart: int, maxiter: int):
+    """``A x = b`` by GMRES on ``A M u = b``, ``x = M u``: preconditioned on the right, so its residual is the true
+    one's and it stops when ``||b - A x|| <= rtol ||b||`` (scipy's GMRES, preconditioned on the left, stops on the
+    preconditioned residual: on the rig 5 to 20 times below the tolerance asked). Restarted every ``restart``
+    iterations; Gram-Schmidt classical and done twice (two products with the basis an iteration).
+
+    Parameters
+    ----------
+    A, M : callable
+        ``v -> A v`` and ``v -> M v`` (M an approximate inverse of A) for v of shape (n,).
+    b : ndarray, shape (n,)
+        The right-hand side.
+    x0 : ndarray, shape (n,), optional
+        The start (default 0).
+    rtol : float
+        The relative residual to reach.
+    restart, maxiter : int
+        Iterations between restarts, and in all.
+
+    Returns
+    -------
+    x : ndarray, shape (n,)
+        In the units of ``b`` over those of A.
+    iterations : int
+        Products with A (besides the residuals at the restarts).
+    residual : float
+        ``||b - A x|| / ||b||`` reached.
+    """
+    norm = float(np.linalg.norm(b)) or 1.0
+    n, target = b.size, rtol * norm
+    x = np.zeros(n) if x0 is None else x0.copy()
+    r = b - A(x) if x0 is not None else b.copy()
+    beta, total = float(np.linalg.norm(r)), 0
+    while beta > target and total < maxiter:
+        m = min(restart, maxiter - total)
+        V, Z, H = np.empty((m + 1, n)), np.empty((m, n)), np.zeros((m + 1, m))
+        cs, sn, g = np.zeros(m), np.zeros(m), np.zeros(m + 1)
+        V[0], g[0] = r / beta, beta
+        for j in range(m):
+            Z[j] = M(V[j])
+            w = A(Z[j])
+            h = V[:j + 1] @ w
+            w -= h @ V[:j + 1]
+            again = V[:j + 1] @ w
+            w -= again @ V[:j + 1]
+            H[:j + 1, j], H[j + 1, j] = h + again, np.linalg.norm(w)
+            if H[j + 1, j] > 0.0:
+                V[j + 1] = w / H[j + 1, j]
+            for i in range(j):  # the earlier rotations on the new column
+                H[i, j], H[i + 1, j] = cs[i] * H[i, j] + sn[i] * H[i + 1, j], -sn[i] * H[i, j] + cs[i] * H[i + 1, j]
+            radius = math.hypot(H[j, j], H[j + 1, j])
+            cs[j], sn[j] = (1.0, 0.0) if radius == 0.0 else (H[j, j] / radius, H[j + 1, j] / radius)
+            H[j, j], H[j + 1, j] = radius, 0.0
+            g[j], g[j + 1] = cs[j] * g[j], -sn[j] * g[j]
+            total += 1
+            if abs(g[j + 1]) <= target or H[j, j] == 0.0:
+                break
+        k = j + 1
+        u = sla.solve_triangular(H[:k, :k], g[:k], check_finite=False)
+        x += u @ Z[:k]
+        r = b - A(x)
+        beta = float(np.linalg.norm(r))
+        if H[k - 1, k - 1] == 0.0:
+            break
+    return x, total, beta / norm
+
+
+def _field_product(M: np.ndarray, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``M(theta) x(theta)`` at each sample: fields (r, s, N) times signals (s, N), shape (r, N) (into ``out``)."""
+    if M.shape[:2] == (1, 1):
+        return np.multiply(M[0], x, out=out)
+    return np.einsum("rsn,sn->rn", M, x, out=out)
 
 
 def _phasors(p: np.ndarray) -> np.ndarray:
@@ -218,5 +301,10 @@ def block_product(B0: np.ndarray, Bk: np.ndarray, X: np.ndarray, c: int) -> np.n
     a = B0.shape[0]
     out = np.empty((a + 2 * a * len(Bk), X.shape[1]))
     out[:a] = B0 @ X[:c]
-    out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
+    if Bk.shape[1:] == (2, 2):  # one signal (a rub's rank): the 2 x 2 products written out (matmul's are slow)
+        x, y = X[1::2], X[2::2]
+        out[1::2] = Bk[:, 0, 0, None] * x + Bk[:, 0, 1, None] * y
+        out[2::2] = Bk[:, 1, 0, None] * x + Bk[:, 1, 1, None] * y
+    else:
+        out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
     return out
