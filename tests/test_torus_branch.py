@@ -142,3 +142,33 @@ def test_a_point_of_the_upper_branch_is_the_torus_solve_ivp_stays_on():
     t = np.linspace(T - 20.0, T, 400)
     error = np.max(np.abs(sol.sol(t)[0] - np.array([on_torus(ti)[0] for ti in t])))
     assert error < 2e-7 * np.max(np.abs(Q))
+
+
+# ------------------------------------------------------------------------------------------------- the rig, the CLI
+def test_rotorred_continue_follows_a_torus_and_writes_its_branch(tmp_path):
+    """``rotorred continue --torus 1,3`` on paper-rub at outer 91.37 Hz (incommensurate: no periodic branch), in the
+    clearance from 14 to 12 µm on a small box (|k1| <= 2, |k2| <= 8): it reaches the end, writes branch.csv (a row a
+    point, the clearance from 14 µm down past 12 µm, the bases 70 and 91.37 / 3 Hz), branch_lines.csv, branch.nc,
+    branch.png and branch.txt (no report.html: no interactive view of a torus branch)."""
+    import csv
+
+    import xarray as xr
+
+    from rotorred.cli import main
+
+    out = tmp_path / "o"
+    status = main(["continue", "paper-rub", "--set", "speeds.outer=91.37", "--param", "rub.clearance=14e-6:12e-6",
+                   "--torus", "1,3", "--orders", "2,8", "--out", str(out)])
+    assert status == 0
+    for name in ("branch.csv", "branch_lines.csv", "branch.nc", "branch.png", "branch.txt"):
+        assert (out / name).is_file(), name
+    assert not (out / "report.html").exists()
+    rows = list(csv.reader(open(out / "branch.csv")))
+    values = np.array([float(r[0]) for r in rows[1:]])
+    assert rows[0][0] == "rub.clearance (m)" and len(values) >= 3
+    assert values[0] == pytest.approx(14e-6) and values[-1] <= 12e-6 < values[-2]
+    assert np.allclose([float(r[1]) for r in rows[1:]], 70.0, rtol=1e-8)
+    assert np.allclose([float(r[2]) for r in rows[1:]], 91.37 / 3, rtol=1e-8)
+    with xr.open_dataset(out / "branch.nc") as ds:
+        assert ds["amplitude"].shape[0] == len(values) and ds["amplitude"].attrs["units"] == "m"
+    assert "reached the end" in (out / "branch.txt").read_text()

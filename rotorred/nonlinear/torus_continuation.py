@@ -119,11 +119,17 @@ class TorusFamily:
         The value that sets the scale of the carried parameter (its unit), != 0.
     parameter : (str, str)
         The parameter's name and unit, for the branch and its messages.
+    frozen : float
+        ``dR/dvalue`` is computed afresh only where the value has moved by more than this share of it since it last
+        was (else that one serves: the corrector's iterates of one point, a chord in the parameter's direction), >= 0;
+        0 (default): at every iterate. Where a value's problem costs its compliance (a speed: every order's dynamic
+        stiffness solved) this halves the problems built; the folds are then located to about this share.
     """
 
     build: Callable[[float], TorusProblem]
     reference: float
     parameter: tuple = ("value", "-")
+    frozen: float = 0.0
     _problems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     _state: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -133,7 +139,8 @@ class TorusFamily:
             checks.fail("reference", reference, "must not be 0 (it scales the carried parameter)", self.parameter[1])
         p = self.at(reference)
         object.__setattr__(self, "scale", float(np.linalg.norm(p.linear_response()) or 1.0) / abs(reference))
-        self._state.update(last=None, krylov=0, jacobians=0)
+        checks.non_negative("frozen", self.frozen)
+        self._state.update(last=None, krylov=0, jacobians=0, column=None)
 
     # ------------------------------------------------------------------------------------------ the problems
     def at(self, value: float) -> TorusProblem:
@@ -196,6 +203,14 @@ class TorusFamily:
         relative = float(np.linalg.norm(R)) / p.scale
 
         def dR_ds():
+            kept = self._state["column"]
+            if kept is not None and abs(kept[0] - value) <= self.frozen * abs(value) and len(kept[1]) == len(z):
+                return kept[1]
+            column = difference()
+            self._state["column"] = (value, column)
+            return column
+
+        def difference():
             h = STEP * abs(value)
             up = self._valid(value + h)
             if up is None:
