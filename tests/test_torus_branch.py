@@ -172,3 +172,30 @@ def test_rotorred_continue_follows_a_torus_and_writes_its_branch(tmp_path):
     with xr.open_dataset(out / "branch.nc") as ds:
         assert ds["amplitude"].shape[0] == len(values) and ds["amplitude"].attrs["units"] == "m"
     assert "reached the end" in (out / "branch.txt").read_text()
+
+
+def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there(tmp_path):
+    """``continue_torus`` in the outer speed from 91.37 to 91.8 Hz (inner 70 Hz held), |k1| <= 2, |k2| <= 8: the bases
+    are (70, f_outer / 3) Hz at every point, and each point's coefficients solve the problem
+    ``torus_rub_problem`` builds on its own at that speed (its relative residual below 1e-7, the branch asking 1e-6:
+    measured at most 8e-9); the branch shows itself (repr, figure, NetCDF)."""
+    from results_checks import assert_shows_itself
+
+    import rotorred as rr
+    from rotorred.scenes.quasi_periodic import default_grid
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = build_model(scene).model
+    branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05)))
+    assert branch.stopped.startswith("reached the end") and len(branch.values) >= 3
+    assert np.allclose(branch.bases_hz[:, 0], 70.0, rtol=1e-12)
+    assert np.allclose(branch.bases_hz[:, 1], branch.values / 3, rtol=1e-12)
+    for v, z in zip(branch.values, branch.z):
+        there = load_scene("paper-rub", {"speeds.outer": float(v)})
+        problem = torus_rub_problem(there, model, (70.0, v / 3), 2, 8, *default_grid(2, 8), 1500.0).problem
+        assert np.linalg.norm(problem.residual(z)) < 1e-7 * problem.scale
+    assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)

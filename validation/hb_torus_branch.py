@@ -10,7 +10,7 @@ line fit, its 10 largest lines), whose solve time is the point's reference.
 
 Run::
 
-    OPENBLAS_NUM_THREADS=1 python validation/hb_torus_branch.py
+    OPENBLAS_NUM_THREADS=1 python validation/hb_torus_branch.py [--orders H1,H2]
 
 Prints, per branch: a row a point (the key, the bases, the corrections, the point's wall time and the transients'
 median time over it: the speed-up), the folds (or, where none, the evidence: the tangent's parameter component keeps
@@ -21,6 +21,7 @@ other work: the ratios are of times measured in the same run.
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -31,7 +32,8 @@ from rotorred.scenes.schema import load_scene
 from rotorred.scenes.torus_branch import TorusBranchOptions, continue_torus
 
 OUTER_HZ = 91.37  #: Hz, the clearance branch's outer speed (inner 70 Hz)
-ORDERS = (8, 40)  #: the box of orders |k1| <= 8, |k2| <= 40 (band 1500 Hz)
+ORDERS = (8, 40)  #: the box of orders |k1| <= 8, |k2| <= 40 (band 1500 Hz); ``--orders H1,H2`` another
+DIVISORS = (1, 3)  #: the torus (f_L, f_H / 3) (at 91 Hz the speeds are 13:10, where the line fit sees no torus)
 TOL = 1e-6  #: the relative residual of every point
 #: the branches: key, start, end, the values checked against a transient (the branch's points nearest to them), and
 #: how each is shown (scale, unit)
@@ -73,7 +75,8 @@ def follow(key, start, end, checked, xs, xu):
     scene = scene_for(key, start, record=False)
     sm = build_model(scene)
     t0 = time.perf_counter()
-    branch = continue_torus(scene, sm.model, key, start, end, TorusBranchOptions(orders=ORDERS, tol=TOL))
+    branch = continue_torus(scene, sm.model, key, start, end, TorusBranchOptions(orders=ORDERS, divisors=DIVISORS,
+                                                                               tol=TOL))
     wall = time.perf_counter() - t0
     print("\n".join(branch.summary()))
     at = sorted({int(np.argmin(np.abs(branch.values - v))) for v in checked})
@@ -107,6 +110,9 @@ def follow(key, start, end, checked, xs, xu):
 
 
 def main():
+    global ORDERS
+    if "--orders" in sys.argv:
+        ORDERS = tuple(int(v) for v in sys.argv[sys.argv.index("--orders") + 1].split(","))
     rows = []
     for key, start, end, checked, xs, xu in BRANCHES:
         print(f"branch in {key} from {xs * start:g} to {xs * end:g} {xu}, orders |k1| <= {ORDERS[0]}, |k2| <= "

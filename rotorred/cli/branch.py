@@ -49,10 +49,11 @@ def add_parser(subparsers):
     p.add_argument("--tol", type=float, default=None,
                    help="relative residual of every point (default 1e-9; 1e-6 on a torus)")
     p.add_argument("--torus", nargs="?", const="found", default=None, metavar="J,K",
-                   help="follow the quasi-periodic response on the torus of the bases (f_L/J, f_H/K) (incommensurate "
-                        "speeds; without J,K: the torus the start's line fit finds)")
+                   help="follow the quasi-periodic response on the torus of the bases f_L/J, f_H/K (Hz, the spools' "
+                        "frequencies over integers; incommensurate speeds; without J,K: the torus the start's line "
+                        "fit finds)")
     p.add_argument("--orders", default="8,40", metavar="H1,H2",
-                   help="with --torus: the box of orders |k1| <= H1, |k2| <= H2 (default 8,40)")
+                   help="with --torus: the box of orders |k1| <= H1, |k2| <= H2 (default 8,40), lines up to 1500 Hz")
     p.add_argument("--no-stability", action="store_true", help="skip the Floquet multipliers (the slow part)")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true",

@@ -12,7 +12,8 @@ back onto its own path stops there (:func:`_retraced`).
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
-point, to ``1e-10`` of the step. Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
+point, to the larger of ``1e-10`` and the corrector's tolerance of the step (a looser corrector, a torus's inexact
+Newton, leaves ``d omega / ds`` that uncertain: Brent would spend its evaluations on noise). Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
 
 An *interrupt* (:data:`INTERRUPTS`, or the exceptions a caller names: the command line's SIGTERM) ends the tracing
 where it is: the points so far are returned, ``stopped`` and ``interrupt`` saying so.
@@ -58,6 +59,8 @@ CONTRACTION = 0.5
 #: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
 CORNER_ITERATIONS = 12
 CORNER_HALVINGS = 4
+#: Brent's tolerance on a fold's position, a share of the step (at least the corrector's tolerance)
+FOLD_XTOL = 1e-10
 
 
 @dataclass(frozen=True)
@@ -598,7 +601,7 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
         return _tangent(problem, done[0], a.t)[-1]  # at the point itself: the fold's position rests on it
 
     try:
-        s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
+        s = brentq(domega, 0.0, span, xtol=max(FOLD_XTOL, tol) * abs(span), rtol=4 * np.finfo(float).eps)
     except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
         return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
     y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]

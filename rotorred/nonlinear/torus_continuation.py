@@ -8,7 +8,7 @@ at the reference value, so that the arclength weighs it like the coefficients (m
 evaluates the residual of :class:`rotorred.nonlinear.torus.TorusProblem` at ``(z, s)``; its Jacobian is held by the
 contact's rank and never formed (:class:`rotorred.nonlinear.torus_krylov.RankJacobian`), and ``dR/ds`` is a forward
 difference of the residual (a relative step :data:`STEP` of the value: one problem more an iteration where the value
-changes the compliance, a speed).
+changes the compliance, a speed; with ``frozen``, the pair of problems of a nearby value).
 
 The bordered system of the corrector and the tangent, ``[[J, c], [t^T, tau]] [x; mu] = [b; beta]``, is solved by block
 elimination with two solves of J (:meth:`RankJacobian.solve`: Woodbury on the rank, preconditioned GMRES):
@@ -120,10 +120,11 @@ class TorusFamily:
     parameter : (str, str)
         The parameter's name and unit, for the branch and its messages.
     frozen : float
-        ``dR/dvalue`` is computed afresh only where the value has moved by more than this share of it since it last
-        was (else that one serves: the corrector's iterates of one point, a chord in the parameter's direction), >= 0;
-        0 (default): at every iterate. Where a value's problem costs its compliance (a speed: every order's dynamic
-        stiffness solved) this halves the problems built; the folds are then located to about this share.
+        ``dR/dvalue`` at ``(z, value)`` is the difference of the residuals at z of the problems at ``v_c`` and
+        ``v_c (1 + STEP)``, ``v_c`` the value itself (default, 0) or, with ``frozen`` > 0, the last value they were
+        built at while it is within ``frozen |value|`` (>= 0): exact in z, first order in ``value - v_c``. Where a
+        value's problem costs its compliance (a speed: every order's dynamic stiffness solved) this halves the
+        problems built, and the next steps' derivatives cost two residuals.
     """
 
     build: Callable[[float], TorusProblem]
@@ -144,7 +145,17 @@ class TorusFamily:
 
     # ------------------------------------------------------------------------------------------ the problems
     def at(self, value: float) -> TorusProblem:
-        """The problem at ``value`` (the last :data:`KEPT` kept)."""
+        """The problem at ``value`` (the last :data:`KEPT` kept).
+
+        Parameters
+        ----------
+        value : float
+            The parameter (its unit).
+
+        Returns
+        -------
+        TorusProblem
+        """
         value = float(value)
         if value not in self._problems:
             if len(self._problems) >= KEPT:
@@ -159,11 +170,33 @@ class TorusFamily:
             return None
 
     def parameter_value(self, s: float) -> float:
-        """The parameter's value (its unit) of the carried ``s``."""
+        """The parameter's value of the carried ``s``.
+
+        Parameters
+        ----------
+        s : float
+            The carried parameter (m).
+
+        Returns
+        -------
+        float
+            Its unit.
+        """
         return s / self.scale
 
     def carried(self, value: float) -> float:
-        """The carried ``s`` of the parameter's ``value``."""
+        """The carried ``s`` of the parameter's ``value``.
+
+        Parameters
+        ----------
+        value : float
+            Its unit.
+
+        Returns
+        -------
+        float
+            (m).
+        """
         return value * self.scale
 
     @property
@@ -188,13 +221,36 @@ class TorusFamily:
 
     # ------------------------------------------------------------------------------------------ the continuation's
     def linear_response(self, s: float) -> np.ndarray:
-        """The linear response at the carried ``s`` (NaN where the value is refused)."""
+        """The linear response at the carried ``s`` (NaN where the value is refused).
+
+        Parameters
+        ----------
+        s : float
+            The carried parameter (m).
+
+        Returns
+        -------
+        ndarray, shape (size,)
+            (m; rad for a rotation DOF).
+        """
         p = self._valid(self.parameter_value(s))
         return np.full(self.size, np.nan) if p is None else p.linear_response()
 
     def evaluate(self, z: np.ndarray, s: float) -> Evaluation:
         """The residual at ``(z, s)``; its Jacobian (:class:`TorusJacobian`) and ``dR/ds`` built on first use. Where
-        the value is refused, an infinite residual (the corrector takes it for a failed step)."""
+        the value is refused, an infinite residual (the corrector takes it for a failed step).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients (m; rad for a rotation DOF).
+        s : float
+            The carried parameter (m).
+
+        Returns
+        -------
+        Evaluation
+        """
         value = self.parameter_value(s)
         p = self._valid(value)
         if p is None:
@@ -202,25 +258,27 @@ class TorusFamily:
         R = p.residual(z)
         relative = float(np.linalg.norm(R)) / p.scale
 
-        def dR_ds():
+        def dR_ds():  # the difference of two problems' residuals at z: exact in z, kept near a value
             kept = self._state["column"]
-            if kept is not None and abs(kept[0] - value) <= self.frozen * abs(value) and len(kept[1]) == len(z):
-                return kept[1]
-            column = difference()
-            self._state["column"] = (value, column)
-            return column
-
-        def difference():
-            h = STEP * abs(value)
-            up = self._valid(value + h)
-            if up is None:
-                up, h = p, -h
-                p_down = self._valid(value - abs(h))
-                if p_down is None:
-                    raise sla.LinAlgError("no problem on either side of the value")
-                return (R - p_down.residual(z)) / (abs(h) * self.scale)
-            return (up.residual(z) - R) / (h * self.scale)
+            if kept is None or abs(kept[0] - value) > self.frozen * abs(value):
+                kept = (value, *self._pair(value, p))
+                self._state["column"] = kept
+            _, low, high, dv = kept
+            R_low = R if low is p else low.residual(z)
+            return (high.residual(z) - R_low) / (dv * self.scale)
         return Evaluation(R, p.scale, lambda: self._jacobian(p, z, relative), dR_ds)
+
+    def _pair(self, value: float, p: TorusProblem):
+        """The problems at ``value`` and ``value (1 + STEP)`` (or ``value (1 - STEP)`` and ``value`` where the larger
+        is refused) and the difference of their values."""
+        h = STEP * abs(value)
+        up = self._valid(value + h)
+        if up is not None:
+            return p, up, h
+        down = self._valid(value - h)
+        if down is None:
+            raise sla.LinAlgError("no problem on either side of the value")
+        return down, p, h
 
     def _jacobian(self, p: TorusProblem, z: np.ndarray, relative: float) -> TorusJacobian:
         """The Jacobian at ``z``, keeping the last one's preconditioner (its compliance projected afresh where the
@@ -238,7 +296,29 @@ class TorusFamily:
 
     def solve_point(self, z0: np.ndarray, s: float, tol: float, max_iter: int, max_halvings: int) -> _Point:
         """The torus at the carried ``s`` by :func:`rotorred.nonlinear.torus.solve_torus` from ``z0`` (the
-        continuation's step in the parameter alone, past a corner); NotConverged if it does not converge."""
+        continuation's start, and its step in the parameter alone past a corner).
+
+        Parameters
+        ----------
+        z0 : ndarray, shape (size,)
+            The start (m; rad for a rotation DOF).
+        s : float
+            The carried parameter (m).
+        tol : float
+            Relative residual to reach.
+        max_iter, max_halvings : int
+            Newton iterations, and halvings of a step in its line search.
+
+        Returns
+        -------
+        object
+            With ``z`` (size,) and ``iterations``.
+
+        Raises
+        ------
+        NotConverged
+            If Newton does not converge, or the value is refused.
+        """
         p = self._valid(self.parameter_value(s))
         if p is None or not np.all(np.isfinite(z0)):
             raise NotConverged(s, np.inf, tol, 0, "no problem at this value")

@@ -98,7 +98,19 @@ class TorusBranchOptions:
         object.__setattr__(self, "steps", (first, checks.number("options.steps[1]", s[1], ge=first)))
 
     def torus_options(self, bases, outputs) -> TorusOptions:
-        """The start's :class:`rotorred.scenes.quasi_periodic.TorusOptions` (``bases`` in Hz, or None: found)."""
+        """The start's :class:`rotorred.scenes.quasi_periodic.TorusOptions`.
+
+        Parameters
+        ----------
+        bases : (float, float) or None
+            The base frequencies (Hz), or None: found by the start's line fit.
+        outputs : sequence of (int, str)
+            The model DOFs reported.
+
+        Returns
+        -------
+        TorusOptions
+        """
         return TorusOptions(bases=bases, orders=self.orders, grid=self.grid, f_max=self.f_max,
                             start_window=self.start_window, tol=self.tol, outputs=outputs)
 
@@ -186,7 +198,17 @@ class TorusBranch(Result):
         return np.argsort(-a)[:SHOWN_LINES]
 
     def line_label(self, k: int) -> str:
-        """The order ``(k1, k2)`` at position ``k``, as text."""
+        """The order at position ``k`` as text, ``(k1,k2)``.
+
+        Parameters
+        ----------
+        k : int
+            Position in :attr:`orders`.
+
+        Returns
+        -------
+        str
+        """
         return f"({self.orders[k, 0]},{self.orders[k, 1]})"
 
     def summary(self) -> list[str]:
@@ -196,7 +218,7 @@ class TorusBranch(Result):
         turns = [f"{xs * v:.6g}{'' if smooth else ' (corner)'}" for v, smooth in self.folds]
         steps = self.point_time[1:]
         return [f"torus branch of {self.scene} in {self.key} ({xu}): {p} points from {xs * self.values[0]:.6g} to "
-                f"{xs * self.values[-1]:.6g}; {self.truncation}",
+                f"{xs * self.values[-1]:.6g}", *textwrap.wrap(self.truncation, 110),
                 f"bases from ({self.bases_hz[0, 0]:.6g}, {self.bases_hz[0, 1]:.6g}) to ({self.bases_hz[-1, 0]:.6g}, "
                 f"{self.bases_hz[-1, 1]:.6g}) Hz; largest line at {dof_name(self.dof)} {self.line_label(top)} from "
                 f"{1e6 * self.amplitudes[:, top].min():.4g} to {1e6 * self.amplitudes[:, top].max():.4g} µm",
