@@ -10,7 +10,7 @@ line fit, its 10 largest lines), whose solve time is the point's reference.
 
 Run::
 
-    OPENBLAS_NUM_THREADS=1 python validation/hb_torus_branch.py [--orders H1,H2]
+    OPENBLAS_NUM_THREADS=1 python validation/hb_torus_branch.py [--orders H1,H2] [--branch rub.clearance]
 
 Prints, per branch: a row a point (the key, the bases, the corrections, the point's wall time and the transients'
 median time over it: the speed-up), the folds (or, where none, the evidence: the tangent's parameter component keeps
@@ -113,8 +113,9 @@ def main():
     global ORDERS
     if "--orders" in sys.argv:
         ORDERS = tuple(int(v) for v in sys.argv[sys.argv.index("--orders") + 1].split(","))
+    keys = sys.argv[sys.argv.index("--branch") + 1].split(",") if "--branch" in sys.argv else [b[0] for b in BRANCHES]
     rows = []
-    for key, start, end, checked, xs, xu in BRANCHES:
+    for key, start, end, checked, xs, xu in (b for b in BRANCHES if b[0] in keys):
         print(f"branch in {key} from {xs * start:g} to {xs * end:g} {xu}, orders |k1| <= {ORDERS[0]}, |k2| <= "
               f"{ORDERS[1]}, tol {TOL:g}:")
         rows.append((key, *follow(key, start, end, checked, xs, xu)))
