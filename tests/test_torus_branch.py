@@ -199,3 +199,22 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
         problem = torus_rub_problem(there, model, (70.0, v / 3), 2, 8, *default_grid(2, 8), 1500.0).problem
         assert np.linalg.norm(problem.residual(z)) < 1e-7 * problem.scale
     assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)
+
+
+@pytest.mark.parametrize("extra, tokens", [
+    (["--torus", "1", "--param", "rub.clearance=14e-6:12e-6"], ["--torus", "1,3"]),
+    (["--torus", "1,3", "--orders", "0,8", "--param", "rub.clearance=14e-6:12e-6"], ["--orders", "0,8"]),
+    (["--torus", "--param", "speeds.middle=80:90"], ["--param", "speeds.middle", "speeds.outer"]),
+    (["--torus", "--param", "rub.mu_s=0.1:0.2"], ["--param", "rub.mu_s", "rub.k_n"]),
+])
+def test_rotorred_continue_torus_refuses_bad_input_before_computing(extra, tokens, tmp_path, capsys):
+    """A bad ``--torus``, ``--orders`` or key is refused with exit 2 and one line naming it, nothing written."""
+    from rotorred.cli import main
+
+    out = tmp_path / "o"
+    assert main(["continue", "paper-rub", "--set", "speeds.outer=91.37", *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    for token in tokens:
+        assert token in err, (token, err)
+    assert not out.exists()
