@@ -9,6 +9,13 @@ harmonic of f_0 at the first output DOF), ``branch.nc`` (the same, labelled, xar
 against the key: stable solid, unstable dashed, folds and corners marked), ``branch.txt`` and ``report.html`` (the
 same, interactive; ``--no-html``: none).
 
+With ``--torus [J,K]`` the scene's speeds are incommensurate and the response quasi-periodic: its torus of the bases
+``(f_L / J, f_H / K)`` (default: the torus the start's line fit finds) is followed instead (``--orders H1,H2`` its box,
+band 1500 Hz), in ``rub.clearance``, a plate's number or a spool's speed (``speeds.<spool>``, the other spool held), its
+folds located, no stability; ``branch.csv`` then has a row a point (the key, the bases, the 10 largest lines of the
+table DOF in µm, the corrections and the point's time), ``branch_lines.csv`` every order's line at each point, and no
+``report.html`` (no interactive view of a torus branch yet).
+
 SIGINT or SIGTERM while the branch is traced or its stability computed ends it there and keeps every point traced:
 the files are written with them all (those without their stability marked "unknown", the folder INCOMPLETE, the
 summary saying which signal, where, how many points traced and with their stability), exit 130 or 143. The files
@@ -39,7 +46,14 @@ def add_parser(subparsers):
     add_settings(p, "fix")
     p.add_argument("--harmonics", type=int, default=50, help="harmonics of the base frequency f_0 (default 50)")
     p.add_argument("--samples", type=int, default=1024, help="AFT samples a period, even (default 1024)")
-    p.add_argument("--tol", type=float, default=1e-9, help="relative residual of every point (default 1e-9)")
+    p.add_argument("--tol", type=float, default=None,
+                   help="relative residual of every point (default 1e-9; 1e-6 on a torus)")
+    p.add_argument("--torus", nargs="?", const="found", default=None, metavar="J,K",
+                   help="follow the quasi-periodic response on the torus of the bases f_L/J, f_H/K (Hz, the spools' "
+                        "frequencies over integers; incommensurate speeds; without J,K: the torus the start's line "
+                        "fit finds)")
+    p.add_argument("--orders", default="8,40", metavar="H1,H2",
+                   help="with --torus: the box of orders |k1| <= H1, |k2| <= H2 (default 8,40), lines up to 1500 Hz")
     p.add_argument("--no-stability", action="store_true", help="skip the Floquet multipliers (the slow part)")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--force", action="store_true",
@@ -70,17 +84,19 @@ def _param(text: str) -> tuple[str, float, float]:
 
 def run(args) -> int:
     """Check everything, then follow the branch into ``--out`` (exit 130 or 143 when interrupted, its points kept)."""
-    from rotorred.cli import interrupted_status, interrupts as signals
+    from rotorred.cli import interrupts as signals
     from rotorred.cli.run import _settings
-    from rotorred import BranchOptions, build_model, check_key, continue_scene, format_branch, load_scene, scene_toml
+    from rotorred import BranchOptions, build_model, check_key, continue_scene, load_scene, scene_toml
 
     out = out_dir("--out", args.out)
     key, start, stop = _param(args.param)
+    if args.torus is not None:
+        return _run_torus(args, out, key, start, stop)
     H = checks.integer("--harmonics", args.harmonics, ge=1)
     N = checks.integer("--samples", args.samples, ge=2 * H + 2)
     if N % 2:
         checks.fail("--samples", N, "must be even")
-    tol = float(checks.bounded("--tol", args.tol, checks.positive("--tol", args.tol), "tolerance"))
+    tol = _tol(args, 1e-9)
     scene = load_scene(args.scene, _settings(args.set))
     check_key(scene, key, start, stop)
     options = BranchOptions(H, N, tol, not args.no_stability)
@@ -93,6 +109,54 @@ def run(args) -> int:
     with _Progress(key) as tracing:
         branch = continue_scene(scene, model, key, start, stop, options,
                                 progress=tracing, interrupts=interrupts)
+    return _finish(branch, out, interrupts, record, args)
+
+
+def _tol(args, default: float) -> float:
+    """``--tol`` checked, or ``default``."""
+    value = default if args.tol is None else args.tol
+    return float(checks.bounded("--tol", value, checks.positive("--tol", value), "tolerance"))
+
+
+def _pair(field: str, text: str) -> tuple[int, int]:
+    """Two positive integers ``A,B`` of an option."""
+    parts = text.split(",")
+    try:
+        values = tuple(int(v) for v in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2 or min(values) < 1:
+        checks.fail(field, text, "must be two integers >= 1, A,B (e.g. 1,3)")
+    return values
+
+
+def _run_torus(args, out, key: str, start: float, stop: float) -> int:
+    """``--torus``: check everything, then follow the torus into ``--out``."""
+    from rotorred.cli import interrupts as signals
+    from rotorred.cli.run import _settings
+    from rotorred import TorusBranchOptions, build_model, check_torus_key, continue_torus, load_scene, scene_toml
+
+    divisors = None if args.torus == "found" else _pair("--torus", args.torus)
+    orders = _pair("--orders", args.orders)
+    options = TorusBranchOptions(orders=orders, divisors=divisors, tol=_tol(args, 1e-6))
+    scene = load_scene(args.scene, _settings(args.set))
+    check_torus_key(scene, key, start, stop)
+    record = provenance(args, "scene", scene_toml(scene))
+    model = build_model(scene).model
+    report(f"torus branch of {scene.name} in {key} from {start:g} to {stop:g}: orders |k1| <= {orders[0]}, |k2| <= "
+           f"{orders[1]}")
+    interrupts = signals()
+    progress.stage("tracing the torus branch of %s in %s from %g to %g", scene.name, key, start, stop)
+    with _Progress(key) as tracing:
+        branch = continue_torus(scene, model, key, start, stop, options, progress=tracing, interrupts=interrupts)
+    return _finish(branch, out, interrupts, record, args)
+
+
+def _finish(branch, out, interrupts, record, args) -> int:
+    """Report the branch, write its files and the exit status (130 or 143 when interrupted, its points kept)."""
+    from rotorred.cli import interrupted_status
+    from rotorred import format_branch
+
     report(format_branch(branch))
     files, late = _write(branch, out, interrupts, record, args)
     for f in files:
@@ -111,13 +175,13 @@ def _write(branch, out, interrupts: dict, record=None, args=None) -> tuple[list,
     as a commit is), so that a signal does not cut them (nor leave a file half made): the points an interrupt kept,
     or a complete branch, are written whole. A signal that came meanwhile is dropped once they are committed. The
     files written, and that signal ("SIGINT", "SIGTERM"; "" if none)."""
-    from rotorred import write_branch, writers
+    from rotorred import TorusBranch, write_branch, writers
 
     folder, files, late = writers.OutputFolder(out), [], ""
     try:
         with writers.signals_held(), folder:
             write_branch(branch, folder, record)
-            if args is not None:
+            if args is not None and not isinstance(branch, TorusBranch):  # no interactive view of a torus branch
                 stage_report(args, folder, branch)
             files = folder.commit(incomplete=branch.stopped if branch.interrupted else None)
     except tuple(interrupts) as exc:

@@ -12,7 +12,8 @@ back onto its own path stops there (:func:`_retraced`).
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
-point, to ``1e-10`` of the step. Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
+point, to the larger of ``1e-10`` and the corrector's tolerance of the step (a looser corrector, a torus's inexact
+Newton, leaves ``d omega / ds`` that uncertain: Brent would spend its evaluations on noise). Each point's stability is Hill's (:mod:`rotorred.nonlinear.stability`).
 
 An *interrupt* (:data:`INTERRUPTS`, or the exceptions a caller names: the command line's SIGTERM) ends the tracing
 where it is: the points so far are returned, ``stopped`` and ``interrupt`` saying so.
@@ -58,6 +59,8 @@ CONTRACTION = 0.5
 #: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
 CORNER_ITERATIONS = 12
 CORNER_HALVINGS = 4
+#: Brent's tolerance on a fold's position, a share of the step (at least the corrector's tolerance)
+FOLD_XTOL = 1e-10
 
 
 @dataclass(frozen=True)
@@ -325,7 +328,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     checks.positive("omega_start", omega_start, "rad/s")
     checks.positive("omega_end", omega_end, "rad/s")
     direction = 1.0 if omega_end > omega_start else -1.0
-    start = solve_periodic(problem, z0, omega_start, tol=tol)
+    start = _solved(problem, z0, omega_start, tol)
     y = np.append(start.z, omega_start)
     first = _Point(y, _tangent(problem, y, None, direction, start.evaluation), start.iterations)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
@@ -428,7 +431,14 @@ def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarra
     ``previous`` (or with omega growing in ``direction`` at the start)."""
     ev = ev if ev is not None else problem.evaluate(y[:-1], y[-1])
     guide = previous if previous is not None else np.append(np.zeros(len(y) - 1), direction)
-    return _unit_along(bordered(ev.dR_dz, ev.dR_domega, guide), guide)
+    return _unit_along(_bordered(ev.dR_dz, ev.dR_domega, guide), guide)
+
+
+def _bordered(A, column: np.ndarray, row: np.ndarray):
+    """The bordered matrix ``[[A, column], [row]]``, ready to solve with: a Jacobian that borders itself (``A.bordered``:
+    the torus's matrix-free one, :class:`rotorred.nonlinear.torus_continuation.TorusJacobian`, and the identity plus a
+    low-rank product), else a dense one (:func:`rotorred.nonlinear.lowrank.bordered`)."""
+    return A.bordered(column, row) if hasattr(A, "bordered") else bordered(A, column, row)
 
 
 def _unit_along(matrix, guide: np.ndarray) -> np.ndarray:
@@ -450,7 +460,7 @@ def _correct(problem, y_pred, t, tol, max_iter: int = 20, contraction: float | N
         return None
     for it in range(max_iter):
         try:
-            matrix = bordered(ev.dR_dz, ev.dR_domega, t)
+            matrix = _bordered(ev.dR_dz, ev.dR_domega, t)
             step = matrix.solve(-np.append(ev.R, t @ (y - y_pred)))
         except (sla.LinAlgError, ValueError):
             return None
@@ -551,11 +561,22 @@ def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
     return None
 
 
+def _solved(problem, z0, omega, tol, max_iter: int = 40, max_halvings: int = 30):
+    """The solution at ``omega`` by Newton from ``z0``: the problem's own point solver where it has one
+    (``problem.solve_point(z0, omega, tol, max_iter, max_halvings)``: a family of tori,
+    :class:`rotorred.nonlinear.torus_continuation.TorusFamily`), else :func:`rotorred.nonlinear.hb.solve_periodic`.
+    NotConverged if it does not converge."""
+    own = getattr(problem, "solve_point", None)
+    if own is not None:
+        return own(z0, omega, tol, max_iter, max_halvings)
+    return solve_periodic(problem, z0, omega, tol=tol, max_iter=max_iter, max_halvings=max_halvings)
+
+
 def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds, tol):
     """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
     just traced."""
     try:
-        found = solve_periodic(problem, start, omega, tol=tol, max_iter=CORNER_ITERATIONS, max_halvings=CORNER_HALVINGS)
+        found = _solved(problem, start, omega, tol, CORNER_ITERATIONS, CORNER_HALVINGS)
     except NotConverged:
         return None
     y = np.append(found.z, omega)
@@ -580,7 +601,7 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
         return _tangent(problem, done[0], a.t)[-1]  # at the point itself: the fold's position rests on it
 
     try:
-        s = brentq(domega, 0.0, span, xtol=1e-10 * abs(span), rtol=4 * np.finfo(float).eps)
+        s = brentq(domega, 0.0, span, xtol=max(FOLD_XTOL, tol) * abs(span), rtol=4 * np.finfo(float).eps)
     except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
         return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
     y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]

@@ -1,0 +1,447 @@
+"""Branches of a rub scene's quasi-periodic response: tori continued by pseudo-arclength in a scene key, their folds
+located (docs/model.md §26).
+
+Keys: ``rub.clearance`` (m) and the plate's numbers (:data:`rotorred.scenes.branch.PLATE_KEYS`), and ``speeds.<spool>``
+(Hz): that spool's speed alone, every other spool held (the speed ratio is what moves: a torus has no ratio to keep,
+unlike a periodic branch, :mod:`rotorred.scenes.branch`). The bases move with the speeds: ``(f_L / j, f_H / k)``,
+``f_L`` and ``f_H`` the two turning spools' frequencies (slower first, at the start), the divisors ``(j, k)`` given or
+read from the torus the start's line fit finds; each spool's unbalance forces its order, its force growing with its
+speed squared.
+
+The first point is :func:`rotorred.scenes.quasi_periodic.torus_balance` at the start (a short transient, the line
+fit's torus, least squares, Newton). Every point keeps its orders: the box and band of the start's truncation (the band
+``|k . f| <= f_max`` at the start's bases), so that the unknowns do not change along the branch; the problem at a value
+is :func:`rotorred.scenes.torus_balance.torus_rub_problem` on the whole box, its forcing put on those orders. The
+continuation is :func:`rotorred.nonlinear.continuation.continue_branch` on a
+:class:`rotorred.nonlinear.torus_continuation.TorusFamily` (matrix-free bordered solves, the preconditioner kept from
+point to point, inexact Newton). No stability: that of a torus is another part of issue 40.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import textwrap
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotorred import checks
+from rotorred.model.operating import Operating
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
+from rotorred.nonlinear.torus import TorusProblem
+from rotorred.nonlinear.torus_continuation import TorusFamily
+from rotorred.progress import INTERRUPTS
+from rotorred.results import Result
+from rotorred.scenes.branch import KEYS, PLATE_KEYS, dof_name
+from rotorred.scenes.keys import cf_units, netcdf_name
+from rotorred.scenes.quasi_periodic import TorusOptions, default_grid, torus_balance
+from rotorred.scenes.torus_balance import TorusRubProblem, torus_rub_problem
+from rotorred.transient.options import Loads
+from rotorred.writers import signals_held
+
+__all__ = ["TorusBranchOptions", "TorusBranch", "continue_torus", "check_torus_key"]
+
+#: a speed's dR/dvalue is computed afresh where the speed moved by more than this share since it last was
+#: (:class:`rotorred.nonlinear.torus_continuation.TorusFamily`): a point's corrections share one
+FROZEN = 1e-3
+#: lines of the output DOF a branch's summary and files show: the largest at the start
+SHOWN_LINES = 10
+
+
+@dataclass(frozen=True)
+class TorusBranchOptions:
+    """The truncation, start, accuracy and extent of a torus branch (:func:`continue_torus`).
+
+    Parameters
+    ----------
+    orders : (int, int)
+        The box of orders ``|k_1| <= H1``, ``|k_2| <= H2`` (default (8, 40)).
+    grid : (int, int), optional
+        The AFT grid ``(N_1, N_2)``; default :func:`rotorred.scenes.quasi_periodic.default_grid` of the orders.
+    f_max : float, optional
+        Keep only the orders whose line is at most ``f_max`` (Hz) at the start (default 1500 Hz; None: the box).
+    divisors : (int, int), optional
+        ``(j, k)``: the bases ``(f_L / j, f_H / k)``; default those of the torus the start's line fit finds.
+    start_window : (float, float)
+        The start's transient window (s) (:class:`rotorred.scenes.quasi_periodic.TorusOptions`).
+    tol : float
+        Relative residual of every point, in (0, 1).
+    max_points : int
+        Most points traced, >= 2.
+    steps : (float, float)
+        The first and the largest arclength step, as shares of ``max(||z_start||, |s_end - s_start|)`` (the
+        coefficients' norm and the carried parameter's range, m), 0 < first <= largest.
+    """
+
+    orders: tuple[int, int] = (8, 40)
+    grid: tuple[int, int] | None = None
+    f_max: float | None = 1500.0
+    divisors: tuple[int, int] | None = None
+    start_window: tuple[float, float] = (2.0, 3.0)
+    tol: float = 1e-8
+    max_points: int = 200
+    steps: tuple[float, float] = (0.05, 0.15)
+
+    def __post_init__(self):
+        # the orders, grid, band and window by TorusOptions's own checks
+        self.torus_options(None, ())
+        if self.divisors is not None:
+            d = checks.sequence("options.divisors", list(np.ravel(self.divisors)), min_len=2, max_len=2)
+            object.__setattr__(self, "divisors", tuple(checks.integer(f"options.divisors[{i}]", v, ge=1)
+                                                       for i, v in enumerate(d)))
+        checks.number("options.tol", self.tol, gt=0.0, lt=1.0)
+        checks.integer("options.max_points", self.max_points, ge=2)
+        s = checks.sequence("options.steps", list(np.ravel(self.steps)), min_len=2, max_len=2)
+        first = checks.positive("options.steps[0]", s[0])
+        object.__setattr__(self, "steps", (first, checks.number("options.steps[1]", s[1], ge=first)))
+
+    def torus_options(self, bases, outputs) -> TorusOptions:
+        """The start's :class:`rotorred.scenes.quasi_periodic.TorusOptions`.
+
+        Parameters
+        ----------
+        bases : (float, float) or None
+            The base frequencies (Hz), or None: found by the start's line fit.
+        outputs : sequence of (int, str)
+            The model DOFs reported.
+
+        Returns
+        -------
+        TorusOptions
+        """
+        return TorusOptions(bases=bases, orders=self.orders, grid=self.grid, f_max=self.f_max,
+                            start_window=self.start_window, tol=self.tol, outputs=outputs)
+
+    @property
+    def n_grid(self) -> tuple[int, int]:
+        """``(N_1, N_2)``: the grid given, or the default of the orders."""
+        return self.grid if self.grid is not None else default_grid(*self.orders)
+
+
+@dataclass(frozen=True, repr=False)
+class TorusBranch(Result):
+    """A branch of a rub scene's quasi-periodic response (:func:`continue_torus`).
+
+    Attributes
+    ----------
+    scene : str
+    key, unit : str
+        The varied key and its unit (m for a clearance, Hz for a speed).
+    values : ndarray, shape (p,)
+        The key at each point.
+    bases_hz : ndarray, shape (p, 2)
+        The base frequencies ``(f_L / j, f_H / k)`` at each point (Hz).
+    orders : ndarray, shape (K, 2)
+        The orders ``(k_1, k_2)`` of every point's lines.
+    dof : (int, str)
+        The output DOF whose lines are kept (the scene's table DOF).
+    amplitudes : ndarray, shape (p, K)
+        Amplitude of each order's line at ``dof`` at each point (m; the mean's absolute value for (0, 0)).
+    z : ndarray, shape (p, size)
+        Each point's coefficients of the unknowns (:class:`rotorred.nonlinear.torus.TorusProblem`).
+    folds : tuple of (float, bool)
+        Each turn of the branch: the key's value and whether it is smooth (a saddle-node) or a corner.
+    stopped : str
+        Why the branch ended.
+    iterations : ndarray, shape (p,)
+        Corrector iterations of each point.
+    point_time : ndarray, shape (p,)
+        Wall time of each point (s): the first the start (its transient, line fit and Newton), each next its step
+        (prediction, corrections, a fold's location).
+    slope : ndarray, shape (p,)
+        d value / ds of the unit tangent at each point (its sign changes at the folds).
+    truncation : str
+        The orders, grid and band.
+    interrupt : str
+        The signal that ended the branch, or "".
+    """
+
+    scene: str
+    key: str
+    unit: str
+    values: np.ndarray
+    bases_hz: np.ndarray
+    orders: np.ndarray
+    dof: tuple
+    amplitudes: np.ndarray
+    z: np.ndarray
+    folds: tuple
+    stopped: str
+    iterations: np.ndarray
+    point_time: np.ndarray
+    slope: np.ndarray
+    truncation: str
+    interrupt: str = ""
+
+    @property
+    def interrupted(self) -> bool:
+        """Whether a signal ended the branch."""
+        return bool(self.interrupt)
+
+    @property
+    def shown(self) -> tuple[float, str]:
+        """The key's shown scale and unit: a clearance in µm, any other key in its own unit."""
+        return (1e6, "µm") if self.key == "rub.clearance" else (1.0, self.unit)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The frequency ``|k_1 f_1 + k_2 f_2|`` of each order's line at each point, shape (p, K) (Hz)."""
+        return np.abs(self.bases_hz @ self.orders.T)
+
+    @property
+    def largest(self) -> np.ndarray:
+        """The positions of the :data:`SHOWN_LINES` largest lines at the first point (the mean left out)."""
+        a = self.amplitudes[0].copy()
+        a[0] = -np.inf
+        return np.argsort(-a)[:SHOWN_LINES]
+
+    def line_label(self, k: int) -> str:
+        """The order at position ``k`` as text, ``(k1,k2)``.
+
+        Parameters
+        ----------
+        k : int
+            Position in :attr:`orders`.
+
+        Returns
+        -------
+        str
+        """
+        return f"({self.orders[k, 0]},{self.orders[k, 1]})"
+
+    def summary(self) -> list[str]:
+        """The key's range, the torus, the largest line's range (µm), the turns, why it stopped and the times."""
+        xs, xu = self.shown
+        p, top = len(self.values), self.largest[0]
+        turns = [f"{xs * v:.6g}{'' if smooth else ' (corner)'}" for v, smooth in self.folds]
+        steps = self.point_time[1:]
+        return [f"torus branch of {self.scene} in {self.key} ({xu}): {p} points from {xs * self.values[0]:.6g} to "
+                f"{xs * self.values[-1]:.6g}", *textwrap.wrap(self.truncation, 110),
+                f"bases from ({self.bases_hz[0, 0]:.6g}, {self.bases_hz[0, 1]:.6g}) to ({self.bases_hz[-1, 0]:.6g}, "
+                f"{self.bases_hz[-1, 1]:.6g}) Hz; largest line at {dof_name(self.dof)} {self.line_label(top)} from "
+                f"{1e6 * self.amplitudes[:, top].min():.4g} to {1e6 * self.amplitudes[:, top].max():.4g} µm",
+                f"turns: {len(turns)}" + (f", at {', '.join(turns[:4])}" if turns else "")
+                + (f" and {len(turns) - 4} more" if len(turns) > 4 else ""),
+                *textwrap.wrap(f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}", 110),
+                f"times: start {self.point_time[0]:.3g} s, then {steps.sum():.3g} s for {p - 1} points "
+                f"({1e3 * (steps.mean() if p > 1 else 0.0):.0f} ms a point on average, "
+                f"{np.mean(self.iterations[1:]) if p > 1 else 0.0:.2g} corrections)"]
+
+    def plot(self, ax=None, *, lines: int = 4, title: str | None = None):
+        """The amplitude (µm) of the ``lines`` largest lines of the output DOF against the key, the folds marked
+        (:func:`rotorred.plots.branch.plot_branch`, stability not computed: grey).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Axes to draw into; default a new figure.
+        lines : int
+            How many of the largest lines (at the start), 1 to 10.
+        title : str, optional
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from rotorred.plots.branch import plot_branch
+
+        xs, xu = self.shown
+        title = title or f"{self.scene}: torus branch" + (f" (INCOMPLETE: interrupted by {self.interrupt})"
+                                                          if self.interrupted else "")
+        fig = None
+        for k in self.largest[:checks.integer("lines", lines, ge=1, le=SHOWN_LINES)]:
+            fig = plot_branch(self.values, self.amplitudes[:, k], None, self.folds, ax if fig is None else fig.axes[0],
+                              xlabel=f"{self.key} ({xu})", ylabel=f"lines of {dof_name(self.dof)} (µm)", xscale=xs,
+                              title=title)
+        return fig
+
+    def to_xarray(self):
+        """Dims point, order, base: ``amplitude`` (m) and ``frequency`` (Hz) of each order's line at each point, the
+        orders' ``k1``, ``k2``, ``base_frequency`` (Hz), ``iterations``, ``point_time`` (s), ``slope``; the key's
+        coordinate named :func:`rotorred.scenes.keys.netcdf_name`; the folds, why it stopped and the truncation as
+        attributes."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {"amplitude": (("point", "order"), self.amplitudes,
+                           {"units": "m", "long_name": f"amplitude of each line of {dof_name(self.dof)}"}),
+             "frequency": (("point", "order"), self.frequencies, {"units": "Hz", "long_name": "|k1 f_1 + k2 f_2|"}),
+             "base_frequency": (("point", "base"), self.bases_hz, {"units": "Hz", "long_name": "base frequencies"}),
+             "iterations": ("point", self.iterations, {"units": "1", "long_name": "corrector iterations"}),
+             "point_time": ("point", self.point_time, {"units": "s", "long_name": "wall time of the point"}),
+             "slope": ("point", self.slope, {"units": "1", "long_name": "d parameter / ds of the unit tangent"})},
+            coords={netcdf_name(self.key): ("point", self.values, {"units": cf_units(self.key), "long_name": self.key,
+                                                                   "rotorred_key": self.key}),
+                    "k1": ("order", self.orders[:, 0], {"units": "1", "long_name": "order of f_1"}),
+                    "k2": ("order", self.orders[:, 1], {"units": "1", "long_name": "order of f_2"})},
+            attrs={"scene": self.scene, "stopped": self.stopped, "interrupted": self.interrupt or "no",
+                   "truncation": self.truncation,
+                   "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds)})
+
+
+def check_torus_key(scene, key: str, start: float, end: float) -> None:
+    """Refuse, before anything is computed, a key a torus branch cannot follow in ``scene``: a scene without one rub
+    plate (a plate's key) or without plates, a ``[runup]``, not two turning spools, a key not of :data:`KEYS`, a
+    value <= 0 or one the plate refuses.
+
+    Parameters
+    ----------
+    scene : Scene
+    key : str
+        ``"rub.clearance"``, ``"speeds.<spool>"`` or a plate's number.
+    start, end : float
+        The key's first and last value, > 0 (its unit).
+
+    Raises
+    ------
+    InputError
+        Naming ``--param`` (or the scene) and what is allowed.
+    """
+    if not scene.plates:
+        checks.fail("SCENE", scene.name, "must have a rub plate ([[rub]]): the branch is of the rub response")
+    if getattr(scene, "runup", None) is not None:
+        checks.fail("SCENE", scene.name, "has a [runup], which a torus branch cannot honour (steady speeds)")
+    turning = [s for s, f in scene.frequencies_hz.items() if f > 0]
+    if len(turning) != 2:
+        checks.fail("SCENE", scene.name, f"must have two turning spools for a torus (it has {len(turning)})")
+    allowed = ("rub.clearance",) + tuple(f"speeds.{s}" for s in scene.speeds) + tuple(PLATE_KEYS)
+    if key not in allowed:
+        checks.fail("--param", key, f"must be one of {', '.join(allowed)}")
+    if key.startswith("rub.") and len(scene.plates) != 1:
+        checks.fail("--param", key, f"needs a scene with one rub plate (this one has {len(scene.plates)})")
+    for value in (start, end):
+        checks.positive("--param", value, KEYS.get(key, "Hz"))
+        if key.startswith("rub."):
+            scene.plates[0].with_(**{key.partition(".")[2]: value})
+
+
+def _scene_at(scene, key: str, value: float):
+    """``scene`` with ``key`` at ``value``: a spool's speed (Hz), every other spool held, or a number of the plate."""
+    group, _, name = key.partition(".")
+    if group == "speeds":
+        hz = dict(scene.frequencies_hz)
+        hz[name] = value
+        return dataclasses.replace(scene, operating=Operating.point(hz, unit="Hz"))
+    return dataclasses.replace(scene, plates=(scene.plates[0].with_(**{name: value}),) + tuple(scene.plates[1:]))
+
+
+class _Family:
+    """The rub tori of a scene along a key, all on the start's orders: ``rub_at(value)`` (the problem and its lines)
+    and ``problem_at(value)`` (for :class:`TorusFamily`). Where a value leaves the model's matrices and the bases as
+    they were (a clearance, the law's numbers), the start's compliance serves."""
+
+    def __init__(self, scene, model, key, first: TorusRubProblem, divisors, options: TorusBranchOptions):
+        self.scene, self.model, self.key, self.first, self.divisors = scene, model, key, first, divisors
+        self.box = (*options.orders, *options.n_grid)
+        self.spools = sorted((s for s, f in scene.frequencies_hz.items() if f > 0),
+                             key=lambda s: scene.frequencies_hz[s])  # (L, H) at the start
+        self._kept: dict = {}
+
+    def bases(self, scene) -> tuple[float, float]:
+        f = scene.frequencies_hz
+        return f[self.spools[0]] / self.divisors[0], f[self.spools[1]] / self.divisors[1]
+
+    def rub_at(self, value: float) -> TorusRubProblem:
+        value = float(value)
+        if value not in self._kept:
+            if len(self._kept) >= 6:
+                self._kept.pop(next(iter(self._kept)))
+            self._kept[value] = self._built(value)
+        return self._kept[value]
+
+    def problem_at(self, value: float) -> TorusProblem:
+        return self.rub_at(value).problem
+
+    def _built(self, value: float) -> TorusRubProblem:
+        scene = _scene_at(self.scene, self.key, value)
+        box = torus_rub_problem(scene, self.model, self.bases(scene), *self.box, None)
+        h, n_all, start = self.first.problem.harmonics, box.problem.M.shape[0], self.first.problem
+        p = box.problem
+        problem = TorusProblem(p.M, p.D, p.K, h, p.w, p.dofs, p.harmonics.transfer(p.forcing, n_all, h), p.forces)
+        if p.w == start.w and all(np.array_equal(getattr(p, m), getattr(start, m)) for m in "MDK"):
+            # the compliance and linear response are the start's (a clearance, a law's number): computed once. Its
+            # cache is TorusProblem's own; a public with_forces (as CondensedProblem's) would say it better
+            problem._cache["compliance"] = start._compliance()
+        return dataclasses.replace(box, problem=problem)
+
+
+def continue_torus(scene, model, key: str, start: float, end: float,
+                   options: TorusBranchOptions = TorusBranchOptions(), *, progress=None,
+                   interrupts: Mapping[type[BaseException], str] = INTERRUPTS) -> TorusBranch:
+    """The branch of ``scene``'s quasi-periodic rub response on ``model`` as ``key`` goes from ``start`` to ``end``.
+
+    Parameters
+    ----------
+    scene : Scene
+        With rub plates and two turning spools at incommensurate speeds.
+    model : SystemMatrices or ReducedSystem
+        The scene's model (:func:`rotorred.scenes.run.build_model`); the rub node's x and y its own coordinates.
+    key : str
+        ``rub.clearance`` (m), ``speeds.<spool>`` (Hz, the other spool held) or a plate's number.
+    start, end : float
+        The key's first and last value (its unit).
+    options : TorusBranchOptions
+        Orders, grid, band, divisors, the start's window, tolerance, the most points and the steps.
+    progress : callable, optional
+        ``progress(points, value)`` as the branch grows.
+    interrupts : mapping of exception type to str
+        The exceptions that end the tracing where it is, every point traced kept, and the signal each stands for.
+
+    Returns
+    -------
+    TorusBranch
+
+    Raises
+    ------
+    InputError
+        If ``options`` is not a :class:`TorusBranchOptions` or the key cannot be followed (:func:`check_torus_key`);
+        from the start (:func:`rotorred.scenes.quasi_periodic.torus_balance`), if its line fit finds no torus.
+    NotConverged
+        If the start's Newton does not converge.
+    """
+    if not isinstance(options, TorusBranchOptions):
+        checks.fail("options", type(options).__name__, "must be a TorusBranchOptions")
+    check_torus_key(scene, key, start, end)
+    t0 = time.perf_counter()
+    first_scene = _scene_at(scene, key, start)
+    dof = scene.output.table or (scene.plates[0].node, "y")
+    spools = sorted((s for s, f in first_scene.frequencies_hz.items() if f > 0),
+                    key=lambda s: first_scene.frequencies_hz[s])
+    f = first_scene.frequencies_hz
+    bases = None if options.divisors is None else (f[spools[0]] / options.divisors[0],
+                                                   f[spools[1]] / options.divisors[1])
+    first = torus_balance(model, first_scene.operating, Loads(first_scene.unbalances), first_scene.plates,
+                          options.torus_options(bases, (dof,)))
+    divisors = options.divisors or tuple(int(round(f[s] / b)) for s, b in zip(spools, first.bases_hz))
+    rubs = _Family(scene, model, key, first.problem, divisors, options)
+    family = TorusFamily(rubs.problem_at, start, (key, KEYS.get(key, "Hz")),
+                         FROZEN if key.startswith("speeds.") else 0.0)
+    s_start, s_end = family.carried(start), family.carried(end)
+    scale = max(float(np.linalg.norm(first.solution.z)), abs(s_end - s_start))
+    stamps = [time.perf_counter()]
+
+    def stamped(points: int, s: float) -> None:
+        stamps.append(time.perf_counter())
+        if progress is not None:
+            progress(points, family.parameter_value(s))
+    ds, ds_max = options.steps
+    branch = continue_branch(family, first.solution.z, s_start, s_end,
+                             ContinuationOptions(ds=ds * scale, ds_min=1e-9 * scale, ds_max=ds_max * scale,
+                                                 max_points=options.max_points, tol=options.tol, stability=False,
+                                                 curved=True), progress=stamped, interrupts=interrupts)
+    stamps.append(time.perf_counter())
+    times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
+    point_time = np.concatenate([[stamps[1] - t0], times, np.zeros(len(branch.values) - 1 - len(times))])
+    with signals_held():  # a few ms a point: the branch's lines whole
+        amplitudes = np.array([rubs.rub_at(v).lines(z, dof)[2] for v, z in zip(branch.values, branch.z)])
+    h = first.problem.problem.harmonics
+    truncation = (f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}"
+                  + (f", |k . f| <= {options.f_max:g} Hz at the start" if options.f_max is not None else "")
+                  + f"), grid {h.N1} x {h.N2}, bases (f_L/{divisors[0]}, f_H/{divisors[1]})")
+    return TorusBranch(scene.name, key, KEYS.get(key, "Hz"), branch.values,
+                       np.array([rubs.bases(_scene_at(scene, key, v)) for v in branch.values]), h.orders, dof,
+                       amplitudes, branch.z, tuple((fd.value, fd.smooth) for fd in branch.folds), branch.stopped,
+                       branch.iterations, point_time, branch.slope, truncation, branch.interrupt)
+

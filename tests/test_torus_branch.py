@@ -1,0 +1,220 @@
+"""Continuation of tori (rotorred.nonlinear.torus_continuation on rotorred.nonlinear.continuation's machinery) against
+independent references: the single-term Duffing closed form and its folds, the dense Jacobian (a bordered solve, the
+singularity at a fold), single-point torus solves, and scipy's solve_ivp.
+
+The cubic oscillator ``x'' + C x' + x + K3 x^3 = F cos(w_1 t) + F_2 cos(w_2 t)`` (pyHarm's Duffing, C = 0.02,
+K3 = 0.1, F = 0.1: rotorred.nonlinear.examples) continued in w_1 from 0.5 to 2.5 rad/s, w_2 = 0.7 rad/s held.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
+from rotorred.nonlinear.examples import C, F, K3
+from rotorred.nonlinear.forces import CubicSpring
+from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
+from rotorred.nonlinear.torus_continuation import TorusFamily, TorusJacobian
+from test_nonlinear_hb import duffing_folds_closed_form
+
+W2, F2 = 0.7, 0.02
+
+
+def two_tones(H: int, F2: float):
+    """``build(w_1) -> TorusProblem`` of the cubic oscillator on the box |k1|, |k2| <= H."""
+    h = TorusHarmonics(H, H, *alias_free_grid(H, H, 3))
+
+    def at(w1: float) -> TorusProblem:
+        Q = np.zeros((h.n_orders, 1), complex)
+        Q[h.index(1, 0)], Q[h.index(0, 1)] = F, F2
+        return TorusProblem(np.eye(1), C * np.eye(1), np.eye(1), h, (w1, W2), (0,), h.from_phasors(Q),
+                            (CubicSpring(0, K3),))
+    return at
+
+
+def branch_of(H: int, F2: float):
+    family = TorusFamily(two_tones(H, F2), 0.5, ("w1", "rad/s"))
+    z0 = family.at(0.5).linear_response()
+    branch = continue_branch(family, z0, family.carried(0.5), family.carried(2.5),
+                             ContinuationOptions(ds=0.1, ds_max=0.1, ds_min=1e-8, stability=False))
+    return family, branch
+
+
+@pytest.fixture(scope="module")
+def two_tone_branch():
+    return branch_of(3, F2)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")  # the preconditioner's block at a fold: singular
+def test_a_torus_branch_without_the_second_tone_has_the_closed_form_folds():
+    """With F_2 = 0 and |k1|, |k2| <= 1 the torus is the one-harmonic periodic response: every point satisfies the
+    single-term balance ((1 - w^2 + 3/4 K3 A^2)^2 + (C w)^2) A^2 = F^2 (measured 1.5e-10 of F^2: each point to the
+    corrector's relative residual 1e-10), and the two folds the torus continuation locates are the roots of its
+    discriminant (measured 1.5e-12 and 3e-14 relative)."""
+    family, branch = branch_of(1, 0.0)
+    assert branch.stopped.startswith("reached the end")
+    h = family.harmonics
+    A = np.abs(np.array([h.phasors(z, 1)[h.index(1, 0), 0] for z in branch.z]))
+    w = branch.values
+    G = ((1 - w**2 + 0.75 * K3 * A**2) ** 2 + (C * w) ** 2) * A**2 - F**2
+    assert np.max(np.abs(G)) < 2e-9 * F**2
+    located = sorted(f.value for f in branch.folds)
+    assert all(f.smooth for f in branch.folds)
+    assert np.allclose(located, duffing_folds_closed_form(), rtol=2e-11, atol=0)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
+def test_a_two_tone_torus_branch_folds_where_the_dense_jacobian_is_singular(two_tone_branch):
+    """With both tones (|k1|, |k2| <= 3) the branch turns twice; at each fold located the dense torus Jacobian (an
+    independent construction: Toeplitz matrices by the 2-D spectrum) is singular, its smallest singular value below
+    1e-9 of its largest (measured 1e-16 and 1e-12), where at every tenth point farther than 0.05 rad/s from a fold it
+    is above 3e-4 (measured at least 2.9e-3); the second tone moves the folds from the single-tone ones by less than
+    1 % (measured 0.012 % and 0.23 %)."""
+    family, branch = two_tone_branch
+    assert branch.stopped.startswith("reached the end") and len(branch.folds) == 2
+    for fold in branch.folds:
+        J = family.at(fold.value).evaluate(fold.z).dR_dz
+        sv = np.linalg.svd(J, compute_uv=False)
+        assert sv[-1] < 1e-9 * sv[0]
+    far = np.min([np.abs(branch.values - f.value) for f in branch.folds], axis=0) > 0.05
+    for z, w in zip(branch.z[far][::10], branch.values[far][::10]):
+        sv = np.linalg.svd(family.at(w).evaluate(z).dR_dz, compute_uv=False)
+        assert sv[-1] > 3e-4 * sv[0]
+    assert np.allclose(sorted(f.value for f in branch.folds), duffing_folds_closed_form(), rtol=1e-2)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
+def test_the_branch_points_are_the_single_point_tori(two_tone_branch):
+    """Points on the three parts of the branch (below, between and above the folds, at w_1 = 1.2 rad/s where three
+    tori coexist) equal solve_torus's at their w_1 (to a relative residual of 1e-12), started 3 % of the way from each
+    to the linear response (measured 2e-14 relative): the corrector converged on the torus equations."""
+    family, branch = two_tone_branch
+    at = np.flatnonzero(np.diff(np.sign(branch.values - 1.2)))
+    assert len(at) == 3
+    for i in at:
+        z = branch.z[i]
+        solved = solve_torus(family.at(branch.values[i]), 0.97 * z + 0.03 * family.at(branch.values[i]).linear_response(),
+                             tol=1e-12)
+        assert np.linalg.norm(solved.z - z) < 1e-11 * np.linalg.norm(z)
+
+
+def test_the_bordered_torus_solve_is_the_dense_one():
+    """The block elimination of [[J, c], [r^T, d]] with GMRES solves of J (matrix-free) equals numpy's dense solve of
+    the bordered matrix built from the dense Jacobian (measured 6e-16 relative)."""
+    family = TorusFamily(two_tones(3, F2), 1.0, ("w1", "rad/s"))
+    problem = family.at(1.0)
+    z = solve_torus(problem, problem.linear_response()).z
+    rng = np.random.default_rng(1)
+    c, row, rhs = rng.normal(size=problem.size), rng.normal(size=problem.size + 1), rng.normal(size=problem.size + 1)
+    _, J = problem.jacobian(z)
+    x = TorusJacobian(J, 1e-13).bordered(c, row).solve(rhs)
+    dense = np.vstack([np.column_stack([problem.evaluate(z).dR_dz, c]), row])
+    assert np.linalg.norm(x - np.linalg.solve(dense, rhs)) < 1e-12 * np.linalg.norm(x)
+
+
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
+def test_a_point_of_the_upper_branch_is_the_torus_solve_ivp_stays_on():
+    """On the upper (stable) part, the first point past w_1 = 1.3 rad/s (the branch from 0.5 rad/s), |k1|, |k2| <= 9:
+    solve_ivp (DOP853, rtol 1e-11) started on the torus stays on it for 200 s, within 2e-7 of the largest amplitude
+    over the last 20 s (measured 1.6e-8; the issue asks 1e-6)."""
+    family = TorusFamily(two_tones(9, F2), 0.5, ("w1", "rad/s"))
+    z0 = family.at(0.5).linear_response()
+    branch = continue_branch(family, z0, family.carried(0.5), family.carried(1.3),
+                             ContinuationOptions(ds=0.1, ds_max=0.1, ds_min=1e-8, stability=False))
+    problem, z = family.at(branch.values[-1]), branch.z[-1]
+    h, w = problem.harmonics, problem.w
+    Q = h.phasors(z, 1)[:, 0]
+    k = h.orders @ np.asarray(w)
+
+    def on_torus(t):
+        return np.real(Q[0] + np.sum(Q[1:] * np.exp(1j * k[1:] * t))), np.real(np.sum(1j * k[1:] * Q[1:] *
+                                                                                        np.exp(1j * k[1:] * t)))
+    w1 = w[0]
+
+    def rhs(t, y):
+        return [y[1], F * math.cos(w1 * t) + F2 * math.cos(W2 * t) - C * y[1] - y[0] - K3 * y[0] ** 3]
+    T = 200.0
+    sol = solve_ivp(rhs, (0.0, T), list(on_torus(0.0)), rtol=1e-11, atol=1e-13, dense_output=True, method="DOP853")
+    t = np.linspace(T - 20.0, T, 400)
+    error = np.max(np.abs(sol.sol(t)[0] - np.array([on_torus(ti)[0] for ti in t])))
+    assert error < 2e-7 * np.max(np.abs(Q))
+
+
+# ------------------------------------------------------------------------------------------------- the rig, the CLI
+def test_rotorred_continue_follows_a_torus_and_writes_its_branch(tmp_path):
+    """``rotorred continue --torus 1,3`` on paper-rub at outer 91.37 Hz (incommensurate: no periodic branch), in the
+    clearance from 14 to 12 µm on a small box (|k1| <= 2, |k2| <= 8): it reaches the end, writes branch.csv (a row a
+    point, the clearance from 14 µm down past 12 µm, the bases 70 and 91.37 / 3 Hz), branch_lines.csv, branch.nc,
+    branch.png and branch.txt (no report.html: no interactive view of a torus branch)."""
+    import csv
+
+    import xarray as xr
+
+    from rotorred.cli import main
+
+    out = tmp_path / "o"
+    status = main(["continue", "paper-rub", "--set", "speeds.outer=91.37", "--param", "rub.clearance=14e-6:12e-6",
+                   "--torus", "1,3", "--orders", "2,8", "--out", str(out)])
+    assert status == 0
+    for name in ("branch.csv", "branch_lines.csv", "branch.nc", "branch.png", "branch.txt"):
+        assert (out / name).is_file(), name
+    assert not (out / "report.html").exists()
+    rows = list(csv.reader(open(out / "branch.csv")))
+    values = np.array([float(r[0]) for r in rows[1:]])
+    assert rows[0][0] == "rub.clearance (m)" and len(values) >= 3
+    assert values[0] == pytest.approx(14e-6) and values[-1] <= 12e-6 < values[-2]
+    assert np.allclose([float(r[1]) for r in rows[1:]], 70.0, rtol=1e-8)
+    assert np.allclose([float(r[2]) for r in rows[1:]], 91.37 / 3, rtol=1e-8)
+    with xr.open_dataset(out / "branch.nc") as ds:
+        assert ds["amplitude"].shape[0] == len(values) and ds["amplitude"].attrs["units"] == "m"
+    assert "reached the end" in (out / "branch.txt").read_text()
+
+
+def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there(tmp_path):
+    """``continue_torus`` in the outer speed from 91.37 to 91.8 Hz (inner 70 Hz held), |k1| <= 2, |k2| <= 8: the bases
+    are (70, f_outer / 3) Hz at every point, and each point's coefficients solve the problem
+    ``torus_rub_problem`` builds on its own at that speed (its relative residual below 1e-7, the branch asking 1e-6:
+    measured at most 8e-9); the branch shows itself (repr, figure, NetCDF)."""
+    from results_checks import assert_shows_itself
+
+    import rotorred as rr
+    from rotorred.scenes.quasi_periodic import default_grid
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = build_model(scene).model
+    branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05)))
+    assert branch.stopped.startswith("reached the end") and len(branch.values) >= 3
+    assert np.allclose(branch.bases_hz[:, 0], 70.0, rtol=1e-12)
+    assert np.allclose(branch.bases_hz[:, 1], branch.values / 3, rtol=1e-12)
+    for v, z in zip(branch.values, branch.z):
+        there = load_scene("paper-rub", {"speeds.outer": float(v)})
+        problem = torus_rub_problem(there, model, (70.0, v / 3), 2, 8, *default_grid(2, 8), 1500.0).problem
+        assert np.linalg.norm(problem.residual(z)) < 1e-7 * problem.scale
+    assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)
+
+
+@pytest.mark.parametrize("extra, tokens", [
+    (["--torus", "1", "--param", "rub.clearance=14e-6:12e-6"], ["--torus", "1,3"]),
+    (["--torus", "1,3", "--orders", "0,8", "--param", "rub.clearance=14e-6:12e-6"], ["--orders", "0,8"]),
+    (["--torus", "--param", "speeds.middle=80:90"], ["--param", "speeds.middle", "speeds.outer"]),
+    (["--torus", "--param", "rub.mu_s=0.1:0.2"], ["--param", "rub.mu_s", "rub.k_n"]),
+])
+def test_rotorred_continue_torus_refuses_bad_input_before_computing(extra, tokens, tmp_path, capsys):
+    """A bad ``--torus``, ``--orders`` or key is refused with exit 2 and one line naming it, nothing written."""
+    from rotorred.cli import main
+
+    out = tmp_path / "o"
+    assert main(["continue", "paper-rub", "--set", "speeds.outer=91.37", *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    for token in tokens:
+        assert token in err, (token, err)
+    assert not out.exists()
