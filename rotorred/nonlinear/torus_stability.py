@@ -211,8 +211,9 @@ class TorusStability(Result):
 
 
 def torus_trajectory(problem, z: np.ndarray, t: np.ndarray, dofs: str = "unknowns") -> tuple[np.ndarray, np.ndarray]:
-    """The torus's displacements and velocities at times ``t``, read along ``theta = w t`` (phase origin t = 0, the
-    forcing's): ``q(t) = sum_k Re(Q_k exp(i k . w t))``.
+    """The torus's displacements and velocities at times ``t``, read along ``theta = w t``.
+
+    The phase origin is t = 0, the forcing's: ``q(t) = sum_k Re(Q_k exp(i k·w t))``.
 
     Parameters
     ----------
