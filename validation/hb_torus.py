@@ -28,7 +28,9 @@ Prints:
 5. the table of the issue's measure: transient time, torus time (everything after the transient that provides the
    start: the start's least squares, every truncation's problem, compliance and Newton solve, the transfers between
    them), their ratio, the worst of the 10 lines, the torus's peak memory (tracemalloc) and the process's peak
-   resident memory (transient, record and torus together: an upper bound of the torus's).
+   resident memory (transient, record and torus together: an upper bound of the torus's), and the peak resident memory
+   of a process that only builds the model and solves the cold-started torus (``--alone``: imports, kernels, the
+   start's 3 s transient and the torus on the last truncation, everything a user's torus run holds).
 
 The force kernel is compiled (numba) before the torus's clock starts, as the transient's is before its own.
 """
@@ -36,6 +38,8 @@ The force kernel is compiled (numba) before the torus's clock starts, as the tra
 from __future__ import annotations
 
 import resource
+import subprocess
+import sys
 import time
 from dataclasses import dataclass
 
@@ -211,6 +215,7 @@ def main() -> Comparison:
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     print("the torus once more, for its memory (tracemalloc, not timed):")
     torus_mb = torus_memory(scene, sm, torus, result, largest, records)
+    alone_mb = alone_peak_mb()
     verdict = "within" if out.worst <= TOLERANCE else "NOT within"
     print(f"result ({verdict} {TOLERANCE:.1%} on the 10 largest lines):")
     print("  | transient (s) | torus (s) | torus / transient | worst line | torus peak (MB) | process peak (MB) |")
@@ -219,10 +224,37 @@ def main() -> Comparison:
     print(f"  (transient: {DURATION - RECORD_START:g} s recorded from the settled linear state; torus: the start's "
           "least squares and every truncation; torus peak: the largest memory numpy and Python hold during the torus "
           "(tracemalloc, a second run, not timed); process peak: the resident maximum of the whole run)")
+    print(f"  a process that only solves the cold-started torus ({TRUNCATIONS[-1][0]} x {TRUNCATIONS[-1][1]}: model, "
+          f"kernels, the start's transient, the torus) peaks at {alone_mb:.0f} MB resident")
     print(f"  cold start: {cold_time:.2f} s for its short transient and the torus ({cold_time / out.transient_time:.2f} "
           f"of the long transient's time), on the warm solve's torus to {cold_difference:.2g}")
     return out
 
 
+def alone() -> float:
+    """The cold-started torus in this process only (model, start's transient, torus on the last truncation); prints
+    and returns the process's peak resident memory (MB)."""
+    import rotorred as rr
+
+    scene = load_scene("paper-rub", {"speeds.outer": OUTER_HZ})
+    sm = build_model(scene)
+    H1, H2, N1, N2 = TRUNCATIONS[-1]
+    options = rr.TorusOptions(orders=(H1, H2), grid=(N1, N2), f_max=F_MAX, outputs=[OUTPUT])
+    rr.torus_balance(sm.model, rr.Operating.point(dict(scene.speeds)), rr.Loads(scene.unbalances), scene.plates,
+                     options)
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    print(f"{peak:.0f}")
+    return peak
+
+
+def alone_peak_mb() -> float:
+    """:func:`alone` in a child process: its peak resident memory (MB)."""
+    run = subprocess.run([sys.executable, __file__, "--alone"], capture_output=True, text=True, check=True)
+    return float(run.stdout.split()[-1])
+
+
 if __name__ == "__main__":
-    main()
+    if "--alone" in sys.argv:
+        alone()
+    else:
+        main()
