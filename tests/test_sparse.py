@@ -72,6 +72,29 @@ def test_sparse_assembly_is_the_dense_one(name):
     assert np.array_equal(null_space(s)[2][:4], null_space(d)[2][:4])
 
 
+def test_the_sparse_twin_of_an_assembled_model_is_its_sparse_assembly():
+    """``assemble(rotor).sparse()`` is the rotor's sparse assembly, not its dense matrices converted (so an analysis
+    on the sparse path runs the sparse assembly, ``pytest --solve-sparse-from 0``), equal to them to the bit, its loss
+    frequency the model's; a model changed after assembly gets its own matrices converted; ``system_of`` assembles a
+    rotor solved sparse sparse at once."""
+    from rotorred.model.assembly import system_of
+
+    model = assemble(_tabulated_and_damped(), as_sparse=False)
+    twin = model.sparse()
+    assert twin is model.sparse() and twin.is_sparse and twin.loss_frequency == model.loss_frequency
+    assert twin._assembled and not twin._twin
+    d = twin.dense()
+    assert all(np.array_equal(getattr(d, k), getattr(model, k)) for k in ("M", "K", "C"))
+    assert all(np.array_equal(d.G[k], model.G[k]) and np.array_equal(d.rotating[k].N_h, model.rotating[k].N_h)
+               for k in model.rotating)
+    speeds = {k: 0.7 * w for k, w in model.nominal_speeds.items()}
+    assert np.array_equal(sparse.dense(twin.stiffness(speeds)), model.stiffness(speeds))
+    changed = dataclasses.replace(model, K=2.0 * model.K)
+    assert not changed._assembled and np.array_equal(changed.sparse().K.toarray(), 2.0 * model.K)
+    rig = rr.load_rotor("seed-rig")
+    assert system_of(rig, sparse_ok=True).is_sparse is (assemble(rig).n_dof >= sparse.SOLVE_SPARSE_FROM)
+
+
 def test_size_decides_the_form_and_the_path(request):
     """The unrefined rig is assembled and solved dense; refined(16), 1160 DOFs, is assembled dense and solved through
     its sparse twin (system_of); refined(32), 2312 DOFs, dense too; refined(64) sparse."""

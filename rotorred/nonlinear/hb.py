@@ -24,6 +24,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
+from rotorred.model import sparse
 from rotorred.nonlinear.fourier import Harmonics, to_phasors
 from rotorred.nonlinear.lowrank import factored
 from rotorred.results import Result
@@ -335,10 +336,16 @@ def local_forces(forces, dofs: tuple[int, ...]) -> tuple:
 
 
 def checked_matrices(problem) -> int:
-    """Check a problem's M, D, K (and D1, K1) as square matrices of one size, and its harmonics; the size n."""
+    """Check a problem's M, D, K (and D1, K1) as square matrices of one size, and its harmonics; the size n. Sparse
+    matrices (a full model assembled sparse) are made dense below :data:`rotorred.model.sparse.SPARSE_FROM` DOFs and
+    refused from there: the harmonic-balance operators are dense in the (2H + 1) n unknowns (docs/model.md §24)."""
     n = np.shape(problem.M)[0] if np.ndim(problem.M) == 2 else 0
     for name in ("M", "D", "K") + tuple(k for k in ("D1", "K1") if getattr(problem, k) is not None):
-        object.__setattr__(problem, name, checks.array(name, getattr(problem, name), (n, n)))
+        X = getattr(problem, name)
+        if sparse.is_sparse(X) and n >= sparse.SPARSE_FROM:
+            checks.fail(name, f"a sparse matrix of {n} DOFs", f"must have fewer than {sparse.SPARSE_FROM} DOFs: "
+                        "harmonic balance is dense in its unknowns; reduce the model first (reduce_rotor)")
+        object.__setattr__(problem, name, checks.array(name, sparse.dense(X), (n, n)))
     if not isinstance(problem.harmonics, Harmonics):
         checks.fail("harmonics", problem.harmonics, "must be a Harmonics")
     return n
