@@ -339,9 +339,23 @@ class SystemMatrices(SpoolSpeedMixin):
             ``rows @ q`` gives the physical displacements.
         """
         rows = np.zeros((len(outputs), self.n_dof))
-        for i, (node, direction) in enumerate(outputs):
-            rows[i, self.dofs.index(node, direction)] = 1.0
+        rows[np.arange(len(outputs)), self.output_index(outputs)] = 1.0
         return rows
+
+    def output_index(self, outputs) -> np.ndarray:
+        """The model coordinate of each physical DOF: ``q[index]`` are the displacements :meth:`output_rows` gives,
+        with no row of n entries (a full model's outputs are its own coordinates).
+
+        Parameters
+        ----------
+        outputs : sequence of (int, str)
+            (node, direction) pairs.
+
+        Returns
+        -------
+        ndarray of int, shape (len(outputs),)
+        """
+        return np.array([self.dofs.index(node, direction) for node, direction in outputs], dtype=int)
 
     def summary(self) -> list[str]:
         """Rotor, DOFs, spools and speed-dependent bearings: at most 9 lines, no arrays (``repr``)."""
