@@ -18,14 +18,16 @@ def pytest_addoption(parser):
                      help="assemble and solve models of at least this many DOFs sparse (rotorred.model.sparse."
                           "SPARSE_FROM, SOLVE_SPARSE_FROM); 0 runs every test on the sparse path")
     parser.addoption("--solve-sparse-from", type=int, default=None,
-                     help="solve models of at least this many DOFs sparse (rotorred.model.sparse.SOLVE_SPARSE_FROM), "
-                          "assembled as the size says; 0 runs every analysis with a sparse path on it")
+                     help="solve models of at least this many DOFs sparse (rotorred.model.sparse.SOLVE_SPARSE_FROM): "
+                          "an analysis with a sparse path assembles them sparse and solves them sparse, a test's own "
+                          "matrices are assembled as their size says; 0 runs every such analysis on the sparse path")
 
 
 @pytest.fixture(autouse=True)
 def _sparse_from(request, monkeypatch):
     """``--sparse-from N``: the size from which models are assembled and solved sparse, for this run;
-    ``--solve-sparse-from N``: the size from which they are solved sparse."""
+    ``--solve-sparse-from N``: the size from which the analyses assemble and solve them sparse
+    (``system_of(..., sparse_ok=True)``: a rotor's or an assembled model's sparse assembly, docs/model.md §24)."""
     from rotorred.model import sparse
 
     value = request.config.getoption("--sparse-from")
