@@ -381,6 +381,30 @@ def markdown_checks(checks: dict[str, dict[str, str]]) -> str:
     return "\n".join(lines)
 
 
+def markdown_ratios(rows: list[dict]) -> str:
+    """Dense against sparse at the largest mesh solved both ways, each task's ratio of times in the same run."""
+    refine = max((r["refine"] for r in rows if not r["sparse"]), default=None)
+    pair = {r["sparse"]: r for r in rows if r["refine"] == refine}
+    if refine is None or len(pair) < 2:
+        return ""
+    return (f"Dense against sparse at refined({refine}), {pair[True]['n_dof']} DOFs, in the same run: "
+            + ", ".join(f"{LABELS[t].split(' (')[0]} **{pair[False][t] / pair[True][t]:.3g}×**" for t in TASKS[:4])
+            + ".")
+
+
+def markdown_scene(checks: dict[str, dict[str, str]]) -> str:
+    """The ``cli_scene`` check (:func:`read_checks`) as a Markdown table: ``rotorred run`` of paper-rub on the rig
+    and on refined(128) (:func:`format_scene`)."""
+    c = {k: float(v) for k, v in checks["cli_scene"].items()}
+    lines = ["| rotor | DOF | µs/step | build (s) | wall (s) | peak RSS (MB) |", "|---|---:|---:|---:|---:|---:|"]
+    for key, label, n in (("rig", "seed-rig (preset)", 80), ("refined128", "refined(128) rotor file", 9224),
+                          ("refined128_auto", 'refined(128), `solver.modes = "auto"`', 9224)):
+        lines.append(f"| {label} | {n} | {c[key + '_us_step']:.3g} | {c[key + '_build_s']:.3g} | "
+                     f"{c[key + '_wall_s']:.3g} | {c[key + '_rss_mb']:.0f} |")
+    lines += ["", f"µs/step of refined(128) against the rig's in the same run: **{c['us_step_ratio']:.2f}×**."]
+    return "\n".join(lines)
+
+
 def format_scene(c: dict) -> str:
     """The ``cli_scene`` check as a table: ``rotorred run`` of paper-rub on the rig and on refined(128)."""
     lines = ["rotorred run paper-rub (median of 3 alternating runs, one thread)",
