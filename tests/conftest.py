@@ -11,7 +11,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 
-
 def pytest_addoption(parser):
     parser.addoption("--sparse-from", type=int, default=None,
                      help="assemble and solve models of at least this many DOFs sparse (rotorred.model.sparse."

@@ -168,6 +168,31 @@ def test_sparse_craig_bampton_is_the_dense_one():
     assert np.max(np.abs(fa[:12] / fb[:12] - 1)) < 1e-9
 
 
+def test_harmonic_balance_takes_a_small_sparse_model_dense_and_refuses_a_large_one():
+    """PeriodicProblem handed sparse matrices: up to DENSE_UP_TO DOFs their dense copies (the same linear response to
+    the bit), beyond refused by name before any work (its operators are dense in the (2H + 1) n unknowns)."""
+    from rotorred.nonlinear.hb import DENSE_UP_TO
+
+    model = assemble(rr.load_rotor("seed-rig"), as_sparse=False)
+    h = rr.Harmonics(1, 8)
+    n = model.n_dof
+
+    def forcing(omega):
+        F = np.zeros((h.size, n))
+        F[1, 4] = 1.0
+        return F.reshape(-1), np.zeros(h.size * n)
+
+    args = dict(harmonics=h, forcing=forcing)
+    dense = rr.PeriodicProblem(M=model.M, D=model.C, K=model.K, **args)
+    twin = model.sparse()
+    as_sparse = rr.PeriodicProblem(M=twin.M, D=twin.C, K=twin.K, **args)
+    assert not sp.issparse(as_sparse.M)
+    assert np.array_equal(as_sparse.linear_response(300.0), dense.linear_response(300.0))
+    big = sp.identity(DENSE_UP_TO + 1, format="csr")
+    with pytest.raises(InputError, match="M = 'a sparse matrix of 2501 DOFs'.*reduce_rotor"):
+        rr.PeriodicProblem(M=big, D=big, K=big, **args)
+
+
 def test_sparse_reduction_refuses_a_free_interior():
     rig = rr.load_rotor("seed-rig")
     loose = assemble(dataclasses.replace(rig, intershaft_bearings=()), as_sparse=True)
