@@ -41,4 +41,4 @@ def test_performance_page_quotes_the_committed_csv():
     assert len(rows) >= 8 and {r["n_dof"] for r in rows} >= {80, 1160, 9224}
     assert bs.markdown_table(rows) in page
     assert bs.markdown_checks(bs.read_checks(CSV.with_name("bench_sparse_checks.csv"))) in page
-    assert header[2].split(",")[0] in page  # the commit measured
+    assert f"commit `{header[2].split(',')[0].split()[-1]}`" in page  # the commit measured

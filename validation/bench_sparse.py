@@ -366,7 +366,7 @@ def markdown_checks(checks: dict[str, dict[str, str]]) -> str:
                              lambda c: f"{c['cli_n_critical']} critical speeds with margins"),
             "unbalance200": ("unbalance response at 200 speeds", lambda c: ""),
             "reduction": ("automatic Craig-Bampton reduction", lambda c: f"{c['n_modes']} modes, whirl error "
-                          f"{float(c['error']):.2g}"),
+                          f"{100 * float(c['error']):.2g} %"),
             "rub": ("paper-rub transient on its 10-mode reduced model", lambda c: f"{float(c['us_step_128']):.2f} "
                     f"µs/step against {float(c['us_step_1']):.2f} for the rig's")}
     lines = ["| check on refined(128), 9224 DOFs | wall (s) | CPU (s) | peak RSS (MB) | result |",
@@ -432,7 +432,7 @@ def write_csv(rows: list[dict], checks: list[dict], path: str, command: str) -> 
     commit = subprocess.run(["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                             check=False).stdout.strip() or "unknown"
     header = [f"# python validation/bench_sparse.py {command}",
-              f"# machine: {platform.machine()} {platform.processor() or ''}, {os.cpu_count()} cores, "
+              f"# machine: {' '.join(filter(None, (platform.machine(), platform.processor())))}, {os.cpu_count()} cores, "
               f"{platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, one thread; "
               f"load average at the start {os.getloadavg()[0]:.1f}",
               f"# commit {commit}, {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
@@ -496,7 +496,7 @@ def draw(rows: list[dict], ax1, ax2=None) -> None:
             sel = sorted((r for r in rows if r["sparse"] == as_sparse and r.get(task)), key=lambda r: r["n_dof"])
             if not sel:
                 continue
-            growth = f" (n^{slopes[task]:.2f} from 1000 DOFs)" if as_sparse and task in slopes else ""
+            growth = f" ($n^{{{slopes[task]:.2f}}}$ from 1000 DOFs)" if as_sparse and task in slopes else ""
             ax1.loglog([r["n_dof"] for r in sel], [r[task] for r in sel], style, color=f"C{k}",
                        mfc="none" if not as_sparse else None,
                        label=f"{LABELS[task].split(' (')[0]}, {'sparse' if as_sparse else 'dense'}{growth}")
