@@ -257,10 +257,6 @@ class SystemMatrices(SpoolSpeedMixin):
     rotor: Rotor | None = field(default=None, compare=False, repr=False)
     rotating: Mapping[str, RotatingDamping] = field(default_factory=dict)
     loss_frequency: float = 0.0
-    #: the sparse assembly of ``rotor`` (:meth:`sparse`), kept once made; None until then, and for a model not made
-    #: by :func:`assemble` as it is (``dataclasses.replace`` resets it, and with it ``_assembled``)
-    _twin: SystemMatrices | None = field(default=None, init=False, compare=False, repr=False)
-    _assembled: bool = field(default=False, init=False, compare=False, repr=False)
 
     @property
     def n_dof(self) -> int:
@@ -284,12 +280,12 @@ class SystemMatrices(SpoolSpeedMixin):
         ``loss_frequency`` kept: docs/model.md §24), any other model its matrices converted."""
         if self.is_sparse:
             return self
-        if self._assembled and self.rotor is not None:
-            if self._twin is None:
+        if self.__dict__.get(_AS_ASSEMBLED) and self.rotor is not None:
+            if "_twin" not in self.__dict__:  # made once, kept (an attribute, not a field: replace() drops it)
                 twin = dataclasses.replace(_assembled(self.rotor, True), loss_frequency=self.loss_frequency)
-                object.__setattr__(twin, "_assembled", True)
+                object.__setattr__(twin, _AS_ASSEMBLED, True)
                 object.__setattr__(self, "_twin", twin)
-            return self._twin
+            return self.__dict__["_twin"]
         c = sparse.csr
         return dataclasses.replace(
             self, M=c(self.M), K=c(self.K), C=c(self.C), G={k: c(v) for k, v in self.G.items()},
@@ -483,8 +479,14 @@ def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
     supported = _assembled(rotor, as_sparse)
     if any(sparse.nonzero(r.C_h) for r in supported.rotating.values()):
         supported = dataclasses.replace(supported, loss_frequency=first_natural_frequency(supported.M, supported.K))
-    object.__setattr__(supported, "_assembled", True)
+    object.__setattr__(supported, _AS_ASSEMBLED, True)
     return supported
+
+
+#: the mark :func:`assemble` leaves on the model it returns (an attribute, not a field: ``dataclasses.replace``, and
+#: any other way of making a changed model, drops it); :meth:`SystemMatrices.sparse` of a marked model is its rotor's
+#: sparse assembly
+_AS_ASSEMBLED = "_as_assembled"
 
 
 def _assembled(rotor: Rotor, as_sparse: bool) -> SystemMatrices:
