@@ -82,10 +82,8 @@ def gravity_force(model, g: float) -> np.ndarray:
     g = checks.number("g", g, "m/s^2")
     if model.supported_weight is not None:  # supports remove DOFs that move with a rigid translation
         return -g * model.supported_weight
-    from rotorred.model.assembly import SystemMatrices  # assembly imports rotor, which imports this module
-
     pairs = list(model.full_dofs.pairs)
-    if isinstance(model, SystemMatrices):  # its physical DOFs are its coordinates: e is 1 on every y, 0 elsewhere
+    if hasattr(model, "output_index"):  # a full model: its DOFs are its coordinates, e is 1 on every y, 0 elsewhere
         e = np.zeros(model.n_dof)
         e[model.output_index([p for p in pairs if p[1] == "y"])] = 1.0
         return -g * (model.M @ e)
