@@ -323,7 +323,7 @@ def _margin(sm, result: CampbellResult, c: CriticalSpeed, rng: OperatingRange | 
         if not _interior_peaks(A, W, c.speed, near * c.speed):
             # no sampled peak near the crossing: a wider band samples the same speeds more coarsely (the near
             # region lies inside the first band, band >= 2.5 near), so it is widened only to take in the
-            # half-power points of a peak found (each band 41 full solves: a 9224-DOF model's 1.6 s)
+            # half-power points of a peak found (each band is 41 full solves)
             break
         hp = half_power(lambda V, W=W, A=A: A if V is W else amplitude(V), W, c.speed, near * c.speed)
         band *= 2.0
