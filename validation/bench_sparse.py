@@ -36,7 +36,7 @@ machine, its load average at the start, the commit and the date, and the checks 
 examples/plot_sparse_scaling.py (the site's figure) and by tests/test_bench.py against docs/performance.md.
 
 Run ``python validation/bench_sparse.py [--quick] [--checks] [--scene] [--dense-up-to N] [--plot PATH] [--csv PATH]``
-(about 10 minutes with ``--checks`` on a quiet 2-core machine, 21 at a load average of 4-7).
+(about 4 minutes with ``--checks`` on a quiet 2-core machine, 21 at a load average of 4-7).
 """
 
 from __future__ import annotations
