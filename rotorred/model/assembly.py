@@ -345,11 +345,12 @@ class SystemMatrices(SpoolSpeedMixin):
         Parameters
         ----------
         outputs : sequence of (int, str)
-            (node, direction) pairs.
+            The physical DOFs, (node, direction) pairs as :meth:`output_rows` takes them.
 
         Returns
         -------
         ndarray of int, shape (len(outputs),)
+            Indices into the model's coordinates.
         """
         return np.array([self.dofs.index(node, direction) for node, direction in outputs], dtype=int)
 
