@@ -72,6 +72,29 @@ def test_sparse_assembly_is_the_dense_one(name):
     assert np.array_equal(null_space(s)[2][:4], null_space(d)[2][:4])
 
 
+def test_the_sparse_twin_of_an_assembled_model_is_its_sparse_assembly():
+    """``assemble(rotor).sparse()`` is the rotor's sparse assembly, not its dense matrices converted (so an analysis
+    on the sparse path runs the sparse assembly, ``pytest --solve-sparse-from 0``), equal to them to the bit, its loss
+    frequency the model's; a model changed after assembly gets its own matrices converted; ``system_of`` assembles a
+    rotor solved sparse sparse at once."""
+    from rotorred.model.assembly import system_of
+
+    model = assemble(_tabulated_and_damped(), as_sparse=False)
+    twin = model.sparse()
+    assert twin is model.sparse() and twin.is_sparse and twin.loss_frequency == model.loss_frequency
+    assert twin._as_assembled and "_twin" not in vars(twin)
+    d = twin.dense()
+    assert all(np.array_equal(getattr(d, k), getattr(model, k)) for k in ("M", "K", "C"))
+    assert all(np.array_equal(d.G[k], model.G[k]) and np.array_equal(d.rotating[k].N_h, model.rotating[k].N_h)
+               for k in model.rotating)
+    speeds = {k: 0.7 * w for k, w in model.nominal_speeds.items()}
+    assert np.array_equal(sparse.dense(twin.stiffness(speeds)), model.stiffness(speeds))
+    changed = dataclasses.replace(model, K=2.0 * model.K)
+    assert not hasattr(changed, "_as_assembled") and np.array_equal(changed.sparse().K.toarray(), 2.0 * model.K)
+    rig = rr.load_rotor("seed-rig")
+    assert system_of(rig, sparse_ok=True).is_sparse is (assemble(rig).n_dof >= sparse.SOLVE_SPARSE_FROM)
+
+
 def test_size_decides_the_form_and_the_path(request):
     """The unrefined rig is assembled and solved dense; refined(16), 1160 DOFs, is assembled dense and solved through
     its sparse twin (system_of); refined(32), 2312 DOFs, dense too; refined(64) sparse."""
@@ -143,6 +166,51 @@ def test_sparse_craig_bampton_is_the_dense_one():
     fa = eigen(a.M, a.damping(speeds), a.stiffness(speeds)).frequencies
     fb = eigen(b.M, b.damping(speeds), b.stiffness(speeds)).frequencies
     assert np.max(np.abs(fa[:12] / fb[:12] - 1)) < 1e-9
+
+
+def test_harmonic_balance_takes_a_small_sparse_model_dense_and_refuses_a_large_one():
+    """PeriodicProblem handed sparse matrices: up to DENSE_UP_TO DOFs their dense copies (the same linear response to
+    the bit), beyond refused by name before any work (its operators are dense in the (2H + 1) n unknowns)."""
+    from rotorred.nonlinear.hb import DENSE_UP_TO
+
+    model = assemble(rr.load_rotor("seed-rig"), as_sparse=False)
+    h = rr.Harmonics(1, 8)
+    n = model.n_dof
+
+    def forcing(omega):
+        F = np.zeros((h.size, n))
+        F[1, 4] = 1.0
+        return F.reshape(-1), np.zeros(h.size * n)
+
+    args = dict(harmonics=h, forcing=forcing)
+    dense = rr.PeriodicProblem(M=model.M, D=model.C, K=model.K, **args)
+    twin = model.sparse()
+    as_sparse = rr.PeriodicProblem(M=twin.M, D=twin.C, K=twin.K, **args)
+    assert not sp.issparse(as_sparse.M)
+    assert np.array_equal(as_sparse.linear_response(300.0), dense.linear_response(300.0))
+    big = sp.identity(DENSE_UP_TO + 1, format="csr")
+    with pytest.raises(InputError, match="M = 'a sparse matrix of 2501 DOFs'.*reduce_rotor"):
+        rr.PeriodicProblem(M=big, D=big, K=big, **args)
+
+
+def test_gravity_and_node_motion_of_a_full_model_pick_its_coordinates():
+    """A full model's gravity load and mode-shape node motion read its coordinates by index (no n x n rows, no
+    least squares: 680 MB and O(n^3) at 9224 DOFs): equal to the least-squares and row-product formulas they
+    replace, on the dense and the sparse form."""
+    from rotorred.linear.modes import node_motion
+    from rotorred.model.loads import gravity_force
+
+    d = assemble(rr.load_rotor("seed-rig"), as_sparse=False)
+    pairs = list(d.full_dofs.pairs)
+    R = d.output_rows(pairs)
+    e = np.linalg.lstsq(R, np.array([1.0 if k == "y" else 0.0 for _, k in pairs]), rcond=None)[0]
+    expected = -9.81 * (d.M @ e)
+    for model in (d, d.sparse()):
+        assert np.max(np.abs(gravity_force(model, 9.81) - expected)) <= 1e-14 * np.max(np.abs(expected))
+    shapes = np.random.default_rng(1).standard_normal((d.n_dof, 3)) + 0j
+    nodes, _, _, X, Y = node_motion(d, shapes)
+    rows = d.output_rows([(n, k) for n in nodes for k in ("x", "y")]) @ shapes
+    assert np.array_equal(X, rows[0::2].T) and np.array_equal(Y, rows[1::2].T)
 
 
 def test_sparse_reduction_refuses_a_free_interior():

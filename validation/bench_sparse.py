@@ -25,7 +25,18 @@ the paper-rub scene whose ``[rotor] file`` is the rig refined(128) written by ``
 runs each: the µs per step, the model's build time (both from the run's summary.txt), the command's wall time and its
 peak resident set (its own ``ru_maxrss``).
 
-Run ``python validation/bench_sparse.py [--quick] [--checks] [--scene] [--dense-up-to N] [--plot PATH]``.
+The ``cli_campbell`` check is the same Campbell diagram through the command line with its margins:
+``rotorred campbell`` of the refined(128) rotor file at 0:12000:61 rpm with an operating range of 4000-9000 rpm (the
+critical speeds, their API 684 amplification factors and API 617 margins), its wall time, CPU time and peak resident
+set (its own ``ru_maxrss``).
+
+``--csv PATH`` writes the table (one row per mesh and form) as CSV, with ``#`` lines first naming the command, the
+machine, its load average at the start, the commit and the date, and the checks beside it as
+``PATH``'s ``_checks.csv`` (check, quantity, value); docs/data/bench_sparse.csv is this file, read by
+examples/plot_sparse_scaling.py (the site's figure) and by tests/test_bench.py against docs/performance.md.
+
+Run ``python validation/bench_sparse.py [--quick] [--checks] [--scene] [--dense-up-to N] [--plot PATH] [--csv PATH]``
+(about 4 minutes with ``--checks`` on a quiet 2-core machine, 21 at a load average of 4-7).
 """
 
 from __future__ import annotations
@@ -53,6 +64,8 @@ QUICK = (1, 4, 16, 64)
 TASKS = ("assembly", "campbell_speed", "unbalance_freq", "reduction", "rub_us_step")
 LABELS = {"assembly": "assembly (s)", "campbell_speed": "Campbell/speed (s)", "unbalance_freq": "unbalance/freq (s)",
           "reduction": "reduction (s)", "rub_us_step": "rub µs/step"}
+#: the issue's checks on refined(128) (:func:`check`)
+CHECKS = ("campbell61", "cli_campbell", "unbalance200", "reduction", "rub", "cli_scene")
 TOP_RPM = 12000.0
 RUB_SECONDS = 1.0
 DT = 1e-5
@@ -161,6 +174,7 @@ def check(name: str) -> dict:
     rotor = rr.load_rotor("seed-rig").refined(128)
     out = {"check": name}
     t0 = time.perf_counter()
+    cpu0 = _cpu_seconds(resource.RUSAGE_SELF)
     if name == "campbell61":
         result = rr.campbell(rotor, rr.Operating.line(_rpm(np.linspace(0.0, TOP_RPM, 61))))
         out.update(n_modes=result.n_modes, n_critical=len(result.critical_speeds),
@@ -181,9 +195,49 @@ def check(name: str) -> dict:
         out.update({f"us_step_{refine}": statistics.median(v) for refine, v in runs.items()})
     elif name == "cli_scene":
         out.update(cli_scene_runs())
-    out["seconds"] = time.perf_counter() - t0
-    out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    elif name == "cli_campbell":
+        out.update(cli_campbell_run(rotor))
+    out["seconds"] = round(time.perf_counter() - t0, 2)
+    out["cpu_s"] = round(_cpu_seconds(resource.RUSAGE_SELF) - cpu0, 2)
+    out["rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
     return out
+
+
+def _cpu_seconds(who) -> float:
+    import resource
+
+    usage = resource.getrusage(who)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _rotorred_command() -> str:
+    import shutil
+
+    return shutil.which("rotorred", path=str(Path(sys.executable).parent)) or shutil.which("rotorred")
+
+
+def cli_campbell_run(rotor) -> dict:
+    """``rotorred campbell`` of ``rotor`` (written by ``Rotor.to_toml``) at 0:12000:61 rpm, operating range
+    4000-9000 rpm: its wall time (s), CPU time (s) and peak RSS (MB), its critical speeds and how many of them have
+    an amplification factor (a response peak of their own)."""
+    import csv
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        rotor.to_toml(tmp / "rig128.toml")
+        t0 = time.perf_counter()
+        child = subprocess.Popen([_rotorred_command(), "campbell", str(tmp / "rig128.toml"), "--speeds",
+                                  f"0:{TOP_RPM:.0f}:61", "--operating-range", "4000:9000", "--out", str(tmp / "out"),
+                                  "--no-html", "-q"], stdout=subprocess.DEVNULL)
+        _, status, usage = os.wait4(child.pid, 0)
+        wall = time.perf_counter() - t0
+        if os.waitstatus_to_exitcode(status) != 0:
+            raise RuntimeError(f"rotorred campbell failed: exit {os.waitstatus_to_exitcode(status)}")
+        with open(tmp / "out" / "critical_speeds.csv", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))][1:]
+    return {"cli_wall_s": round(wall, 2), "cli_cpu_s": round(usage.ru_utime + usage.ru_stime, 2),
+            "cli_rss_mb": round(usage.ru_maxrss / 1024, 1), "cli_n_critical": len(rows)}
 
 
 def cli_scene_runs(repeats: int = 3) -> dict:
@@ -192,13 +246,12 @@ def cli_scene_runs(repeats: int = 3) -> dict:
     ``repeats`` times after one warm-up run: the medians of the µs per step and the build time (summary.txt), of the
     wall time (s) and the peak RSS (MB) of each."""
     import re
-    import shutil
     import tempfile
     from importlib import resources
 
     import rotorred as rr
 
-    command = shutil.which("rotorred", path=str(Path(sys.executable).parent)) or shutil.which("rotorred")
+    command = _rotorred_command()
     runs = {"rig": [], "refined128": [], "refined128_auto": []}
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -289,6 +342,69 @@ def format_table(rows: list[dict], checks: list[dict] | None = None) -> str:
     return "\n".join(lines)
 
 
+def markdown_table(rows: list[dict]) -> str:
+    """The table of :func:`format_table` in Markdown (docs/performance.md quotes it as printed from the CSV), with
+    the growth exponents of the sparse tasks from 1000 DOFs on."""
+    lines = ["| mesh | form | DOF | " + " | ".join(LABELS[t] for t in TASKS) + " | peak MB | RSS MB |",
+             "|---|---|---:|" + "---:|" * (len(TASKS) + 2)]
+    for r in sorted(rows, key=lambda r: (r["refine"], not r["sparse"])):
+        peak = max(r[f"{t}_mb"] for t in TASKS[:4])
+        lines.append(f"| refined({r['refine']}) | {'sparse' if r['sparse'] else 'dense'} | {r['n_dof']} | "
+                     + " | ".join(f"{r[t]:.3g}" if r.get(t) is not None else "" for t in TASKS)
+                     + f" | {peak:.1f} | {r['rss_mb']:.0f} |")
+    lines += ["", "Growth exponents of the sparse tasks from 1000 DOFs on (slope of log cost against log DOFs): "
+              + ", ".join(f"{LABELS[t].split(' (')[0]} **n^{p:.2f}**" for t, p in exponents(rows).items()) + "."]
+    return "\n".join(lines)
+
+
+def markdown_checks(checks: dict[str, dict[str, str]]) -> str:
+    """The issue's checks on refined(128) (:func:`read_checks`) as a Markdown table: wall and CPU time, peak RSS and
+    what each found."""
+    what = {"campbell61": ("61-speed Campbell 0-12 000 rpm, critical speeds (`rr.campbell`)",
+                           lambda c: f"{c['n_modes']} modes, {c['n_critical']} critical speeds"),
+            "cli_campbell": ("the same through `rotorred campbell`, with the API 684/617 margins",
+                             lambda c: f"{c['cli_n_critical']} critical speeds with margins"),
+            "unbalance200": ("unbalance response at 200 speeds", lambda c: ""),
+            "reduction": ("automatic Craig-Bampton reduction", lambda c: f"{c['n_modes']} modes, whirl error "
+                          f"{100 * float(c['error']):.2g} %"),
+            "rub": ("paper-rub transient on its 10-mode reduced model", lambda c: f"{float(c['us_step_128']):.2f} "
+                    f"µs/step against {float(c['us_step_1']):.2f} for the rig's")}
+    lines = ["| check on refined(128), 9224 DOFs | wall (s) | CPU (s) | peak RSS (MB) | result |",
+             "|---|---:|---:|---:|---|"]
+    for name, (label, result) in what.items():
+        if name not in checks:
+            continue
+        c = checks[name]
+        wall, cpu, rss = ((c["cli_wall_s"], c["cli_cpu_s"], c["cli_rss_mb"]) if name == "cli_campbell"
+                          else (c["seconds"], c["cpu_s"], c["rss_mb"]))
+        lines.append(f"| {label} | {float(wall):.1f} | {float(cpu):.1f} | {float(rss):.0f} | {result(c)} |")
+    return "\n".join(lines)
+
+
+def markdown_ratios(rows: list[dict]) -> str:
+    """Dense against sparse at the largest mesh solved both ways, each task's ratio of times in the same run."""
+    refine = max((r["refine"] for r in rows if not r["sparse"]), default=None)
+    pair = {r["sparse"]: r for r in rows if r["refine"] == refine}
+    if refine is None or len(pair) < 2:
+        return ""
+    return (f"Dense against sparse at refined({refine}), {pair[True]['n_dof']} DOFs, in the same run: "
+            + ", ".join(f"{LABELS[t].split(' (')[0]} **{pair[False][t] / pair[True][t]:.3g}×**" for t in TASKS[:4])
+            + ".")
+
+
+def markdown_scene(checks: dict[str, dict[str, str]]) -> str:
+    """The ``cli_scene`` check (:func:`read_checks`) as a Markdown table: ``rotorred run`` of paper-rub on the rig
+    and on refined(128) (:func:`format_scene`)."""
+    c = {k: float(v) for k, v in checks["cli_scene"].items()}
+    lines = ["| rotor | DOF | µs/step | build (s) | wall (s) | peak RSS (MB) |", "|---|---:|---:|---:|---:|---:|"]
+    for key, label, n in (("rig", "seed-rig (preset)", 80), ("refined128", "refined(128) rotor file", 9224),
+                          ("refined128_auto", 'refined(128), `solver.modes = "auto"`', 9224)):
+        lines.append(f"| {label} | {n} | {c[key + '_us_step']:.3g} | {c[key + '_build_s']:.3g} | "
+                     f"{c[key + '_wall_s']:.3g} | {c[key + '_rss_mb']:.0f} |")
+    lines += ["", f"µs/step of refined(128) against the rig's in the same run: **{c['us_step_ratio']:.2f}×**."]
+    return "\n".join(lines)
+
+
 def format_scene(c: dict) -> str:
     """The ``cli_scene`` check as a table: ``rotorred run`` of paper-rub on the rig and on refined(128)."""
     lines = ["rotorred run paper-rub (median of 3 alternating runs, one thread)",
@@ -301,27 +417,109 @@ def format_scene(c: dict) -> str:
     return "\n".join(lines)
 
 
+CSV_COLUMNS = ("mesh", "form", "n_dof", *TASKS, *(f"{t}_mb" for t in TASKS[:4]), "peak_mb", "rss_mb")
+
+
+def write_csv(rows: list[dict], checks: list[dict], path: str, command: str) -> list[str]:
+    """The table as CSV at ``path`` (``#`` lines first: the command, the machine, the commit, the date) and the
+    checks as ``<stem>_checks.csv`` beside it (check, quantity, value); the paths written."""
+    import csv
+    import datetime
+    import platform
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    commit = subprocess.run(["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            check=False).stdout.strip() or "unknown"
+    header = [f"# python validation/bench_sparse.py {command}",
+              f"# machine: {' '.join(filter(None, (platform.machine(), platform.processor())))}, {os.cpu_count()} cores, "
+              f"{platform.python_implementation()} {platform.python_version()}, numpy {np.__version__}, one thread; "
+              f"load average at the start {os.getloadavg()[0]:.1f}",
+              f"# commit {commit}, {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        f.write("\n".join(header) + "\n")
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(CSV_COLUMNS)
+        for r in sorted(rows, key=lambda r: (r["refine"], not r["sparse"])):
+            peak = max(r[f"{t}_mb"] for t in TASKS[:4])
+            w.writerow([f"refined({r['refine']})", "sparse" if r["sparse"] else "dense", r["n_dof"],
+                        *(f"{r[t]:.4g}" if r.get(t) is not None else "" for t in TASKS),
+                        *(f"{r[f'{t}_mb']:.4g}" for t in TASKS[:4]), f"{peak:.1f}", f"{r['rss_mb']:.0f}"])
+    written = [str(path)]
+    if checks:
+        side = path.with_name(path.stem + "_checks.csv")
+        with open(side, "w", encoding="utf-8", newline="") as f:
+            f.write("\n".join(header) + "\n")
+            w = csv.writer(f, lineterminator="\n")
+            w.writerow(("check", "quantity", "value"))
+            for c in checks:
+                for k, v in c.items():
+                    if k != "check":
+                        w.writerow((c["check"], k, json.dumps(v) if isinstance(v, (list, dict)) else v))
+        written.append(str(side))
+    return written
+
+
+def read_csv(path) -> tuple[list[dict], list[str]]:
+    """The rows :func:`write_csv` wrote (the fields of :func:`measure`'s rows: refine, sparse, n_dof, each task and
+    its ``_mb``, peak_mb, rss_mb) and its ``#`` header lines."""
+    import csv
+
+    with open(path, encoding="utf-8") as f:
+        lines = f.read().splitlines()
+    header = [line[1:].strip() for line in lines if line.startswith("#")]
+    rows = []
+    for r in csv.DictReader(line for line in lines if not line.startswith("#")):
+        row = {"refine": int(r["mesh"][len("refined("):-1]), "sparse": r["form"] == "sparse", "n_dof": int(r["n_dof"])}
+        row.update({k: float(v) if v else None for k, v in r.items() if k not in ("mesh", "form", "n_dof")})
+        rows.append(row)
+    return rows, header
+
+
+def read_checks(path) -> dict[str, dict[str, str]]:
+    """The checks of :func:`write_csv` (``<stem>_checks.csv``): check -> quantity -> value (text)."""
+    import csv
+
+    with open(path, encoding="utf-8") as f:
+        out: dict[str, dict[str, str]] = {}
+        for r in csv.DictReader(line for line in f if not line.startswith("#")):
+            out.setdefault(r["check"], {})[r["quantity"]] = r["value"]
+    return out
+
+
+def draw(rows: list[dict], ax1, ax2=None) -> None:
+    """Cost (``ax1``) and, if given, memory (``ax2``) against DOFs, log-log, each task sparse (solid) and dense
+    (dashed), the sparse growth exponents (:func:`exponents`) in the legend."""
+    slopes = exponents(rows)
+    for k, task in enumerate(TASKS[:4]):
+        for as_sparse, style in ((True, "-o"), (False, "--s")):
+            sel = sorted((r for r in rows if r["sparse"] == as_sparse and r.get(task)), key=lambda r: r["n_dof"])
+            if not sel:
+                continue
+            growth = f" ($n^{{{slopes[task]:.2f}}}$ from 1000 DOFs)" if as_sparse and task in slopes else ""
+            ax1.loglog([r["n_dof"] for r in sel], [r[task] for r in sel], style, color=f"C{k}",
+                       mfc="none" if not as_sparse else None,
+                       label=f"{LABELS[task].split(' (')[0]}, {'sparse' if as_sparse else 'dense'}{growth}")
+            if ax2 is not None:
+                ax2.loglog([r["n_dof"] for r in sel], [r[f"{task}_mb"] for r in sel], style, color=f"C{k}",
+                           mfc="none" if not as_sparse else None)
+    ax1.set_ylabel("wall time (s), one thread")
+    for ax, title in ((ax1, "Cost against model size"), (ax2, "Memory")):
+        if ax is None:
+            continue
+        ax.set_xlabel("full-model DOFs (seed rig refined 1 ... 128)")
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
+    if ax2 is not None:
+        ax2.set_ylabel("peak traced allocations (MB)")
+    ax1.legend(fontsize=6.5)
+
+
 def plot(rows: list[dict], path: str) -> str:
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(10, 4.2))
-    ax1, ax2 = fig.subplots(1, 2)
-    for k, task in enumerate(TASKS[:4]):
-        for as_sparse, style in ((True, "-o"), (False, "--s")):
-            sel = sorted((r for r in rows if r["sparse"] == as_sparse), key=lambda r: r["n_dof"])
-            if sel:
-                ax1.loglog([r["n_dof"] for r in sel], [r[task] for r in sel], style, color=f"C{k}", mfc="none"
-                           if not as_sparse else None, label=f"{LABELS[task].split(' (')[0]}, "
-                           f"{'sparse' if as_sparse else 'dense'}")
-                ax2.loglog([r["n_dof"] for r in sel], [r[f"{task}_mb"] for r in sel], style, color=f"C{k}",
-                           mfc="none" if not as_sparse else None)
-    ax1.set_ylabel("wall time (s), one thread")
-    ax2.set_ylabel("peak traced allocations (MB)")
-    for ax, title in ((ax1, "Cost against model size"), (ax2, "Memory")):
-        ax.set_xlabel("full-model DOFs (seed rig refined 1 ... 128)")
-        ax.set_title(title, fontsize=10)
-        ax.grid(True, which="both", lw=0.3)
-    ax1.legend(fontsize=6.5, ncol=2)
+    draw(rows, *fig.subplots(1, 2))
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     return path
@@ -334,6 +532,8 @@ def main(argv=None) -> int:
     parser.add_argument("--scene", action="store_true", help="only `rotorred run` on refined(128) against the rig")
     parser.add_argument("--dense-up-to", type=int, default=16, help="largest refinement solved dense too")
     parser.add_argument("--plot", metavar="PATH")
+    parser.add_argument("--csv", metavar="PATH", help="write the table (and the checks beside it) as CSV, e.g. "
+                        "docs/data/bench_sparse.csv")
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     parser.add_argument("--check", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -347,11 +547,12 @@ def main(argv=None) -> int:
         print(format_scene(_subprocess(["--check", "cli_scene"])))
         return 0
     rows = measure(QUICK if args.quick else REFINES, args.dense_up_to)
-    checks = [_subprocess(["--check", c]) for c in ("campbell61", "unbalance200", "reduction", "rub", "cli_scene")] \
-        if args.checks else []
+    checks = [_subprocess(["--check", c]) for c in CHECKS] if args.checks else []
     print(format_table(rows, checks))
     if args.plot:
         print(f"plot: {plot(rows, args.plot)}")
+    if args.csv:
+        print("csv: " + ", ".join(write_csv(rows, checks, args.csv, " ".join(sys.argv[1:] if argv is None else argv))))
     return 0
 
 

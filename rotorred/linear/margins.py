@@ -238,8 +238,7 @@ def half_power(amplitude: Callable[[np.ndarray], np.ndarray], speeds: np.ndarray
     HalfPower or None
     """
     A = np.asarray(amplitude(speeds), dtype=float)
-    peaks = [i for i in range(1, len(A) - 1)
-             if A[i] >= A[i - 1] and A[i] >= A[i + 1] and A[i] > 0 and abs(speeds[i] - near) <= within]
+    peaks = _interior_peaks(A, speeds, near, within)
     if not peaks:
         return None
     i = min(peaks, key=lambda k: abs(speeds[k] - near))
@@ -263,6 +262,12 @@ def half_power(amplitude: Callable[[np.ndarray], np.ndarray], speeds: np.ndarray
     lower = brentq(gap, speeds[left], min(float(speeds[left + 1]), Wp), xtol=1e-12 * Wp)
     upper = brentq(gap, max(float(speeds[right - 1]), Wp), speeds[right], xtol=1e-12 * Wp)
     return HalfPower(Wp, peak, float(lower), float(upper))
+
+
+def _interior_peaks(A: np.ndarray, speeds: np.ndarray, near: float, within: float) -> list[int]:
+    """The indices of the interior maxima of the samples ``A`` at ``speeds`` at most ``within`` from ``near``."""
+    return [i for i in range(1, len(A) - 1)
+            if A[i] >= A[i - 1] and A[i] >= A[i + 1] and A[i] > 0 and abs(speeds[i] - near) <= within]
 
 
 def separation_margins(model, result: CampbellResult, operating_range: OperatingRange | None = None
@@ -311,9 +316,16 @@ def _margin(sm, result: CampbellResult, c: CriticalSpeed, rng: OperatingRange | 
         return _verdict(c, None, node, rng, f"undamped (damping ratio {c.damping_ratio:.2g}): AF infinite",
                         verdict=True, af=math.inf)
     band, near = max(BAND_ZETAS * zeta, MIN_BAND), max(PEAK_ZETAS * zeta, MIN_PEAK)
+    amplitude = _response(sm, result, c.spool, node)
     while hp is None and band <= MAX_BAND:  # the peak near the crossing; its half-power points maybe farther
         W = np.linspace(c.speed * (1.0 - band), c.speed * (1.0 + band), BAND_SAMPLES)
-        hp = half_power(_response(sm, result, c.spool, node), W, c.speed, near * c.speed)
+        A = amplitude(W)
+        if not _interior_peaks(A, W, c.speed, near * c.speed):
+            # no sampled peak near the crossing: a wider band samples the same speeds more coarsely (the near
+            # region lies inside the first band, band >= 2.5 near), so it is widened only to take in the
+            # half-power points of a peak found (each band is 41 full solves)
+            break
+        hp = half_power(lambda V, W=W, A=A: A if V is W else amplitude(V), W, c.speed, near * c.speed)
         band *= 2.0
     if hp is not None and 0.0 < zeta and (hp.upper - hp.lower) / hp.peak_speed > OWN_BANDWIDTH * 2.0 * zeta:
         hp = None  # a peak this broad is a better damped mode's, not this one's

@@ -275,9 +275,17 @@ class SystemMatrices(SpoolSpeedMixin):
         return sparse.is_sparse(self.M)
 
     def sparse(self) -> SystemMatrices:
-        """The same model with CSR arrays (itself if it has them): for an analysis's sparse path."""
+        """The same model with CSR arrays (itself if it has them): for an analysis's sparse path. A model made by
+        :func:`assemble` as it is gets its rotor's sparse assembly (equal to the bit to its own matrices, its
+        ``loss_frequency`` kept: docs/model.md §24), any other model its matrices converted."""
         if self.is_sparse:
             return self
+        if self.__dict__.get(_AS_ASSEMBLED) and self.rotor is not None:
+            if "_twin" not in self.__dict__:  # made once, kept (an attribute, not a field: replace() drops it)
+                twin = dataclasses.replace(_assembled(self.rotor, True), loss_frequency=self.loss_frequency)
+                object.__setattr__(twin, _AS_ASSEMBLED, True)
+                object.__setattr__(self, "_twin", twin)
+            return self.__dict__["_twin"]
         c = sparse.csr
         return dataclasses.replace(
             self, M=c(self.M), K=c(self.K), C=c(self.C), G={k: c(v) for k, v in self.G.items()},
@@ -327,9 +335,24 @@ class SystemMatrices(SpoolSpeedMixin):
             ``rows @ q`` gives the physical displacements.
         """
         rows = np.zeros((len(outputs), self.n_dof))
-        for i, (node, direction) in enumerate(outputs):
-            rows[i, self.dofs.index(node, direction)] = 1.0
+        rows[np.arange(len(outputs)), self.output_index(outputs)] = 1.0
         return rows
+
+    def output_index(self, outputs) -> np.ndarray:
+        """The model coordinate of each physical DOF: ``q[index]`` are the displacements :meth:`output_rows` gives,
+        with no row of n entries (a full model's outputs are its own coordinates).
+
+        Parameters
+        ----------
+        outputs : sequence of (int, str)
+            The physical DOFs, (node, direction) pairs as :meth:`output_rows` takes them.
+
+        Returns
+        -------
+        ndarray of int, shape (len(outputs),)
+            Indices into the model's coordinates.
+        """
+        return np.array([self.dofs.index(node, direction) for node, direction in outputs], dtype=int)
 
     def summary(self) -> list[str]:
         """Rotor, DOFs, spools and speed-dependent bearings: at most 9 lines, no arrays (``repr``)."""
@@ -416,8 +439,9 @@ def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):
     rotorred.checks.InputError
         For anything else, naming ``field_name``.
     """
-    if isinstance(model, Rotor):
-        model = assemble(model)
+    if isinstance(model, Rotor):  # assembled sparse at once where it would be solved sparse
+        solved_sparse = sparse_ok and _dof_map(model, supported=True).n_dof >= sparse.SOLVE_SPARSE_FROM
+        model = assemble(model, as_sparse=True if solved_sparse else None)
     if not isinstance(model, SpoolSpeedMixin):
         checks.fail(field_name, type(model).__name__, "must be a Rotor, a SystemMatrices (assemble) or a "
                     "ReducedSystem (reduce_rotor)")
@@ -426,6 +450,14 @@ def system_of(model, field_name: str = "model", *, sparse_ok: bool = False):
     if not sparse_ok:
         return model.dense()
     return model.sparse() if model.n_dof >= sparse.SOLVE_SPARSE_FROM else model
+
+
+def _dof_map(rotor: Rotor, supported: bool = False) -> DofMap:
+    """The DOF numbering of ``rotor``: four per shaft node, two per pedestal node, then the elements' internal DOFs;
+    less those its supports fix if ``supported``."""
+    n_internal = sum(e.n_internal for s in rotor.spools for e in s.all_elements)
+    fixed = frozenset((sp.node, d) for sp in rotor.supports for d in sp.fixed) if supported else frozenset()
+    return DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals), fixed=fixed)
 
 
 def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
@@ -444,11 +476,25 @@ def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
     SystemMatrices
         ``M``, ``K``, ``C``, ``G`` and ``K_G`` in the DOF order of :class:`rotorred.model.dofs.DofMap`.
     """
-    n_internal = sum(e.n_internal for s in rotor.spools for e in s.all_elements)
-    dofs = DofMap(rotor.all_nodes, n_internal, translational=frozenset(p.node for p in rotor.pedestals))
+    as_sparse = _dof_map(rotor).n_dof >= sparse.SPARSE_FROM if as_sparse is None else bool(as_sparse)
+    supported = _assembled(rotor, as_sparse)
+    if any(sparse.nonzero(r.C_h) for r in supported.rotating.values()):
+        supported = dataclasses.replace(supported, loss_frequency=first_natural_frequency(supported.M, supported.K))
+    object.__setattr__(supported, _AS_ASSEMBLED, True)
+    return supported
+
+
+#: the mark :func:`assemble` leaves on the model it returns (an attribute, not a field: ``dataclasses.replace``, and
+#: any other way of making a changed model, drops it); :meth:`SystemMatrices.sparse` of a marked model is its rotor's
+#: sparse assembly
+_AS_ASSEMBLED = "_as_assembled"
+
+
+def _assembled(rotor: Rotor, as_sparse: bool) -> SystemMatrices:
+    """:func:`assemble` but the loss frequency: the matrices of ``rotor``, sparse or dense, its supports applied."""
+    dofs = _dof_map(rotor)
     n = dofs.n_dof
-    as_sparse = n >= sparse.SPARSE_FROM if as_sparse is None else bool(as_sparse)
-    next_internal = n - n_internal
+    next_internal = n - dofs.n_internal
     M, K, C, M_shaft, K_shaft = (_Triplets() for _ in range(5))
     parts = {s.name: [_Triplets() for _ in range(4)] for s in rotor.spools}  # C_v, N_v, C_h, N_h of RotatingDamping
     G = {s.name: _Triplets() for s in rotor.spools}
@@ -498,10 +544,7 @@ def assemble(rotor: Rotor, as_sparse: bool | None = None) -> SystemMatrices:
                           G={k: v.matrix(n, as_sparse) for k, v in G.items()}, dofs=dofs,
                           K_G={k: v.matrix(n, as_sparse) for k, v in K_G.items()}, tables=tuple(tables), rotor=rotor,
                           rotating=rotating)
-    supported = _supported(free, rotor.supports)
-    if any(sparse.nonzero(r.C_h) for r in rotating.values()):
-        supported = dataclasses.replace(supported, loss_frequency=first_natural_frequency(supported.M, supported.K))
-    return supported
+    return _supported(free, rotor.supports)
 
 
 #: generalised eigenvalues w^2 of (K, M) below this fraction of the largest are rigid-body motions (as in

@@ -64,8 +64,8 @@ def unbalance_from_table(field: str, table, nodes: Collection[int]) -> Unbalance
 def gravity_force(model, g: float) -> np.ndarray:
     """Force of gravity ``g`` (m/s^2) along -y in model coordinates, ``-g M e``.
 
-    ``e`` is a rigid unit translation in y expressed in the model's coordinates (for a reduced
-    model, the least-squares fit of the recovery rows, which is exact when every bearing node is
+    ``e`` is a rigid unit translation in y expressed in the model's coordinates (1 on every y of a full model; for a
+    reduced model, the least-squares fit of the recovery rows, which is exact when every bearing node is
     on the boundary). A model with supports carries ``M e`` of the rotor before its fixed DOFs were removed
     (``supported_weight``): the fixed DOFs' share of the consistent load acts on their free neighbours.
 
@@ -83,6 +83,10 @@ def gravity_force(model, g: float) -> np.ndarray:
     if model.supported_weight is not None:  # supports remove DOFs that move with a rigid translation
         return -g * model.supported_weight
     pairs = list(model.full_dofs.pairs)
+    if hasattr(model, "output_index"):  # a full model: its DOFs are its coordinates, e is 1 on every y, 0 elsewhere
+        e = np.zeros(model.n_dof)
+        e[model.output_index([p for p in pairs if p[1] == "y"])] = 1.0
+        return -g * (model.M @ e)
     R = model.output_rows(pairs)
     target = np.array([1.0 if d == "y" else 0.0 for _, d in pairs])
     e, *_ = np.linalg.lstsq(R, target, rcond=None)

@@ -24,6 +24,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from rotorred import checks
+from rotorred.model import sparse
 from rotorred.nonlinear.fourier import Harmonics, to_phasors
 from rotorred.nonlinear.lowrank import factored
 from rotorred.results import Result
@@ -334,11 +335,22 @@ def local_forces(forces, dofs: tuple[int, ...]) -> tuple:
     return tuple((force, [local[d] for d in force.dofs]) for force in forces)
 
 
+#: a harmonic-balance problem takes sparse matrices of at most this many DOFs as dense copies (50 MB each; its
+#: operators are dense in the (2H + 1) n unknowns) and refuses larger ones: a large model is reduced first
+DENSE_UP_TO = 2500
+
+
 def checked_matrices(problem) -> int:
-    """Check a problem's M, D, K (and D1, K1) as square matrices of one size, and its harmonics; the size n."""
+    """Check a problem's M, D, K (and D1, K1) as square matrices of one size, and its harmonics; the size n. Sparse
+    matrices (a full model assembled sparse) are made dense up to :data:`DENSE_UP_TO` DOFs and refused beyond: the
+    harmonic-balance operators are dense in the (2H + 1) n unknowns (docs/model.md §24)."""
     n = np.shape(problem.M)[0] if np.ndim(problem.M) == 2 else 0
     for name in ("M", "D", "K") + tuple(k for k in ("D1", "K1") if getattr(problem, k) is not None):
-        object.__setattr__(problem, name, checks.array(name, getattr(problem, name), (n, n)))
+        X = getattr(problem, name)
+        if sparse.is_sparse(X) and n > DENSE_UP_TO:
+            checks.fail(name, f"a sparse matrix of {n} DOFs", f"must have at most {DENSE_UP_TO} DOFs: harmonic "
+                        "balance is dense in its unknowns; reduce the model first (reduce_rotor)")
+        object.__setattr__(problem, name, checks.array(name, sparse.dense(X), (n, n)))
     if not isinstance(problem.harmonics, Harmonics):
         checks.fail("harmonics", problem.harmonics, "must be a Harmonics")
     return n
