@@ -863,3 +863,47 @@ def test_default_mode_count_at_rest_and_bad_margin():
         default_mode_count(rig, Operating.line([0.0, 100.0]), margin=0.5)
     wide = default_mode_count(rig, Operating.line([0.0, 600.0]), margin=2.0)
     assert wide.n_modes > default_mode_count(rig, Operating.line([0.0, 600.0])).n_modes
+
+
+def test_modes_that_become_oscillating_along_the_sweep_are_reported_not_tracked():
+    """ROSS's compressor example over 0-10 000 rpm: near-overdamped pairs (its seals and bearings) turn into whirl modes
+    below the highest excitation frequency (166.7 Hz) from about 5000 rpm on. No curve tracked from the first speed can
+    follow them, and growing the count for them grew it to every mode and failed naming ``n_modes`` ("221 must be <=
+    220"), an option never given. They are reported instead (``ModeCount.born``). Checked against the dense state- space
+    eigenvalues (scipy), independent of the tracking: at 0 rpm there are two whirl modes (damping ratio < 0.99) below
+    the limit, the count the default rule made; at each speed where modes are born there are more, at least two plus
+    those born there; each born mode is an eigenvalue there (measured relative distance 6e-12 to 1.2e-11: the dense
+    state-space solve's own round-off), heavily damped (measured 0.916-0.950); the tracked curves at 0 rpm are the six
+    lowest whirl modes there."""
+    import scipy.linalg
+
+    from rotorred.linear.modal import WHIRL_MAX_DAMPING_RATIO
+
+    rotor = load_rotor(Path(__file__).parents[1] / "validation" / "reference" / "ross3" / "compressor_example.toml")
+    Omega = np.linspace(0.0, 10000 * math.pi / 30, 21)
+    result = campbell(rotor, Operating.line(Omega))
+    count = result.mode_count
+    assert result.n_modes == 6 and count.grown_at is None and len(count.born) >= 2
+    sm = assemble(rotor)
+
+    def whirl(W):
+        speeds = {s: W for s in sm.spools}
+        D, K = sm.damping(speeds), sm.stiffness(speeds)
+        Minv = np.linalg.inv(sm.M)
+        n = sm.n_dof
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ D]])
+        lam = scipy.linalg.eigvals(A)
+        lam = lam[lam.imag > 0]
+        return lam[-lam.real / np.abs(lam) < WHIRL_MAX_DAMPING_RATIO]
+
+    at_rest = np.sort(whirl(0.0).imag)
+    assert np.sum(at_rest < count.limit) == 2 == max(count.below)
+    for W in sorted({b[0] for b in count.born}):
+        here = whirl(W)
+        born = [(w, zeta) for V, w, zeta in count.born if V == W]
+        assert np.sum(here.imag < count.limit) >= 2 + len(born), W
+        for w, zeta in born:
+            assert w < count.limit and 0.85 < zeta < WHIRL_MAX_DAMPING_RATIO
+            assert np.min(np.abs(here - complex(-zeta * w / math.sqrt(1 - zeta ** 2), w))) < 1.2e-10 * w
+    at_rest = at_rest[:6]
+    np.testing.assert_allclose(np.sort(result.frequencies[0]), at_rest, rtol=1e-9)

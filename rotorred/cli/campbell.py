@@ -227,6 +227,11 @@ def format_mode_count(result) -> str:
         text += f"; at least {MIN_DEFAULT_MODES}"
     elif result.n_modes < max(mc.below):
         text += "; all the oscillating modes"
+    if mc.born:
+        speed, w, zeta = mc.born[0]
+        text += (f"; {len(mc.born)} mode{'s' * (len(mc.born) > 1)} below {mc.limit_hz:.4g} Hz become oscillating "
+                 f"along the sweep (overdamped before), not tracked: the first at {speed * rpm:.6g} rpm, "
+                 f"{w / (2 * math.pi):.4g} Hz, damping ratio {zeta:.3g}")
     return text + ". --modes N sets the number"
 
 

@@ -254,6 +254,12 @@ class ModeCount:
         Set by :func:`campbell` if a mode below ``limit`` was left untracked at this reference speed (rad/s)
         with the counted modes (their order changed along the sweep), so more were tracked; ``n_modes``
         is then the number finally tracked.
+    born : tuple of (float, float, float)
+        Set by :func:`campbell`: the modes below ``limit`` that become oscillating along the sweep (a pair
+        overdamped at the speed before, damping ratio at least ``WHIRL_MAX_DAMPING_RATIO``, turned into a whirl
+        mode; or a mode descending from one), each as (reference speed (rad/s), frequency (rad/s), damping ratio
+        (-)) where it first appears: no curve tracked from the first speed can follow them, so they are reported,
+        not tracked, and more modes are not tracked for them (docs/model.md §21).
     """
 
     n_modes: int
@@ -265,6 +271,7 @@ class ModeCount:
     speeds: tuple[float, ...]
     below: tuple[int, ...]
     grown_at: float | None = None
+    born: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def limit_hz(self) -> float:
@@ -441,6 +448,9 @@ class CampbellResult(Result):
             mc = self.mode_count
             lines.append(f"modes: every mode below {mc.margin:g} x {mc.limit_hz:.4g} Hz "
                          f"({excitation_label(mc.harmonic, mc.spool)} at the top speed), at least {MIN_DEFAULT_MODES}")
+            if mc.born:
+                lines.append(f"{len(mc.born)} mode(s) below {mc.limit_hz:.4g} Hz become oscillating along the sweep "
+                             f"(overdamped before; not tracked), the first at {mc.born[0][0] * 30 / math.pi:.6g} rpm")
         f = self.frequencies_hz
         lines.append(f"whirl frequencies {f.min():.4g}-{f.max():.4g} Hz")
         lines += self._critical_lines(5) + [self._stability_line()]
@@ -878,7 +888,9 @@ def campbell(model, operating: Operating, *, n_modes: int | None = None,
     solved = {}  # eigen-solves of the grid speeds, kept for a second tracking with more modes
     while True:
         cover = None if count is None else (count.limit, count.margin * count.limit)
-        lam_all, shapes, tracking, missed = _track(solver, Omega, n_modes, cover, solved)
+        lam_all, shapes, tracking, missed, born = _track(solver, Omega, n_modes, cover, solved)
+        if count is not None:
+            count = replace(count, born=born)
         if missed is None or n_modes >= n_available:
             break
         i, needed = missed  # a mode below the limit left out (the modes' order changed): track more
@@ -993,16 +1005,19 @@ def _track(solver: _Solver, Omega: np.ndarray, n_modes: int, cover: tuple[float,
     """The lowest ``n_modes`` modes at ``Omega[0]`` followed by MAC (:func:`_assign`) along ``Omega``; ``solved``
     holds the eigen-solve of each grid speed (index: (eigenvalues, modes)) and is filled where it has none.
 
-    Returns (eigenvalues (n_s, n_modes), shapes per speed, tracking MAC (n_s - 1, n_modes), missed). With
+    Returns (eigenvalues (n_s, n_modes), shapes per speed, tracking MAC (n_s - 1, n_modes), missed, born). With
     ``cover`` = (limit, covered) (rad/s), ``missed`` is (first speed index where an untracked mode lies below
-    ``limit``, the most modes below ``covered`` at a speed), or None if every mode below ``limit`` is tracked.
+    ``limit``, the most modes below ``covered`` at a speed), or None if every mode below ``limit`` is tracked;
+    only modes that descend from the first speed's count (:func:`_descends`): ``born`` lists the others below
+    ``limit`` where each lineage first appears, (speed, frequency (rad/s), damping ratio), as
+    :attr:`ModeCount.born`.
     """
     n_s = len(Omega)
     lam_all = np.empty((n_s, n_modes), complex)
     shapes = []
     tracking = np.ones((n_s - 1, n_modes))
-    first, needed = None, 0
-    cur = None
+    first, needed, born = None, 0, []
+    cur = descends = None
     for i in range(n_s):
         if i not in solved:
             solved[i] = solver.solve(Omega[i])
@@ -1017,12 +1032,40 @@ def _track(solver: _Solver, Omega: np.ndarray, n_modes: int, cover: tuple[float,
         lam_all[i], cur = lam[cols], modes[:, cols]
         shapes.append(cur)
         if cover is not None:
+            previous = None if i == 0 else solved[i - 1]
+            descends, new = _descends(previous, descends, modes, cols)
             untracked = np.ones(len(lam), bool)
             untracked[cols] = False
-            if first is None and np.any(lam.imag[untracked] < cover[0]):
+            if first is None and np.any(lam.imag[untracked & descends] < cover[0]):
                 first = i
-            needed = max(needed, int(np.sum(lam.imag < cover[1])))
-    return lam_all, shapes, tracking, None if first is None else (first, needed)
+            born += [(float(Omega[i]), float(lam[j].imag), float(-lam[j].real / abs(lam[j])))
+                     for j in np.flatnonzero(new & untracked & (lam.imag < cover[0]))]
+            needed = max(needed, int(np.sum(lam.imag[descends] < cover[1])))
+    return lam_all, shapes, tracking, None if first is None else (first, needed), tuple(born)
+
+
+#: a mode at a grid speed continues a mode of the speed before if their MAC is at least this (else it was not
+#: oscillating there: an overdamped pair turned into a whirl mode)
+BORN_MAC = 0.5
+
+
+def _descends(previous, descends_before, modes: np.ndarray, tracked: np.ndarray):
+    """Which modes of a grid speed descend from the first speed's oscillating modes, and which begin there.
+
+    A mode descends if it continues (MAC >= :data:`BORN_MAC`, its best match) a mode of the speed before that
+    descends; every mode of the first speed (``previous`` None) and every tracked column ``tracked`` descends. A
+    mode matching none of the speed before's begins there (``new``); one continuing a mode that began later
+    neither descends nor begins. Returns (descends, new), boolean arrays of shape (n_modes_here,).
+    """
+    n = modes.shape[1]
+    if previous is None:
+        return np.ones(n, bool), np.zeros(n, bool)
+    m = mac(previous[1], modes)  # (n_before, n)
+    best, match = m.max(axis=0), m.argmax(axis=0)
+    continues = best >= BORN_MAC
+    descends = continues & descends_before[match]
+    descends[tracked] = True
+    return descends, ~continues & ~descends
 
 
 def _beyond_tables(sm, lines: Mapping[str, SpoolLine], Omega: np.ndarray) -> tuple[tuple[int, float, float, str], ...]:
