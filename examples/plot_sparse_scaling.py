@@ -42,7 +42,7 @@ for task, p in bench.exponents(rows).items():
 
 # %%
 # Cost (left) and traced memory (right) against DOFs, log-log: sparse solid, dense dashed.
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.2))
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 5.6))
 bench.draw(rows, ax1, ax2)
-fig.tight_layout()
+fig.tight_layout(rect=(0, 0.15, 1, 1))
 plt.show()

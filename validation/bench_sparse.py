@@ -512,15 +512,17 @@ def draw(rows: list[dict], ax1, ax2=None) -> None:
         ax.grid(True, which="both", lw=0.3)
     if ax2 is not None:
         ax2.set_ylabel("peak traced allocations (MB)")
-    ax1.legend(fontsize=6.5)
+    # below the axes: inside, it hid the dense curves' middle
+    (ax2 or ax1).figure.legend(*ax1.get_legend_handles_labels(), fontsize=7.5, loc="lower center", ncol=2,
+                               frameon=False)
 
 
 def plot(rows: list[dict], path: str) -> str:
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(10, 4.2))
+    fig = Figure(figsize=(10, 5.6))
     draw(rows, *fig.subplots(1, 2))
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.15, 1, 1))
     fig.savefig(path, dpi=130)
     return path
 
