@@ -364,6 +364,8 @@ class _Family:
             # the compliance and linear response are the start's (a clearance, a law's number): computed once. Its
             # cache is TorusProblem's own; a public with_forces (as CondensedProblem's) would say it better
             problem._cache["compliance"] = start._compliance()
+        else:  # a speed: its matrices and bases move, the compliance by the modes (one eigen-solution a value)
+            problem.by_modes()
         return dataclasses.replace(box, problem=problem)
 
 
