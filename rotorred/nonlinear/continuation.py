@@ -610,20 +610,12 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
     return _Point(y, t, found.iterations, matrix=matrix)
 
 
-def _between(a: _Point, b: _Point, s: float, span: float) -> np.ndarray:
-    """The point of the cubic Hermite curve from ``a`` to ``b`` (their tangents scaled by the chord) at the share
-    ``s / span`` of it, moved along ``a.t`` onto the plane ``a.t . (y - a.y) = s``."""
-    u, chord = s / span, float(np.linalg.norm(b.y - a.y))
-    y = ((1 + 2 * u) * (1 - u) ** 2 * a.y + u * (1 - u) ** 2 * chord * a.t + u**2 * (3 - 2 * u) * b.y
-         - u**2 * (1 - u) * chord * b.t)
-    return y + (s - (y - a.y) @ a.t) * a.t
-
-
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
     """The fold between points ``a`` and ``b``: d omega/ds = 0, by Brent on the arclength from ``a``. Each evaluation
-    corrects in the plane normal to ``a.t`` at ``s`` along it, started from the cubic through ``a`` and ``b`` with their
-    tangents (:func:`_between`), or once Brent closes in, from the nearest point corrected so far along its tangent
-    (chord steps on its Jacobian): the same point as from ``a.y + s a.t``, in fewer iterations."""
+    corrects in the plane normal to ``a.t`` at ``s`` along it, started from ``a.y + s a.t`` or, once Brent closes in,
+    from the nearest point corrected so far along its tangent (chord steps on its Jacobian; a start from the cubic
+    through ``a`` and ``b`` with their tangents was tried and taken back: near the rig's speed folds the plane meets the
+    branch twice, and Newton from the cubic went to the other, Brent's signs then read the folds as corners)."""
     span = float((b.y - a.y) @ a.t)
     corrected = {}  # each arclength's corrected point (y, its tangent, its matrix): Brent's last is the fold
 
@@ -635,7 +627,7 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
             y_k, t_k, chord = corrected[near]
             start = y_k + (s - near) / (a.t @ t_k) * t_k
         else:
-            start, chord = _between(a, b, s, span), a.matrix
+            start, chord = a.y + s * a.t, a.matrix
         done = _correct(problem, start, a.t, tol, chord=chord)
         if done is None:
             raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")

@@ -500,11 +500,13 @@ def _checked_box(scene, model, box, rub: TorusRubProblem, z, dof, options: Torus
         if H == tuple(box[:2]):
             return box, rub, z, ", ".join(said + ["the ladder's last"])
         nxt = (*H, *default_grid(*H))
-        fine = torus_rub_problem(scene, model, rub.bases_hz, *nxt, options.f_max)
         n = rub.problem.n
         try:
+            fine = torus_rub_problem(scene, model, rub.bases_hz, *nxt, options.f_max)
             z_fine = solve_torus(fine.problem, rub.problem.harmonics.transfer(z, n, fine.problem.harmonics),
                                  tol=options.tol).z
+        except checks.InputError:  # a speed ratio the larger box holds as an order of both bases: none here
+            return box, rub, z, ", ".join(said + [f"{H[0]}x{H[1]} commensurate here"])
         except NotConverged:
             return box, rub, z, ", ".join(said + [f"{H[0]}x{H[1]} did not converge"])
         change = _lines_change(rub, z, fine, z_fine, dof)
