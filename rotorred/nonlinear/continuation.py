@@ -59,8 +59,6 @@ CONTRACTION = 0.5
 #: the branch converges in a few full steps; most candidates do not, and cost the continuation its time
 CORNER_ITERATIONS = 12
 CORNER_HALVINGS = 4
-#: a chord step (:func:`_correct`) must leave at most this fraction of the last residual, else Newton goes on
-CHORD_CONTRACTION = 0.3
 #: Brent's tolerance on a fold's position, a share of the step (at least the corrector's tolerance)
 FOLD_XTOL = 1e-10
 
@@ -249,7 +247,6 @@ class _Point:
     t: np.ndarray  # unit tangent
     iterations: int
     clean: bool = False  # reached by an arclength step at its first try (no halving): the branch is smooth there
-    matrix: object = None  # the bordered Jacobian the tangent was solved with, where it can serve chord steps
 
 
 @dataclass(frozen=True)
@@ -333,8 +330,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     direction = 1.0 if omega_end > omega_start else -1.0
     start = _solved(problem, z0, omega_start, tol)
     y = np.append(start.z, omega_start)
-    t, matrix = _tangent(problem, y, None, direction, start.evaluation, keep=True)
-    first = _Point(y, t, start.iterations, matrix=matrix)
+    first = _Point(y, _tangent(problem, y, None, direction, start.evaluation), start.iterations)
     points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
     path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
@@ -430,15 +426,12 @@ def _branch(problem, points, folds, stopped, stability, interrupt="") -> Branch:
                   np.array([_value(problem, w) for w in omega]))
 
 
-def _tangent(problem, y, previous, direction: float = 1.0, ev=None, keep: bool = False):
+def _tangent(problem, y, previous, direction: float = 1.0, ev=None) -> np.ndarray:
     """The unit null vector of ``[dR/dz, dR/domega]`` at ``y`` (``ev``: its evaluation, if at hand), oriented along
-    ``previous`` (or with omega growing in ``direction`` at the start); with ``keep``, and the bordered matrix it was
-    solved with (for chord steps from ``y``)."""
+    ``previous`` (or with omega growing in ``direction`` at the start)."""
     ev = ev if ev is not None else problem.evaluate(y[:-1], y[-1])
     guide = previous if previous is not None else np.append(np.zeros(len(y) - 1), direction)
-    matrix = _bordered(ev.dR_dz, ev.dR_domega, guide)
-    t = _unit_along(matrix, guide)
-    return (t, matrix) if keep else t
+    return _unit_along(_bordered(ev.dR_dz, ev.dR_domega, guide), guide)
 
 
 def _bordered(A, column: np.ndarray, row: np.ndarray):
@@ -456,41 +449,27 @@ def _unit_along(matrix, guide: np.ndarray) -> np.ndarray:
     return t if t @ guide > 0 else -t
 
 
-def _correct(problem, y_pred, t, tol, max_iter: int = 20, contraction: float | None = None, chord=None):
+def _correct(problem, y_pred, t, tol, max_iter: int = 20, contraction: float | None = None):
     """Newton on ``R(y) = 0`` and ``t . (y - y_pred) = 0``, each step shortened until it lowers the residual (a
     contact's kink at grazing makes full steps cycle): the corrected point, its iterations and its unit tangent, or
     None. An iterate's derivatives are built only if the iteration goes on from it (:class:`Evaluation`): the
-    tangent is the one of the last Jacobian (the iterate a Newton step before, solved with its factors).
-
-    With ``chord`` (the bordered Jacobian of the point stepped from, one that offers ``again(row, relative)``: a
-    torus's, :class:`rotorred.nonlinear.torus_continuation.TorusJacobian`), the first steps are chord steps on it, a
-    solve each and no Jacobian built, while each leaves at most :data:`CHORD_CONTRACTION` of the residual before it
-    (then Newton goes on from there); the tangent, and the matrix returned fourth for the next step's chords, are
-    then built at the corrected point itself (fifth: True), else the last Newton step's (False)."""
+    tangent is the one of the last Jacobian (the iterate a Newton step before, solved with its factors)."""
     y = y_pred.copy()
     ev = problem.evaluate(y[:-1], y[-1])
     if not np.isfinite(ev.relative):  # no problem there (a family's value refused): a failed step
         return None
-    chord = getattr(chord, "again", None)
     for it in range(max_iter):
         try:
-            matrix = chord(t, ev.relative) if chord is not None else _bordered(ev.dR_dz, ev.dR_domega, t)
+            matrix = _bordered(ev.dR_dz, ev.dR_domega, t)
             step = matrix.solve(-np.append(ev.R, t @ (y - y_pred)))
         except (sla.LinAlgError, ValueError):
             return None
         before = ev.relative
         y, ev = _shortened(problem, y, step, ev)
-        if ev is None and chord is not None:  # a chord step that fails: Newton from the iterate
-            chord, ev = None, problem.evaluate(y[:-1], y[-1])
-            continue
-        if ev is None or (chord is None and contraction is not None and ev.relative > contraction * before):
+        if ev is None or (contraction is not None and ev.relative > contraction * before):
             return None
         if ev.relative <= tol:
-            if chord is not None:
-                return (y, it + 1, *_tangent(problem, y, t, ev=ev, keep=True), True)
-            return y, it + 1, _unit_along(matrix, t), matrix, False
-        if chord is not None and ev.relative > CHORD_CONTRACTION * before:
-            chord = None
+            return y, it + 1, _unit_along(matrix, t)
     return None
 
 
@@ -551,13 +530,13 @@ def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: 
         kappa = (point.t - previous.t) / np.linalg.norm(point.y - previous.y)
         if ds * np.linalg.norm(kappa) <= MAX_TURN:
             prediction += 0.5 * ds**2 * kappa
-    done = _correct(problem, prediction, point.t, tol, contraction=contraction, chord=point.matrix)
+    done = _correct(problem, prediction, point.t, tol, contraction=contraction)
     if done is None:
         return None
-    y, it, t, matrix, _ = done
+    y, it, t = done
     if np.linalg.norm(y - point.y) > MAX_JUMP * ds:
         return None
-    return _Point(y, t, it, clean, matrix), it
+    return _Point(y, t, it, clean), it
 
 
 def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
@@ -606,39 +585,26 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
         previous is not None and np.linalg.norm(y - previous.y) < np.linalg.norm(point.y - previous.y))
     if np.linalg.norm(secant) > MAX_JUMP * ds or traced:
         return None
-    t, matrix = _tangent(problem, y, secant, ev=found.evaluation, keep=True)
-    return _Point(y, t, found.iterations, matrix=matrix)
+    return _Point(y, _tangent(problem, y, secant, ev=found.evaluation), found.iterations)
 
 
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
-    """The fold between points ``a`` and ``b``: d omega/ds = 0, by Brent on the arclength from ``a``. Each evaluation
-    corrects in the plane normal to ``a.t`` at ``s`` along it, started from ``a.y + s a.t`` or, once Brent closes in,
-    from the nearest point corrected so far along its tangent (chord steps on its Jacobian; a start from the cubic
-    through ``a`` and ``b`` with their tangents was tried and taken back: near the rig's speed folds the plane meets the
-    branch twice, and Newton from the cubic went to the other, Brent's signs then read the folds as corners)."""
+    """The fold between points ``a`` and ``b``: d omega/ds = 0, by Brent on the arclength from ``a``."""
     span = float((b.y - a.y) @ a.t)
-    corrected = {}  # each arclength's corrected point (y, its tangent, its matrix): Brent's last is the fold
+    corrected = {}  # each arclength's corrected point: Brent's last is the fold, not corrected again
 
     def domega(s: float) -> float:
         if s == 0.0:
             return a.t[-1]
-        near = min(corrected, key=lambda k: abs(k - s), default=None)
-        if near is not None and abs(near - s) < min(abs(s), abs(span - s)):
-            y_k, t_k, chord = corrected[near]
-            start = y_k + (s - near) / (a.t @ t_k) * t_k
-        else:
-            start, chord = a.y + s * a.t, a.matrix
-        done = _correct(problem, start, a.t, tol, chord=chord)
+        done = _correct(problem, a.y + s * a.t, a.t, tol)
         if done is None:
             raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")
-        corrected[s] = done[0], done[2], done[3]
-        if done[4]:  # chord steps: the tangent is the corrected point's own
-            return done[2][-1]
+        corrected[s] = done[0]
         return _tangent(problem, done[0], a.t)[-1]  # at the point itself: the fold's position rests on it
 
     try:
         s = brentq(domega, 0.0, span, xtol=max(FOLD_XTOL, tol) * abs(span), rtol=4 * np.finfo(float).eps)
     except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
         return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
-    y = a.y if s == 0.0 else corrected[s][0] if s in corrected else _correct(problem, a.y + s * a.t, a.t, tol)[0]
+    y = a.y if s == 0.0 else corrected[s] if s in corrected else _correct(problem, a.y + s * a.t, a.t, tol)[0]
     return Fold(float(y[-1]), y[:-1].copy(), _value(problem, y[-1]))

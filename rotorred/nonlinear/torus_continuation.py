@@ -27,7 +27,6 @@ Krylov module's own rule alone (a fresh one past 60 iterations), the same load, 
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -104,17 +103,6 @@ class _Bordered:
             raise sla.LinAlgError("the bordered torus Jacobian is singular")
         mu = (beta - r @ x_b) / schur
         return np.append(x_b - mu * self._x_c, mu)
-
-    def again(self, row: np.ndarray, relative: float) -> _Bordered:
-        """The same J and column bordered by ``row``, ``J^-1 c`` kept, its solves to the forcing term of an iterate of
-        relative residual ``relative``: a chord step's matrix (:func:`rotorred.nonlinear.continuation._correct`)."""
-        if self._x_c is None:
-            self._x_c = self.jacobian.solve(self.column)
-        jacobian = copy.copy(self.jacobian)
-        jacobian.rtol = forcing_term(relative)
-        out = _Bordered(jacobian, self.column, row)
-        out._x_c = self._x_c
-        return out
 
 
 @dataclass(frozen=True)
