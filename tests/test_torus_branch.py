@@ -218,3 +218,40 @@ def test_rotorred_continue_torus_refuses_bad_input_before_computing(extra, token
     for token in tokens:
         assert token in err, (token, err)
     assert not out.exists()
+
+
+def test_a_lines_tolerance_grows_the_box_along_the_branch_and_each_point_solves_its_own_box():
+    """``continue_torus`` in the clearance from 14 to 12 µm from the box |k1| <= 2, |k2| <= 8 with a lines tolerance of
+    2 %: the box grows up the ladder (bounds times 1.5, to 4 x 16 at most) where its largest lines change by more than
+    that against the next; every point, its coefficients (kept on the last box's orders) put back on one box of the
+    ladder, solves ``torus_rub_problem`` there at its value (relative residual below 1e-7, the branch asking 1e-6),
+    the boxes in the order they were taken, and the last point's lines are those of the last box's problem."""
+    from rotorred.scenes.quasi_periodic import default_grid
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_branch import TorusBranchOptions, continue_torus
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = build_model(scene).model
+    branch = continue_torus(scene, model, "rub.clearance", 14e-6, 12e-6,
+                            TorusBranchOptions(orders=(2, 8), divisors=(1, 3), lines_tol=0.02, max_orders=(4, 16)))
+    assert branch.stopped.startswith("reached the end")
+    last_box = (int(branch.orders[:, 0].max()), int(branch.orders[:, 1].max()))
+    assert last_box > (2, 8)  # it grew
+    ladder = [(2, 8), (3, 12), (4, 16)]
+    taken = []
+    for v, z in zip(branch.values, branch.z):
+        there = load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": float(v)})
+        problems = {H: torus_rub_problem(there, model, (70.0, 91.37 / 3), *H, *default_grid(*H), 1500.0)
+                    for H in ladder}
+        h_last, n = problems[last_box].problem.harmonics, problems[last_box].problem.n
+        assert np.array_equal(h_last.orders, branch.orders)
+        solving = [H for H, rp in problems.items()
+                   if np.linalg.norm(rp.problem.residual(h_last.transfer(z, n, rp.problem.harmonics)))
+                   < 1e-7 * rp.problem.scale]
+        assert solving, v
+        taken.append(ladder.index(solving[0]))
+    assert taken == sorted(taken) and ladder[taken[-1]] == last_box
+    rp = problems[last_box]
+    assert np.allclose(rp.lines(branch.z[-1], branch.dof)[2], branch.amplitudes[-1], rtol=1e-9, atol=1e-15)

@@ -591,6 +591,7 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
     """The fold between points ``a`` and ``b``: d omega/ds = 0, by Brent on the arclength from ``a``."""
     span = float((b.y - a.y) @ a.t)
+    corrected = {}  # each arclength's corrected point: Brent's last is the fold, not corrected again
 
     def domega(s: float) -> float:
         if s == 0.0:
@@ -598,11 +599,12 @@ def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:
         done = _correct(problem, a.y + s * a.t, a.t, tol)
         if done is None:
             raise NotConverged(float(a.y[-1]), np.inf, tol, 20, "while locating a fold")
+        corrected[s] = done[0]
         return _tangent(problem, done[0], a.t)[-1]  # at the point itself: the fold's position rests on it
 
     try:
         s = brentq(domega, 0.0, span, xtol=max(FOLD_XTOL, tol) * abs(span), rtol=4 * np.finfo(float).eps)
     except (ValueError, NotConverged):  # omega turned at a corner (a kink of the branch), not at a smooth fold
         return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
-    y = a.y if s == 0.0 else _correct(problem, a.y + s * a.t, a.t, tol)[0]
+    y = a.y if s == 0.0 else corrected[s] if s in corrected else _correct(problem, a.y + s * a.t, a.t, tol)[0]
     return Fold(float(y[-1]), y[:-1].copy(), _value(problem, y[-1]))

@@ -49,6 +49,7 @@ import scipy.fft as sfft
 import scipy.linalg as sla
 
 from rotorred import checks
+from rotorred.linear.modal import state_matrix
 from rotorred.nonlinear.condensed import dynamic_compliance, real_form
 from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
 from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, harmonic_dataset, sampled_forces
@@ -65,6 +66,9 @@ FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
 FORCING_ORDER = 1.5
 #: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
 COMPLIANCE_CHUNK = 256
+#: the compliance by the modes (:func:`modal_compliance`) is taken where it matches the direct solve at a few orders to
+#: this relative difference, else the direct solve serves
+MODAL_MATCH = 1e-8
 
 def alias_free_grid(H1: int, H2: int, degree: int) -> tuple[int, int]:
     """The least even grid ``(N_1, N_2)`` that transforms a degree-``degree`` polynomial of a box ``H_1 x H_2``
@@ -606,6 +610,38 @@ def _assembled(blocks: np.ndarray, n: int) -> np.ndarray:
     return blocks.reshape(n, n, m, m).transpose(2, 0, 3, 1).reshape(m * n, m * n)
 
 
+def _stiffness(M, D, K, w: np.ndarray) -> np.ndarray:
+    """The dynamic stiffnesses ``K - w^2 M + i w D`` at the frequencies ``w`` (k,) (rad/s): (k, n, n)."""
+    w = w[:, None, None]
+    return K[None] - w**2 * M[None] + 1j * w * D[None]
+
+
+def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray):
+    """``(Z_k^-1)[:, dofs]`` and ``Z_k^-1 f_k`` at the frequencies ``w`` (k,) (rad/s) by the first-order system's
+    modes, ``Z(iw)^-1 = V_q (iw - Lambda)^-1 V^-1 [0; M^-1]`` (one eigen-solution of the 2n state matrix, then O(k n^2)
+    products, against k solves of n x n), as ``(X, Q)`` of shapes (k, n, len(dofs)) and (k, n); None where M is
+    singular or the modes are too ill-conditioned: the direct solve at sixteen of the orders differs by more than
+    :data:`MODAL_MATCH`. Where the speed moves along a branch, every value's problem has its own matrices (the
+    gyroscopic term): the modes cost one eigen-solution a value (docs/model.md §26)."""
+    n, c = M.shape[0], list(dofs)
+    try:
+        lam, V = sla.eig(state_matrix(M, D, K))
+        W = sla.solve(V, np.vstack([np.zeros((n, n)), sla.inv(M)]))  # (2n, n): V^-1 [0; M^-1]
+    except (sla.LinAlgError, ValueError):
+        return None
+    r = 1.0 / (1j * w[:, None] - lam[None, :])  # (k, 2n)
+    Vq = V[:n]
+    X = np.einsum("ij,kj,jc->kic", Vq, r, W[:, c], optimize=True)
+    Q = (r * (forcing @ W.T)) @ Vq.T
+    probe = np.unique(np.linspace(0, len(w) - 1, 16).astype(int))
+    X_d, Q_d = dynamic_compliance(_stiffness(M, D, K, w[probe]), c, forcing[probe])
+    scale_x, scale_q = np.max(np.abs(X_d)), np.max(np.abs(Q_d)) or 1.0
+    if not (np.max(np.abs(X[probe] - X_d)) <= MODAL_MATCH * scale_x
+            and np.max(np.abs(Q[probe] - Q_d)) <= MODAL_MATCH * scale_q):
+        return None
+    return X, Q
+
+
 @dataclass(frozen=True)
 class _Compliance:
     """The condensation at the problem's base frequencies: G as blocks (G0, the (2c, 2c) block of each order), the
@@ -703,16 +739,33 @@ class TorusProblem:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
         forcing = self.harmonics.phasors(self.forcing, n_all)
-        X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
-        for lo in range(0, len(wk), COMPLIANCE_CHUNK):
-            part = slice(lo, lo + COMPLIANCE_CHUNK)
-            w = wk[part][:, None, None]
-            Z = self.K[None] - w**2 * self.M[None] + 1j * w * self.D[None]
-            X[part], Q_full[part] = dynamic_compliance(Z, c, forcing[part])
+        found = modal_compliance(self.M, self.D, self.K, c, wk, forcing) if self._cache.get("modes") else None
+        if found is not None:
+            X, Q_full = found
+        else:
+            X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
+            for lo in range(0, len(wk), COMPLIANCE_CHUNK):
+                part = slice(lo, lo + COMPLIANCE_CHUNK)
+                X[part], Q_full[part] = dynamic_compliance(_stiffness(self.M, self.D, self.K, wk[part]), c,
+                                                           forcing[part])
         H = X[:, c, :]
         out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
         self._cache["compliance"] = out
         return out
+
+    def by_modes(self) -> TorusProblem:
+        """This problem with its compliance computed by the modes (:func:`modal_compliance`, the direct solve where
+        they do not match it): one eigen-solution in place of an order's solve each, to about 1e-8 of the direct one
+        (for a family that builds a problem a value, a speed branch: docs/model.md §26).
+
+        Returns
+        -------
+        TorusProblem
+            ``self``, its compliance not yet computed.
+        """
+        if "compliance" not in self._cache:
+            self._cache["modes"] = True
+        return self
 
     def linear_response(self) -> np.ndarray:
         """The coefficients of the ``dofs`` without the nonlinear forces, shape (size,)."""

@@ -35,7 +35,7 @@ import scipy.linalg as sla
 
 from rotorred import checks
 from rotorred.nonlinear.hb import Evaluation, NotConverged
-from rotorred.nonlinear.torus import FORCING_MAX, KRYLOV_FLOOR, TorusProblem, solve_torus
+from rotorred.nonlinear.torus import FORCING_MAX, TorusProblem, solve_torus
 from rotorred.nonlinear.torus_krylov import projected_blocks
 
 __all__ = ["TorusFamily", "TorusJacobian"]
@@ -44,6 +44,11 @@ __all__ = ["TorusFamily", "TorusJacobian"]
 STEP = 1e-6
 #: GMRES iterations of a solve past which the next Jacobian builds its own preconditioner
 FRESH_AFTER = 20
+#: the tightest GMRES tolerance of a continuation's solves: at a corrected point (rho below the branch's tolerance,
+#: down to 1e-14 in a fold's Brent) the solve is the tangent's ``J^-1 c``, whose relative error moves the tangent's
+#: parameter component by as much relatively and its sign (the fold's test) not at all; at the rig's folds the
+#: solves to 1e-12 took half the location's time
+SOLVE_FLOOR = 1e-8
 #: problems a family keeps (the corrector's iterates and their differences revisit a few values)
 KEPT = 6
 
@@ -295,8 +300,7 @@ class TorusFamily:
         if J is not None:
             self._state["last"] = J
         self._state["jacobians"] += 1
-        rtol = max(min(FORCING_MAX, relative), KRYLOV_FLOOR)
-        jacobian = TorusJacobian(J, rtol)
+        jacobian = TorusJacobian(J, forcing_term(relative))
         return _Counted(jacobian, self._state)
 
     def solve_point(self, z0: np.ndarray, s: float, tol: float, max_iter: int, max_halvings: int) -> _Point:
@@ -344,6 +348,12 @@ class _Counted(TorusJacobian):
         self._family_state["krylov"] += self.krylov - before
         self._family_state["slow"] = max(self._family_state.get("slow", 0), self.krylov - before)
         return x
+
+
+def forcing_term(relative: float) -> float:
+    """GMRES's relative tolerance on a solve at an iterate of relative residual ``relative``: ``min(1e-2, rho)``,
+    floored at :data:`SOLVE_FLOOR`."""
+    return max(min(FORCING_MAX, relative), SOLVE_FLOOR)
 
 
 def _refused():

@@ -30,7 +30,8 @@ import numpy as np
 from rotorred import checks
 from rotorred.model.operating import Operating
 from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
-from rotorred.nonlinear.torus import TorusProblem
+from rotorred.nonlinear.hb import NotConverged
+from rotorred.nonlinear.torus import TorusProblem, solve_torus
 from rotorred.nonlinear.torus_continuation import TorusFamily
 from rotorred.progress import INTERRUPTS
 from rotorred.results import Result
@@ -48,6 +49,14 @@ __all__ = ["TorusBranchOptions", "TorusBranch", "continue_torus", "check_torus_k
 FROZEN = 1e-3
 #: lines of the output DOF a branch's summary and files show: the largest at the start
 SHOWN_LINES = 10
+#: the ladder of boxes a lines tolerance climbs (:class:`TorusBranchOptions`): each box's bounds times this
+GROWTH = 1.5
+#: with a lines tolerance, the box is checked at the start and each time the key passes a further this-th of its range
+CHECKS = 8
+
+
+class _Check(Exception):
+    """Ends a segment of a branch where its box is to be checked (:func:`continue_torus`)."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +82,14 @@ class TorusBranchOptions:
     steps : (float, float)
         The first and the largest arclength step, as shares of ``max(||z_start||, |s_end - s_start|)`` (the
         coefficients' norm and the carried parameter's range, m), 0 < first <= largest.
+    lines_tol : float, optional
+        The orders chosen by the tolerance along the branch: at the start and each time the key passes a further
+        :data:`CHECKS`-th of its range, the box is checked against the next one of the ladder (bounds times
+        :data:`GROWTH`, the grid the default's): while the :data:`SHOWN_LINES` largest lines of the output DOF change
+        by more than ``lines_tol`` (relative, the largest), the branch goes on on the larger box. None (default): the
+        box ``orders`` throughout.
+    max_orders : (int, int)
+        The largest box the ladder climbs to.
     """
 
     orders: tuple[int, int] = (8, 40)
@@ -83,6 +100,8 @@ class TorusBranchOptions:
     tol: float = 1e-8
     max_points: int = 200
     steps: tuple[float, float] = (0.05, 0.15)
+    lines_tol: float | None = None
+    max_orders: tuple[int, int] = (27, 135)
 
     def __post_init__(self):
         # the orders, grid, band and window by TorusOptions's own checks
@@ -96,6 +115,11 @@ class TorusBranchOptions:
         s = checks.sequence("options.steps", list(np.ravel(self.steps)), min_len=2, max_len=2)
         first = checks.positive("options.steps[0]", s[0])
         object.__setattr__(self, "steps", (first, checks.number("options.steps[1]", s[1], ge=first)))
+        if self.lines_tol is not None:
+            checks.number("options.lines_tol", self.lines_tol, gt=0.0, lt=1.0)
+        m = checks.sequence("options.max_orders", list(np.ravel(self.max_orders)), min_len=2, max_len=2)
+        object.__setattr__(self, "max_orders", tuple(checks.integer(f"options.max_orders[{i}]", v, ge=1)
+                                                     for i, v in enumerate(m)))
 
     def torus_options(self, bases, outputs) -> TorusOptions:
         """The start's :class:`rotorred.scenes.quasi_periodic.TorusOptions`.
@@ -332,9 +356,9 @@ class _Family:
     and ``problem_at(value)`` (for :class:`TorusFamily`). Where a value leaves the model's matrices and the bases as
     they were (a clearance, the law's numbers), the start's compliance serves."""
 
-    def __init__(self, scene, model, key, first: TorusRubProblem, divisors, options: TorusBranchOptions):
+    def __init__(self, scene, model, key, first: TorusRubProblem, divisors, box: tuple[int, int, int, int]):
         self.scene, self.model, self.key, self.first, self.divisors = scene, model, key, first, divisors
-        self.box = (*options.orders, *options.n_grid)
+        self.box = box  # (H1, H2, N1, N2)
         self.spools = sorted((s for s, f in scene.frequencies_hz.items() if f > 0),
                              key=lambda s: scene.frequencies_hz[s])  # (L, H) at the start
         self._kept: dict = {}
@@ -364,6 +388,8 @@ class _Family:
             # the compliance and linear response are the start's (a clearance, a law's number): computed once. Its
             # cache is TorusProblem's own; a public with_forces (as CondensedProblem's) would say it better
             problem._cache["compliance"] = start._compliance()
+        else:  # a speed: its matrices and bases move, the compliance by the modes (one eigen-solution a value)
+            problem.by_modes()
         return dataclasses.replace(box, problem=problem)
 
 
@@ -415,33 +441,125 @@ def continue_torus(scene, model, key: str, start: float, end: float,
     first = torus_balance(model, first_scene.operating, Loads(first_scene.unbalances), first_scene.plates,
                           options.torus_options(bases, (dof,)))
     divisors = options.divisors or tuple(int(round(f[s] / b)) for s, b in zip(spools, first.bases_hz))
-    rubs = _Family(scene, model, key, first.problem, divisors, options)
-    family = TorusFamily(rubs.problem_at, start, (key, KEYS.get(key, "Hz")),
-                         FROZEN if key.startswith("speeds.") else 0.0)
-    s_start, s_end = family.carried(start), family.carried(end)
-    scale = max(float(np.linalg.norm(first.solution.z)), abs(s_end - s_start))
+    box = (*options.orders, *options.n_grid)
+    segments, value, z, rub, notes, direction = [], float(start), first.solution.z, first.problem, [], np.sign(end - start)
+    reach, furthest, began = abs(end - start) / CHECKS, float(start), t0
+    while True:
+        if options.lines_tol is not None:  # the box against the ladder's next, here
+            box, rub, z, note = _checked_box(_scene_at(scene, key, value), model, box, rub, z, dof, options)
+            notes.append(f"{notes and 'then ' or ''}{box[0]}x{box[1]} from {value:.6g} ({note})")
+        rubs = _Family(scene, model, key, rub, divisors, box)
+        family = TorusFamily(rubs.problem_at, value, (key, KEYS.get(key, "Hz")),
+                             FROZEN if key.startswith("speeds.") else 0.0)
+        check_at = furthest + direction * reach if options.lines_tol is not None else None
+        branch, stamps = _segment(family, z, value, end, options, check_at, progress, sum(len(b.values) - 1
+                                                                                            for _, b, _ in segments),
+                                  interrupts)
+        times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
+        point_time = np.concatenate([[stamps[1] - began], times, np.zeros(len(branch.values) - 1 - len(times))])
+        segments.append((rubs, branch, point_time))
+        if branch.interrupt != "check":
+            break
+        value, z, rub = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1])
+        furthest, began = value, time.perf_counter()
+    return _joined(scene, key, segments, dof, divisors, options, notes)
+
+
+def _segment(family, z, value, end, options, check_at, progress, before, interrupts):
+    """The continuation from ``z`` at ``value`` towards ``end`` on ``family``, ended (interrupt "check") where the key
+    passes ``check_at`` (None: never): the branch and the stamps of its progress calls."""
+    s_start, s_end = family.carried(value), family.carried(end)
+    scale = max(float(np.linalg.norm(z)), abs(s_end - s_start))
     stamps = [time.perf_counter()]
+    ahead = np.sign(end - value)
 
     def stamped(points: int, s: float) -> None:
         stamps.append(time.perf_counter())
+        v = family.parameter_value(s)
         if progress is not None:
-            progress(points, family.parameter_value(s))
+            progress(before + points, v)
+        if check_at is not None and points > 1 and ahead * (v - check_at) >= 0.0:
+            raise _Check()
     ds, ds_max = options.steps
-    branch = continue_branch(family, first.solution.z, s_start, s_end,
+    branch = continue_branch(family, z, s_start, s_end,
                              ContinuationOptions(ds=ds * scale, ds_min=1e-9 * scale, ds_max=ds_max * scale,
                                                  max_points=options.max_points, tol=options.tol, stability=False,
-                                                 curved=True), progress=stamped, interrupts=interrupts)
+                                                 curved=True), progress=stamped,
+                             interrupts={**interrupts, _Check: "check"})
     stamps.append(time.perf_counter())
-    times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
-    point_time = np.concatenate([[stamps[1] - t0], times, np.zeros(len(branch.values) - 1 - len(times))])
-    with signals_held():  # a few ms a point: the branch's lines whole
-        amplitudes = np.array([rubs.rub_at(v).lines(z, dof)[2] for v, z in zip(branch.values, branch.z)])
-    h = first.problem.problem.harmonics
-    truncation = (f"{h.n_orders} orders (|k1| <= {h.H1}, |k2| <= {h.H2}"
-                  + (f", |k . f| <= {options.f_max:g} Hz at the start" if options.f_max is not None else "")
-                  + f"), grid {h.N1} x {h.N2}, bases (f_L/{divisors[0]}, f_H/{divisors[1]})")
-    return TorusBranch(scene.name, key, KEYS.get(key, "Hz"), branch.values,
-                       np.array([rubs.bases(_scene_at(scene, key, v)) for v in branch.values]), h.orders, dof,
-                       amplitudes, branch.z, tuple((fd.value, fd.smooth) for fd in branch.folds), branch.stopped,
-                       branch.iterations, point_time, branch.slope, truncation, branch.interrupt)
+    return branch, stamps
 
+
+def _checked_box(scene, model, box, rub: TorusRubProblem, z, dof, options: TorusBranchOptions):
+    """The box (H1, H2, N1, N2), problem and solution the lines tolerance keeps at this value: the box while its
+    :data:`SHOWN_LINES` largest lines (of the next box's solution) differ from the next box's by at most
+    ``options.lines_tol``, else the next, checked in turn, up to ``options.max_orders``; and what was measured."""
+    said = []
+    while True:
+        H = tuple(min(int(round(GROWTH * h)), m) for h, m in zip(box[:2], options.max_orders))
+        if H == tuple(box[:2]):
+            return box, rub, z, ", ".join(said + ["the ladder's last"])
+        nxt = (*H, *default_grid(*H))
+        n = rub.problem.n
+        try:
+            fine = torus_rub_problem(scene, model, rub.bases_hz, *nxt, options.f_max)
+            z_fine = solve_torus(fine.problem, rub.problem.harmonics.transfer(z, n, fine.problem.harmonics),
+                                 tol=options.tol).z
+        except checks.InputError:  # a speed ratio the larger box holds as an order of both bases: none here
+            return box, rub, z, ", ".join(said + [f"{H[0]}x{H[1]} commensurate here"])
+        except NotConverged:
+            return box, rub, z, ", ".join(said + [f"{H[0]}x{H[1]} did not converge"])
+        change = _lines_change(rub, z, fine, z_fine, dof)
+        said.append(f"{H[0]}x{H[1]} {change:.2g}")
+        if change <= options.lines_tol:
+            return box, rub, z, ", ".join(said)
+        box, rub, z = nxt, fine, z_fine
+
+
+def _lines_change(coarse: TorusRubProblem, z_c, fine: TorusRubProblem, z_f, dof) -> float:
+    """The largest relative difference of the :data:`SHOWN_LINES` largest lines of ``fine``'s solution (the mean left
+    out) from the same orders' lines of ``coarse``'s (an order it lacks: 1)."""
+    orders_c, _, a_c = coarse.lines(z_c, dof)
+    orders_f, _, a_f = fine.lines(z_f, dof)
+    index = {(int(k1), int(k2)): i for i, (k1, k2) in enumerate(orders_c)}
+    ranked = np.argsort(-np.where(np.any(orders_f != 0, axis=1), a_f, -np.inf))[:SHOWN_LINES]
+    return max(abs(a_c[index[key]] / a_f[k] - 1.0) if (key := (int(orders_f[k, 0]), int(orders_f[k, 1]))) in index
+               else 1.0 for k in ranked)
+
+
+def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes) -> TorusBranch:
+    """The segments' branches as one: each segment's points after the first (that is the last one's), their
+    coefficients and lines on the last box's orders (the ones a segment lacks at 0), the times of a segment's start
+    (the box's check, the solve at the new box) on its first point."""
+    last = segments[-1][0].first
+    h, n = last.problem.harmonics, last.problem.n
+    where = {(int(k1), int(k2)): i for i, (k1, k2) in enumerate(h.orders)}
+    values, z, amplitudes, times, folds, iterations, slope = [], [], [], [], [], [], []
+    for j, (rubs, branch, point_time) in enumerate(segments):
+        keep = slice(0 if j == 0 else 1, None)
+        own = rubs.first.problem.harmonics
+        with signals_held():  # a few ms a point: the branch's lines whole
+            lines = np.array([rubs.rub_at(v).lines(zi, dof)[2] for v, zi in zip(branch.values, branch.z)])
+        placed = np.zeros((len(branch.values), h.n_orders))
+        placed[:, [where[(int(a), int(b))] for a, b in own.orders]] = lines
+        t = point_time.copy()
+        if j > 0 and len(t) > 1:
+            t[1] += t[0]  # the check and the new box's start: the first step's
+        values.append(branch.values[keep])
+        z.append(np.array([own.transfer(zi, n, h) for zi in branch.z[keep]]).reshape(-1, h.size * n))
+        amplitudes.append(placed[keep])
+        times.append(t[keep])
+        folds += [(fd.value, fd.smooth) for fd in branch.folds]
+        iterations.append(branch.iterations[keep])
+        slope.append(branch.slope[keep])
+    final = segments[-1][1]
+    truncation = (f"{h.n_orders} orders at the end (|k1| <= {h.H1}, |k2| <= {h.H2}"
+                  + (f", |k . f| <= {options.f_max:g} Hz at a box's start" if options.f_max is not None else "")
+                  + f"), grid {h.N1} x {h.N2}, bases (f_L/{divisors[0]}, f_H/{divisors[1]})"
+                  + (f"; boxes by the lines' tolerance {options.lines_tol:g}: {'; '.join(notes)}" if notes else ""))
+    values = np.concatenate(values)
+    return TorusBranch(scene.name, key, KEYS.get(key, "Hz"), values,
+                       np.array([segments[0][0].bases(_scene_at(scene, key, v)) for v in values]), h.orders, dof,
+                       np.concatenate(amplitudes), np.concatenate(z), tuple(folds), final.stopped,
+                       np.concatenate(iterations), np.concatenate(times), np.concatenate(slope), truncation,
+                       final.interrupt)
