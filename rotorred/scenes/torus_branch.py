@@ -278,7 +278,10 @@ class TorusBranch(Result):
         for k in self.largest[:checks.integer("lines", lines, ge=1, le=SHOWN_LINES)]:
             fig = plot_branch(self.values, self.amplitudes[:, k], None, self.folds, ax if fig is None else fig.axes[0],
                               xlabel=f"{self.key} ({xu})", ylabel=f"lines of {dof_name(self.dof)} (µm)", xscale=xs,
-                              title=title)
+                              title=title if fig is None else None)
+            fig.axes[0].annotate(f"{self.line_label(k)}: {self.frequencies[0, k]:.4g} Hz",
+                                 (xs * self.values[0], 1e6 * self.amplitudes[0, k]), xytext=(4, 4),
+                                 textcoords="offset points", fontsize=8)
         return fig
 
     def to_xarray(self):
