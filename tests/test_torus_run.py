@@ -158,3 +158,4 @@ def test_a_tolerance_the_boxes_do_not_meet_is_said(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert err.startswith("rotorred run: error: the torus did not meet the tolerance 0.05") and "Traceback" not in err
     assert "|k1| <= 16, |k2| <= 80" in err, err
+    assert "solver.harmonics = [H1, H2]" in err and "a larger tolerance" in err, err  # what to do instead

@@ -63,7 +63,9 @@ class TorusOrdersNotConverged(NotConverged):
     def __init__(self, omega: float, change: float, tol: float, orders: tuple[int, int]):
         self.omega, self.residual, self.tol, self.iterations = omega, change, tol, 0
         RuntimeError.__init__(self, f"the torus did not meet the tolerance {tol:g}: its response still changes by "
-                              f"{change:.3g} at orders |k1| <= {orders[0]}, |k2| <= {orders[1]}, the ladder's last")
+                              f"{change:.3g} at orders |k1| <= {orders[0]}, |k2| <= {orders[1]}, the ladder's last; give "
+                              "the box of orders instead (a scene's solver.harmonics = [H1, H2], or "
+                              "TorusOptions(orders=(H1, H2))) or a larger tolerance")
 
 
 def torus_change(coarse: TorusHarmonics, Q_coarse: np.ndarray, fine: TorusHarmonics, Q_fine: np.ndarray) -> float:

@@ -52,7 +52,7 @@ def format_branch(branch) -> str:
     changes = ", ".join(f"{kind} between {xs * a:.6g} and {xs * b:.6g} {xu}" for a, b, kind in branch.bifurcations)
     n = len(branch.values)
     head, tail = (f"INCOMPLETE: {branch.stopped}\n", "") if branch.interrupted else ("", f"{branch.stopped}\n")
-    return (f"{head}{table}\n{n} points{f' (every {step}th shown)' if step > 1 else ''}; turns: {folds}\n"
+    return (f"{head}{table}\n{n} points{f' (one in {step} shown)' if step > 1 else ''}; turns: {folds}\n"
             f"stability changes: {changes or 'none'}\n{tail}"
             f"times: cold start {branch.start_time:.2f} s, continuation {branch.solve_time:.2f} s "
             f"({1e3 * branch.solve_time / max(n - 1, 1):.0f} ms a point), stability {branch.stability_time:.2f} s")
@@ -72,7 +72,7 @@ def _format_torus(branch: TorusBranch) -> str:
     n = len(branch.values)
     head, tail = (f"INCOMPLETE: {branch.stopped}\n", "") if branch.interrupted else ("", f"{branch.stopped}\n")
     steps = branch.point_time[1:]
-    return (f"{head}{table}\n{n} points{f' (every {step}th shown)' if step > 1 else ''}; {branch.truncation}\n"
+    return (f"{head}{table}\n{n} points{f' (one in {step} shown)' if step > 1 else ''}; {branch.truncation}\n"
             f"turns: {folds}\n{tail}times: start {branch.point_time[0]:.2f} s, then {steps.sum():.2f} s "
             f"({1e3 * steps.sum() / max(n - 1, 1):.0f} ms a point)")
 
