@@ -130,17 +130,24 @@ def torus_memory(scene, sm, torus, result, largest, records) -> float:
         tracemalloc.stop()
 
 
-def cold(scene, sm, torus, rp, z):
-    """The cold start: :func:`rotorred.torus_balance` from its own short transient (2-3 s from the settled linear
-    state), the bases the line fit's torus search finds in its last second, least squares on |k1| <= 4, |k2| <= 30
-    there, and Newton on the same truncation as the warm solve ``z`` of ``rp``. Returns its time (transient and torus, s) and the largest difference of the two tori's
-    complex amplitudes at node 14 Y over every order, relative to the largest."""
+def cold_torus(scene, sm):
+    """:func:`rotorred.torus_balance` of the scene from its own short transient, on the last truncation, the bases
+    its line fit finds. Returns the result and its options."""
     import rotorred as rr
 
     H1, H2, N1, N2 = TRUNCATIONS[-1]
     options = rr.TorusOptions(orders=(H1, H2), grid=(N1, N2), f_max=F_MAX, outputs=[OUTPUT])  # bases: its line fit
     result = rr.torus_balance(sm.model, rr.Operating.point(dict(scene.speeds)), rr.Loads(scene.unbalances),
                               scene.plates, options)
+    return result, options
+
+
+def cold(scene, sm, torus, rp, z):
+    """The cold start: :func:`rotorred.torus_balance` from its own short transient (2-3 s from the settled linear
+    state), the bases the line fit's torus search finds in its last second, least squares on |k1| <= 4, |k2| <= 30
+    there, and Newton on the same truncation as the warm solve ``z`` of ``rp``. Returns its time (transient and torus, s) and the largest difference of the two tori's
+    complex amplitudes at node 14 Y over every order, relative to the largest."""
+    result, options = cold_torus(scene, sm)
     warm = rp.problem.recover(z)[:, :rp.n_model] @ sm.model.output_rows([OUTPUT]).T
     difference = np.max(np.abs(result.phasors - warm)) / np.max(np.abs(warm))
     assert result.bases_hz == rp.bases_hz, (result.bases_hz, rp.bases_hz)
@@ -234,17 +241,22 @@ def main() -> Comparison:
 def alone() -> float:
     """The cold-started torus in this process only (model, start's transient, torus on the last truncation); prints
     and returns the process's peak resident memory (MB)."""
-    import rotorred as rr
-
     scene = load_scene("paper-rub", {"speeds.outer": OUTER_HZ})
-    sm = build_model(scene)
-    H1, H2, N1, N2 = TRUNCATIONS[-1]
-    options = rr.TorusOptions(orders=(H1, H2), grid=(N1, N2), f_max=F_MAX, outputs=[OUTPUT])
-    rr.torus_balance(sm.model, rr.Operating.point(dict(scene.speeds)), rr.Loads(scene.unbalances), scene.plates,
-                     options)
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    cold_torus(scene, build_model(scene))
+    peak = _own_peak_mb()
     print(f"{peak:.0f}")
     return peak
+
+
+def _own_peak_mb() -> float:
+    """This process's peak resident memory (MB) since it was started. Linux carries ``ru_maxrss`` across ``exec`` from
+    the process that forked it (a child of this script reported the script's own 778 MB), so the peak of the process's
+    own memory map, ``VmHWM``, is read where there is one."""
+    try:
+        with open("/proc/self/status") as status:
+            return next(float(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024.0
+    except (OSError, StopIteration):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def alone_peak_mb() -> float:
