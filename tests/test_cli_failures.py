@@ -152,7 +152,7 @@ def test_ctrl_c_to_the_process_group_while_the_figure_pool_starts(tmp_path):
     """Ctrl-C in a terminal reaches the whole process group: the figure pool's fork server too, which imports
     matplotlib and builds the figures' frames for about a second before multiprocessing ignores SIGINT there. It used
     to print its own KeyboardInterrupt traceback beside the command's one line (measured: every SIGINT between 0.6
-    and 1.4 s after the start). The server now starts with SIGINT ignored; the command still gets it: exit 130, one
+    and 1.4 s after the start). The server now ignores SIGINT from its first preloaded line; the command still gets it: exit 130, one
     line, no traceback from any process."""
     import psutil
 

@@ -11,14 +11,22 @@
   (multiprocessing's own).
 """
 
-import ast
-import atexit
-import os
-import sys
+import signal
 
-import rotorred.plots._preload  # noqa: F401
-from rotorred.plots.pool import FRAMES
-from rotorred.plots.scene import prepare_frames
+# first, before matplotlib's import and the frames (about a second): Ctrl-C reaches the whole process group, and the
+# server printed a KeyboardInterrupt traceback from its preload before multiprocessing ignores SIGINT there. Ignoring
+# it in the caller while it starts the server would have the child inherit that, but a SIGINT meanwhile could be lost
+# to the caller (the kernel hands it to a thread that does not block it, where it is ignored).
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+import ast  # noqa: E402
+import atexit  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+
+import rotorred.plots._preload  # noqa: F401, E402
+from rotorred.plots.pool import FRAMES  # noqa: E402
+from rotorred.plots.scene import prepare_frames  # noqa: E402
 
 
 def _exit_now() -> None:

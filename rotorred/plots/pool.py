@@ -12,8 +12,8 @@ Workers are forked from a fork server (a fresh interpreter, not the caller: no f
 numba's threads) that imports matplotlib once (:mod:`rotorred.plots._preload`, through
 :mod:`rotorred.plots._fork_server`, which also ends the server without a teardown), so two workers cost one
 import of it, not two: a warm ``rotorred run`` of paper-rub took 3.51 s against 3.87 s with spawned workers
-(medians of 10, alternated). Where there is no fork server (Windows) they are spawned. The server and the workers ignore
-SIGINT (the server from its start, :func:`_sigint_ignored_by_children`): Ctrl-C is the caller's to handle, and leaving the pool stops them before the caller cleans up
+(medians of 10, alternated). Where there is no fork server (Windows) they are spawned. The server (from its first preloaded line,
+:mod:`rotorred.plots._fork_server`) and the workers ignore SIGINT: Ctrl-C is the caller's to handle, and leaving the pool stops them before the caller cleans up
 (:class:`rotorred.writers.OutputFolder` removes its staging folder after a worker can no longer write into
 it). ``workers=0`` draws in the calling process.
 """
@@ -21,12 +21,10 @@ it). ``workers=0`` draws in the calling process.
 from __future__ import annotations
 
 import concurrent.futures
-import contextlib
 import multiprocessing
 from concurrent.futures.process import BrokenProcessPool
 import os
 import signal
-import threading
 
 __all__ = ["FigurePool", "Drawing", "default_workers"]
 
@@ -64,39 +62,16 @@ def _context(frames=()):
     context.set_forkserver_preload(["rotorred.plots._fork_server"])
     previous = os.environ.get(FRAMES)
     os.environ[FRAMES] = repr([tuple(key) for key in frames])
-    with _sigint_ignored_by_children():
-        try:
-            forkserver.ensure_running()
-        except OSError:  # no server now: the pool starts one when it starts a worker (without the frames), or breaks
-            pass  # and its figures are drawn in the calling process (Drawing)
-        finally:
-            if previous is None:
-                del os.environ[FRAMES]
-            else:
-                os.environ[FRAMES] = previous
-    return context
-
-
-@contextlib.contextmanager
-def _sigint_ignored_by_children():
-    """Processes started inside start with SIGINT ignored; a SIGINT meanwhile reaches this process when it leaves.
-
-    Ctrl-C reaches the whole process group, and the fork server would otherwise print a KeyboardInterrupt traceback
-    from its preload (matplotlib's import, the frames: about a second) before multiprocessing ignores SIGINT there.
-    An ignored signal stays ignored across ``exec`` and Python keeps it so at startup; the signal is blocked while
-    it is ignored here, so one that comes meanwhile stays pending (Linux keeps a blocked signal pending whatever its
-    action) and is delivered to the caller's own handler, restored before the mask.
-    """
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
-        yield  # signal.signal works in the main thread only; no fork server without POSIX signals
-        return
-    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        yield
+        forkserver.ensure_running()
+    except OSError:  # no server now: the pool starts one when it starts a worker (without the frames), or breaks and
+        pass  # its figures are drawn in the calling process (Drawing)
     finally:
-        signal.signal(signal.SIGINT, signal.default_int_handler if handler is None else handler)  # None: set in C
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        if previous is None:
+            del os.environ[FRAMES]
+        else:
+            os.environ[FRAMES] = previous
+    return context
 
 
 def _ready() -> int:
