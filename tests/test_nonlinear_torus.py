@@ -333,3 +333,55 @@ def test_rub_torus_from_a_second_of_the_transient_converges_and_holds_the_forced
     for label, tol in (("f_H", 1.5e-2), ("4f_H/3", 3.5e-2), ("f_L", 2e-3)):
         ln = largest[label]
         assert rp.amplitudes_at(sol.z, (14, "y"), [ln.frequency_hz])[0] == pytest.approx(ln.amplitude, rel=tol)
+
+
+def test_positions_and_transfer_match_a_lookup_by_hand():
+    """``TorusHarmonics.positions`` (sorted codes) is the dictionary lookup it replaced, -1 where an order is absent,
+    and ``transfer`` to a larger set and back is the identity on the orders (exactly: a copy of coefficients)."""
+    w = (2 * math.pi * 70.0, 2 * math.pi * 91.37 / 3)
+    small, large = TorusHarmonics(3, 9, 16, 32, 2 * math.pi * 400.0, w), TorusHarmonics(5, 14, 16, 32)
+    by_hand = {(int(a), int(b)): i for i, (a, b) in enumerate(small.orders)}
+    expected = np.array([by_hand.get((int(a), int(b)), -1) for a, b in large.orders])
+    assert np.array_equal(small.positions(large.orders), expected)
+    assert np.sum(expected >= 0) == small.n_orders and np.sum(expected < 0) > 0
+    z = np.random.default_rng(1).standard_normal(small.size * 2)
+    assert np.array_equal(large.transfer(small.transfer(z, 2, large), 2, small), z)
+
+
+def test_a_problem_with_other_forces_shares_the_compliance_and_is_a_fresh_build():
+    """``TorusProblem.with_forces`` (a clearance along a branch): its residual at the rig's 14 µm torus start equals
+    the residual of the problem built afresh at that clearance to round-off (measured 0), and its compliance is the
+    original's object (computed once)."""
+    from rotorred.scenes.harmonic_balance import plate_rubs
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": 13e-6})
+    model = build_model(scene).model
+    there = load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": 9e-6})
+    first = torus_rub_problem(scene, model, (70.0, 91.37 / 3), 2, 8, 16, 64).problem
+    fresh = torus_rub_problem(there, model, (70.0, 91.37 / 3), 2, 8, 16, 64).problem
+    moved = first.with_forces(plate_rubs(model, there)[1])
+    z = 3.0 * first.linear_response()  # in contact at both clearances
+    assert np.linalg.norm(first.residual(z) - moved.residual(z)) > 1e-3 * np.linalg.norm(moved.residual(z))
+    assert np.linalg.norm(moved.residual(z) - fresh.residual(z)) <= 1e-14 * np.linalg.norm(fresh.residual(z))
+    assert moved._compliance() is first._compliance()
+
+
+def test_a_spool_frequency_held_by_several_far_apart_orders_is_its_lowest():
+    """At outer 91 Hz the bases (70, 91/3) Hz are 13:10: in the box |k1| <= 32, |k2| <= 80 (band 900 Hz) 70 Hz is the
+    order (1, 0) and (12, -30) (and more), 91 Hz (0, 3) and (13, -27). The spool's order is the lowest, the others 42
+    and more times higher (|k1| + |k2|); bases commensurate at low orders stay refused (tests/test_scene_analyses.py: (70, 35)
+    Hz, 70 Hz the orders (1, 0) and (0, 2))."""
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    scene = load_scene("paper-rub", {"speeds.outer": 91.0})
+    model = build_model(scene).model
+    rp = torus_rub_problem(scene, model, (70.0, 91.0 / 3), 32, 80, 128, 256, 900.0)
+    h, f = rp.problem.harmonics, np.abs(rp.problem.harmonics.frequencies(rp.bases_hz))
+    held = {(int(a), int(b)) for a, b in h.orders[np.abs(f - 70.0) < 1e-9 * 70.0]}
+    assert {(1, 0), (12, -30)} <= held and min(abs(a) + abs(b) for a, b in held - {(1, 0)}) == 42
+    assert rp.spool_orders == {"inner": (1, 0), "outer": (0, 3)}

@@ -68,6 +68,29 @@ def test_a_torus_branch_without_the_second_tone_has_the_closed_form_folds():
 
 
 @pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
+def test_interpolated_folds_are_near_the_closed_form_at_no_cost():
+    """``fold_refine=False`` (a torus branch's default): each fold is the turn of the cubic Hermite curve through the
+    points either side of it, no solve. On the single-tone branch of the closed form (steps 0.1 of the scaled
+    arclength) they are within 4e-6 relative of the discriminant's roots (measured 3.9e-7 and 1.3e-9), where Brent's
+    are within 2e-11 (above); the branch has the same 122 points as with Brent (its values within 1.2e-6: the
+    corrections' Krylov histories differ), and a third of its GMRES iterations (measured 1467 against 4611)."""
+    def branch(refine):
+        family = TorusFamily(two_tones(1, 0.0), 0.5, ("w1", "rad/s"))
+        z0 = family.at(0.5).linear_response()
+        return family, continue_branch(family, z0, family.carried(0.5), family.carried(2.5),
+                                       ContinuationOptions(ds=0.1, ds_max=0.1, ds_min=1e-8, stability=False,
+                                                           fold_refine=refine))
+    (fast_family, fast), (slow_family, slow) = branch(False), branch(True)
+    roots = duffing_folds_closed_form()
+    located = sorted(f.value for f in fast.folds)
+    assert len(located) == 2 and all(f.smooth for f in fast.folds)
+    assert np.allclose(located, roots, rtol=4e-6, atol=0)
+    assert len(fast.values) == len(slow.values)
+    assert np.allclose(fast.values, slow.values, rtol=1e-5)
+    assert fast_family.krylov < 0.5 * slow_family.krylov
+
+
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
 def test_a_two_tone_torus_branch_folds_where_the_dense_jacobian_is_singular(two_tone_branch):
     """With both tones (|k1|, |k2| <= 3) the branch turns twice; at each fold located the dense torus Jacobian (an
     independent construction: Toeplitz matrices by the 2-D spectrum) is singular, its smallest singular value below

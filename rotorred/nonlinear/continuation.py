@@ -61,6 +61,9 @@ CORNER_ITERATIONS = 12
 CORNER_HALVINGS = 4
 #: Brent's tolerance on a fold's position, a share of the step (at least the corrector's tolerance)
 FOLD_XTOL = 1e-10
+#: a fold interpolated without a solve (:func:`_interpolated_fold`) is a corner where the tangents either side of it
+#: turn by more than this (rad): at a smooth fold traced in steps that follow its curvature they turn by little
+CORNER_TURN = np.pi / 3
 
 
 @dataclass(frozen=True)
@@ -268,6 +271,11 @@ class ContinuationOptions:
         where each costs much (the rig's condensed problem: 2 in place of 3). Off by default: on a small problem with
         kinks it lets the steps grow past what the kinks allow (the Jeffcott rotor at H = 10, N = 1024 then jumped
         from the free branch above resonance to the one below, at ds_max = 0.5, and traced its loop twice).
+    fold_refine : bool
+        Locate each fold by Brent on d omega / ds (default: each evaluation a corrected point and a tangent, to
+        :data:`FOLD_XTOL` of the step). False: the fold is the turn of the cubic Hermite curve through the two points
+        either side of it and their tangents, without a solve (:func:`_interpolated_fold`), for a problem whose
+        corrections are costly (a torus); a corner where the tangents turn by more than :data:`CORNER_TURN`.
     """
 
     ds: float = 0.05
@@ -277,6 +285,7 @@ class ContinuationOptions:
     tol: float = 1e-10
     stability: bool = True
     curved: bool = False
+    fold_refine: bool = True
 
     def __post_init__(self):
         checks.positive("ds_min", self.ds_min)
@@ -286,6 +295,7 @@ class ContinuationOptions:
         checks.positive("tol", self.tol)
         checks.boolean("stability", self.stability)
         checks.boolean("curved", self.curved)
+        checks.boolean("fold_refine", self.fold_refine)
 
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float,
@@ -336,7 +346,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
     try:  # the whole loop: an interrupt anywhere in it leaves ``points`` whole
         stopped = _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max,
-                         max_points, tol, progress, curved) or stopped
+                         max_points, tol, progress, curved, o.fold_refine) or stopped
         interrupt = ""
     except tuple(interrupts) as exc:
         interrupt = interrupt_name(exc, interrupts)
@@ -345,7 +355,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
 
 
 def _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max, max_points,
-           tol, progress, curved) -> str:
+           tol, progress, curved, fold_refine: bool = True) -> str:
     """Step from ``points[-1]`` on, appending to ``points`` and ``folds`` (``path`` and ``chords`` kept with them),
     until omega passes ``omega_end``: why it stopped, or "" when it reached the end."""
     while len(points) < max_points:
@@ -354,7 +364,8 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
         nxt, ds, why = _step(problem, points[-1], points[-2] if len(points) > 1 else None, ds, ds_min, ds_max, tol,
                              curved)
         if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
-            folds.append(_locate_fold(problem, points[-1], nxt, tol))
+            folds.append(_locate_fold(problem, points[-1], nxt, tol) if fold_refine else
+                         _interpolated_fold(problem, points[-1], nxt))
         if nxt is None:
             return why
         points.append(nxt)
@@ -586,6 +597,25 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
     if np.linalg.norm(secant) > MAX_JUMP * ds or traced:
         return None
     return _Point(y, _tangent(problem, y, secant, ev=found.evaluation), found.iterations)
+
+
+def _interpolated_fold(problem, a: _Point, b: _Point) -> Fold:
+    """The fold between points ``a`` and ``b`` without a solve: where omega turns on the cubic Hermite curve
+    ``y(u)``, u in [0, 1], through ``a.y`` and ``b.y`` with derivatives ``L a.t`` and ``L b.t`` (L the chord, the
+    tangents oriented alike), its point there; a corner (at ``a``) where the tangents turn by more than
+    :data:`CORNER_TURN`. Its error is the curve's, O(L^4) in omega (docs/model.md §26 gives it measured against
+    Brent's)."""
+    if a.t @ b.t < np.cos(CORNER_TURN):
+        return Fold(float(a.y[-1]), a.y[:-1].copy(), _value(problem, a.y[-1]), smooth=False)
+    chord = b.y - a.y
+    L = np.linalg.norm(chord)
+    A, B = L * a.t, L * b.t
+    c2, c3 = 3.0 * chord - 2.0 * A - B, A + B - 2.0 * chord
+    roots = np.roots([3.0 * c3[-1], 2.0 * c2[-1], A[-1]]) if c3[-1] != 0.0 else np.roots([2.0 * c2[-1], A[-1]])
+    inside = [r.real for r in roots if abs(r.imag) <= 1e-12 and 0.0 <= r.real <= 1.0]
+    u = min(inside, key=lambda r: abs(r - 0.5)) if inside else 0.5  # the sign change of A[-1] and B[-1]: one root
+    y = a.y + A * u + c2 * u**2 + c3 * u**3
+    return Fold(float(y[-1]), y[:-1].copy(), _value(problem, y[-1]))
 
 
 def _locate_fold(problem, a: _Point, b: _Point, tol) -> Fold:

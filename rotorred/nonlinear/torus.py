@@ -86,6 +86,11 @@ def _half_plane_orders(H1: int, H2: int, w, w_max) -> np.ndarray:
     return np.vstack([[0, 0], np.column_stack([k1[keep], k2[keep]])]).astype(int)
 
 
+def _order_codes(orders: np.ndarray) -> np.ndarray:
+    """One integer an order ``(k_1, k_2)``, distinct for |k_2| < 2**31."""
+    return orders[:, 0].astype(np.int64) * (1 << 32) + orders[:, 1].astype(np.int64)
+
+
 @dataclass(frozen=True)
 class TorusHarmonics:
     """The 2-D harmonic basis: the orders of a box (and band) and an ``N_1 x N_2`` AFT grid.
@@ -285,12 +290,32 @@ class TorusHarmonics:
         """
         Q = self.phasors(z, n)
         out = np.zeros((target.n_orders, n), complex)
-        position = {(int(a), int(b)): i for i, (a, b) in enumerate(self.orders)}
-        for i, (a, b) in enumerate(target.orders):
-            j = position.get((int(a), int(b)))
-            if j is not None:
-                out[i] = Q[j]
+        j = self.positions(target.orders)
+        held = j >= 0
+        out[held] = Q[j[held]]
         return target.from_phasors(out)
+
+    def positions(self, orders: np.ndarray) -> np.ndarray:
+        """The position of each of ``orders`` in this set's :attr:`orders`, -1 where it lacks one (a vectorised
+        lookup on the orders' sorted codes, built once: a branch moves coefficients between sets at every point).
+
+        Parameters
+        ----------
+        orders : ndarray, shape (L, 2), int
+            Orders ``(k_1, k_2)`` of the half-plane (as :attr:`orders`).
+
+        Returns
+        -------
+        ndarray, shape (L,), int
+        """
+        if "codes" not in self._lazy:
+            codes = _order_codes(self.orders)
+            at = np.argsort(codes)
+            self._lazy["codes"] = (codes[at], at)
+        sorted_codes, at = self._lazy["codes"]
+        codes = _order_codes(np.asarray(orders, int).reshape(-1, 2))
+        i = np.minimum(np.searchsorted(sorted_codes, codes), len(sorted_codes) - 1)
+        return np.where(sorted_codes[i] == codes, at[i], -1)
 
     def samples(self, z: np.ndarray, n: int) -> np.ndarray:
         """``q`` on the grid of the harmonic-major coefficients ``z`` of ``n`` DOFs (inverse 2-D FFT).
@@ -752,6 +777,23 @@ class TorusProblem:
         out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
         self._cache["compliance"] = out
         return out
+
+    def with_forces(self, forces) -> TorusProblem:
+        """This problem with other nonlinear forces on the same DOFs (a contact's clearance, its law's numbers): the
+        matrices, orders, bases and forcing kept, and with them the compliance and linear response, computed once.
+
+        Parameters
+        ----------
+        forces : tuple
+            Nonlinear forces (:mod:`rotorred.nonlinear.forces`) on ``dofs``, as the constructor's.
+
+        Returns
+        -------
+        TorusProblem
+        """
+        other = TorusProblem(self.M, self.D, self.K, self.harmonics, self.w, self.dofs, self.forcing, tuple(forces))
+        other._cache["compliance"] = self._compliance()
+        return other
 
     def by_modes(self) -> TorusProblem:
         """This problem with its compliance computed by the modes (:func:`modal_compliance`, the direct solve where

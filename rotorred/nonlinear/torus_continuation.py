@@ -51,6 +51,8 @@ FRESH_AFTER = 20
 SOLVE_FLOOR = 1e-8
 #: problems a family keeps (the corrector's iterates and their differences revisit a few values)
 KEPT = 6
+#: J^-1 c of an iterate starts from the last one's (where the bases are the same)
+WARM_COLUMN = True
 
 
 class TorusJacobian:
@@ -65,19 +67,19 @@ class TorusJacobian:
         GMRES's relative tolerance on each solve (the inexact Newton's forcing term).
     """
 
-    def __init__(self, J, rtol: float):
-        self.J, self.rtol, self.krylov = J, float(rtol), 0
+    def __init__(self, J, rtol: float, column_start: np.ndarray | None = None):
+        self.J, self.rtol, self.krylov, self.column_start = J, float(rtol), 0, column_start
 
     def times(self, v: np.ndarray) -> np.ndarray:
         """``J v`` (v of shape (size,))."""
         return v.copy() if self.J is None else self.J.times(v)
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """``J^-1 b`` to the relative tolerance ``rtol`` (GMRES on the reduced equation); LinAlgError if GMRES gives
-        a non-finite solution."""
+    def solve(self, b: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+        """``J^-1 b`` to the relative tolerance ``rtol`` (GMRES on the reduced equation, from the reduced ``start``
+        if given); LinAlgError if GMRES gives a non-finite solution."""
         if self.J is None:
             return b.copy()
-        x, stats = self.J.solve(b, self.rtol)
+        x, stats = self.J.solve(b, self.rtol, start=start)
         self.krylov += stats.iterations
         return x
 
@@ -94,8 +96,9 @@ class _Bordered:
         self._x_c = None
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        if self._x_c is None:
-            self._x_c = self.jacobian.solve(self.column)
+        if self._x_c is None:  # from the last iterate's J^-1 c where its bases are this one's (a nearby system)
+            self._x_c = self.jacobian.solve(self.column, self.jacobian.column_start)
+            self.jacobian.column_reduced = None if self.jacobian.J is None else self.jacobian.J.reduced
         b, beta, r, d = rhs[:-1], rhs[-1], self.row[:-1], self.row[-1]
         x_b = self.jacobian.solve(b) if np.any(b) else np.zeros_like(b)
         schur = d - r @ self._x_c
@@ -297,11 +300,13 @@ class TorusFamily:
         self._state["slow"] = 0
         if J is not None and J.reused and J.G0 is not last.G0:
             J.P0, J.Pk = projected_blocks(J.G0, J.Gk, J.V, J.U)
+        start = None
         if J is not None:
+            kept = self._state.get("column_reduced")
+            start = kept[1] if kept is not None and kept[0] is J.U and WARM_COLUMN else None
             self._state["last"] = J
         self._state["jacobians"] += 1
-        jacobian = TorusJacobian(J, forcing_term(relative))
-        return _Counted(jacobian, self._state)
+        return _Counted(TorusJacobian(J, forcing_term(relative), start), self._state)
 
     def solve_point(self, z0: np.ndarray, s: float, tol: float, max_iter: int, max_halvings: int) -> _Point:
         """The torus at the carried ``s`` by :func:`rotorred.nonlinear.torus.solve_torus` from ``z0`` (the
@@ -336,15 +341,24 @@ class TorusFamily:
 
 
 class _Counted(TorusJacobian):
-    """A :class:`TorusJacobian` adding its GMRES iterations to the family's count."""
+    """A :class:`TorusJacobian` adding its GMRES iterations to the family's count, and keeping its ``J^-1 c``'s
+    reduced solution (with the bases it is in) for the next Jacobian's start."""
 
     def __init__(self, jacobian: TorusJacobian, state: dict):
-        super().__init__(jacobian.J, jacobian.rtol)
+        super().__init__(jacobian.J, jacobian.rtol, jacobian.column_start)
         self._family_state = state
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
+    @property
+    def column_reduced(self):
+        return None
+
+    @column_reduced.setter
+    def column_reduced(self, y):
+        self._family_state["column_reduced"] = None if y is None else (self.J.U, y)
+
+    def solve(self, b: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
         before = self.krylov
-        x = super().solve(b)
+        x = super().solve(b, start)
         self._family_state["krylov"] += self.krylov - before
         self._family_state["slow"] = max(self._family_state.get("slow", 0), self.krylov - before)
         return x

@@ -197,18 +197,21 @@ class RankJacobian:
         return out
 
     # ------------------------------------------------------------------------------------------ the step
-    def solve(self, b: np.ndarray, rtol: float, maxiter: int = 300, restart: int = 100):
+    def solve(self, b: np.ndarray, rtol: float, maxiter: int = 300, restart: int = 100,
+              start: np.ndarray | None = None):
         """``J^-1 b`` by Woodbury's identity and GMRES on the reduced equation to the relative residual ``rtol``
-        (:func:`right_gmres`); returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced
-        residual reached)."""
+        (:func:`right_gmres`), from the reduced solution ``start`` if given (a nearby system's :attr:`reduced`, in
+        this Jacobian's bases); returns the solution and :class:`KrylovStats` (GMRES's iterations, the reduced
+        residual reached), and keeps the reduced solution as :attr:`reduced`."""
         rhs = self.core(b.reshape(-1, self.c) @ self.V).reshape(-1)
-        y, iterations, achieved = right_gmres(self.inner, self.precondition, rhs, None, rtol, restart, maxiter)
+        y, iterations, achieved = right_gmres(self.inner, self.precondition, rhs, start, rtol, restart, maxiter)
         if self.reused and (achieved > rtol or iterations > REFRESH_ITERATIONS):  # the earlier factors serve badly:
             self._preconditioner, self.reused = None, False  # fresh ones from the current fields
             y, more, achieved = right_gmres(self.inner, self.precondition, rhs, y, rtol, restart, maxiter)
             iterations += more
         if not np.all(np.isfinite(y)):
             raise sla.LinAlgError("GMRES gave a non-finite solution")
+        self.reduced = y
         X_y = block_product(self.G0, self.Gk, (y.reshape(-1, self.r) @ self.U.T).reshape(-1, 1), self.c).reshape(-1)
         return b - X_y, KrylovStats(iterations, achieved)
 

@@ -23,10 +23,14 @@ from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem
 from rotorred.scenes.harmonic_balance import augmented_matrices, plate_rubs
 from rotorred.signals.linefit import Torus
 
-__all__ = ["TorusRubProblem", "torus_rub_problem", "torus_bases"]
+__all__ = ["TorusRubProblem", "torus_rub_problem", "torus_rub_problem_on", "torus_bases"]
 
 #: a spool frequency is an order of the bases when ``|k . f - f_s| <= ORDER_RTOL f_s``
 ORDER_RTOL = 1e-9
+#: where several orders hold a spool's frequency, the lowest is its order if the others are this many times higher
+#: (|k_1| + |k_2|): a torus commensurate far out in its box (the response there periodic, of a long period, read on
+#: the torus), not one commensurate at low orders (refused: a periodic harmonic balance)
+LOWEST_MARGIN = 4
 
 
 def torus_bases(torus) -> tuple[float, float]:
@@ -40,15 +44,19 @@ def torus_bases(torus) -> tuple[float, float]:
 
 
 def _spool_order(h: TorusHarmonics, bases: tuple[float, float], f_s: float) -> tuple[int, int]:
-    """The one order (k_1, k_2) of the truncated set whose frequency is ``f_s`` (Hz), or an error."""
+    """The order (k_1, k_2) of the truncated set whose frequency is ``f_s`` (Hz): the one order, or where several are
+    (bases commensurate within the box: 91 Hz on (70, 91/3) Hz is 13:10, so (1, 0) and (12, -30) are both 70 Hz) the
+    lowest, if every other is at least :data:`LOWEST_MARGIN` times higher (|k_1| + |k_2|); else an error."""
     f = h.frequencies(bases)
     hits = np.flatnonzero(np.abs(np.abs(f) - f_s) <= ORDER_RTOL * f_s)
-    if hits.size != 1:
+    height = np.abs(h.orders[hits]).sum(axis=1)
+    at = np.argsort(height, kind="stable")
+    if hits.size == 0 or (hits.size > 1 and LOWEST_MARGIN * height[at[0]] > height[at[1]]):
         why = "is no order of the bases in the truncated set" if hits.size == 0 else \
             "is several orders: the bases are commensurate (a periodic harmonic balance)"
         checks.fail("torus", bases, f"must hold each spool frequency as one order k1 f1 + k2 f2; {f_s:.9g} Hz {why}",
                     "Hz")
-    return tuple(int(k) for k in h.orders[hits[0]])
+    return tuple(int(k) for k in h.orders[hits[at[0]]])
 
 
 @dataclass(frozen=True)
@@ -135,11 +143,42 @@ def torus_rub_problem(scene, model, torus, H1: int, H2: int, N1: int, N2: int,
     bases = torus_bases(torus)
     w = tuple(2 * math.pi * f for f in bases)
     w_max = None if f_max is None else 2 * math.pi * checks.positive("f_max", f_max, "Hz")
-    h = TorusHarmonics(H1, H2, N1, N2, w_max, w if w_max is not None else None)
+    return torus_rub_problem_on(scene, model, bases, TorusHarmonics(H1, H2, N1, N2, w_max, w if w_max else None))
+
+
+def torus_rub_problem_on(scene, model, torus, harmonics: TorusHarmonics,
+                         spool_orders: dict | None = None) -> TorusRubProblem:
+    """The torus harmonic-balance problem of ``scene`` on ``model`` on the orders and grid ``harmonics``: a branch
+    keeps its orders while the speeds move its bases (:func:`rotorred.scenes.torus_branch.continue_torus`).
+
+    Parameters
+    ----------
+    scene : rotorred.scenes.schema.Scene
+    model : SystemMatrices or ReducedSystem
+        As :func:`torus_rub_problem`'s.
+    torus : rotorred.signals.linefit.Torus or (float, float)
+        The torus, or the base frequencies ``(f_1, f_2)`` (Hz).
+    harmonics : TorusHarmonics
+        The orders (each spool's frequency one of them) and the AFT grid.
+    spool_orders : dict of str to (int, int), optional
+        The order each spool forces, kept along a branch (where a speed makes the bases commensurate within the
+        orders, several orders hold its frequency: the branch keeps the one it started on); default: the one order
+        of ``harmonics`` at each spool's frequency (an error if none or several).
+
+    Returns
+    -------
+    TorusRubProblem
+    """
+    if not scene.plates:
+        checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
+    bases = torus_bases(torus)
+    w = tuple(2 * math.pi * f for f in bases)
+    h = harmonics
     n, p = model.n_dof, 2 * len(scene.plates)
     M, D, K = augmented_matrices(model, scene)
     dofs, forces = plate_rubs(model, scene)
-    orders = {s: _spool_order(h, bases, f_s) for s, f_s in scene.frequencies_hz.items()}
+    orders = dict(spool_orders) if spool_orders is not None else \
+        {s: _spool_order(h, bases, f_s) for s, f_s in scene.frequencies_hz.items()}
     Q = np.zeros((h.n_orders, n + p), complex)
     phasors = unbalance_forces(model, scene.unbalances) if scene.unbalances else {}
     for s, phasor in phasors.items():  # F = Re(Omega_s^2 F_s e^{i Omega_s t}) at the spool's order

@@ -38,7 +38,8 @@ from rotorred.results import Result
 from rotorred.scenes.branch import KEYS, PLATE_KEYS, dof_name
 from rotorred.scenes.keys import cf_units, netcdf_name
 from rotorred.scenes.quasi_periodic import TorusOptions, default_grid, torus_balance
-from rotorred.scenes.torus_balance import TorusRubProblem, torus_rub_problem
+from rotorred.scenes.harmonic_balance import augmented_matrices, plate_rubs
+from rotorred.scenes.torus_balance import TorusRubProblem, torus_rub_problem, torus_rub_problem_on
 from rotorred.transient.options import Loads
 from rotorred.writers import signals_held
 
@@ -53,6 +54,9 @@ SHOWN_LINES = 10
 GROWTH = 1.5
 #: with a lines tolerance, the box is checked at the start and each time the key passes a further this-th of its range
 CHECKS = 8
+#: the default box of orders and its grid: with the band of 900 Hz, 1799 orders on the rig's torus (f_L, f_H/3); the
+#: grid 128 x 256 gives the lines of 128 x 1024 to 0.06 % (docs/model.md §26)
+DEFAULT_ORDERS, DEFAULT_GRID = (32, 80), (128, 256)
 
 
 class _Check(Exception):
@@ -66,11 +70,13 @@ class TorusBranchOptions:
     Parameters
     ----------
     orders : (int, int)
-        The box of orders ``|k_1| <= H1``, ``|k_2| <= H2`` (default (8, 40)).
+        The box of orders ``|k_1| <= H1``, ``|k_2| <= H2`` (default (32, 80): with the band of 900 Hz, the rig's
+        lines within 0.5 % of settled transients from 20 to 5 µm of clearance, docs/model.md §26).
     grid : (int, int), optional
-        The AFT grid ``(N_1, N_2)``; default :func:`rotorred.scenes.quasi_periodic.default_grid` of the orders.
+        The AFT grid ``(N_1, N_2)``; default :data:`DEFAULT_GRID` for the default orders, else
+        :func:`rotorred.scenes.quasi_periodic.default_grid` of the orders.
     f_max : float, optional
-        Keep only the orders whose line is at most ``f_max`` (Hz) at the start (default 1500 Hz; None: the box).
+        Keep only the orders whose line is at most ``f_max`` (Hz) at the start (default 900 Hz; None: the box).
     divisors : (int, int), optional
         ``(j, k)``: the bases ``(f_L / j, f_H / k)``; default those of the torus the start's line fit finds.
     start_window : (float, float)
@@ -90,18 +96,23 @@ class TorusBranchOptions:
         box ``orders`` throughout.
     max_orders : (int, int)
         The largest box the ladder climbs to.
+    fold_refine : bool
+        Locate each fold by Brent, each evaluation a corrected point (as a periodic branch's); default False: the
+        turn of the cubic Hermite curve through the points either side of it, without a solve
+        (:class:`rotorred.nonlinear.continuation.ContinuationOptions`; its error on the rig in docs/model.md §26).
     """
 
-    orders: tuple[int, int] = (8, 40)
+    orders: tuple[int, int] = DEFAULT_ORDERS
     grid: tuple[int, int] | None = None
-    f_max: float | None = 1500.0
+    f_max: float | None = 900.0
     divisors: tuple[int, int] | None = None
     start_window: tuple[float, float] = (2.0, 3.0)
     tol: float = 1e-8
     max_points: int = 200
     steps: tuple[float, float] = (0.05, 0.15)
     lines_tol: float | None = None
-    max_orders: tuple[int, int] = (27, 135)
+    max_orders: tuple[int, int] = (72, 180)
+    fold_refine: bool = False
 
     def __post_init__(self):
         # the orders, grid, band and window by TorusOptions's own checks
@@ -117,6 +128,7 @@ class TorusBranchOptions:
         object.__setattr__(self, "steps", (first, checks.number("options.steps[1]", s[1], ge=first)))
         if self.lines_tol is not None:
             checks.number("options.lines_tol", self.lines_tol, gt=0.0, lt=1.0)
+        checks.boolean("options.fold_refine", self.fold_refine)
         m = checks.sequence("options.max_orders", list(np.ravel(self.max_orders)), min_len=2, max_len=2)
         object.__setattr__(self, "max_orders", tuple(checks.integer(f"options.max_orders[{i}]", v, ge=1)
                                                      for i, v in enumerate(m)))
@@ -135,13 +147,15 @@ class TorusBranchOptions:
         -------
         TorusOptions
         """
-        return TorusOptions(bases=bases, orders=self.orders, grid=self.grid, f_max=self.f_max,
+        return TorusOptions(bases=bases, orders=self.orders, grid=self.n_grid, f_max=self.f_max,
                             start_window=self.start_window, tol=self.tol, outputs=outputs)
 
     @property
     def n_grid(self) -> tuple[int, int]:
-        """``(N_1, N_2)``: the grid given, or the default of the orders."""
-        return self.grid if self.grid is not None else default_grid(*self.orders)
+        """``(N_1, N_2)``: the grid given, or the default of the orders (:attr:`grid`)."""
+        if self.grid is not None:
+            return self.grid
+        return DEFAULT_GRID if tuple(self.orders) == DEFAULT_ORDERS else default_grid(*self.orders)
 
 
 @dataclass(frozen=True, repr=False)
@@ -383,17 +397,14 @@ class _Family:
 
     def _built(self, value: float) -> TorusRubProblem:
         scene = _scene_at(self.scene, self.key, value)
-        box = torus_rub_problem(scene, self.model, self.bases(scene), *self.box, None)
-        h, n_all, start = self.first.problem.harmonics, box.problem.M.shape[0], self.first.problem
-        p = box.problem
-        problem = TorusProblem(p.M, p.D, p.K, h, p.w, p.dofs, p.harmonics.transfer(p.forcing, n_all, h), p.forces)
-        if p.w == start.w and all(np.array_equal(getattr(p, m), getattr(start, m)) for m in "MDK"):
-            # the compliance and linear response are the start's (a clearance, a law's number): computed once. Its
-            # cache is TorusProblem's own; a public with_forces (as CondensedProblem's) would say it better
-            problem._cache["compliance"] = start._compliance()
-        else:  # a speed: its matrices and bases move, the compliance by the modes (one eigen-solution a value)
-            problem.by_modes()
-        return dataclasses.replace(box, problem=problem)
+        start, bases = self.first.problem, self.bases(scene)
+        if bases == self.first.bases_hz and all(np.array_equal(a, getattr(start, m)) for a, m in
+                                                zip(augmented_matrices(self.model, scene), "MDK")):
+            # a clearance, a law's number: the start's problem with the value's forces, its compliance computed once
+            return dataclasses.replace(self.first, problem=start.with_forces(plate_rubs(self.model, scene)[1]))
+        rub = torus_rub_problem_on(scene, self.model, bases, start.harmonics, self.first.spool_orders)  # a speed:
+        rub.problem.by_modes()  # matrices and bases move, the compliance by the modes (an eigen-solution a value)
+        return rub
 
 
 def continue_torus(scene, model, key: str, start: float, end: float,
@@ -487,7 +498,7 @@ def _segment(family, z, value, end, options, check_at, progress, before, interru
     branch = continue_branch(family, z, s_start, s_end,
                              ContinuationOptions(ds=ds * scale, ds_min=1e-9 * scale, ds_max=ds_max * scale,
                                                  max_points=options.max_points, tol=options.tol, stability=False,
-                                                 curved=True), progress=stamped,
+                                                 curved=True, fold_refine=options.fold_refine), progress=stamped,
                              interrupts={**interrupts, _Check: "check"})
     stamps.append(time.perf_counter())
     return branch, stamps
