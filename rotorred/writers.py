@@ -626,23 +626,30 @@ def signals_held():
     on exit, under the handlers restored. Masking them (``pthread_sigmask``) held them back from the calling thread
     only: the kernel then hands the signal to another thread (the figure pool's, a library's), and Python still runs
     its handler in the main thread at once. Outside the main thread, where handlers cannot be set, nothing is held.
+
+    A signal as the handlers are set or restored (its own handler, raising, already in place) still restores both:
+    the other one never keeps the noting handler, which would drop its signals for the rest of the run.
     """
     import signal
+    import threading
 
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
     noted: list[int] = []
-    previous = {}
+    # read before any is set: a signal raised between setting one and noting what it replaced loses nothing
+    previous_int, previous_term = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     try:
         for held in (signal.SIGINT, signal.SIGTERM):
-            previous[held] = signal.signal(held, lambda signum, frame: noted.append(signum))
-    except ValueError:  # not the main thread
-        pass
-    try:
+            signal.signal(held, lambda signum, frame: noted.append(signum))
         yield
     finally:
-        for held, handler in previous.items():
-            signal.signal(held, signal.SIG_DFL if handler is None else handler)
-        if noted:
-            signal.raise_signal(noted[0])
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_DFL if previous_int is None else previous_int)
+        finally:  # also when SIGINT came right after its handler was restored
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous_term is None else previous_term)
+            if noted:
+                signal.raise_signal(noted[0])
 
 
 class OutputFolder:
@@ -675,11 +682,14 @@ class OutputFolder:
 
     def __enter__(self) -> OutputFolder:
         self._created = not self.folder.exists()
-        self.folder.mkdir(parents=True, exist_ok=True)
-        try:
-            self._lock = _acquire_lock(self.folder)
-            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
-            self._identity = _identity(self.staging)
+        try:  # signals held: the lock and the staging folder are each taken and noted here at once, never one
+            # without the other (a signal between _acquire_lock's return and the assignment left the lock behind);
+            # a signal meanwhile is raised at the end of the hold, still inside this try
+            with signals_held():
+                self.folder.mkdir(parents=True, exist_ok=True)
+                self._lock = _acquire_lock(self.folder)
+                self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
+                self._identity = _identity(self.staging)
         except BaseException:  # the lock released, and the folder removed if this run created it
             self.__exit__()
             raise
@@ -688,17 +698,19 @@ class OutputFolder:
     def __exit__(self, exc_type=None, exc=None, tb=None) -> None:
         import shutil
 
-        fault = None if exc is None else self._fault(exc)
-        if self.staging is not None:
-            shutil.rmtree(self.staging, ignore_errors=True)
-        if self._lock is not None:
-            _release_lock(self.folder / LOCK, self._lock)
-            self._lock = None
-        if (self._created and not self.committed) or isinstance(fault, _Vanished):  # (recreated by a writer: empty)
-            try:
-                self.folder.rmdir()
-            except OSError:
-                pass
+        with signals_held():  # removed whole: a signal cutting it left the lock, or the staging folder, behind
+            fault = None if exc is None else self._fault(exc)
+            if self.staging is not None:
+                shutil.rmtree(self.staging, ignore_errors=True)
+            if self._lock is not None:
+                _release_lock(self.folder / LOCK, self._lock)
+                self._lock = None
+            # (a folder removed meanwhile and made again by a writer is empty)
+            if (self._created and not self.committed) or isinstance(fault, _Vanished):
+                try:
+                    self.folder.rmdir()
+                except OSError:
+                    pass
         if fault is not None and fault is not exc:
             raise fault from exc
 
