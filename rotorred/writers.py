@@ -696,23 +696,33 @@ class OutputFolder:
         return self
 
     def __exit__(self, exc_type=None, exc=None, tb=None) -> None:
-        import shutil
-
-        with signals_held():  # removed whole: a signal cutting it left the lock, or the staging folder, behind
-            fault = None if exc is None else self._fault(exc)
-            if self.staging is not None:
-                shutil.rmtree(self.staging, ignore_errors=True)
-            if self._lock is not None:
-                _release_lock(self.folder / LOCK, self._lock)
-                self._lock = None
-            # (a folder removed meanwhile and made again by a writer is empty)
-            if (self._created and not self.committed) or isinstance(fault, _Vanished):
-                try:
-                    self.folder.rmdir()
-                except OSError:
-                    pass
+        try:
+            with signals_held():  # left whole: a signal cutting it left the lock, or the staging folder, behind
+                fault = self._leave(exc)
+        except BaseException:  # a signal as the hold began, before its handlers were set: left all the same
+            self._leave(exc)
+            raise
         if fault is not None and fault is not exc:
             raise fault from exc
+
+    def _leave(self, exc: BaseException | None) -> BaseException | None:
+        """Remove the staging folder and the lock, and the folder if this run created it and committed nothing (or it
+        was removed meanwhile); ``exc`` as :meth:`_fault` names it. Twice is as once."""
+        import shutil
+
+        fault = None if exc is None else self._fault(exc)
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+        if self._lock is not None:
+            _release_lock(self.folder / LOCK, self._lock)
+            self._lock = None
+        # (a folder removed meanwhile and made again by a writer is empty)
+        if (self._created and not self.committed) or isinstance(fault, _Vanished):
+            try:
+                self.folder.rmdir()
+            except OSError:
+                pass
+        return fault
 
     def _fault(self, exc: BaseException) -> BaseException:
         """``exc`` as a :class:`ResourceFault` naming the folder's file (:func:`as_fault`), the folder gone as one."""

@@ -121,17 +121,19 @@ def _sigint() -> None:
     signal.raise_signal(signal.SIGINT)  # its handler runs at the next bytecode: here
 
 
-@pytest.mark.parametrize("moment", ["the lock just taken", "the staging folder just made", "the staging folder just "
-                                    "removed", "the lock file just removed"])
+@pytest.mark.parametrize("moment", ["the lock just taken", "the staging folder just made", "the exit's hold not yet "
+                                    "begun", "the staging folder just removed", "the lock file just removed"])
 def test_an_interrupt_as_an_output_folder_is_entered_or_left_leaves_no_lock_nor_staging(tmp_path, monkeypatch,
                                                                                        sigint_raises, moment):
     """A SIGINT between _acquire_lock's return and the lock's assignment left ``.rotorred.lock`` behind (tests/
     test_faults.py's random moments, CI: a run-up interrupted at 0.08 s); so did one between mkdtemp's return and the
     staging folder's assignment (the staging folder), one after the staging folder's removal on exit (the lock), and
     one inside _release_lock (the lock's file open, held until collected, and the folder this run made). Each is now
-    held back until the folder is entered or left whole: the interrupt is raised, and nothing of the run is left."""
+    held back until the folder is entered or left whole, and one that comes as the exit's hold begins, before its
+    handlers are set, leaves it all the same: the interrupt is raised, and nothing of the run is left."""
     import shutil
     import tempfile
+    from contextlib import contextmanager
 
     import filelock
 
@@ -145,13 +147,22 @@ def test_an_interrupt_as_an_output_folder_is_entered_or_left_leaves_no_lock_nor_
     elif moment == "the staging folder just removed":
         real_rmtree = shutil.rmtree
         monkeypatch.setattr(shutil, "rmtree", lambda *a, **kw: (real_rmtree(*a, **kw), _sigint())[0])
-    else:  # POSIX: after the unlink, before the unlock and the close
+    elif moment == "the lock file just removed":  # POSIX: after the unlink, before the unlock and the close
         real_unlock = filelock.unlock_descriptor
         monkeypatch.setattr(filelock, "unlock_descriptor", lambda fd: (_sigint(), real_unlock(fd))[1])
+    real_held = writers.signals_held
+
+    @contextmanager
+    def late():  # the signal before the hold's handlers are set
+        _sigint()
+        with real_held():
+            yield
+
     folder = writers.OutputFolder(out)
     with pytest.raises(_Interrupted):
         with folder:
-            pass
+            if moment == "the exit's hold not yet begun":
+                monkeypatch.setattr(writers, "signals_held", late)
     monkeypatch.undo()
     assert folder._lock is None  # the lock's file closed: released
     # made by this run, which committed nothing: removed, so nothing is left in it
