@@ -663,7 +663,8 @@ class OutputFolder:
 
     Use as a context manager: the lock is taken on entry (:class:`FolderBusy` if another run holds
     it), and on exit the staging folder and the lock are removed, and the folder too if this run
-    created it and committed nothing.
+    created it and committed nothing. Both hold SIGINT and SIGTERM back (:func:`signals_held`): a signal
+    as the folder is entered or left is raised once it is, never leaving the lock or the staging folder behind.
 
     Faults of the machine within the block (a full disk, the file-size limit, memory, the folder removed meanwhile)
     leave it as one :class:`ResourceFault` naming the file of the folder being written (not its staged name) or the
@@ -682,10 +683,8 @@ class OutputFolder:
 
     def __enter__(self) -> OutputFolder:
         self._created = not self.folder.exists()
-        try:  # signals held: the lock and the staging folder are each taken and noted here at once, never one
-            # without the other (a signal between _acquire_lock's return and the assignment left the lock behind);
-            # a signal meanwhile is raised at the end of the hold, still inside this try
-            with signals_held():
+        try:
+            with signals_held():  # a signal here is raised once the lock and the staging folder are taken and noted
                 self.folder.mkdir(parents=True, exist_ok=True)
                 self._lock = _acquire_lock(self.folder)
                 self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
@@ -716,8 +715,7 @@ class OutputFolder:
         if self._lock is not None:
             _release_lock(self.folder / LOCK, self._lock)
             self._lock = None
-        # (a folder removed meanwhile and made again by a writer is empty)
-        if (self._created and not self.committed) or isinstance(fault, _Vanished):
+        if (self._created and not self.committed) or isinstance(fault, _Vanished):  # (recreated by a writer: empty)
             try:
                 self.folder.rmdir()
             except OSError:

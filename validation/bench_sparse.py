@@ -16,8 +16,8 @@ subprocess measures, one thread
 Memory: ``MB`` is each task's peak of traced Python/numpy allocations (``tracemalloc``, in a second, untimed run of
 the task; SuperLU's own work arrays are not traced), ``RSS`` the subprocess's own peak resident set after all its
 tasks (``VmHWM``: validation/peak_memory.py; not ``ru_maxrss``, which on Linux a child carries from its parent),
-interpreter and libraries included. The growth exponent of each task is the slope of log(cost) against log(DOFs) over the sparse
-rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
+interpreter and libraries included. The growth exponent of each task is the slope of log(cost) against log(DOFs) over
+the sparse rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
 the 61-speed Campbell 0-12 000 rpm with critical speeds (default mode count), the unbalance response at 200
 speeds, the automatic Craig-Bampton reduction, and the rub transient's µs per step against the unrefined rig's
 (median of three alternating runs). The last check (``--scene`` runs it alone) is the user's way: ``rotorred run`` of
