@@ -626,23 +626,30 @@ def signals_held():
     on exit, under the handlers restored. Masking them (``pthread_sigmask``) held them back from the calling thread
     only: the kernel then hands the signal to another thread (the figure pool's, a library's), and Python still runs
     its handler in the main thread at once. Outside the main thread, where handlers cannot be set, nothing is held.
+
+    A signal as the handlers are set or restored (its own handler, raising, already in place) still restores both:
+    the other one never keeps the noting handler, which would drop its signals for the rest of the run.
     """
     import signal
+    import threading
 
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
     noted: list[int] = []
-    previous = {}
+    # read before any is set: a signal raised between setting one and noting what it replaced loses nothing
+    previous_int, previous_term = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     try:
         for held in (signal.SIGINT, signal.SIGTERM):
-            previous[held] = signal.signal(held, lambda signum, frame: noted.append(signum))
-    except ValueError:  # not the main thread
-        pass
-    try:
+            signal.signal(held, lambda signum, frame: noted.append(signum))
         yield
     finally:
-        for held, handler in previous.items():
-            signal.signal(held, signal.SIG_DFL if handler is None else handler)
-        if noted:
-            signal.raise_signal(noted[0])
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_DFL if previous_int is None else previous_int)
+        finally:  # also when SIGINT came right after its handler was restored
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous_term is None else previous_term)
+            if noted:
+                signal.raise_signal(noted[0])
 
 
 class OutputFolder:
@@ -656,7 +663,8 @@ class OutputFolder:
 
     Use as a context manager: the lock is taken on entry (:class:`FolderBusy` if another run holds
     it), and on exit the staging folder and the lock are removed, and the folder too if this run
-    created it and committed nothing.
+    created it and committed nothing. Both hold SIGINT and SIGTERM back (:func:`signals_held`): a signal
+    as the folder is entered or left is raised once it is, never leaving the lock or the staging folder behind.
 
     Faults of the machine within the block (a full disk, the file-size limit, memory, the folder removed meanwhile)
     leave it as one :class:`ResourceFault` naming the file of the folder being written (not its staged name) or the
@@ -675,17 +683,30 @@ class OutputFolder:
 
     def __enter__(self) -> OutputFolder:
         self._created = not self.folder.exists()
-        self.folder.mkdir(parents=True, exist_ok=True)
         try:
-            self._lock = _acquire_lock(self.folder)
-            self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
-            self._identity = _identity(self.staging)
+            with signals_held():  # a signal here is raised once the lock and the staging folder are taken and noted
+                self.folder.mkdir(parents=True, exist_ok=True)
+                self._lock = _acquire_lock(self.folder)
+                self.staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=self.folder))
+                self._identity = _identity(self.staging)
         except BaseException:  # the lock released, and the folder removed if this run created it
             self.__exit__()
             raise
         return self
 
     def __exit__(self, exc_type=None, exc=None, tb=None) -> None:
+        try:
+            with signals_held():  # left whole: a signal cutting it left the lock, or the staging folder, behind
+                fault = self._leave(exc)
+        except BaseException:  # a signal as the hold began, before its handlers were set: left all the same
+            self._leave(exc)
+            raise
+        if fault is not None and fault is not exc:
+            raise fault from exc
+
+    def _leave(self, exc: BaseException | None) -> BaseException | None:
+        """Remove the staging folder and the lock, and the folder if this run created it and committed nothing (or it
+        was removed meanwhile); ``exc`` as :meth:`_fault` names it. Twice is as once."""
         import shutil
 
         fault = None if exc is None else self._fault(exc)
@@ -699,8 +720,7 @@ class OutputFolder:
                 self.folder.rmdir()
             except OSError:
                 pass
-        if fault is not None and fault is not exc:
-            raise fault from exc
+        return fault
 
     def _fault(self, exc: BaseException) -> BaseException:
         """``exc`` as a :class:`ResourceFault` naming the folder's file (:func:`as_fault`), the folder gone as one."""

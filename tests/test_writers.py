@@ -95,3 +95,99 @@ def test_netcdf_is_cf_in_the_file_and_reads_back_as_written(tmp_path):
     back = read_netcdf(tmp_path / "a.nc")
     assert back.identical(ds.assign_attrs(Conventions="CF-1.10"))
     assert back.sel(direction="down")["peak"].values.tolist() == [3.0, 4.0]
+
+
+class _Interrupted(BaseException):
+    """This test's SIGINT (a BaseException as KeyboardInterrupt and rotorred.cli.Terminated are; not
+    KeyboardInterrupt itself, which would stop pytest if it escaped)."""
+
+
+@pytest.fixture()
+def sigint_raises():
+    """SIGINT raises :class:`_Interrupted` in this test."""
+    import signal
+
+    def handler(signum, frame):
+        raise _Interrupted(signum)
+
+    previous = signal.signal(signal.SIGINT, handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def _sigint() -> None:
+    import signal
+
+    signal.raise_signal(signal.SIGINT)  # its handler runs at the next bytecode: here
+
+
+@pytest.mark.parametrize("moment", ["the lock just taken", "the staging folder just made", "the exit's hold not yet "
+                                    "begun", "the staging folder just removed", "the lock file just removed"])
+def test_an_interrupt_as_an_output_folder_is_entered_or_left_leaves_no_lock_nor_staging(tmp_path, monkeypatch,
+                                                                                       sigint_raises, moment):
+    """A SIGINT between _acquire_lock's return and the lock's assignment left ``.rotorred.lock`` behind (tests/
+    test_faults.py's random moments, CI: a run-up interrupted at 0.08 s); so did one between mkdtemp's return and the
+    staging folder's assignment (the staging folder), one after the staging folder's removal on exit (the lock), and
+    one inside _release_lock (the lock's file open, held until collected, and the folder this run made). Each is now
+    held back until the folder is entered or left whole, and one that comes as the exit's hold begins, before its
+    handlers are set, leaves it all the same: the interrupt is raised, and nothing of the run is left."""
+    import shutil
+    import tempfile
+    from contextlib import contextmanager
+
+    import filelock
+
+    out = tmp_path / "o"
+    if moment == "the lock just taken":
+        real_acquire = writers._acquire_lock
+        monkeypatch.setattr(writers, "_acquire_lock", lambda folder: (real_acquire(folder), _sigint())[0])
+    elif moment == "the staging folder just made":
+        real_mkdtemp = tempfile.mkdtemp
+        monkeypatch.setattr(tempfile, "mkdtemp", lambda *a, **kw: (real_mkdtemp(*a, **kw), _sigint())[0])
+    elif moment == "the staging folder just removed":
+        real_rmtree = shutil.rmtree
+        monkeypatch.setattr(shutil, "rmtree", lambda *a, **kw: (real_rmtree(*a, **kw), _sigint())[0])
+    elif moment == "the lock file just removed":  # POSIX: after the unlink, before the unlock and the close
+        real_unlock = filelock.unlock_descriptor
+        monkeypatch.setattr(filelock, "unlock_descriptor", lambda fd: (_sigint(), real_unlock(fd))[1])
+    real_held = writers.signals_held
+
+    @contextmanager
+    def late():  # the signal before the hold's handlers are set
+        _sigint()
+        with real_held():
+            yield
+
+    folder = writers.OutputFolder(out)
+    with pytest.raises(_Interrupted):
+        with folder:
+            if moment == "the exit's hold not yet begun":
+                monkeypatch.setattr(writers, "signals_held", late)
+    monkeypatch.undo()
+    assert folder._lock is None  # the lock's file closed: released
+    # made by this run, which committed nothing: removed, so nothing is left in it
+    assert not out.exists(), sorted(p.name for p in out.iterdir())
+    with writers.OutputFolder(out):  # the lock is free
+        pass
+
+
+def test_a_signal_as_the_held_signals_are_restored_restores_the_other_too(monkeypatch, sigint_raises):
+    """A SIGINT right after signals_held had restored SIGINT's handler, before SIGTERM's: the exception left the
+    noting handler on SIGTERM, so every later SIGTERM of the run was dropped. Both are restored now."""
+    import signal
+
+    ours, term = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    real = signal.signal
+
+    def setting(signum, handler):
+        was = real(signum, handler)
+        if signum == signal.SIGINT and handler is ours:  # restored: the signal comes now
+            _sigint()
+        return was
+
+    monkeypatch.setattr(signal, "signal", setting)
+    with pytest.raises(_Interrupted):
+        with writers.signals_held():
+            pass
+    monkeypatch.undo()
+    assert signal.getsignal(signal.SIGINT) is ours and signal.getsignal(signal.SIGTERM) is term

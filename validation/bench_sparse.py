@@ -14,21 +14,23 @@ subprocess measures, one thread
   dt = 1e-5 s (1e5 steps), its µs per step (the reduced model does not depend on the form: sparse form only).
 
 Memory: ``MB`` is each task's peak of traced Python/numpy allocations (``tracemalloc``, in a second, untimed run of
-the task; SuperLU's own work arrays are not traced), ``RSS`` the subprocess's peak resident set after all its tasks (``ru_maxrss``), interpreter and
-libraries included. The growth exponent of each task is the slope of log(cost) against log(DOFs) over the sparse
-rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
+the task; SuperLU's own work arrays are not traced), ``RSS`` the subprocess's own peak resident set after all its
+tasks (``VmHWM``: validation/peak_memory.py; not ``ru_maxrss``, which on Linux a child carries from its parent),
+interpreter and libraries included. The growth exponent of each task is the slope of log(cost) against log(DOFs) over
+the sparse rows from refined(16) on. The issue's checks on refined(128) (``--checks``) run each in its own subprocess:
 the 61-speed Campbell 0-12 000 rpm with critical speeds (default mode count), the unbalance response at 200
 speeds, the automatic Craig-Bampton reduction, and the rub transient's µs per step against the unrefined rig's
 (median of three alternating runs). The last check (``--scene`` runs it alone) is the user's way: ``rotorred run`` of
 the paper-rub scene whose ``[rotor] file`` is the rig refined(128) written by ``Rotor.to_toml``, against
 ``rotorred run paper-rub`` (the unrefined rig), and the first with ``--set solver.modes=auto``, alternating, three
 runs each: the µs per step, the model's build time (both from the run's summary.txt), the command's wall time and its
-peak resident set (its own ``ru_maxrss``).
+peak resident set (``ru_maxrss`` from ``wait4``, its own when above the check process's peak, else an error:
+validation/peak_memory.py).
 
 The ``cli_campbell`` check is the same Campbell diagram through the command line with its margins:
 ``rotorred campbell`` of the refined(128) rotor file at 0:12000:61 rpm with an operating range of 4000-9000 rpm (the
 critical speeds, their API 684 amplification factors and API 617 margins), its wall time, CPU time and peak resident
-set (its own ``ru_maxrss``).
+set (as ``rotorred run``'s).
 
 ``--csv PATH`` writes the table (one row per mesh and form) as CSV, with ``#`` lines first naming the command, the
 machine, its load average at the start, the commit and the date, and the checks beside it as
@@ -71,15 +73,15 @@ RUB_SECONDS = 1.0
 DT = 1e-5
 
 
-def _bench_pareto():
-    """validation/bench_pareto.py (the paper-rub case), imported by path."""
-    name = "rotorred_bench_pareto"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, HERE / "bench_pareto.py")
+def _sibling(name: str):
+    """validation/``name``.py (bench_pareto: the paper-rub case; peak_memory), imported by path once."""
+    key = f"rotorred_{name}"
+    if key not in sys.modules:
+        spec = importlib.util.spec_from_file_location(key, HERE / f"{name}.py")
         module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
+        sys.modules[key] = module
         spec.loader.exec_module(module)
-    return sys.modules[name]
+    return sys.modules[key]
 
 
 def _timed(f):
@@ -115,8 +117,6 @@ def worker(refine: int, as_sparse: bool, rub: bool) -> dict:
 
 def _tasks(refine: int, as_sparse: bool, rub: bool) -> dict:
     """Every task on one mesh and form (:func:`worker`)."""
-    import resource
-
     import rotorred as rr
     from rotorred.linear.campbell import modes_at
     from rotorred.linear.reduction import default_boundary_nodes, reduce
@@ -146,7 +146,7 @@ def _tasks(refine: int, as_sparse: bool, rub: bool) -> dict:
     model, out["reduction"], out["reduction_mb"] = _timed(lambda: reduce(system, boundary, n_modes=10))
     if rub:
         out["rub_us_step"] = rub_us_per_step(refine, model)
-    out["rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    out["rss_mb"] = _sibling("peak_memory").own_peak_mb()  # not ru_maxrss: the parent's peak on Linux
     return out
 
 
@@ -155,7 +155,7 @@ def rub_us_per_step(refine: int, model) -> float:
     ``refine`` times), after a warm-up run that loads the compiled kernel."""
     import dataclasses
 
-    bp = _bench_pareto()
+    bp = _sibling("bench_pareto")
     warm = bp.paper_rub(refine, t_end=0.01, n_periods=0)
     bp.run(model, warm, DT)
     case = dataclasses.replace(bp.paper_rub(refine, t_end=RUB_SECONDS, n_periods=0), record_start=0.0)
@@ -186,7 +186,7 @@ def check(name: str) -> dict:
         red = reduce_rotor(rotor, (18,), system=assemble(rotor))
         out.update(n_modes=red.n_modes, error=red.selection.error)
     elif name == "rub":
-        bp = _bench_pareto()
+        bp = _sibling("bench_pareto")
         models = {refine: bp.reduced_model(bp.paper_rub(refine), 10) for refine in (1, 128)}
         runs = {refine: [] for refine in models}
         for _ in range(3):  # alternating, the median of three: a busy machine moves one run by up to 60 %
@@ -199,7 +199,7 @@ def check(name: str) -> dict:
         out.update(cli_campbell_run(rotor))
     out["seconds"] = round(time.perf_counter() - t0, 2)
     out["cpu_s"] = round(_cpu_seconds(resource.RUSAGE_SELF) - cpu0, 2)
-    out["rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+    out["rss_mb"] = round(_sibling("peak_memory").own_peak_mb(), 1)
     return out
 
 
@@ -237,7 +237,7 @@ def cli_campbell_run(rotor) -> dict:
         with open(tmp / "out" / "critical_speeds.csv", encoding="utf-8") as f:
             rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))][1:]
     return {"cli_wall_s": round(wall, 2), "cli_cpu_s": round(usage.ru_utime + usage.ru_stime, 2),
-            "cli_rss_mb": round(usage.ru_maxrss / 1024, 1), "cli_n_critical": len(rows)}
+            "cli_rss_mb": round(_sibling("peak_memory").child_peak_mb(usage), 1), "cli_n_critical": len(rows)}
 
 
 def cli_scene_runs(repeats: int = 3) -> dict:
@@ -272,7 +272,7 @@ def cli_scene_runs(repeats: int = 3) -> dict:
             summary = (out / "summary.txt").read_text(encoding="utf-8")
             return {"us_step": float(re.search(r"\(([0-9.]+) us/step", summary).group(1)),
                     "build_s": float(re.search(r"built in ([0-9.]+) s", summary).group(1)),
-                    "wall_s": wall, "rss_mb": usage.ru_maxrss / 1024}
+                    "wall_s": wall, "rss_mb": _sibling("peak_memory").child_peak_mb(usage)}
 
         run("rig", 0)  # the step kernel compiled and cached once: not measured
         for k in range(repeats):
