@@ -37,7 +37,6 @@ The force kernel is compiled (numba) before the torus's clock starts, as the tra
 
 from __future__ import annotations
 
-import resource
 import subprocess
 import sys
 import time
@@ -45,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from peak_memory import own_peak_mb
 from rotorred.nonlinear.torus import solve_torus
 from rotorred.scenes.harmonic_balance import unknown_records
 from rotorred.scenes.run import build_model, run_scene
@@ -219,7 +219,7 @@ def main() -> Comparison:
     out = Comparison(np.array([ln.frequency_hz for ln in largest]), reference, amplitudes[-1], relative,
                      float(np.max(np.abs(relative))), result.solve_time, total)
     cold_time, cold_difference = cold(scene, sm, torus, rp, z)
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    peak_mb = own_peak_mb()
     print("the torus once more, for its memory (tracemalloc, not timed):")
     torus_mb = torus_memory(scene, sm, torus, result, largest, records)
     alone_mb = alone_peak_mb()
@@ -243,20 +243,9 @@ def alone() -> float:
     and returns the process's peak resident memory (MB)."""
     scene = load_scene("paper-rub", {"speeds.outer": OUTER_HZ})
     cold_torus(scene, build_model(scene))
-    peak = _own_peak_mb()
+    peak = own_peak_mb()
     print(f"{peak:.0f}")
     return peak
-
-
-def _own_peak_mb() -> float:
-    """This process's peak resident memory (MB) since it was started. Linux carries ``ru_maxrss`` across ``exec`` from
-    the process that forked it (a child of this script reported the script's own 778 MB), so the peak of the process's
-    own memory map, ``VmHWM``, is read where there is one."""
-    try:
-        with open("/proc/self/status") as status:
-            return next(float(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024.0
-    except (OSError, StopIteration):
-        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def alone_peak_mb() -> float:

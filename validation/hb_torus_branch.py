@@ -130,7 +130,7 @@ def follow(key, start, ends, checked, xs, xu):
         print(f"  | {xs * v:10.5g} | {branch.bases_hz[i, 0]:.5g}, {branch.bases_hz[i, 1]:.5g} | "
               f"{branch.iterations[i]:11d} |" + (" (the start)" if v == start else ""))
     steps = branch.steps
-    print(f"  the points' times (s), in the order traced: " + " ".join(f"{t:.3f}" for t in steps))
+    print("  the points' times (s), in the order traced: " + " ".join(f"{t:.3f}" for t in steps))
     if branch.folds:
         print("  folds (interpolated): " + ", ".join(f"{xs * v:.6g} {xu} ({'smooth' if s else 'corner'})"
                                                      for v, s in branch.folds))
