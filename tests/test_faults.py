@@ -654,6 +654,30 @@ def test_an_error_raised_from_an_interrupt_is_the_interrupt(monkeypatch, tmp_pat
     assert "internal error (ValueError" in capsys.readouterr().err
 
 
+def test_an_error_after_a_signal_a_library_swallowed_is_the_interrupt(monkeypatch, tmp_path, capsys):
+    """A SIGINT as matplotlib draws markers came back from its extension as ``ValueError: Invalid bounding box``, the
+    interrupt not in its chain (seen once at a random moment of ``modes``: an internal error with its traceback, exit
+    130): an error raised after a signal came is reported as that signal."""
+    import os
+    import signal
+    import time
+
+    import rotorred.cli.convert as convert
+
+    def drawing(args):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass  # swallowed, as an extension does
+        raise ValueError("Invalid bounding box")
+
+    monkeypatch.setattr(convert, "run", drawing)
+    assert main(["convert", "a.toml", str(tmp_path / "b.toml")]) == 130
+    err = capsys.readouterr().err
+    assert "internal error" not in err and "interrupted (SIGINT)" in err, err
+
+
 #: a child that sends itself ``SIG`` as it first imports ``MODULE`` (an import hook), then runs the console script
 SELF_SIGNAL = """
 import os, signal, sys

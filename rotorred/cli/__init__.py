@@ -199,7 +199,9 @@ def main(argv: list[str] | None = None) -> int:
     The one place where every command is interruptible: SIGINT and SIGTERM raise their exceptions (:func:`interrupts`)
     from the first line on, imports and parsing included, and end the command with one line and 130 or 143, never a
     traceback (:func:`_noting`). An error raised from an interrupt (:func:`rotorred.progress.interrupt_in`: a signal
-    that came as a module was imported or a class made) is reported as that interrupt. A signal that a library
+    that came as a module was imported or a class made) is reported as that interrupt, and so is any error after a
+    signal came: an extension that swallows the signal's exception fails otherwise (a SIGINT as matplotlib draws
+    markers: ``ValueError: Invalid bounding box``, seen at a random moment of ``modes``). A signal that a library
     swallowed (raised in a ctypes callback of llvmlite as numba loads the step kernel, where Python prints "Exception
     ignored" and goes on) leaves the command to run to its end, which then exits 130 or 143 saying so, its result
     written whole: a command never exits 0 when a signal came."""
@@ -222,7 +224,10 @@ def main(argv: list[str] | None = None) -> int:
         except BaseException as exc:  # noqa: BLE001 -- the one place every error is turned into a message
             from rotorred import progress
 
-            status = _report(args, progress.interrupt_in(exc, tuple(interrupts())) or exc)
+            found = progress.interrupt_in(exc, tuple(interrupts()))
+            if found is None and noted:  # the signal's exception swallowed in an extension, which failed otherwise
+                found = {name: kind for kind, name in interrupts().items()}[noted[0]]()  # (matplotlib's markers)
+            status = _report(args, found or exc)
     if noted and status not in (interrupted_status(n) for n in noted):
         if status == EXIT_OK:  # an error's status: its message is said
             _error(args, f"interrupted ({noted[0]}), but the signal was lost in a library and the command went on to "
