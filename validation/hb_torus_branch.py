@@ -100,6 +100,7 @@ def trace(key, pieces, refine):
                                TorusBranchOptions(divisors=DIVISORS, tol=TOL, fold_refine=refine,
                                                   max_points=MAX_POINTS, **box))
         done.append(piece)
+        print("\n".join(piece.summary()), flush=True)
     return Joined(done), time.perf_counter() - t0
 
 
@@ -110,10 +111,11 @@ class Joined:
     def __init__(self, pieces):
         self.pieces = pieces
         names = ("values", "iterations", "bases_hz", "frequencies", "amplitudes", "slope")
-        joined = {name: np.concatenate([getattr(p, name) for p in pieces]) for name in names}
+        joined = {name: [row for p in pieces for row in getattr(p, name)] for name in names}  # (pieces' orders differ)
         order = np.argsort(joined["values"], kind="stable")
         for name in names:
-            setattr(self, name, joined[name][order])
+            rows = [joined[name][i] for i in order]
+            setattr(self, name, np.array(rows) if name not in ("frequencies", "amplitudes") else rows)
         self.steps = np.concatenate([p.point_time[1:] for p in pieces])
         self.start_time = sum(p.point_time[0] for p in pieces)
         self.folds = [f for p in pieces for f in p.folds]
@@ -128,7 +130,6 @@ def follow(key, pieces, checked, xs, xu, refine):
     largest difference between an interpolated fold and Brent's (the key's unit), the Brent branch's median and worst
     point time over the transients' median)."""
     branch, wall = trace(key, pieces, refine=False)
-    print("\n".join(branch.summary()))
     at = sorted({int(np.argmin(np.abs(branch.values - v))) for v in checked})
     checks = {i: against_transient(branch, i, key) for i in at}
     reference = float(np.median([c[0] for c in checks.values()]))
