@@ -115,6 +115,11 @@ class TorusRubProblem:
         return z.reshape(-1)
 
 
+def _check_plates(scene) -> None:
+    if not scene.plates:
+        checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
+
+
 def torus_rub_problem(scene, model, torus, H1: int, H2: int, N1: int, N2: int,
                       f_max: float | None = None) -> TorusRubProblem:
     """The torus harmonic-balance problem of ``scene`` (with rub plates) on ``model``.
@@ -138,12 +143,11 @@ def torus_rub_problem(scene, model, torus, H1: int, H2: int, N1: int, N2: int,
     -------
     TorusRubProblem
     """
-    if not scene.plates:
-        checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
+    _check_plates(scene)
     bases = torus_bases(torus)
-    w = tuple(2 * math.pi * f for f in bases)
     w_max = None if f_max is None else 2 * math.pi * checks.positive("f_max", f_max, "Hz")
-    return torus_rub_problem_on(scene, model, bases, TorusHarmonics(H1, H2, N1, N2, w_max, w if w_max else None))
+    w = tuple(2 * math.pi * f for f in bases) if w_max else None
+    return torus_rub_problem_on(scene, model, bases, TorusHarmonics(H1, H2, N1, N2, w_max, w))
 
 
 def torus_rub_problem_on(scene, model, torus, harmonics: TorusHarmonics,
@@ -169,8 +173,7 @@ def torus_rub_problem_on(scene, model, torus, harmonics: TorusHarmonics,
     -------
     TorusRubProblem
     """
-    if not scene.plates:
-        checks.fail("rub", (), "must hold at least one plate: harmonic balance here is of the rub response")
+    _check_plates(scene)
     bases = torus_bases(torus)
     w = tuple(2 * math.pi * f for f in bases)
     h = harmonics
