@@ -278,3 +278,17 @@ def test_a_lines_tolerance_grows_the_box_along_the_branch_and_each_point_solves_
     assert taken == sorted(taken) and ladder[taken[-1]] == last_box
     rp = problems[last_box]
     assert np.allclose(rp.lines(branch.z[-1], branch.dof)[2], branch.amplitudes[-1], rtol=1e-9, atol=1e-15)
+
+
+def test_the_default_box_starts_through_the_coarse_torus_at_a_deep_rub():
+    """paper-rub at outer 91.37 Hz, 14 µm: the default box (|k1| <= 32, |k2| <= 80, 900 Hz) from the start's record
+    alone did not converge (40 Newton steps, relative residual 0.37); through the coarse 10 x 40 torus
+    (quasi_periodic._through_coarse) it does, and the branch steps on (three points, each to its tolerance 1e-6)."""
+    import rotorred as rr
+
+    scene = rr.load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": 14e-6})
+    model = rr.build_model(scene).model
+    branch = rr.continue_torus(scene, model, "rub.clearance", 14e-6, 12e-6,
+                               rr.TorusBranchOptions(divisors=(1, 3), tol=1e-6, max_points=3))
+    assert len(branch.values) == 3 and branch.values[-1] < 14e-6
+    assert branch.frequencies.shape[1] == 1799
