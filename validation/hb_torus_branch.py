@@ -52,10 +52,6 @@ BRANCHES = (("rub.clearance", ((20e-6, 5e-6),), (19e-6, 14e-6, 6e-6), 1e6, "µm"
 #: branch traced again with Brent's folds (the clearance's only: the speed's pieces take minutes more)
 MAX_POINTS = 120  #: a piece's most points
 SPEEDUP = 10.0  #: the issue's: each point at least 10x cheaper than a settled transient there
-LINES = 0.01  #: the issue's: the lines within 1 % of the transient's
-#: each branch is traced twice on the same box: its folds interpolated (the default, timed as the issue's measure)
-#: and located by Brent (``fold_refine``: each evaluation a corrected point), the two locations compared
-REFINE = (False, True)
 
 
 def scene_for(key: str, value: float, record: bool):

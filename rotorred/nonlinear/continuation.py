@@ -611,7 +611,7 @@ def _interpolated_fold(problem, a: _Point, b: _Point) -> Fold:
     L = np.linalg.norm(chord)
     A, B = L * a.t, L * b.t
     c2, c3 = 3.0 * chord - 2.0 * A - B, A + B - 2.0 * chord
-    roots = np.roots([3.0 * c3[-1], 2.0 * c2[-1], A[-1]]) if c3[-1] != 0.0 else np.roots([2.0 * c2[-1], A[-1]])
+    roots = np.roots([3.0 * c3[-1], 2.0 * c2[-1], A[-1]])  # (a zero leading coefficient: np.roots drops it)
     inside = [r.real for r in roots if abs(r.imag) <= 1e-12 and 0.0 <= r.real <= 1.0]
     u = min(inside, key=lambda r: abs(r - 0.5)) if inside else 0.5  # the sign change of A[-1] and B[-1]: one root
     y = a.y + A * u + c2 * u**2 + c3 * u**3

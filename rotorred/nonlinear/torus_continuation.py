@@ -67,8 +67,8 @@ class TorusJacobian:
         GMRES's relative tolerance on each solve (the inexact Newton's forcing term).
     """
 
-    def __init__(self, J, rtol: float, column_start: np.ndarray | None = None):
-        self.J, self.rtol, self.krylov, self.column_start = J, float(rtol), 0, column_start
+    def __init__(self, J, rtol: float):
+        self.J, self.rtol, self.krylov = J, float(rtol), 0
 
     def times(self, v: np.ndarray) -> np.ndarray:
         """``J v`` (v of shape (size,))."""
@@ -83,6 +83,10 @@ class TorusJacobian:
         self.krylov += stats.iterations
         return x
 
+    def solve_column(self, c: np.ndarray) -> np.ndarray:
+        """``J^-1 c`` for the border's column (:meth:`solve`; a family's Jacobian starts it from the last one's)."""
+        return self.solve(c)
+
     def bordered(self, column: np.ndarray, row: np.ndarray) -> _Bordered:
         """The bordered matrix ``[[J, column], [row]]`` (``row`` of length size + 1), ready to solve with."""
         return _Bordered(self, column, row)
@@ -96,9 +100,8 @@ class _Bordered:
         self._x_c = None
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        if self._x_c is None:  # from the last iterate's J^-1 c where its bases are this one's (a nearby system)
-            self._x_c = self.jacobian.solve(self.column, self.jacobian.column_start)
-            self.jacobian.column_reduced = None if self.jacobian.J is None else self.jacobian.J.reduced
+        if self._x_c is None:
+            self._x_c = self.jacobian.solve_column(self.column)
         b, beta, r, d = rhs[:-1], rhs[-1], self.row[:-1], self.row[-1]
         x_b = self.jacobian.solve(b) if np.any(b) else np.zeros_like(b)
         schur = d - r @ self._x_c
@@ -300,13 +303,10 @@ class TorusFamily:
         self._state["slow"] = 0
         if J is not None and J.reused and J.G0 is not last.G0:
             J.P0, J.Pk = projected_blocks(J.G0, J.Gk, J.V, J.U)
-        start = None
         if J is not None:
-            kept = self._state.get("column_reduced")
-            start = kept[1] if kept is not None and kept[0] is J.U and WARM_COLUMN else None
             self._state["last"] = J
         self._state["jacobians"] += 1
-        return _Counted(TorusJacobian(J, forcing_term(relative), start), self._state)
+        return _Counted(TorusJacobian(J, forcing_term(relative)), self._state)
 
     def solve_point(self, z0: np.ndarray, s: float, tol: float, max_iter: int, max_halvings: int) -> _Point:
         """The torus at the carried ``s`` by :func:`rotorred.nonlinear.torus.solve_torus` from ``z0`` (the
@@ -341,20 +341,20 @@ class TorusFamily:
 
 
 class _Counted(TorusJacobian):
-    """A :class:`TorusJacobian` adding its GMRES iterations to the family's count, and keeping its ``J^-1 c``'s
-    reduced solution (with the bases it is in) for the next Jacobian's start."""
+    """A :class:`TorusJacobian` adding its GMRES iterations to the family's count; its ``J^-1 c`` starts from the
+    last Jacobian's reduced solution where the two share their bases (:data:`WARM_COLUMN`), and keeps its own."""
 
     def __init__(self, jacobian: TorusJacobian, state: dict):
-        super().__init__(jacobian.J, jacobian.rtol, jacobian.column_start)
+        super().__init__(jacobian.J, jacobian.rtol)
         self._family_state = state
 
-    @property
-    def column_reduced(self):
-        return None
-
-    @column_reduced.setter
-    def column_reduced(self, y):
-        self._family_state["column_reduced"] = None if y is None else (self.J.U, y)
+    def solve_column(self, c: np.ndarray) -> np.ndarray:
+        kept = self._family_state.get("column_reduced")
+        start = kept[1] if WARM_COLUMN and self.J is not None and kept is not None and kept[0] is self.J.U else None
+        x = self.solve(c, start)
+        if self.J is not None:
+            self._family_state["column_reduced"] = (self.J.U, self.J.reduced)
+        return x
 
     def solve(self, b: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
         before = self.krylov

@@ -11,7 +11,8 @@ speed squared.
 The first point is :func:`rotorred.scenes.quasi_periodic.torus_balance` at the start (a short transient, the line
 fit's torus, least squares, Newton). Every point keeps its orders: the box and band of the start's truncation (the band
 ``|k . f| <= f_max`` at the start's bases), so that the unknowns do not change along the branch; the problem at a value
-is :func:`rotorred.scenes.torus_balance.torus_rub_problem` on the whole box, its forcing put on those orders. The
+is the start's with that value's forces where the matrices and bases stay (a clearance, a law's number), else
+:func:`rotorred.scenes.torus_balance.torus_rub_problem_on` on those orders, each spool forcing the order it started on. The
 continuation is :func:`rotorred.nonlinear.continuation.continue_branch` on a
 :class:`rotorred.nonlinear.torus_continuation.TorusFamily` (matrix-free bordered solves, the preconditioner kept from
 point to point, inexact Newton). No stability: that of a torus is another part of issue 40.
@@ -373,9 +374,8 @@ class _Family:
     and ``problem_at(value)`` (for :class:`TorusFamily`). Where a value leaves the model's matrices and the bases as
     they were (a clearance, the law's numbers), the start's compliance serves."""
 
-    def __init__(self, scene, model, key, first: TorusRubProblem, divisors, box: tuple[int, int, int, int]):
+    def __init__(self, scene, model, key, first: TorusRubProblem, divisors):
         self.scene, self.model, self.key, self.first, self.divisors = scene, model, key, first, divisors
-        self.box = box  # (H1, H2, N1, N2)
         self.spools = sorted((s for s, f in scene.frequencies_hz.items() if f > 0),
                              key=lambda s: scene.frequencies_hz[s])  # (L, H) at the start
         self._kept: dict = {}
@@ -462,7 +462,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         if options.lines_tol is not None:  # the box against the ladder's next, here
             box, rub, z, note = _checked_box(_scene_at(scene, key, value), model, box, rub, z, dof, options)
             notes.append(f"{notes and 'then ' or ''}{box[0]}x{box[1]} from {value:.6g} ({note})")
-        rubs = _Family(scene, model, key, rub, divisors, box)
+        rubs = _Family(scene, model, key, rub, divisors)
         family = TorusFamily(rubs.problem_at, value, (key, KEYS.get(key, "Hz")),
                              FROZEN if key.startswith("speeds.") else 0.0)
         check_at = furthest + direction * reach if options.lines_tol is not None else None
