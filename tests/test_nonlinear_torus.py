@@ -180,6 +180,30 @@ def test_torus_jacobian_is_the_analytic_chain_rule_and_the_matrix_free_step_is_n
     assert stats1.iterations <= 30
 
 
+@pytest.mark.parametrize("coarse", [10, 1000])
+def test_the_preconditioners_block_is_the_reduced_matrix_between_its_orders(monkeypatch, coarse):
+    """The coarse block (written by one compiled pass from the fields' spectra) is the reduced equation's matrix
+    ``I + C G_VU`` between the orders it keeps, that matrix built column by column through the grid (the matrix-free
+    product, itself the dense J's above): with velocity terms and r = s = 2, on 10 of the 25 orders and on all
+    (measured 4.1e-16 of its largest entry on both, in double precision)."""
+    import scipy.linalg as sla
+    from rotorred.nonlinear import torus_krylov
+    monkeypatch.setattr(torus_krylov, "COARSE_ORDERS", coarse)
+    h = TorusHarmonics(3, 4, *alias_free_grid(3, 4, 3))
+    problem = two_dof(h, (1.0, math.sqrt(2.0)), (CubicSpring(0, 0.5), VelocityCubic(1, 0.3),
+                                                 RankOneCubic((1.0, -0.5), (0.3, 1.0), 2.0)))
+    _, J = problem.jacobian(problem.linear_response() * 3.0)
+    assert J.has_velocity and (J.r, J.s) == (2, 2)
+    reduced = np.column_stack([J.inner(e) for e in np.eye(J.inner_size)])
+    rows, (lu, pivots) = J._coarse_block()
+    assert lu.dtype == np.float64 and len(rows) == (2 * min(coarse, h.n_orders) - 1) * J.r
+    block = (np.tril(lu, -1) + np.eye(len(lu))) @ np.triu(lu)
+    for i, p in reversed(list(enumerate(pivots))):  # undo LAPACK's row interchanges
+        block[[i, p]] = block[[p, i]]
+    expected = reduced[np.ix_(rows, rows)]
+    assert np.max(np.abs(block - expected)) < 1e-14 * np.max(np.abs(expected))
+
+
 # ------------------------------------------------------------------------------------------------- solutions
 def test_linear_system_at_two_incommensurate_frequencies_is_the_closed_form():
     """A 2-DOF system with a linear spring S passed through the AFT as a force, forced at w1 and w2 = sqrt(2) w1: each

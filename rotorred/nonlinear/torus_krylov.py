@@ -32,6 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
+from numba import njit
+
+from rotorred.transient import numba_cache
+
+numba_cache.register()
 
 __all__ = ["RankJacobian", "pattern_bases"]
 
@@ -155,36 +160,28 @@ class RankJacobian:
     # ------------------------------------------------------------------------------------------ preconditioner
     def _coarse_block(self):
         """The orders where the compliance is largest (:data:`COARSE_ORDERS` of them, the mean among them): their
-        positions in the reduced vector and the LU factors (single precision) of the reduced equation's dense block
-        between them, ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders)."""
-        h, r, s, N = self.h, self.r, self.s, self.h.n_samples
+        positions in the reduced vector and the LU factors of the reduced equation's dense block between them,
+        ``I + C_LL G_VU,L`` (C_LL the fields' Toeplitz matrices between those orders, from their 2-D spectra), written
+        by one compiled pass (:func:`_compliant_block`) in the factors' precision."""
+        h, r, s = self.h, self.r, self.s
         weight = np.concatenate([[np.linalg.norm(self.P0)], np.linalg.norm(self.Pk, axis=(1, 2))])
         among = np.union1d([0], np.argsort(-weight)[:COARSE_ORDERS])
-        m = 2 * len(among) - 1
-
-        def assembled(blocks):
-            return blocks.reshape(r, s, m, m).transpose(2, 0, 3, 1).reshape(m * r, m * s)
-        fields = np.vstack([self.Mq.reshape(r * s, N), self.Mv.reshape(r * s, N)]) if self.has_velocity else \
-            self.Mq.reshape(r * s, N)
-        blocks = h.toeplitz_blocks(fields.T, among)  # both fields at once: one spectrum, one map of order pairs
-        C = assembled(blocks[:r * s])
-        if self.has_velocity:  # times the derivative on the right: columns (a_k, b_k) <- (-(k.w) b_k, (k.w) a_k)
-            Tv = assembled(blocks[r * s:]).reshape(m * r, m, s)
-            wk = h.frequencies(self.w)[among[1:]][None, :, None]
-            C3 = C.reshape(m * r, m, s)  # a view
-            C3[:, 1::2] -= wk * Tv[:, 2::2]
-            C3[:, 2::2] += wk * Tv[:, 1::2]
-        GT = block_product(self.P0.T, self.Pk[among[1:] - 1].transpose(0, 2, 1), C.T, s)  # (G_L^T C^T)
-        rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
-        rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
+        n = (2 * len(among) - 1) * r
+        spectra = [np.fft.fft2(M.reshape(r * s, h.N1, h.N2), axes=(1, 2)).reshape(r * s, -1) / h.n_samples
+                   for M in ((self.Mq, self.Mv) if self.has_velocity else (self.Mq,))]
+        velocity = spectra[1] if self.has_velocity else np.zeros((0, 1), complex)
+        orders = h.orders[among]
         # factorised once, in single precision (a preconditioner only shapes GMRES's spectrum: on the rig's 1999 x 1999
         # block the LU takes 1/7 of the double inverse's time and its solve 1/4 of that inverse's product, GMRES's
         # iterations unchanged, docs/model.md §25); in double for a small block (cheap either way, and where it is
         # the whole equation the step is then exact to round-off)
-        precision = np.float64 if m * r <= DOUBLE_BLOCK else np.float32
-        block = GT.astype(precision).T  # Fortran order: LAPACK's, no copy
-        block[np.diag_indices(m * r)] += 1.0
-        return rows, sla.lu_factor(block, check_finite=False, overwrite_a=True)
+        transposed = np.empty((n, n), np.float64 if n <= DOUBLE_BLOCK else np.float32)
+        _compliant_block(spectra[0], velocity, orders[:, 0].astype(np.int64), orders[:, 1].astype(np.int64), h.N1,
+                         h.N2, h.frequencies(self.w)[among[1:]], self.P0, np.ascontiguousarray(self.Pk[among[1:] - 1]),
+                         transposed)
+        rows = np.concatenate([[0], np.column_stack([2 * among[1:] - 1, 2 * among[1:]]).ravel()])
+        rows = (rows[:, None] * r + np.arange(r)[None]).ravel()
+        return rows, sla.lu_factor(transposed.T, check_finite=False, overwrite_a=True)  # Fortran order: no copy
 
     def precondition(self, y: np.ndarray) -> np.ndarray:
         """An approximate inverse of ``I + C G_VU`` applied to y ((2K - 1) r,): exact on the block between the orders
@@ -311,3 +308,72 @@ def block_product(B0: np.ndarray, Bk: np.ndarray, X: np.ndarray, c: int) -> np.n
     else:
         out[a:] = np.matmul(Bk, X[c:].reshape(len(Bk), 2 * c, -1)).reshape(-1, X.shape[1])
     return out
+
+
+@njit(cache=True, inline="always")
+def _wrapped(k, N):  # pragma: no cover (compiled)
+    """``k mod N``, without a division where ``-N <= k < N`` (the pairs of orders of a grid that resolves them)."""
+    if k < 0:
+        k += N
+    return k if 0 <= k < N else k % N
+
+
+@njit(cache=True)
+def _compliant_block(Sq, Sv, k1, k2, N1, N2, wk, P0, Pk, out):  # pragma: no cover (compiled)
+    """``out`` (n, n), n = (2L - 1) r, receives ``(I + C G)^T``: C the Toeplitz matrix (harmonic-major, real form)
+    between the L orders ``(k1, k2)`` (the first (0, 0)) of the position field, spectrum ``Sq`` (r s, N_1 N_2) (the
+    2-D DFT over N_1 N_2 samples, component rho s + sigma), plus the velocity field's (``Sv``, or no rows) times the
+    derivative ``w . nabla`` on the right (``wk`` (L - 1,): each order's ``k . w``, rad/s); G the compliance blocks of
+    those orders, ``P0`` (s, r) and ``Pk`` (L - 1, 2s, 2r). Row by row of ``out`` (a column order b at a time), so
+    that ``out.T`` is the block in Fortran order. The Toeplitz entries of the orders a, b are those of
+    :meth:`rotorred.nonlinear.torus.TorusHarmonics.toeplitz_blocks`, from ``D_(ka - kb)`` and ``D_(ka + kb)``."""
+    rs, L = Sq.shape[0], k1.shape[0]
+    r, s = P0.shape[1], P0.shape[0]
+    n = (2 * L - 1) * r
+    velocity = Sv.shape[0] > 0
+    C = np.empty((n, 2 * s))  # the column order b's columns of C: (cos, sin) x s (the mean: s)
+    for b in range(L):
+        width = s if b == 0 else 2 * s
+        C[:, :width] = 0.0
+        for a in range(L):
+            d = _wrapped(k1[a] - k1[b], N1) * N2 + _wrapped(k2[a] - k2[b], N2)
+            t = _wrapped(k1[a] + k1[b], N1) * N2 + _wrapped(k2[a] + k2[b], N2)
+            for c in range(rs):
+                rho, sigma = c // s, c % s
+                for field in range(2 if velocity else 1):
+                    S = Sq if field == 0 else Sv
+                    rm, im, rp, ip = S[c, d].real, S[c, d].imag, S[c, t].real, S[c, t].imag
+                    if a == 0 and b == 0:
+                        block = ((rm, 0.0), (0.0, 0.0))
+                    elif a == 0:
+                        block = ((0.5 * (rm + rp), 0.5 * (im - ip)), (0.0, 0.0))
+                    elif b == 0:
+                        block = ((rm + rp, 0.0), (-(im + ip), 0.0))
+                    else:
+                        block = ((rm + rp, im - ip), (-(im + ip), rm - rp))
+                    for i in range(1 if a == 0 else 2):  # the row order's cos (or mean), sin
+                        row = (0 if a == 0 else 2 * a - 1 + i) * r + rho
+                        if field == 0:
+                            C[row, sigma] += block[i][0]
+                            if b > 0:
+                                C[row, s + sigma] += block[i][1]
+                        elif b > 0:  # (w . nabla) on the right: cos_b <- -(k.w) sin_b's, sin_b <- (k.w) cos_b's
+                            C[row, sigma] -= wk[b - 1] * block[i][1]
+                            C[row, s + sigma] += wk[b - 1] * block[i][0]
+        if b == 0:
+            for j in range(r):
+                for row in range(n):
+                    acc = 0.0
+                    for k in range(s):
+                        acc += C[row, k] * P0[k, j]
+                    out[j, row] = acc
+                out[j, j] += 1.0
+        else:
+            for j in range(2 * r):
+                col = (2 * b - 1) * r + j  # the block's cos_b comps, then sin_b's
+                for row in range(n):
+                    acc = 0.0
+                    for k in range(2 * s):
+                        acc += C[row, k] * Pk[b - 1, k, j]
+                    out[col, row] = acc
+                out[col, col] += 1.0

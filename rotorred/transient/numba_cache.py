@@ -49,7 +49,8 @@ PACKAGE = Path(__file__).resolve().parent.parent
 #: module, and every module of rotorred that defines or wraps an njit function
 KERNEL_SOURCES = ("transient/contact.py", "transient/contact_solve.py", "transient/kernel.py",
                   "transient/ramp_kernel.py", "transient/eigen_kernel.py", "nonlinear/sampled.py",
-                  "nonlinear/forces.py", "transient/status.py")
+                  "nonlinear/forces.py", "transient/status.py",
+                  "nonlinear/torus_krylov.py")
 GENERATED = "_generated"
 
 
