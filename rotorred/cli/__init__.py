@@ -226,7 +226,7 @@ def main(argv: list[str] | None = None) -> int:
 
             found = progress.interrupt_in(exc, tuple(interrupts()))
             if found is None and noted:  # the signal's exception swallowed in an extension, which failed otherwise
-                found = {name: kind for kind, name in interrupts().items()}[noted[0]]()  # (matplotlib's markers)
+                found = interrupt_of(noted[0])  # (matplotlib's markers)
             status = _report(args, found or exc)
     if noted and status not in (interrupted_status(n) for n in noted):
         if status == EXIT_OK:  # an error's status: its message is said
@@ -244,6 +244,12 @@ def interrupts() -> dict:
     return {KeyboardInterrupt: "SIGINT", Terminated: "SIGTERM"}
 
 
+def interrupt_of(signal_name: str) -> BaseException:
+    """The exception a signal raises in a command (:func:`interrupts`): ``KeyboardInterrupt()`` for "SIGINT",
+    ``Terminated()`` for "SIGTERM"."""
+    return {name: kind for kind, name in interrupts().items()}[signal_name]()
+
+
 def interrupted_status(signal_name: str) -> int:
     """The exit status of a command its signal ended: 130 (SIGINT) or 143 (SIGTERM)."""
     return {"SIGINT": EXIT_SIGINT, "SIGTERM": EXIT_SIGTERM}[signal_name]
@@ -255,12 +261,10 @@ def _noting(noted: list):
     interrupts (raised where Python can only ignore them), and any unraisable error once a signal came, are not
     printed (the command's message says what happened). Restored on exit; in the main thread only, and SIGINT only
     where it is not ignored."""
-    kinds = {name: kind for kind, name in interrupts().items()}
-
     def handler(signum, frame):
         name = signal.Signals(signum).name
         noted.append(name)
-        raise kinds[name]()
+        raise interrupt_of(name)
 
     previous, hook = {}, sys.unraisablehook
     try:
