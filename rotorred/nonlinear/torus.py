@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 import scipy.fft as sfft
@@ -641,25 +642,28 @@ def _stiffness(M, D, K, w: np.ndarray) -> np.ndarray:
     return K[None] - w**2 * M[None] + 1j * w * D[None]
 
 
-def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray):
-    """``(Z_k^-1)[:, dofs]`` and ``Z_k^-1 f_k`` at the frequencies ``w`` (k,) (rad/s) by the first-order system's
-    modes, ``Z(iw)^-1 = V_q (iw - Lambda)^-1 V^-1 [0; M^-1]`` (one eigen-solution of the 2n state matrix, then O(k n^2)
-    products, against k solves of n x n), as ``(X, Q)`` of shapes (k, n, len(dofs)) and (k, n); None where M is
-    singular or the modes are too ill-conditioned: the direct solve at sixteen of the orders differs by more than
-    :data:`MODAL_MATCH`. Where the speed moves along a branch, every value's problem has its own matrices (the
-    gyroscopic term): the modes cost one eigen-solution a value (docs/model.md §26)."""
+def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray, rows=None):
+    """``(Z_k^-1)[rows, dofs]`` and ``(Z_k^-1 f_k)[rows]`` at the frequencies ``w`` (k,) (rad/s) by the first-order
+    system's modes, ``Z(iw)^-1 = V_q (iw - Lambda)^-1 V^-1 [0; M^-1]`` (one eigen-solution of the 2n state matrix, then
+    O(k n len(rows)) products, against k solves of n x n), as ``(X, Q)`` of shapes (k, len(rows), len(dofs)) and
+    (k, len(rows)) (``rows`` default every DOF); None where M is singular or the modes are too ill-conditioned: the
+    direct solve at sixteen of the orders differs by more than :data:`MODAL_MATCH`. Where the speed moves along a
+    branch, every value's problem has its own matrices (the gyroscopic term): the modes cost one eigen-solution a value
+    (docs/model.md §26), and its iterates need only the rows of the ``dofs`` (:meth:`TorusProblem._compliance`)."""
     n, c = M.shape[0], list(dofs)
+    rows = list(range(n)) if rows is None else list(rows)
     try:
         lam, V = sla.eig(state_matrix(M, D, K))
         W = sla.solve(V, np.vstack([np.zeros((n, n)), sla.inv(M)]))  # (2n, n): V^-1 [0; M^-1]
     except (sla.LinAlgError, ValueError):
         return None
     r = 1.0 / (1j * w[:, None] - lam[None, :])  # (k, 2n)
-    Vq = V[:n]
+    Vq = V[rows]
     X = np.einsum("ij,kj,jc->kic", Vq, r, W[:, c], optimize=True)
     Q = (r * (forcing @ W.T)) @ Vq.T
     probe = np.unique(np.linspace(0, len(w) - 1, 16).astype(int))
     X_d, Q_d = dynamic_compliance(_stiffness(M, D, K, w[probe]), c, forcing[probe])
+    X_d, Q_d = X_d[:, rows], Q_d[:, rows]
     scale_x, scale_q = np.max(np.abs(X_d)), np.max(np.abs(Q_d)) or 1.0
     if not (np.max(np.abs(X[probe] - X_d)) <= MODAL_MATCH * scale_x
             and np.max(np.abs(Q[probe] - Q_d)) <= MODAL_MATCH * scale_q):
@@ -670,13 +674,21 @@ def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray):
 @dataclass(frozen=True)
 class _Compliance:
     """The condensation at the problem's base frequencies: G as blocks (G0, the (2c, 2c) block of each order), the
-    linear response of the ``c`` DOFs, and per order the full linear response and the compliance columns."""
+    linear response of the ``c`` DOFs, and per order the full linear response and the compliance columns of every
+    DOF (:meth:`full`: ``Q_full`` (K, n_all) and ``X = (Z_k^-1)[:, c]`` (K, n_all, c), complex), computed by
+    ``recovery`` on first use where they were not at hand (only a solution's recovery asks them)."""
 
     G0: np.ndarray
     Gk: np.ndarray
     z_lin: np.ndarray
-    Q_full: np.ndarray  # (K, n_all) complex
-    X: np.ndarray  # (K, n_all, c) complex: (Z_k^-1)[:, c]
+    recovery: Callable[[], tuple[np.ndarray, np.ndarray]]
+    _kept: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def full(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(Q_full, X)`` of every DOF."""
+        if "full" not in self._kept:
+            self._kept["full"] = self.recovery()
+        return self._kept["full"]
 
 
 @dataclass(frozen=True)
@@ -764,19 +776,31 @@ class TorusProblem:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
         forcing = self.harmonics.phasors(self.forcing, n_all)
-        found = modal_compliance(self.M, self.D, self.K, c, wk, forcing) if self._cache.get("modes") else None
-        if found is not None:
-            X, Q_full = found
+        found = modal_compliance(self.M, self.D, self.K, c, wk, forcing, rows=c) if self._cache.get("modes") else None
+        if found is not None:  # the rows of the dofs: every DOF's only for a solution's recovery
+            H, Q_c = found
+
+            def recovery():
+                every = modal_compliance(self.M, self.D, self.K, c, wk, forcing)
+                return (every[1], every[0]) if every is not None else self._solved(wk, forcing)
         else:
-            X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
-            for lo in range(0, len(wk), COMPLIANCE_CHUNK):
-                part = slice(lo, lo + COMPLIANCE_CHUNK)
-                X[part], Q_full[part] = dynamic_compliance(_stiffness(self.M, self.D, self.K, wk[part]), c,
-                                                           forcing[part])
-        H = X[:, c, :]
-        out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_full[:, c]), Q_full, X)
+            Q_full, X = self._solved(wk, forcing)
+            H, Q_c = X[:, c, :], Q_full[:, c]
+
+            def recovery():
+                return Q_full, X
+        out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_c), recovery)
         self._cache["compliance"] = out
         return out
+
+    def _solved(self, wk: np.ndarray, forcing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(Q_full, X)`` at the frequencies ``wk`` by batched solves of :data:`COMPLIANCE_CHUNK` orders at a time."""
+        n_all, c = self.M.shape[0], list(self.dofs)
+        X, Q_full = np.empty((len(wk), n_all, len(c)), complex), np.empty((len(wk), n_all), complex)
+        for lo in range(0, len(wk), COMPLIANCE_CHUNK):
+            part = slice(lo, lo + COMPLIANCE_CHUNK)
+            X[part], Q_full[part] = dynamic_compliance(_stiffness(self.M, self.D, self.K, wk[part]), c, forcing[part])
+        return Q_full, X
 
     def with_forces(self, forces) -> TorusProblem:
         """This problem with other nonlinear forces on the same DOFs (a contact's clearance, its law's numbers): the
@@ -976,11 +1000,11 @@ class TorusProblem:
         ndarray, shape (K, n_all), complex
             (m; rad for a rotation DOF), n_all the DOFs of ``M``.
         """
-        g = self._compliance()
+        Q_full, X = self._compliance().full()
         q, v = self.samples(z)
         f = self.harmonics.coefficients(sampled_forces(self._local_forces, q, v)[0])
         F = self.harmonics.phasors(f, self.n)
-        return g.Q_full - np.einsum("kac,kc->ka", g.X, F)
+        return Q_full - np.einsum("kac,kc->ka", X, F)
 
 
 @dataclass(frozen=True, repr=False)
