@@ -213,7 +213,7 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
     scene = load_scene("paper-rub", {"speeds.outer": 91.37})
     model = build_model(scene).model
     branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
-                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05)))
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8))
     assert branch.stopped.startswith("reached the end") and len(branch.values) >= 3
     assert np.allclose(branch.bases_hz[:, 0], 70.0, rtol=1e-12)
     assert np.allclose(branch.bases_hz[:, 1], branch.values / 3, rtol=1e-12)
@@ -247,7 +247,7 @@ def test_a_lines_tolerance_grows_the_box_along_the_branch_and_each_point_solves_
     """``continue_torus`` in the clearance from 14 to 12 µm from the box |k1| <= 2, |k2| <= 8 with a lines tolerance of
     2 %: the box grows up the ladder (bounds times 1.5, to 4 x 16 at most) where its largest lines change by more than
     that against the next; every point, its coefficients (kept on the last box's orders) put back on one box of the
-    ladder, solves ``torus_rub_problem`` there at its value (relative residual below 1e-7, the branch asking 1e-6),
+    ladder, solves ``torus_rub_problem`` there at its value (relative residual below 1e-7, the branch asking 1e-8),
     the boxes in the order they were taken, and the last point's lines are those of the last box's problem."""
     from rotorred.scenes.quasi_periodic import default_grid
     from rotorred.scenes.run import build_model
@@ -258,7 +258,8 @@ def test_a_lines_tolerance_grows_the_box_along_the_branch_and_each_point_solves_
     scene = load_scene("paper-rub", {"speeds.outer": 91.37})
     model = build_model(scene).model
     branch = continue_torus(scene, model, "rub.clearance", 14e-6, 12e-6,
-                            TorusBranchOptions(orders=(2, 8), divisors=(1, 3), lines_tol=0.02, max_orders=(4, 16)))
+                            TorusBranchOptions(orders=(2, 8), divisors=(1, 3), lines_tol=0.02, max_orders=(4, 16),
+                                               tol=1e-8))
     assert branch.stopped.startswith("reached the end")
     last_box = (int(branch.orders[:, 0].max()), int(branch.orders[:, 1].max()))
     assert last_box > (2, 8)  # it grew

@@ -146,8 +146,8 @@ def _run_torus(args, out, key: str, start: float, stop: float) -> int:
     divisors = None if args.torus == "found" else _pair("--torus", args.torus)
     orders = _pair("--orders", args.orders)
     lines_tol = None if args.lines_tol is None else checks.number("--lines-tol", args.lines_tol, gt=0.0, lt=1.0)
-    options = TorusBranchOptions(orders=orders, divisors=divisors, tol=_tol(args, 1e-6), lines_tol=lines_tol,
-                                 fold_refine=args.refine_folds)
+    options = TorusBranchOptions(orders=orders, divisors=divisors, tol=_tol(args, TorusBranchOptions.tol),
+                                 lines_tol=lines_tol, fold_refine=args.refine_folds)
     scene = load_scene(args.scene, _settings(args.set))
     check_torus_key(scene, key, start, stop)
     record = provenance(args, "scene", scene_toml(scene))

@@ -83,7 +83,8 @@ class TorusBranchOptions:
     start_window : (float, float)
         The start's transient window (s) (:class:`rotorred.scenes.quasi_periodic.TorusOptions`).
     tol : float
-        Relative residual of every point, in (0, 1).
+        Relative residual of every point, in (0, 1) (default 1e-6, ``rotorred continue --torus``'s: the branches of
+        docs/model.md §26 were measured at it).
     max_points : int
         Most points traced, >= 2.
     steps : (float, float)
@@ -108,7 +109,7 @@ class TorusBranchOptions:
     f_max: float | None = 900.0
     divisors: tuple[int, int] | None = None
     start_window: tuple[float, float] = (2.0, 3.0)
-    tol: float = 1e-8
+    tol: float = 1e-6
     max_points: int = 200
     steps: tuple[float, float] = (0.05, 0.15)
     lines_tol: float | None = None
