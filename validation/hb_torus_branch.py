@@ -2,14 +2,14 @@
 from 20 to 5 µm at outer 91.37 Hz, and in the outer speed from 91 to 97 Hz at the scene's clearance (inner 70 Hz held),
 against settled transients at three points of each branch, in one run.
 
-Each branch is :func:`rotorred.scenes.torus_branch.continue_torus` on the default box (|k1| <= 32, |k2| <= 80, band
-900 Hz, grid 128 x 256; the start by a short transient and the line fit's torus (f_L, f_H/3); pseudo-arclength with
-matrix-free bordered Newton-Krylov corrections, docs/model.md §26), in pieces (``BRANCHES``: the speed's avoid the 3:4
-lock at 93.33 Hz), its folds interpolated; the clearance's traced again with its folds located by Brent, the two
-locations compared. At three points of each branch (the branch's points nearest to them), the scene there runs a
-settled transient 2-22 s (``validation/hb_torus.py``'s ``transient``: node 14 Y line fit, its 10 largest lines),
-whose solve time is the point's reference. A point's time is all the work between two accepted points: the
-corrections, rejected steps, a fold's location.
+Each branch is :func:`rotorred.scenes.torus_branch.continue_torus` on the default box (|k1| <= 32, |k2| <= 80, band 900
+Hz, grid 128 x 256; the start by a short transient and the line fit's torus (f_L, f_H/3); pseudo-arclength with
+matrix-free bordered Newton-Krylov corrections, docs/model.md §26), in pieces (``BRANCHES``: the speed's end short of
+93.1-93.5 Hz, where the response is another torus), its folds interpolated; the clearance's traced again with its folds
+located by Brent, the two locations compared. At three points of each branch (the branch's points nearest to them), the
+scene there runs a settled transient 2-22 s (``validation/hb_torus.py``'s ``transient``: node 14 Y line fit, its 10
+largest lines), whose solve time is the point's reference. A point's time is all the work between two accepted points:
+the corrections, rejected steps, a fold's location.
 
 Run::
 
@@ -41,15 +41,17 @@ TOL = 1e-6  #: the relative residual of every point
 #: the branches: key, start, end, the values checked against a transient (the branch's points nearest to them), and
 #: how each is shown (scale, unit)
 BRANCHES = (("rub.clearance", ((20e-6, 5e-6),), (19e-6, 14e-6, 6e-6), 1e6, "µm", True),
-            ("speeds.outer", ((OUTER_HZ, 91.0), (OUTER_HZ, 93.25), (94.5, 93.45), (94.5, 97.0)), (91.5, 94.0, 96.5),
-             1.0, "Hz", False))
-#: the speed branch in pieces, (start, end) each: at 93.333 Hz the speeds are 3:4 (70 x 4 = 93.333 x 3), the bases
-#: (70, 31.11) Hz 9:4 (the order (4, -9) is 0 Hz), and the response is periodic; near it the torus locks and its
-#: branch crawls (a first run: 200 points from 91.37 to 93.31 Hz, 11 folds and corners, 3.8 s a point). So a piece
-#: goes up from 91.37 to 93.25 Hz and another starts at 94.5 Hz and goes down to 93.45 and up to 97 Hz (the start's 1 s
-#: window resolves the lines there; at 97 Hz the speeds are near 6:13, 420 against 420.3 Hz, and it does not). Down
-#: from 91.37 Hz the branch stops where the orders (23, -53) of the box come to 0 Hz (91.13 Hz). The last field: the
-#: branch traced again with Brent's folds (the clearance's only: the speed's pieces take minutes more)
+            ("speeds.outer", ((OUTER_HZ, 91.0), (OUTER_HZ, 91.44), (92.4, 91.47), (92.4, 93.05), (94.5, 93.55),
+                              (94.5, 97.0)), (92.0, 94.0, 96.5), 1.0, "Hz", False))
+#: the speed branch in pieces, (start, end) each. From about 93.1 to 93.5 Hz the settled response is another torus,
+#: (f_L, f_H/6), and the (f_L, f_H/3) torus, which harmonic balance still finds, is unstable
+#: (validation/hb_torus_speed_window.py); at 93.333 Hz (3:4, the order (4, -9) at 0 Hz) every orbit is periodic. The
+#: pieces end short of that window on either side. Where an order of the box comes to 0 Hz the branch may stall, its
+#: steps shrinking in corners: down from 91.37 Hz near 91.142 Hz ((23, -53) at 91.132), up from it at 91.4569 Hz
+#: ((27, -62) at 91.4516), up from 94.5 Hz at 96.162 Hz; the pieces from 92.4 Hz (a speed whose start window resolves
+#: the start's orders: at 91.6 Hz two of them are 1.5 Hz apart) come to the second from the other side (fixed-speed
+#: solves go through the third: the window script). The last field: the branch traced again with Brent's folds (the
+#: clearance's only: the speed's pieces take minutes more)
 MAX_POINTS = 120  #: a piece's most points
 SPEEDUP = 10.0  #: the issue's: each point at least 10x cheaper than a settled transient there
 
