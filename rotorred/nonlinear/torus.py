@@ -55,6 +55,7 @@ from rotorred.nonlinear.condensed import dynamic_compliance, real_form
 from rotorred.nonlinear.fourier import alias_free_samples, from_phasors, proportional_columns, to_phasors
 from rotorred.nonlinear.hb import Evaluation, NotConverged, checked_unknowns, harmonic_dataset, sampled_forces
 from rotorred.nonlinear.torus_krylov import RankJacobian, block_product
+from rotorred.nonlinear.torus_toeplitz import toeplitz_real_form
 from rotorred.results import Result
 from rotorred.signals.spectra import pyfftw
 
@@ -137,8 +138,7 @@ class TorusHarmonics:
         """Where each order sits on the half spectrum of the real 2-D FFT, the real transform along theta_2 (the
         contiguous axis): ``_half`` the flat position (row k_1 mod N_1, column |k_2|) of each order, its conjugate's
         for k_2 < 0 (``_imaginary_sign``, ``_sine_sign``: the conjugate's signs), and ``_mirror``/``_mirrored``: the
-        orders (k_1 > 0, 0), whose negative the column k_2 = 0 holds too. The K x K maps of differences and sums of
-        two orders are built only when a dense Toeplitz matrix is asked (:meth:`_pair_maps`)."""
+        orders (k_1 > 0, 0), whose negative the column k_2 = 0 holds too."""
         k1, k2 = self.orders[:, 0], self.orders[:, 1]
         width = self.N2 // 2 + 1
         negative = k2 < 0
@@ -150,23 +150,6 @@ class TorusHarmonics:
         object.__setattr__(self, "_mirrored", mirrored)
         object.__setattr__(self, "_mirror", (((-k1[mirrored]) % self.N1) * width).astype(np.intp))
         object.__setattr__(self, "_lazy", {})
-
-    def _pair_maps(self, among: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Where the difference and the sum of each two orders (of the positions ``among``, default all, kept then)
-        sit on the flattened full grid, (L, L) each: only for dense Toeplitz matrices (:meth:`toeplitz_blocks`)."""
-        if among is None and "pairs" in self._lazy:
-            return self._lazy["pairs"]
-        orders = self.orders if among is None else self.orders[among]
-        k1, k2 = orders[:, 0], orders[:, 1]
-        index_type = np.int32 if self.n_samples < 2**31 else np.intp
-
-        def flat(m1, m2):
-            return ((m1 % self.N1) * self.N2 + (m2 % self.N2)).astype(index_type)
-        maps = (flat(k1[:, None] - k1[None, :], k2[:, None] - k2[None, :]),
-                flat(k1[:, None] + k1[None, :], k2[:, None] + k2[None, :]))
-        if among is None:
-            self._lazy["pairs"] = maps
-        return maps
 
     def _plan(self, kind: str, p: int) -> _GridTransform:
         """The real 2-D FFT of p signals on this grid (:class:`_GridTransform`), kept per kind and p."""
@@ -489,41 +472,25 @@ class TorusHarmonics:
         E[:, 1::2], E[:, 2::2] = np.cos(phase), np.sin(phase)
         return E
 
-    def toeplitz_blocks(self, columns: np.ndarray, among: np.ndarray | None = None) -> np.ndarray:
-        """``T(d)`` of each sampled column ``d`` of ``columns``, from its 2-D spectrum (module docstring), between all
-        the orders or only those at the positions ``among`` (ascending, 0 first: the rows and columns of those
-        orders). Written in place, a real part at a time.
+    def toeplitz_blocks(self, columns: np.ndarray) -> np.ndarray:
+        """``T(d)`` of each sampled column ``d`` of ``columns``, from its 2-D spectrum (module docstring), by the
+        compiled rule of :mod:`rotorred.nonlinear.torus_toeplitz` (the one the preconditioner's block is built by).
 
         Parameters
         ----------
         columns : ndarray, shape (N_1 N_2, p)
             p sampled Jacobian entries on the grid (e.g. df/dq (N/m)).
-        among : ndarray of int, shape (L,), optional
-            Positions of orders in :attr:`orders`, starting with 0 (the mean); default all (L = K).
 
         Returns
         -------
-        ndarray, shape (p, 2L - 1, 2L - 1)
+        ndarray, shape (p, 2K - 1, 2K - 1)
             In the units of ``columns``.
         """
         p = columns.shape[1]
-        K = self.n_orders if among is None else len(among)
         S = np.fft.fft2(columns.reshape(self.N1, self.N2, p), axes=(0, 1)).reshape(self.n_samples, p) / self.n_samples
-        real, imag = np.ascontiguousarray(S.real.T), np.ascontiguousarray(S.imag.T)
-        difference, total = self._pair_maps(among)
-        out = np.empty((p, 2 * K - 1, 2 * K - 1))
-        for i in range(p):
-            rm, rp = real[i][difference], real[i][total]  # Re D_{k-j}, Re D_{k+j}
-            im, ip = imag[i][difference], imag[i][total]
-            inner = out[i, 1:, 1:].reshape(K - 1, 2, K - 1, 2)  # (order, a or b) x (order, a or b), a view
-            np.add(rm[1:, 1:], rp[1:, 1:], out=inner[:, 0, :, 0])
-            np.subtract(im[1:, 1:], ip[1:, 1:], out=inner[:, 0, :, 1])
-            np.add(im[1:, 1:], ip[1:, 1:], out=inner[:, 1, :, 0])
-            np.negative(inner[:, 1, :, 0], out=inner[:, 1, :, 0])
-            np.subtract(rm[1:, 1:], rp[1:, 1:], out=inner[:, 1, :, 1])
-            out[i, 0, 0] = rm[0, 0]  # the a_0 row is halved: (Re D_{-j} + Re D_j) / 2
-            out[i, 0, 1::2], out[i, 0, 2::2] = 0.5 * (rm[0, 1:] + rp[0, 1:]), 0.5 * (im[0, 1:] - ip[0, 1:])
-            out[i, 1::2, 0], out[i, 2::2, 0] = rm[1:, 0] + rp[1:, 0], -(im[1:, 0] + ip[1:, 0])
+        out = np.empty((p, self.size, self.size))
+        toeplitz_real_form(np.ascontiguousarray(S.T), self.orders[:, 0].astype(np.int64),
+                           self.orders[:, 1].astype(np.int64), self.N1, self.N2, out)
         return out
 
     def toeplitz(self, d: np.ndarray) -> np.ndarray:

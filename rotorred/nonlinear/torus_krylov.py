@@ -34,6 +34,7 @@ import numpy as np
 import scipy.linalg as sla
 from numba import njit
 
+from rotorred.nonlinear.torus_toeplitz import pair_block, pair_positions
 from rotorred.transient import numba_cache
 
 numba_cache.register()
@@ -310,14 +311,6 @@ def block_product(B0: np.ndarray, Bk: np.ndarray, X: np.ndarray, c: int) -> np.n
     return out
 
 
-@njit(cache=True, inline="always")
-def _wrapped(k, N):  # pragma: no cover (compiled)
-    """``k mod N``, without a division where ``-N <= k < N`` (the pairs of orders of a grid that resolves them)."""
-    if k < 0:
-        k += N
-    return k if 0 <= k < N else k % N
-
-
 @njit(cache=True)
 def _compliant_block(Sq, Sv, k1, k2, N1, N2, wk, P0, Pk, out):  # pragma: no cover (compiled)
     """``out`` (n, n), n = (2L - 1) r, receives ``(I + C G)^T``: C the Toeplitz matrix (harmonic-major, real form)
@@ -325,8 +318,8 @@ def _compliant_block(Sq, Sv, k1, k2, N1, N2, wk, P0, Pk, out):  # pragma: no cov
     2-D DFT over N_1 N_2 samples, component rho s + sigma), plus the velocity field's (``Sv``, or no rows) times the
     derivative ``w . nabla`` on the right (``wk`` (L - 1,): each order's ``k . w``, rad/s); G the compliance blocks of
     those orders, ``P0`` (s, r) and ``Pk`` (L - 1, 2s, 2r). Row by row of ``out`` (a column order b at a time), so
-    that ``out.T`` is the block in Fortran order. The Toeplitz entries of the orders a, b are those of
-    :meth:`rotorred.nonlinear.torus.TorusHarmonics.toeplitz_blocks`, from ``D_(ka - kb)`` and ``D_(ka + kb)``."""
+    that ``out.T`` is the block in Fortran order. The Toeplitz entries of the orders a, b are
+    :func:`rotorred.nonlinear.torus_toeplitz.pair_block`'s, the rule of the dense Jacobian's too."""
     rs, L = Sq.shape[0], k1.shape[0]
     r, s = P0.shape[1], P0.shape[0]
     n = (2 * L - 1) * r
@@ -336,21 +329,12 @@ def _compliant_block(Sq, Sv, k1, k2, N1, N2, wk, P0, Pk, out):  # pragma: no cov
         width = s if b == 0 else 2 * s
         C[:, :width] = 0.0
         for a in range(L):
-            d = _wrapped(k1[a] - k1[b], N1) * N2 + _wrapped(k2[a] - k2[b], N2)
-            t = _wrapped(k1[a] + k1[b], N1) * N2 + _wrapped(k2[a] + k2[b], N2)
+            minus, plus = pair_positions(k1, k2, a, b, N1, N2)
             for c in range(rs):
                 rho, sigma = c // s, c % s
                 for field in range(2 if velocity else 1):
                     S = Sq if field == 0 else Sv
-                    rm, im, rp, ip = S[c, d].real, S[c, d].imag, S[c, t].real, S[c, t].imag
-                    if a == 0 and b == 0:
-                        block = ((rm, 0.0), (0.0, 0.0))
-                    elif a == 0:
-                        block = ((0.5 * (rm + rp), 0.5 * (im - ip)), (0.0, 0.0))
-                    elif b == 0:
-                        block = ((rm + rp, 0.0), (-(im + ip), 0.0))
-                    else:
-                        block = ((rm + rp, im - ip), (-(im + ip), rm - rp))
+                    block = pair_block(S[c, minus], S[c, plus], a, b)
                     for i in range(1 if a == 0 else 2):  # the row order's cos (or mean), sin
                         row = (0 if a == 0 else 2 * a - 1 + i) * r + rho
                         if field == 0:

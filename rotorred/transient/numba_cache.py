@@ -50,7 +50,7 @@ PACKAGE = Path(__file__).resolve().parent.parent
 KERNEL_SOURCES = ("transient/contact.py", "transient/contact_solve.py", "transient/kernel.py",
                   "transient/ramp_kernel.py", "transient/eigen_kernel.py", "nonlinear/sampled.py",
                   "nonlinear/forces.py", "transient/status.py",
-                  "nonlinear/torus_krylov.py")
+                  "nonlinear/torus_krylov.py", "nonlinear/torus_toeplitz.py")
 GENERATED = "_generated"
 
 
