@@ -133,6 +133,24 @@ def test_an_interrupt_keeps_the_points_so_far():
     assert max(problem.evaluate(z, w).relative for z, w in zip(branch.z, branch.omega)) < 1e-10
 
 
+def test_a_corner_step_that_newton_does_not_move_is_no_point():
+    """Past a corner the step in omega alone takes the first candidate Newton reaches: one reached from the corner's
+    own solution without an iteration (omega moved by 1e-13 rad/s: the old coefficients' residual there 5.3e-13, within
+    1e-10) is the same point and is passed over; from the linear response, or for a step Newton has to correct
+    (1e-3 rad/s: 1 iteration, to 1.4e-16), it is the next point, a solution to the tolerance."""
+    import rotorred.nonlinear.continuation as continuation
+    problem, tol = jeffcott(5, 128), 1e-10
+    omega = 0.5
+    found = continuation._solved(problem, problem.linear_response(omega), omega, tol)
+    y = np.append(found.z, omega)
+    point = continuation._Point(y, continuation._tangent(problem, y, None, 1.0, found.evaluation), found.iterations)
+    assert continuation._candidate(problem, point, None, point.y[:-1], omega + 1e-13, 0.1, tol, own=True) is None
+    same = continuation._candidate(problem, point, None, point.y[:-1], omega + 1e-13, 0.1, tol)
+    assert same is not None and same.iterations == 0
+    moved = continuation._candidate(problem, point, None, point.y[:-1], omega + 1e-3, 0.1, tol, own=True)
+    assert moved is not None and moved.iterations >= 1 and problem.evaluate(moved.y[:-1], moved.y[-1]).relative < tol
+
+
 def test_rotorred_continue_writes_the_branch(tmp_path):
     """The command writes branch.csv (a row a point, the key first), branch_lines.csv, branch.nc (the same values,
     labelled), branch.png and branch.txt (with the folds); the multipliers are computed (finite)."""

@@ -224,6 +224,31 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
     assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)
 
 
+def test_a_torus_branch_that_stays_at_one_value_ends_saying_where_and_near_which_order(monkeypatch):
+    """With the stall rule widened (3 points within 100 % of their value: every branch), the speed branch above ends
+    after 3 points, not interrupted, saying where and naming the order of the box nearest 0 Hz there (found here by
+    enumerating the 2 x 8 box); its points are kept. With the rule as it is, the same branch reaches its end (the test
+    above)."""
+    import rotorred as rr
+    import rotorred.scenes.torus_branch as torus_branch
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+
+    monkeypatch.setattr(torus_branch, "STALL_POINTS", 3)
+    monkeypatch.setattr(torus_branch, "STALL_SPAN", 1.0)
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    branch = rr.continue_torus(scene, build_model(scene).model, "speeds.outer", 91.37, 91.8,
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8))
+    v = branch.values[-1]
+    box = [(k1, k2) for k1 in range(3) for k2 in range(-8, 9) if k1 > 0 or k2 > 0]
+    f = {k: k[0] * 70.0 + k[1] * v / 3 for k in box if abs(k[0] * 70.0 + k[1] * v / 3) <= 1500.0}
+    k = min(f, key=lambda key: abs(f[key]))
+    assert len(branch.values) == 3 and not branch.interrupted
+    assert branch.stopped == (f"the branch stalled at speeds.outer = {v:.10g} Hz: its last 3 points lie within "
+                              f"{np.ptp(branch.values):.3g} Hz (the order ({k[0]}, {k[1]}) of the box is at "
+                              f"{f[k]:+.3g} Hz there); start another branch past it")
+
+
 @pytest.mark.parametrize("extra, tokens", [
     (["--torus", "1", "--param", "rub.clearance=14e-6:12e-6"], ["--torus", "1,3"]),
     (["--torus", "1,3", "--orders", "0,8", "--param", "rub.clearance=14e-6:12e-6"], ["--orders", "0,8"]),

@@ -558,15 +558,17 @@ def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
     omega, gets past it, started from the corner's solution and from the linear response (the side without contact);
     the new tangent is oriented along the secant. A candidate back along the tangent (its
     secant within 26 degrees of the reversed tangent), or nearer to the previous point than the corner is, lies on
-    the part just traced, and is passed over."""
+    the part just traced, and is passed over; so is one Newton took from the corner's own solution without an
+    iteration (its residual already within the tolerance at the new omega: the same point, no step; on the rig's
+    outer-speed torus branch such points went back and forth across 5 mHz at 96.162 Hz until ``max_points``)."""
     heading = np.sign(point.t[-1]) or 1.0
     for sign in (heading, -heading):
         for delta in ds * 0.25 ** np.arange(9):  # a steep branch moves far for a small change of omega
             omega = point.y[-1] + sign * delta
             if omega <= 0.0:
                 continue
-            for start in (point.y[:-1], problem.linear_response(omega)):
-                found = _candidate(problem, point, previous, start, omega, ds, tol)
+            for own, start in ((True, point.y[:-1]), (False, problem.linear_response(omega))):
+                found = _candidate(problem, point, previous, start, omega, ds, tol, own)
                 if found is not None:
                     return found
     return None
@@ -583,12 +585,14 @@ def _solved(problem, z0, omega, tol, max_iter: int = 40, max_halvings: int = 30)
     return solve_periodic(problem, z0, omega, tol=tol, max_iter=max_iter, max_halvings=max_halvings)
 
 
-def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds, tol):
-    """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far or on the part
-    just traced."""
+def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds, tol, own: bool = False):
+    """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far, on the part
+    just traced, or (``own``: ``start`` is the corner's solution) reached without an iteration."""
     try:
         found = _solved(problem, start, omega, tol, CORNER_ITERATIONS, CORNER_HALVINGS)
     except NotConverged:
+        return None
+    if own and found.iterations == 0:
         return None
     y = np.append(found.z, omega)
     secant = y - point.y
