@@ -133,11 +133,13 @@ def test_an_interrupt_keeps_the_points_so_far():
     assert max(problem.evaluate(z, w).relative for z, w in zip(branch.z, branch.omega)) < 1e-10
 
 
-def test_a_corner_step_that_newton_does_not_move_is_no_point():
-    """Past a corner the step in omega alone takes the first candidate Newton reaches: one reached from the corner's
-    own solution without an iteration (omega moved by 1e-13 rad/s: the old coefficients' residual there 5.3e-13, within
-    1e-10) is the same point and is passed over; from the linear response, or for a step Newton has to correct
-    (1e-3 rad/s: 1 iteration, to 1.4e-16), it is the next point, a solution to the tolerance."""
+def test_a_corner_step_that_newton_does_not_move_is_no_point(monkeypatch):
+    """Past a corner the step in omega alone takes the first candidate Newton reaches. One reached from the corner's
+    own solution without an iteration at a step shorter than the first (omega moved by 1e-13 rad/s: the old
+    coefficients' residual there 5.3e-13, within 1e-10) is the same point and is passed over; from the linear
+    response, or for a step Newton has to correct (1e-3 rad/s: 1 iteration, to 1.4e-16), it is the next point. At the
+    first step it is a point (a flat branch): with the linear response made useless, ``_past_a_corner`` at ds = 1e-13
+    returns the corner's solution at omega + ds, not at a shorter step."""
     import rotorred.nonlinear.continuation as continuation
     problem, tol = jeffcott(5, 128), 1e-10
     omega = 0.5
@@ -148,7 +150,38 @@ def test_a_corner_step_that_newton_does_not_move_is_no_point():
     same = continuation._candidate(problem, point, None, point.y[:-1], omega + 1e-13, 0.1, tol)
     assert same is not None and same.iterations == 0
     moved = continuation._candidate(problem, point, None, point.y[:-1], omega + 1e-3, 0.1, tol, own=True)
-    assert moved is not None and moved.iterations >= 1 and problem.evaluate(moved.y[:-1], moved.y[-1]).relative < tol
+    assert moved is not None and moved.iterations >= 1
+    monkeypatch.setattr(type(problem), "linear_response", lambda self, w: np.full(self.size, 1e3))
+    flat = continuation._past_a_corner(problem, point, None, 1e-13, tol)
+    assert flat is not None and flat.y[-1] == omega + 1e-13 and flat.iterations == 0
+
+
+def test_a_branch_that_crawls_stops_saying_where_and_one_that_walks_does_not(monkeypatch):
+    """``ContinuationOptions(stall=share)``: a branch whose steps are held to 1 % of its first (real points, each
+    converged) moved 0.09 ds over its last 10 points, within 0.009 rad/s of omega = 0.5 (1.8 %): with a share of 5 % it
+    ends as stalled after 10 points, saying where; with 0.1 % it goes on (the span too wide), and held to 20 % of its
+    first step (1.8 ds over 10 points) too (it walks)."""
+    import rotorred.nonlinear.continuation as continuation
+    problem, traced = jeffcott(5, 128), continuation._step
+    assert continuation.STALL_POINTS == 10
+
+    def held(share):
+        def step(problem, point, previous, ds, ds_min, ds_max, tol, curved=False):
+            cap = share * 0.1
+            return traced(problem, point, previous, min(ds, cap), ds_min, min(ds_max, cap), tol, curved)
+        return step
+
+    def branch(share, stall):
+        monkeypatch.setattr(continuation, "_step", held(share))
+        return continue_branch(problem, problem.linear_response(0.5), 0.5, 12.0,
+                               ContinuationOptions(ds=0.1, stability=False, max_points=30, stall=stall))
+    crawl = branch(0.01, 0.05)
+    assert len(crawl.omega) == 10 and crawl.stopped.startswith(
+        f"the branch stalled at {continuation._at(problem, crawl.omega[-1])}: its last 10 points lie within ")
+    assert "less than its first step ds = 0.1; start another branch past it" in crawl.stopped
+    assert max(problem.evaluate(z, w).relative for z, w in zip(crawl.z, crawl.omega)) < 1e-10
+    assert branch(0.01, 1e-3).stopped.startswith("stopped at max_points = 30")
+    assert branch(0.2, 0.05).stopped.startswith("stopped at max_points = 30")
 
 
 def test_rotorred_continue_writes_the_branch(tmp_path):

@@ -224,17 +224,24 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
     assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)
 
 
-def test_a_torus_branch_that_stays_at_one_value_ends_saying_where_and_near_which_order(monkeypatch):
-    """With the stall rule widened (3 points within 100 % of their value: every branch), the speed branch above ends
-    after 3 points, not interrupted, saying where and naming the order of the box nearest 0 Hz there (found here by
-    enumerating the 2 x 8 box); its points are kept. With the rule as it is, the same branch reaches its end (the test
-    above)."""
+def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monkeypatch):
+    """The speed branch above with its steps held to 1 % of its first (real points, each converged; the span rule
+    widened to 100 % of the speed: ``tests/test_branch.py`` checks the span) stalls after 10 points: it ends, not
+    interrupted, saying where and naming the order of the box nearest 0 Hz there (found here by enumerating the 2 x 8
+    box in its 1500 Hz band); its points are kept. Unheld, the same branch reaches its end (the test above)."""
     import rotorred as rr
+    import rotorred.nonlinear.continuation as continuation
     import rotorred.scenes.torus_branch as torus_branch
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
 
-    monkeypatch.setattr(torus_branch, "STALL_POINTS", 3)
+    traced, first = continuation._step, []
+
+    def held(problem, point, previous, ds, ds_min, ds_max, tol, curved=False):
+        first.append(ds)
+        cap = 0.01 * first[0]
+        return traced(problem, point, previous, min(ds, cap), ds_min, min(ds_max, cap), tol, curved)
+    monkeypatch.setattr(continuation, "_step", held)
     monkeypatch.setattr(torus_branch, "STALL_SPAN", 1.0)
     scene = load_scene("paper-rub", {"speeds.outer": 91.37})
     branch = rr.continue_torus(scene, build_model(scene).model, "speeds.outer", 91.37, 91.8,
@@ -243,10 +250,11 @@ def test_a_torus_branch_that_stays_at_one_value_ends_saying_where_and_near_which
     box = [(k1, k2) for k1 in range(3) for k2 in range(-8, 9) if k1 > 0 or k2 > 0]
     f = {k: k[0] * 70.0 + k[1] * v / 3 for k in box if abs(k[0] * 70.0 + k[1] * v / 3) <= 1500.0}
     k = min(f, key=lambda key: abs(f[key]))
-    assert len(branch.values) == 3 and not branch.interrupted
-    assert branch.stopped == (f"the branch stalled at speeds.outer = {v:.10g} Hz: its last 3 points lie within "
-                              f"{np.ptp(branch.values):.3g} Hz (the order ({k[0]}, {k[1]}) of the box is at "
-                              f"{f[k]:+.3g} Hz there); start another branch past it")
+    assert len(branch.values) == 10 and not branch.interrupted
+    assert branch.stopped.startswith(f"the branch stalled at speeds.outer = {v:.9g} Hz: its last 10 points lie "
+                                     f"within {np.ptp(branch.values):.3g} Hz and moved ")
+    assert branch.stopped.endswith(f"(the order ({k[0]}, {k[1]}) of the box is at {f[k]:+.3g} Hz there); start "
+                                   f"another branch past it")
 
 
 @pytest.mark.parametrize("extra, tokens", [

@@ -64,6 +64,8 @@ FOLD_XTOL = 1e-10
 #: a fold interpolated without a solve (:func:`_interpolated_fold`) is a corner where the tangents either side of it
 #: turn by more than this (rad): at a smooth fold traced in steps that follow its curvature they turn by little
 CORNER_TURN = np.pi / 3
+#: the points a stall is judged on (:class:`ContinuationOptions`'s ``stall``)
+STALL_POINTS = 10
 
 
 @dataclass(frozen=True)
@@ -276,6 +278,10 @@ class ContinuationOptions:
         :data:`FOLD_XTOL` of the step). False: the fold is the turn of the cubic Hermite curve through the two points
         either side of it and their tangents, without a solve (:func:`_interpolated_fold`), for a problem whose
         corrections are costly (a torus); a corner where the tangents turn by more than :data:`CORNER_TURN`.
+    stall : float, optional
+        A branch whose last :data:`STALL_POINTS` points lie within this share of their omega (> 0) and together moved
+        less than the first step ``ds`` along it ends there, saying so: its steps crawl through corners, each point at
+        the step control's greatest cost (its halvings, then a step in omega alone). None (default): no such end.
     """
 
     ds: float = 0.05
@@ -286,6 +292,7 @@ class ContinuationOptions:
     stability: bool = True
     curved: bool = False
     fold_refine: bool = True
+    stall: float | None = None
 
     def __post_init__(self):
         checks.positive("ds_min", self.ds_min)
@@ -296,6 +303,8 @@ class ContinuationOptions:
         checks.boolean("stability", self.stability)
         checks.boolean("curved", self.curved)
         checks.boolean("fold_refine", self.fold_refine)
+        if self.stall is not None:
+            checks.positive("stall", self.stall)
 
 
 def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float, omega_end: float,
@@ -346,7 +355,7 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
     try:  # the whole loop: an interrupt anywhere in it leaves ``points`` whole
         stopped = _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max,
-                         max_points, tol, progress, curved, o.fold_refine) or stopped
+                         max_points, tol, progress, curved, o.fold_refine, o.stall) or stopped
         interrupt = ""
     except tuple(interrupts) as exc:
         interrupt = interrupt_name(exc, interrupts)
@@ -355,9 +364,10 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
 
 
 def _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max, max_points,
-           tol, progress, curved, fold_refine: bool = True) -> str:
+           tol, progress, curved, fold_refine: bool = True, stall: float | None = None) -> str:
     """Step from ``points[-1]`` on, appending to ``points`` and ``folds`` (``path`` and ``chords`` kept with them),
     until omega passes ``omega_end``: why it stopped, or "" when it reached the end."""
+    first_ds = ds
     while len(points) < max_points:
         if progress is not None:
             progress(len(points), points[-1].y[-1])
@@ -380,7 +390,24 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
         if direction * (nxt.y[-1] - omega_start) < 0.0:
             return (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
                     f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
+        if stall is not None and len(points) >= STALL_POINTS:
+            why = _stalled(problem, path[len(points) - STALL_POINTS:len(points)],
+                           chords[len(points) - STALL_POINTS:len(points) - 1], stall, first_ds)
+            if why:
+                return why
     return f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
+
+
+def _stalled(problem, Y: np.ndarray, chords: np.ndarray, share: float, ds: float) -> str:
+    """Why the branch stalled at its last points ``Y`` (their chords ``chords``): within ``share`` of their omega and
+    less than ``ds`` along it together; "" where it did not."""
+    values = [_value(problem, s) for s in Y[:, -1]]
+    span, moved = max(values) - min(values), float(np.sum(chords))
+    if span > share * abs(values[-1]) or moved >= ds:
+        return ""
+    return (f"the branch stalled at {_at(problem, Y[-1, -1])}: its last {len(Y)} points lie within {span:.3g} "
+            f"{parameter_of(problem)[1]} and moved {moved:.3g} along it together, less than its first step ds = "
+            f"{ds:.3g}; start another branch past it")
 
 
 def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
@@ -559,15 +586,16 @@ def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
     the new tangent is oriented along the secant. A candidate back along the tangent (its
     secant within 26 degrees of the reversed tangent), or nearer to the previous point than the corner is, lies on
     the part just traced, and is passed over; so is one Newton took from the corner's own solution without an
-    iteration (its residual already within the tolerance at the new omega: the same point, no step; on the rig's
-    outer-speed torus branch such points went back and forth across 5 mHz at 96.162 Hz until ``max_points``)."""
+    iteration at a step shorter than the first (the larger steps failed, so the solution moves there: the old one
+    within the tolerance at a small step is the same point, no progress; on the rig's outer-speed torus branch such
+    points went back and forth at 96.162 Hz until ``max_points``). At the first step it is a point: a flat branch."""
     heading = np.sign(point.t[-1]) or 1.0
     for sign in (heading, -heading):
-        for delta in ds * 0.25 ** np.arange(9):  # a steep branch moves far for a small change of omega
+        for k, delta in enumerate(ds * 0.25 ** np.arange(9)):  # a steep branch moves far for a small change of omega
             omega = point.y[-1] + sign * delta
             if omega <= 0.0:
                 continue
-            for own, start in ((True, point.y[:-1]), (False, problem.linear_response(omega))):
+            for own, start in ((k > 0, point.y[:-1]), (False, problem.linear_response(omega))):
                 found = _candidate(problem, point, previous, start, omega, ds, tol, own)
                 if found is not None:
                     return found
@@ -587,7 +615,8 @@ def _solved(problem, z0, omega, tol, max_iter: int = 40, max_halvings: int = 30)
 
 def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds, tol, own: bool = False):
     """The solution at ``omega`` Newton reaches from ``start``, as the next point, unless it is too far, on the part
-    just traced, or (``own``: ``start`` is the corner's solution) reached without an iteration."""
+    just traced, or (``own``: ``start`` is the corner's solution, at a step shorter than the first) reached without an
+    iteration."""
     try:
         found = _solved(problem, start, omega, tol, CORNER_ITERATIONS, CORNER_HALVINGS)
     except NotConverged:

@@ -20,11 +20,11 @@ from rotorred.transient import numba_cache
 
 numba_cache.register()
 
-__all__ = ["toeplitz_real_form"]
+__all__ = ["pair_block", "pair_positions", "toeplitz_real_form"]
 
 
 @njit(cache=True, inline="always")
-def wrapped(k, N):  # pragma: no cover (compiled)
+def _wrapped(k, N):  # pragma: no cover (compiled)
     """``k mod N``, without a division where ``-N <= k < N`` (the pairs of orders of a grid that resolves them)."""
     if k < 0:
         k += N
@@ -34,8 +34,8 @@ def wrapped(k, N):  # pragma: no cover (compiled)
 @njit(cache=True, inline="always")
 def pair_positions(k1, k2, a, b, N1, N2):  # pragma: no cover (compiled)
     """The flat positions on the N_1 x N_2 spectrum of the difference and the sum of the orders a and b."""
-    return (wrapped(k1[a] - k1[b], N1) * N2 + wrapped(k2[a] - k2[b], N2),
-            wrapped(k1[a] + k1[b], N1) * N2 + wrapped(k2[a] + k2[b], N2))
+    return (_wrapped(k1[a] - k1[b], N1) * N2 + _wrapped(k2[a] - k2[b], N2),
+            _wrapped(k1[a] + k1[b], N1) * N2 + _wrapped(k2[a] + k2[b], N2))
 
 
 @njit(cache=True, inline="always")

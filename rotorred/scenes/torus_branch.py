@@ -58,21 +58,17 @@ CHECKS = 8
 #: the default box of orders and its grid: with the band of 900 Hz, 1799 orders on the rig's torus (f_L, f_H/3); the
 #: grid 128 x 256 gives the lines of 128 x 1024 to 0.06 % (docs/model.md §26)
 DEFAULT_ORDERS, DEFAULT_GRID = (32, 80), (128, 256)
-#: a branch whose last ``STALL_POINTS`` points lie within ``STALL_SPAN`` of their value (relative) has stalled and ends
-#: saying where, and which order of the box is nearest 0 Hz there: its continuation crawls through corners, each point
-#: at the step control's greatest cost. Down from 91.37 Hz the rig's outer-speed branch crawled at 91.1423 Hz, 10
-#: points within 0.64 mHz (7e-6 of the speed) at about 6 s each, the order (23, -53) of the box at 0.18 Hz; before
-#: the crawl, near its folds at 91.151 and 91.155 Hz, 10 points spanned several mHz. A physical branch is not that
-#: steep: a resonance of 1 % damping near 100 Hz is 1 Hz wide
-STALL_POINTS, STALL_SPAN = 10, 1e-5
+#: a branch whose last 10 points lie within this share of their value and moved less than its first step together has
+#: stalled and ends, saying where and, for a speed, which order of the box is nearest 0 Hz there
+#: (:class:`rotorred.nonlinear.continuation.ContinuationOptions`'s ``stall``): its continuation crawls through
+#: corners, each point at the step control's greatest cost. Down from 91.37 Hz the rig's outer-speed branch so ended at
+#: 91.1423 Hz, its last 10 points within 0.66 mHz (7e-6 of the speed), the order (23, -53) of the box at -0.18 Hz
+#: (docs/model.md §26). A physical branch is not that steep: a resonance of 1 % damping near 100 Hz is 2 Hz wide
+STALL_SPAN = 1e-5
 
 
 class _Check(Exception):
     """Ends a segment of a branch where its box is to be checked (:func:`continue_torus`)."""
-
-
-class _Stalled(Exception):
-    """Ends a branch whose last points stay at one value (:data:`STALL_POINTS`)."""
 
 
 @dataclass(frozen=True)
@@ -483,8 +479,8 @@ def continue_torus(scene, model, key: str, start: float, end: float,
                                   interrupts)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
         point_time = np.concatenate([[stamps[1] - began], times, np.zeros(len(branch.values) - 1 - len(times))])
-        if branch.interrupt == "stalled":
-            branch = dataclasses.replace(branch, interrupt="", stopped=_stalled_at(rubs, scene, key, branch.values))
+        if branch.stopped.startswith("the branch stalled") and key.startswith("speeds."):
+            branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
         segments.append((rubs, branch, point_time))
         if branch.interrupt != "check":
             break
@@ -498,7 +494,7 @@ def _segment(family, z, value, end, options, check_at, progress, before, interru
     passes ``check_at`` (None: never): the branch and the stamps of its progress calls."""
     s_start, s_end = family.carried(value), family.carried(end)
     scale = max(float(np.linalg.norm(z)), abs(s_end - s_start))
-    stamps, recent = [time.perf_counter()], []
+    stamps = [time.perf_counter()]
     ahead = np.sign(end - value)
 
     def stamped(points: int, s: float) -> None:
@@ -508,29 +504,27 @@ def _segment(family, z, value, end, options, check_at, progress, before, interru
             progress(before + points, v)
         if check_at is not None and points > 1 and ahead * (v - check_at) >= 0.0:
             raise _Check()
-        recent[:] = recent[-(STALL_POINTS - 1):] + [v]
-        if len(recent) == STALL_POINTS and max(recent) - min(recent) <= STALL_SPAN * abs(v):
-            raise _Stalled()
     ds, ds_max = options.steps
     branch = continue_branch(family, z, s_start, s_end,
                              ContinuationOptions(ds=ds * scale, ds_min=1e-9 * scale, ds_max=ds_max * scale,
                                                  max_points=options.max_points, tol=options.tol, stability=False,
-                                                 curved=True, fold_refine=options.fold_refine), progress=stamped,
-                             interrupts={**interrupts, _Check: "check", _Stalled: "stalled"})
+                                                 curved=True, fold_refine=options.fold_refine, stall=STALL_SPAN),
+                             progress=stamped,
+                             interrupts={**interrupts, _Check: "check"})
     stamps.append(time.perf_counter())
     return branch, stamps
 
 
-def _stalled_at(rubs: _Family, scene, key: str, values: np.ndarray) -> str:
-    """Why a stalled branch ended: where, its last points' span, and the order of the box nearest 0 Hz there."""
-    v, last = float(values[-1]), values[-STALL_POINTS:]
-    unit = KEYS.get(key, "Hz")
+def _nearest_order(rubs: _Family, scene, key: str, branch) -> str:
+    """A stalled speed branch's ``stopped``, with the order of the box nearest 0 Hz at its last value (the stalls of
+    docs/model.md §26 are near such an order's 0 Hz)."""
+    v = float(branch.values[-1])
     orders = rubs.first.problem.harmonics.orders[1:]
     f = orders @ np.asarray(rubs.bases(_scene_at(scene, key, v)))
     k = int(np.argmin(np.abs(f)))
-    return (f"the branch stalled at {key} = {v:.10g} {unit}: its last {STALL_POINTS} points lie within "
-            f"{float(np.ptp(last)):.3g} {unit} (the order ({orders[k, 0]}, {orders[k, 1]}) of the box is at "
-            f"{f[k]:+.3g} Hz there); start another branch past it")
+    stem = branch.stopped.removesuffix("; start another branch past it")
+    return (f"{stem} (the order ({orders[k, 0]}, {orders[k, 1]}) of the box is at {f[k]:+.3g} Hz there); start "
+            f"another branch past it")
 
 
 def _checked_box(scene, model, box, rub: TorusRubProblem, z, dof, options: TorusBranchOptions):
