@@ -156,6 +156,32 @@ def test_a_corner_step_that_newton_does_not_move_is_no_point(monkeypatch):
     assert flat is not None and flat.y[-1] == omega + 1e-13 and flat.iterations == 0
 
 
+def test_after_a_corner_the_next_step_in_omega_alone_comes_after_one_failed_arclength_step(monkeypatch):
+    """Where the branch goes on in corners (a point reached by a step in omega alone, its arclength steps failing), the
+    next point tries that omega step again after the first failed arclength step, instead of after six halvings and
+    the search from the largest step: with every arclength step made to fail, a point reached by a corner step of
+    1e-3 rad/s gets its next at omega + 1e-3 after 1 arclength attempt; a point reached by an arclength step gets the
+    search's first step (omega + ds) after 7. Each point is a solution to the tolerance."""
+    import rotorred.nonlinear.continuation as continuation
+    problem, tol = jeffcott(5, 128), 1e-10
+    omega = 0.5
+    found = continuation._solved(problem, problem.linear_response(omega), omega, tol)
+    y = np.append(found.z, omega)
+    t = continuation._tangent(problem, y, None, 1.0, found.evaluation)
+    attempts = []
+
+    def failing(*args, **kwargs):
+        attempts.append(1)
+        return None
+    monkeypatch.setattr(continuation, "_arclength", failing)
+    for corner, expected, tries in ((1e-3, omega + 1e-3, 1), (0.0, omega + 0.1, 7)):
+        attempts.clear()
+        point = continuation._Point(y, t, found.iterations, corner=corner)
+        nxt, _, why = continuation._step(problem, point, None, 0.1, 1e-6, 0.5, tol)
+        assert why == "" and nxt.y[-1] == expected and len(attempts) == tries
+        assert nxt.corner == expected - omega and problem.evaluate(nxt.y[:-1], nxt.y[-1]).relative < tol
+
+
 def test_a_branch_that_crawls_stops_saying_where_and_one_that_walks_does_not(monkeypatch):
     """``ContinuationOptions(stall=share)``: a branch whose steps are held to 1 % of its first (real points, each
     converged) moved 0.09 ds over its last 10 points, within 0.009 rad/s of omega = 0.5 (1.8 %): with a share of 5 % it

@@ -252,6 +252,7 @@ class _Point:
     t: np.ndarray  # unit tangent
     iterations: int
     clean: bool = False  # reached by an arclength step at its first try (no halving): the branch is smooth there
+    corner: float = 0.0  # reached by a step in omega alone past a corner: that step (signed), else 0
 
 
 @dataclass(frozen=True)
@@ -534,7 +535,10 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
     """The next point from ``point`` with step control: (point, next ds, "") or (None, ds, why). After six
     halvings (or at ``ds_min``), a corner is tried once (:func:`_past_a_corner`), then the halving goes on down to
     ``ds_min``. (Trying a corner at the first failure was tried and taken back: in smooth stretches its steps in
-    omega land on other parts of the branch.)"""
+    omega land on other parts of the branch.) A point itself reached past a corner tries the corner, its own step in
+    omega first, after the first failure: where the branch goes on in corners, each point a step in omega alone (the
+    rig's outer-speed torus branch down from 92.4 Hz past 91.503 Hz), the halvings and the search's failing candidates
+    took 5 to 8 s a point."""
     first, cornered = ds, False
     while ds >= ds_min:
         smooth = curved and ds == first and point.clean and previous is not None  # a curvature to predict with
@@ -542,9 +546,9 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
                           contraction=CONTRACTION if curved else None)
         if done is not None:
             return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""
-        if not cornered and (ds <= first / 64 or ds / 2 < ds_min):
+        if not cornered and (ds <= first / 64 or ds / 2 < ds_min or point.corner):
             cornered = True
-            corner = _past_a_corner(problem, point, previous, max(first, 64 * ds_min), tol)
+            corner = _past_a_corner(problem, point, previous, max(first, 64 * ds_min), tol, point.corner)
             if corner is not None:
                 return corner, first, ""
         ds *= 0.5
@@ -577,7 +581,7 @@ def _arclength(problem, point: _Point, previous: _Point | None, ds, tol, clean: 
     return _Point(y, t, it, clean), it
 
 
-def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
+def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol, again: float = 0.0):
     """The next point past a corner of the branch, or None. Where a contact starts (grazing) the branch has a kink:
     it may turn by about a right angle, so the plane normal to the old tangent meets the new part far away, and the
     arclength corrector fails at every step. A step in omega alone (``ds``, ``ds``/4, ... down to ``ds`` 4^-8, the first
@@ -588,7 +592,16 @@ def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol):
     the part just traced, and is passed over; so is one Newton took from the corner's own solution without an
     iteration at a step shorter than the first (the larger steps failed, so the solution moves there: the old one
     within the tolerance at a small step is the same point, no progress; on the rig's outer-speed torus branch such
-    points went back and forth at 96.162 Hz until ``max_points``). At the first step it is a point: a flat branch."""
+    points went back and forth at 96.162 Hz until ``max_points``). At the first step it is a point: a flat branch.
+    ``again``: the step in omega that reached ``point`` past a corner, tried first (where the branch goes on in
+    corners, each step in omega alone, its arclength steps failing: :func:`_step` comes here after the first of
+    them instead of six halvings)."""
+    if again:
+        omega = point.y[-1] + again
+        for start in (point.y[:-1], problem.linear_response(omega)):
+            found = _candidate(problem, point, previous, start, omega, ds, tol, own=True) if omega > 0.0 else None
+            if found is not None:
+                return found
     heading = np.sign(point.t[-1]) or 1.0
     for sign in (heading, -heading):
         for k, delta in enumerate(ds * 0.25 ** np.arange(9)):  # a steep branch moves far for a small change of omega
@@ -629,7 +642,7 @@ def _candidate(problem, point: _Point, previous: _Point | None, start, omega, ds
         previous is not None and np.linalg.norm(y - previous.y) < np.linalg.norm(point.y - previous.y))
     if np.linalg.norm(secant) > MAX_JUMP * ds or traced:
         return None
-    return _Point(y, _tangent(problem, y, secant, ev=found.evaluation), found.iterations)
+    return _Point(y, _tangent(problem, y, secant, ev=found.evaluation), found.iterations, corner=omega - point.y[-1])
 
 
 def _interpolated_fold(problem, a: _Point, b: _Point) -> Fold:
