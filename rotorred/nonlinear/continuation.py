@@ -596,22 +596,18 @@ def _past_a_corner(problem, point: _Point, previous: _Point | None, ds, tol, aga
     ``again``: the step in omega that reached ``point`` past a corner, tried first (where the branch goes on in
     corners, each step in omega alone, its arclength steps failing: :func:`_step` comes here after the first of
     them instead of six halvings)."""
-    if again:
-        omega = point.y[-1] + again
-        for start in (point.y[:-1], problem.linear_response(omega)):
-            found = _candidate(problem, point, previous, start, omega, ds, tol, own=True) if omega > 0.0 else None
+    heading = np.sign(point.t[-1]) or 1.0
+    steps = [(again, True)] if again else []  # (the step, shorter than the search's first)
+    steps += [(sign * delta, k > 0) for sign in (heading, -heading)
+              for k, delta in enumerate(ds * 0.25 ** np.arange(9))]  # a steep branch moves far for a small change
+    for step, shorter in steps:
+        omega = point.y[-1] + step
+        if omega <= 0.0:
+            continue
+        for own, start in ((shorter, point.y[:-1]), (False, problem.linear_response(omega))):
+            found = _candidate(problem, point, previous, start, omega, ds, tol, own)
             if found is not None:
                 return found
-    heading = np.sign(point.t[-1]) or 1.0
-    for sign in (heading, -heading):
-        for k, delta in enumerate(ds * 0.25 ** np.arange(9)):  # a steep branch moves far for a small change of omega
-            omega = point.y[-1] + sign * delta
-            if omega <= 0.0:
-                continue
-            for own, start in ((k > 0, point.y[:-1]), (False, problem.linear_response(omega))):
-                found = _candidate(problem, point, previous, start, omega, ds, tol, own)
-                if found is not None:
-                    return found
     return None
 
 
