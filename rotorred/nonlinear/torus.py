@@ -609,28 +609,47 @@ def _stiffness(M, D, K, w: np.ndarray) -> np.ndarray:
     return K[None] - w**2 * M[None] + 1j * w * D[None]
 
 
-def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray, rows=None):
-    """``(Z_k^-1)[rows, dofs]`` and ``(Z_k^-1 f_k)[rows]`` at the frequencies ``w`` (k,) (rad/s) by the first-order
-    system's modes, ``Z(iw)^-1 = V_q (iw - Lambda)^-1 V^-1 [0; M^-1]`` (one eigen-solution of the 2n state matrix, then
-    O(k n len(rows)) products, against k solves of n x n), as ``(X, Q)`` of shapes (k, len(rows), len(dofs)) and
-    (k, len(rows)) (``rows`` default every DOF); None where M is singular or the modes are too ill-conditioned: the
-    direct solve at sixteen of the orders differs by more than :data:`MODAL_MATCH`. Where the speed moves along a
-    branch, every value's problem has its own matrices (the gyroscopic term): the modes cost one eigen-solution a value
-    (docs/model.md §26), and its iterates need only the rows of the ``dofs`` (:meth:`TorusProblem._compliance`)."""
-    n, c = M.shape[0], list(dofs)
-    rows = list(range(n)) if rows is None else list(rows)
+def _projected(Q_full: np.ndarray, X: np.ndarray, outputs: np.ndarray | None):
+    """``(O Q_full, O X)`` of every DOF's linear responses Q_full (k, n) and compliance columns X (k, n, c) (None: O = I,
+    them as they are)."""
+    if outputs is None:
+        return Q_full, X
+    return Q_full @ outputs.T, np.einsum("pn,knc->kpc", outputs, X)
+
+
+def state_modes(M, D, K):
+    """The first-order system's modes: ``(lam, V_q, W)``, its eigenvalues (2n,), their eigenvectors' displacement rows
+    (n, 2n) and ``W = V^-1 [0; M^-1]`` (2n, n), so that ``Z(iw)^-1 = V_q (iw - Lambda)^-1 W``; None where M or the
+    eigenvectors are singular. One eigen-solution of the 2n state matrix (:func:`modal_compliance` takes its products)."""
+    n = M.shape[0]
     try:
         lam, V = sla.eig(state_matrix(M, D, K))
-        W = sla.solve(V, np.vstack([np.zeros((n, n)), sla.inv(M)]))  # (2n, n): V^-1 [0; M^-1]
+        W = sla.solve(V, np.vstack([np.zeros((n, n)), sla.inv(M)]))
     except (sla.LinAlgError, ValueError):
         return None
+    return lam, V[:n], W
+
+
+def modal_compliance(modes, M, D, K, dofs, w: np.ndarray, forcing: np.ndarray, outputs: np.ndarray):
+    """``O (Z_k^-1)[:, dofs]`` and ``O Z_k^-1 f_k`` at the frequencies ``w`` (k,) (rad/s) by the first-order system's
+    ``modes`` (:func:`state_modes`): ``Z(iw)^-1 = V_q (iw - Lambda)^-1 V^-1 [0; M^-1]``, O(k n p) products against k
+    solves of n x n, for the outputs ``O`` (p, n) (rows of the identity: those DOFs; an output row: a combination), as
+    ``(X, Q)`` of shapes (k, p, len(dofs)) and (k, p); None where the modes are too ill-conditioned: the direct solve
+    at sixteen of the orders differs by more than :data:`MODAL_MATCH`. Where the speed moves along a branch, every
+    value's problem has its own matrices (the gyroscopic term): the modes cost one eigen-solution a value (docs/model.md
+    §26); its iterates need only the rows of the ``dofs`` (:meth:`TorusProblem._compliance`), a point's lines only its
+    output's."""
+    lam, V_q, W = modes
+    c = list(dofs)
     r = 1.0 / (1j * w[:, None] - lam[None, :])  # (k, 2n)
-    Vq = V[rows]
+    Vq = outputs @ V_q
     X = np.einsum("ij,kj,jc->kic", Vq, r, W[:, c], optimize=True)
-    Q = (r * (forcing @ W.T)) @ Vq.T
+    Q = np.zeros((len(w), len(outputs)), complex)
+    forced = np.flatnonzero(np.any(forcing != 0.0, axis=1))  # a few orders (each spool's unbalance)
+    Q[forced] = (r[forced] * (forcing[forced] @ W.T)) @ Vq.T
     probe = np.unique(np.linspace(0, len(w) - 1, 16).astype(int))
     X_d, Q_d = dynamic_compliance(_stiffness(M, D, K, w[probe]), c, forcing[probe])
-    X_d, Q_d = X_d[:, rows], Q_d[:, rows]
+    X_d, Q_d = np.einsum("pn,knc->kpc", outputs, X_d), Q_d @ outputs.T
     scale_x, scale_q = np.max(np.abs(X_d)), np.max(np.abs(Q_d)) or 1.0
     if not (np.max(np.abs(X[probe] - X_d)) <= MODAL_MATCH * scale_x
             and np.max(np.abs(Q[probe] - Q_d)) <= MODAL_MATCH * scale_q):
@@ -641,20 +660,21 @@ def modal_compliance(M, D, K, dofs, w: np.ndarray, forcing: np.ndarray, rows=Non
 @dataclass(frozen=True)
 class _Compliance:
     """The condensation at the problem's base frequencies: G as blocks (G0, the (2c, 2c) block of each order), the
-    linear response of the ``c`` DOFs, and per order the full linear response and the compliance columns of every
-    DOF (:meth:`full`: ``Q_full`` (K, n_all) and ``X = (Z_k^-1)[:, c]`` (K, n_all, c), complex), computed by
-    ``recovery`` on first use where they were not at hand (only a solution's recovery asks them)."""
+    linear response of the ``c`` DOFs, and per order the linear response and the compliance columns of outputs,
+    ``recovery(O)`` -> ``(O Q_full, O X)``, ``Q_full`` (K, n_all) the full linear response and ``X = (Z_k^-1)[:, c]``
+    (K, n_all, c) (complex; O (p, n_all), None: every DOF, kept by :meth:`full`), computed on use where they were not at
+    hand (only a solution's recovery asks them)."""
 
     G0: np.ndarray
     Gk: np.ndarray
     z_lin: np.ndarray
-    recovery: Callable[[], tuple[np.ndarray, np.ndarray]]
+    recovery: Callable[[np.ndarray | None], tuple[np.ndarray, np.ndarray]]
     _kept: dict = field(default_factory=dict, repr=False, compare=False)
 
     def full(self) -> tuple[np.ndarray, np.ndarray]:
         """``(Q_full, X)`` of every DOF."""
         if "full" not in self._kept:
-            self._kept["full"] = self.recovery()
+            self._kept["full"] = self.recovery(None)
         return self._kept["full"]
 
 
@@ -743,19 +763,24 @@ class TorusProblem:
             return self._cache["compliance"]
         n_all, c, wk = self.M.shape[0], list(self.dofs), self.frequencies
         forcing = self.harmonics.phasors(self.forcing, n_all)
-        found = modal_compliance(self.M, self.D, self.K, c, wk, forcing, rows=c) if self._cache.get("modes") else None
-        if found is not None:  # the rows of the dofs: every DOF's only for a solution's recovery
+        modes = state_modes(self.M, self.D, self.K) if self._cache.get("modes") else None
+        found = None if modes is None else modal_compliance(modes, self.M, self.D, self.K, c, wk, forcing,
+                                                            np.eye(n_all)[c])
+        if found is not None:  # the rows of the dofs: every DOF's, or an output's, only for a solution's recovery
             H, Q_c = found
 
-            def recovery():
-                every = modal_compliance(self.M, self.D, self.K, c, wk, forcing)
-                return (every[1], every[0]) if every is not None else self._solved(wk, forcing)
+            def recovery(outputs):
+                O = np.eye(n_all) if outputs is None else outputs
+                got = modal_compliance(modes, self.M, self.D, self.K, c, wk, forcing, O)
+                if got is None:
+                    return _projected(*self._solved(wk, forcing), outputs)
+                return got[1], got[0]
         else:
             Q_full, X = self._solved(wk, forcing)
             H, Q_c = X[:, c, :], Q_full[:, c]
 
-            def recovery():
-                return Q_full, X
+            def recovery(outputs):
+                return _projected(Q_full, X, outputs)
         out = _Compliance(H[0].real, real_form(H[1:]), self.harmonics.from_phasors(Q_c), recovery)
         self._cache["compliance"] = out
         return out
@@ -953,21 +978,25 @@ class TorusProblem:
         return R, step, stats, J
 
     # ----------------------------------------------------------------------------------------------- recovery
-    def recover(self, z: np.ndarray) -> np.ndarray:
-        """Complex amplitudes ``Q_k`` of every DOF of the system (the line ``Re(Q_k exp(i k . theta))``) from the
-        solution on the ``dofs``.
+    def recover(self, z: np.ndarray, outputs: np.ndarray | None = None) -> np.ndarray:
+        """Complex amplitudes ``Q_k`` of every DOF of the system (the line ``Re(Q_k exp(i k . theta))``), or of
+        ``outputs``, from the solution on the ``dofs``.
 
         Parameters
         ----------
         z : ndarray, shape (size,)
             Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+        outputs : ndarray, shape (p, n_all), optional
+            Rows that combine the DOFs of ``M`` into p outputs (-); default every DOF (the identity). A few rows
+            cost a few DOFs' compliance (by the modes, no eigen-solution more).
 
         Returns
         -------
-        ndarray, shape (K, n_all), complex
+        ndarray, shape (K, n_all) or (K, p), complex
             (m; rad for a rotation DOF), n_all the DOFs of ``M``.
         """
-        Q_full, X = self._compliance().full()
+        Q_full, X = self._compliance().full() if outputs is None else \
+            self._compliance().recovery(np.atleast_2d(np.asarray(outputs, float)))
         q, v = self.samples(z)
         f = self.harmonics.coefficients(sampled_forces(self._local_forces, q, v)[0])
         F = self.harmonics.phasors(f, self.n)

@@ -84,8 +84,9 @@ class TorusRubProblem:
     def lines(self, z: np.ndarray, dof: tuple[int, str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every order's line at the model DOF ``dof`` = (node, direction): orders (K, 2), frequencies ``|k . f|``
         (Hz, shape (K,)) and amplitudes (m, shape (K,); the mean's absolute value for (0, 0))."""
-        Q = self.problem.recover(z)[:, :self.n_model]
-        y = Q @ self.model.output_rows([dof])[0]
+        row = np.zeros(self.problem.M.shape[0])  # the model's DOFs, then the plates'
+        row[:self.n_model] = self.model.output_rows([dof])[0]
+        y = self.problem.recover(z, row[None])[:, 0]
         h = self.problem.harmonics
         return h.orders, np.abs(h.frequencies(self.bases_hz)), np.abs(y)
 
