@@ -116,6 +116,20 @@ def test_a_branch_shows_itself(duffing_branch, tmp_path):
     assert "in omega (rad/s)" in text and "turns: 2, at omega = " in text and "stopped: reached the end" in text
 
 
+def test_a_branch_figure_breaks_its_line_where_told():
+    """``plot_branch(..., breaks)``: no line joins a point to the one before it at each break (a NaN between them in
+    the drawn data), with stability (its runs) and without; a break that is no point's is refused."""
+    from rotorred.checks import InputError
+    from rotorred.plots.branch import plot_branch
+    values, peaks = np.linspace(1.0, 2.0, 6), np.linspace(1e-6, 2e-6, 6)
+    for stable in (None, np.array([1, 1, 1, 0, 0, 0], float)):
+        fig = plot_branch(values, peaks, stable, (), xlabel="w (rad/s)", ylabel="peak (µm)", breaks=[2, 4])
+        x = np.concatenate([line.get_xdata() for line in fig.axes[0].lines])
+        assert np.isnan(x).sum() == 2 and np.all(np.isin(values, x))
+    with pytest.raises(InputError, match="breaks"):
+        plot_branch(values, peaks, None, (), xlabel="w (rad/s)", ylabel="peak (µm)", breaks=[6])
+
+
 def test_a_branchs_dataset_is_its_points_folds_and_stability(duffing_branch):
     """The amplitude of harmonic 1 of each point is Branch.amplitude (read from z by its own index rule); the
     parameter is omega; the stability flag is the sign of the largest Floquet exponent; the folds are the branch's."""

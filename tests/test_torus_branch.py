@@ -250,11 +250,59 @@ def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monke
     box = [(k1, k2) for k1 in range(3) for k2 in range(-8, 9) if k1 > 0 or k2 > 0]
     f = {k: k[0] * 70.0 + k[1] * v / 3 for k in box if abs(k[0] * 70.0 + k[1] * v / 3) <= 1500.0}
     k = min(f, key=lambda key: abs(f[key]))
-    assert len(branch.values) == 10 and not branch.interrupted
+    assert len(branch.values) == 10 and not branch.interrupted and branch.gaps == ()  # its 0 Hz far: not passed
     assert branch.stopped.startswith(f"the branch stalled at speeds.outer = {v:.9g} Hz: its last 10 points lie "
                                      f"within {np.ptp(branch.values):.3g} Hz and moved ")
     assert branch.stopped.endswith(f"(the order ({k[0]}, {k[1]}) of the box is at {f[k]:+.3g} Hz there); start "
                                    f"another branch past it")
+
+
+def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tmp_path):
+    """``past_stalls`` (the default): the branch of the test above, its steps held to 1 % of its first so that it
+    stalls every 10 points, with the order nearest 0 Hz put 0.01 Hz ahead of each stall (``_nearest`` replaced; the
+    real one is the message's, checked above): each stall is passed by a jump of twice that, 0.02 Hz, and the
+    continuation goes on from there, until the branch's most points; every point after a gap solves the problem built
+    from the scene at its speed (relative residual below the tolerance); the summary, the file's attributes and the
+    figure (its line broken there) show each gap."""
+    import rotorred as rr
+    import rotorred.nonlinear.continuation as continuation
+    import rotorred.scenes.torus_branch as torus_branch
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.quasi_periodic import default_grid
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    traced, first = continuation._step, []
+
+    def held(problem, point, previous, ds, ds_min, ds_max, tol, curved=False):
+        first.append(ds)
+        cap = 0.01 * first[0]
+        return traced(problem, point, previous, min(ds, cap), ds_min, min(ds_max, cap), tol, curved)
+    monkeypatch.setattr(continuation, "_step", held)
+    monkeypatch.setattr(torus_branch, "STALL_SPAN", 1.0)
+    monkeypatch.setattr(torus_branch, "_nearest", lambda rubs, scene, key, v: (7, -21, -0.07, 7.0))  # 0 Hz at v + 0.01
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = build_model(scene).model
+    branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8,
+                                                     max_points=35))
+    assert len(branch.values) == 35 and branch.stopped.startswith("stopped at max_points")
+    assert [i for i, _ in branch.gaps] == [10, 20, 30]
+    for i, why in branch.gaps:
+        v = float(branch.values[i])
+        assert v - branch.values[i - 1] == pytest.approx(0.02, rel=1e-9)
+        assert why == f"a stall passed: the order (7, -21) of the box at 0 Hz at {branch.values[i - 1] + 0.01:.6g} Hz"
+        there = load_scene("paper-rub", {"speeds.outer": v})
+        problem = torus_rub_problem(there, model, (70.0, v / 3), 2, 8, *default_grid(2, 8), 1500.0).problem
+        assert np.linalg.norm(problem.residual(branch.z[i])) < 1e-7 * problem.scale
+    text = "\n".join(branch.summary())
+    assert text.count("not traced: ") == 3 and f"not traced: {branch.values[9]:.6g} to {branch.values[10]:.6g} Hz" in text
+    assert branch.to_xarray().attrs["gaps"].count("a stall passed") == 3
+    fig = branch.plot(lines=1)
+    x = fig.axes[0].lines[0].get_xdata()
+    assert np.isnan(x).sum() == 3 and len(x) == 38
+    import matplotlib.pyplot as plt
+    plt.close(fig)
 
 
 @pytest.mark.parametrize("extra, tokens", [

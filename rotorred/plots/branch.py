@@ -35,7 +35,7 @@ def laid_out(ax, figsize: tuple[float, float]):
 
 
 def plot_branch(values, peaks, stable, folds, ax=None, *, xlabel: str, ylabel: str, changes=(), xscale: float = 1.0,
-                scale: float = 1e6, unit: str = "µm", title: str | None = None):
+                scale: float = 1e6, unit: str = "µm", title: str | None = None, breaks=()):
     """The branch's peak response against the key.
 
     Parameters
@@ -61,6 +61,8 @@ def plot_branch(values, peaks, stable, folds, ax=None, *, xlabel: str, ylabel: s
     unit : str
         The response's plotted unit (in ``ylabel``'s legend entries).
     title : str, optional
+    breaks : sequence of int
+        Positions ``i`` of points not joined to point ``i - 1`` (a stretch not traced between them).
 
     Returns
     -------
@@ -69,11 +71,14 @@ def plot_branch(values, peaks, stable, folds, ax=None, *, xlabel: str, ylabel: s
     values = checks.vector("values", values, min_len=1)
     peaks = checks.vector("peaks", peaks, min_len=values.size, max_len=values.size)
     x, y = xscale * values, scale * peaks
+    cut = [checks.integer("breaks", i, ge=1, le=values.size - 1) for i in breaks]
     fig, ax, new = laid_out(ax, (8, 5))
+    xl, yl = np.insert(x, cut, np.nan), np.insert(y, cut, np.nan)  # NaN: the line stops there
     if stable is None:
-        ax.plot(x, y, color="0.4", lw=1.5, label="branch (stability not computed)")
+        ax.plot(xl, yl, color="0.4", lw=1.5, label="branch (stability not computed)")
     else:
-        _stability_segments(ax, x, y, np.asarray(stable, float))
+        stable = np.asarray(stable, float)
+        _stability_segments(ax, xl, yl, np.insert(stable, cut, stable[np.asarray(cut, int) - 1]))
     for value, smooth in folds:
         i = int(np.argmin(np.abs(values - value)))
         ax.plot(xscale * value, y[i], "o" if smooth else "s", ms=8, mfc="none", mew=1.5,

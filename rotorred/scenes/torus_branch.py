@@ -65,6 +65,15 @@ DEFAULT_ORDERS, DEFAULT_GRID = (32, 80), (128, 256)
 #: 91.1423 Hz, its last 10 points within 0.66 mHz (7e-6 of the speed), the order (23, -53) of the box at -0.18 Hz
 #: (docs/model.md §26). A physical branch is not that steep: a resonance of 1 % damping near 100 Hz is 2 Hz wide
 STALL_SPAN = 1e-5
+#: past a stall (:class:`TorusBranchOptions`'s ``past_stalls``): the first jump in the speed, at least this share of it
+#: beyond the stall (where the nearest order's 0 Hz is behind or at the stall), then doubled, at most this many times
+JUMP_MIN, JUMP_TRIES = 1e-4, 5
+#: a stall is passed only where that order's 0 Hz is within this share of the speed (the rig's at 91.1423 Hz: 1.1e-4):
+#: farther, it does not explain the stall, and the branch ends there
+JUMP_NEAR = 1e-3
+#: Newton iterations a jump's solve gets: from the stall's solution, a torus past a thin resonance converges in a
+#: few; one that does not is the next jump's
+JUMP_ITERATIONS = 15
 
 
 class _Check(Exception):
@@ -122,6 +131,7 @@ class TorusBranchOptions:
     lines_tol: float | None = None
     max_orders: tuple[int, int] = (72, 180)
     fold_refine: bool = False
+    past_stalls: bool = True
 
     def __post_init__(self):
         # the orders, grid, band and window by TorusOptions's own checks
@@ -138,6 +148,7 @@ class TorusBranchOptions:
         if self.lines_tol is not None:
             checks.number("options.lines_tol", self.lines_tol, gt=0.0, lt=1.0)
         checks.boolean("options.fold_refine", self.fold_refine)
+        checks.boolean("options.past_stalls", self.past_stalls)
         m = checks.sequence("options.max_orders", list(np.ravel(self.max_orders)), min_len=2, max_len=2)
         object.__setattr__(self, "max_orders", tuple(checks.integer(f"options.max_orders[{i}]", v, ge=1)
                                                      for i, v in enumerate(m)))
@@ -203,6 +214,9 @@ class TorusBranch(Result):
         The orders, grid and band.
     interrupt : str
         The signal that ended the branch, or "".
+    gaps : tuple of (int, str)
+        Each stretch of the key not traced (a stall passed, :class:`TorusBranchOptions`'s ``past_stalls``): the
+        position of the first point after it, and why.
     """
 
     scene: str
@@ -221,6 +235,7 @@ class TorusBranch(Result):
     slope: np.ndarray
     truncation: str
     interrupt: str = ""
+    gaps: tuple = ()
 
     @property
     def interrupted(self) -> bool:
@@ -271,6 +286,8 @@ class TorusBranch(Result):
                 f"{1e6 * self.amplitudes[:, top].min():.4g} to {1e6 * self.amplitudes[:, top].max():.4g} µm",
                 f"turns: {len(turns)}" + (f", at {', '.join(turns[:4])}" if turns else "")
                 + (f" and {len(turns) - 4} more" if len(turns) > 4 else ""),
+                *[line for i, why in self.gaps for line in textwrap.wrap(
+                    f"not traced: {xs * self.values[i - 1]:.6g} to {xs * self.values[i]:.6g} {xu} ({why})", 110)],
                 *textwrap.wrap(f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}", 110),
                 f"times: start {self.point_time[0]:.3g} s, then {steps.sum():.3g} s for {p - 1} points "
                 f"({1e3 * (steps.mean() if p > 1 else 0.0):.0f} ms a point on average, "
@@ -301,7 +318,7 @@ class TorusBranch(Result):
         for k in self.largest[:checks.integer("lines", lines, ge=1, le=SHOWN_LINES)]:
             fig = plot_branch(self.values, self.amplitudes[:, k], None, self.folds, ax if fig is None else fig.axes[0],
                               xlabel=f"{self.key} ({xu})", ylabel=f"lines of {dof_name(self.dof)} (µm)", xscale=xs,
-                              title=title if fig is None else None)
+                              title=title if fig is None else None, breaks=[i for i, _ in self.gaps])
             fig.axes[0].annotate(f"{self.line_label(k)}: {self.frequencies[0, k]:.4g} Hz",
                                  (xs * self.values[0], 1e6 * self.amplitudes[0, k]), xytext=(4, 4),
                                  textcoords="offset points", fontsize=8)
@@ -328,7 +345,9 @@ class TorusBranch(Result):
                     "k2": ("order", self.orders[:, 1], {"units": "1", "long_name": "order of f_2"})},
             attrs={"scene": self.scene, "stopped": self.stopped, "interrupted": self.interrupt or "no",
                    "truncation": self.truncation,
-                   "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds)})
+                   "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds),
+                   "gaps": "; ".join(f"{self.values[i - 1]:.9g} to {self.values[i]:.9g}: {why}"
+                                     for i, why in self.gaps)})
 
 
 def check_torus_key(scene, key: str, start: float, end: float) -> None:
@@ -465,6 +484,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
     divisors = options.divisors or tuple(int(round(f[s] / b)) for s, b in zip(spools, first.bases_hz))
     box = (*options.orders, *options.n_grid)
     segments, value, z, rub, notes, direction = [], float(start), first.solution.z, first.problem, [], np.sign(end - start)
+    gaps = []  # (the segment after each stall passed, why)
     reach, furthest, began = abs(end - start) / CHECKS, float(start), t0
     while True:
         if options.lines_tol is not None:  # the box against the ladder's next, here
@@ -474,24 +494,37 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         family = TorusFamily(rubs.problem_at, value, (key, KEYS.get(key, "Hz")),
                              FROZEN if key.startswith("speeds.") else 0.0)
         check_at = furthest + direction * reach if options.lines_tol is not None else None
-        branch, stamps = _segment(family, z, value, end, options, check_at, progress, sum(len(b.values) - 1
-                                                                                            for _, b, _ in segments),
-                                  interrupts)
+        after_gap = bool(gaps) and gaps[-1][0] == len(segments)
+        before = sum(len(b.values) - (0 if j == 0 or g else 1) for j, (_, b, _, g) in enumerate(segments)) \
+            - (0 if after_gap or not segments else 1)  # the joined branch's points before this segment's
+        if options.max_points - before < 2:
+            break
+        branch, stamps = _segment(family, z, value, end, options, check_at, progress, before, interrupts,
+                                  options.max_points - before)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
         point_time = np.concatenate([[stamps[1] - began], times, np.zeros(len(branch.values) - 1 - len(times))])
-        if branch.stopped.startswith("the branch stalled") and key.startswith("speeds."):
+        stalled = branch.stopped.startswith("the branch stalled") and key.startswith("speeds.")
+        if stalled:
             branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
-        segments.append((rubs, branch, point_time))
+        segments.append((rubs, branch, point_time, after_gap))
         if branch.interrupt != "check":
-            break
+            jumped = time.perf_counter()  # the jump's solves: the next segment's first point's time
+            past = _past_stall(rubs, scene, key, branch, end, options) if stalled and options.past_stalls else None
+            if past is None:
+                break
+            value, z, rub, why = past
+            gaps.append((len(segments), why))
+            furthest, began = value, jumped
+            continue
         value, z, rub = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1])
         furthest, began = value, time.perf_counter()
-    return _joined(scene, key, segments, dof, divisors, options, notes)
+    return _joined(scene, key, segments, dof, divisors, options, notes, [g[1] for g in gaps])
 
 
-def _segment(family, z, value, end, options, check_at, progress, before, interrupts):
-    """The continuation from ``z`` at ``value`` towards ``end`` on ``family``, ended (interrupt "check") where the key
-    passes ``check_at`` (None: never): the branch and the stamps of its progress calls."""
+def _segment(family, z, value, end, options, check_at, progress, before, interrupts, max_points):
+    """The continuation from ``z`` at ``value`` towards ``end`` on ``family`` in at most ``max_points`` points, ended
+    (interrupt "check") where the key passes ``check_at`` (None: never): the branch and the stamps of its progress
+    calls."""
     s_start, s_end = family.carried(value), family.carried(end)
     scale = max(float(np.linalg.norm(z)), abs(s_end - s_start))
     stamps = [time.perf_counter()]
@@ -507,7 +540,7 @@ def _segment(family, z, value, end, options, check_at, progress, before, interru
     ds, ds_max = options.steps
     branch = continue_branch(family, z, s_start, s_end,
                              ContinuationOptions(ds=ds * scale, ds_min=1e-9 * scale, ds_max=ds_max * scale,
-                                                 max_points=options.max_points, tol=options.tol, stability=False,
+                                                 max_points=max_points, tol=options.tol, stability=False,
                                                  curved=True, fold_refine=options.fold_refine, stall=STALL_SPAN),
                              progress=stamped,
                              interrupts={**interrupts, _Check: "check"})
@@ -515,16 +548,49 @@ def _segment(family, z, value, end, options, check_at, progress, before, interru
     return branch, stamps
 
 
+def _nearest(rubs: _Family, scene, key: str, value: float) -> tuple[int, int, float, float]:
+    """The order ``(k1, k2)`` of the box nearest 0 Hz at the speed ``value`` (Hz) of the spool ``key``, its frequency
+    ``k . f`` there (Hz) and its rate ``d (k . f) / d value`` (-): the spool's order over its divisor."""
+    orders = rubs.first.problem.harmonics.orders[1:]
+    f = orders @ np.asarray(rubs.bases(_scene_at(scene, key, value)))
+    k = int(np.argmin(np.abs(f)))
+    moving = rubs.spools.index(key.partition(".")[2])
+    return int(orders[k, 0]), int(orders[k, 1]), float(f[k]), orders[k, moving] / rubs.divisors[moving]
+
+
 def _nearest_order(rubs: _Family, scene, key: str, branch) -> str:
     """A stalled speed branch's ``stopped``, with the order of the box nearest 0 Hz at its last value (the stalls of
     docs/model.md §26 are near such an order's 0 Hz)."""
-    v = float(branch.values[-1])
-    orders = rubs.first.problem.harmonics.orders[1:]
-    f = orders @ np.asarray(rubs.bases(_scene_at(scene, key, v)))
-    k = int(np.argmin(np.abs(f)))
+    k1, k2, f, _ = _nearest(rubs, scene, key, float(branch.values[-1]))
     stem = branch.stopped.removesuffix("; start another branch past it")
-    return (f"{stem} (the order ({orders[k, 0]}, {orders[k, 1]}) of the box is at {f[k]:+.3g} Hz there); start "
-            f"another branch past it")
+    return f"{stem} (the order ({k1}, {k2}) of the box is at {f:+.3g} Hz there); start another branch past it"
+
+
+def _past_stall(rubs: _Family, scene, key: str, branch, end: float, options: TorusBranchOptions):
+    """Past a speed branch's stall (:class:`TorusBranchOptions`'s ``past_stalls``): the speed as far beyond the
+    nearest order's 0 Hz as the stall is before it (at least :data:`JUMP_MIN` of it beyond the stall), doubled while
+    Newton from the stall's solution does not converge there (:data:`JUMP_TRIES` times), not beyond ``end``: that
+    speed, the solution, its problem and why the stretch was not traced; None if no jump converged, or if that 0 Hz is
+    farther than :data:`JUMP_NEAR` of the speed from the stall."""
+    v, z = float(branch.values[-1]), branch.z[-1]
+    direction = np.sign(end - v)
+    k1, k2, f, rate = _nearest(rubs, scene, key, v)
+    if rate == 0.0 or abs(f / rate) > JUMP_NEAR * abs(v):
+        return None
+    crossing = v - f / rate
+    jump = max(2.0 * direction * (crossing - v), JUMP_MIN * abs(v))
+    for attempt in range(JUMP_TRIES):
+        target = v + direction * jump * 2**attempt
+        if direction * (target - end) > 0.0:
+            return None
+        try:
+            rub = rubs.rub_at(target)
+            found = solve_torus(rub.problem, z, tol=options.tol, max_iter=JUMP_ITERATIONS)
+        except (NotConverged, checks.InputError):
+            continue
+        return (target, found.z, rub, f"a stall passed: the order ({k1}, {k2}) of the box at 0 Hz at "
+                                      f"{crossing:.6g} Hz")
+    return None
 
 
 def _checked_box(scene, model, box, rub: TorusRubProblem, z, dof, options: TorusBranchOptions):
@@ -564,23 +630,26 @@ def _lines_change(coarse: TorusRubProblem, z_c, fine: TorusRubProblem, z_f, dof)
                else 1.0 for k in ranked)
 
 
-def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes) -> TorusBranch:
-    """The segments' branches as one: each segment's points after the first (that is the last one's), their
-    coefficients and lines on the last box's orders (the ones a segment lacks at 0), the times of a segment's start
-    (the box's check, the solve at the new box) on its first point."""
+def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes, gaps=()) -> TorusBranch:
+    """The segments' branches as one: each segment's points after the first (that is the last one's; after a stall
+    passed, its first too, past the gap: ``gaps`` say why each was not traced), their coefficients and lines on the
+    last box's orders (the ones a segment lacks at 0), the times of a segment's start (the box's check, the solve at
+    the new box, or the jump past a stall) on its first point."""
     last = segments[-1][0].first
     h, n = last.problem.harmonics, last.problem.n
     where = {(int(k1), int(k2)): i for i, (k1, k2) in enumerate(h.orders)}
-    values, z, amplitudes, times, folds, iterations, slope = [], [], [], [], [], [], []
-    for j, (rubs, branch, point_time) in enumerate(segments):
-        keep = slice(0 if j == 0 else 1, None)
+    values, z, amplitudes, times, folds, iterations, slope, cut = [], [], [], [], [], [], [], []
+    for j, (rubs, branch, point_time, after_gap) in enumerate(segments):
+        keep = slice(0 if j == 0 or after_gap else 1, None)
+        if after_gap:
+            cut.append(sum(len(v) for v in values))
         own = rubs.first.problem.harmonics
         with signals_held():  # a few ms a point: the branch's lines whole
             lines = np.array([rubs.rub_at(v).lines(zi, dof)[2] for v, zi in zip(branch.values, branch.z)])
         placed = np.zeros((len(branch.values), h.n_orders))
         placed[:, [where[(int(a), int(b))] for a, b in own.orders]] = lines
         t = point_time.copy()
-        if j > 0 and len(t) > 1:
+        if j > 0 and len(t) > 1 and not after_gap:
             t[1] += t[0]  # the check and the new box's start: the first step's
         values.append(branch.values[keep])
         z.append(np.array([own.transfer(zi, n, h) for zi in branch.z[keep]]).reshape(-1, h.size * n))
@@ -599,4 +668,4 @@ def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, no
                        np.array([segments[0][0].bases(_scene_at(scene, key, v)) for v in values]), h.orders, dof,
                        np.concatenate(amplitudes), np.concatenate(z), tuple(folds), final.stopped,
                        np.concatenate(iterations), np.concatenate(times), np.concatenate(slope), truncation,
-                       final.interrupt)
+                       final.interrupt, tuple(zip(cut, gaps)))
