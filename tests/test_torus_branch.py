@@ -260,7 +260,8 @@ def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monke
 def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tmp_path):
     """``past_stalls`` (the default): the branch of the test above, its steps held to 1 % of its first so that it
     stalls every 10 points, with the order nearest 0 Hz put 0.01 Hz ahead of each stall (``_nearest`` replaced; the
-    real one is the message's, checked above): each stall is passed by a jump of twice that, 0.02 Hz, and the
+    real one is the message's, checked above): each stall is passed by a jump to 1e-4 of the speed past that 0 Hz,
+    0.01 Hz + 9.1 mHz, and the
     continuation goes on from there, until the branch's most points; every point after a gap solves the problem built
     from the scene at its speed (relative residual below the tolerance); the summary, the file's attributes and the
     figure (its line broken there) show each gap."""
@@ -290,7 +291,7 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     assert [i for i, _ in branch.gaps] == [10, 20, 30]
     for i, why in branch.gaps:
         v = float(branch.values[i])
-        assert v - branch.values[i - 1] == pytest.approx(0.02, rel=1e-9)
+        assert v - branch.values[i - 1] == pytest.approx(0.01 + 1e-4 * branch.values[i - 1], rel=1e-9)
         assert why == f"a stall passed: the order (7, -21) of the box at 0 Hz at {branch.values[i - 1] + 0.01:.6g} Hz"
         there = load_scene("paper-rub", {"speeds.outer": v})
         problem = torus_rub_problem(there, model, (70.0, v / 3), 2, 8, *default_grid(2, 8), 1500.0).problem

@@ -41,18 +41,18 @@ TOL = 1e-6  #: the relative residual of every point
 #: the branches: key, start, end, the values checked against a transient (the branch's points nearest to them), and
 #: how each is shown (scale, unit)
 BRANCHES = (("rub.clearance", ((20e-6, 5e-6),), (19e-6, 14e-6, 6e-6), 1e6, "µm", True),
-            ("speeds.outer", ((OUTER_HZ, 91.0), (OUTER_HZ, 91.44), (92.4, 91.47), (92.4, 93.05), (94.5, 93.55),
-                              (94.5, 97.0)), (92.0, 94.0, 96.5), 1.0, "Hz", False))
+            ("speeds.outer", ((OUTER_HZ, 91.0), (OUTER_HZ, 93.05), (94.5, 93.55), (94.5, 97.0)), (92.0, 94.0, 96.5),
+             1.0, "Hz", False))
 #: the speed branch in pieces, (start, end) each. From about 93.1 to 93.5 Hz the settled response is another torus,
 #: (f_L, f_H/6), and the (f_L, f_H/3) torus, which harmonic balance still finds, is unstable
 #: (validation/hb_torus_speed_window.py); at 93.333 Hz (3:4, the order (4, -9) at 0 Hz) every orbit is periodic. The
 #: pieces end short of that window on either side. Where an order of the box comes to 0 Hz the branch may stall, its
-#: steps shrinking in corners: down from 91.37 Hz near 91.142 Hz ((23, -53) at 91.132; the piece ends there, stalled),
-#: up from it at 91.4569 Hz ((27, -62) at 91.4516); the pieces from 92.4 Hz (a speed whose start window resolves the
-#: start's orders: at 91.6 Hz two of them are 1.5 Hz apart) come to the second from the other side. Up from 94.5 Hz the
-#: piece goes through 96.162 Hz in corners, steps in the speed alone, and on through 8:11 (96.25 Hz) to 97 Hz. The last
-#: field: the branch traced again with Brent's folds (the clearance's only: the speed's pieces take minutes more)
-MAX_POINTS = 120  #: a piece's most points
+#: steps shrinking in corners, and goes on past that order (TorusBranchOptions.past_stalls): down from 91.37 Hz near
+#: 91.142 Hz ((23, -53) at 91.132), up from it at 91.4569 Hz ((27, -62) at 91.4516), each stretch passed a gap of the
+#: branch. Up from 94.5 Hz the piece goes through 96.162 Hz in corners, steps in the speed alone, and on through 8:11
+#: (96.25 Hz) to 97 Hz. The last field: the branch traced again with Brent's folds (the clearance's only: the speed's
+#: pieces take minutes more)
+MAX_POINTS = 200  #: a piece's most points
 SPEEDUP = 10.0  #: the issue's: each point at least 10x cheaper than a settled transient there
 
 

@@ -65,8 +65,8 @@ DEFAULT_ORDERS, DEFAULT_GRID = (32, 80), (128, 256)
 #: 91.1423 Hz, its last 10 points within 0.66 mHz (7e-6 of the speed), the order (23, -53) of the box at -0.18 Hz
 #: (docs/model.md §26). A physical branch is not that steep: a resonance of 1 % damping near 100 Hz is 2 Hz wide
 STALL_SPAN = 1e-5
-#: past a stall (:class:`TorusBranchOptions`'s ``past_stalls``): the first jump in the speed, at least this share of it
-#: beyond the stall (where the nearest order's 0 Hz is behind or at the stall), then doubled, at most this many times
+#: past a stall (:class:`TorusBranchOptions`'s ``past_stalls``): the first jump in the speed goes this share of it past
+#: the nearest order's 0 Hz (past the stall, where that 0 Hz is behind it), then doubled, at most this many times
 JUMP_MIN, JUMP_TRIES = 1e-4, 5
 #: a stall is passed only where that order's 0 Hz is within this share of the speed (the rig's at 91.1423 Hz: 1.1e-4):
 #: farther, it does not explain the stall, and the branch ends there
@@ -567,18 +567,18 @@ def _nearest_order(rubs: _Family, scene, key: str, branch) -> str:
 
 
 def _past_stall(rubs: _Family, scene, key: str, branch, end: float, options: TorusBranchOptions):
-    """Past a speed branch's stall (:class:`TorusBranchOptions`'s ``past_stalls``): the speed as far beyond the
-    nearest order's 0 Hz as the stall is before it (at least :data:`JUMP_MIN` of it beyond the stall), doubled while
-    Newton from the stall's solution does not converge there (:data:`JUMP_TRIES` times), not beyond ``end``: that
-    speed, the solution, its problem and why the stretch was not traced; None if no jump converged, or if that 0 Hz is
-    farther than :data:`JUMP_NEAR` of the speed from the stall."""
+    """Past a speed branch's stall (:class:`TorusBranchOptions`'s ``past_stalls``): the speed :data:`JUMP_MIN` of it
+    past the nearest order's 0 Hz (past the stall, where that 0 Hz is behind it), the jump doubled while Newton from the
+    stall's solution does not converge there (:data:`JUMP_TRIES` times), not beyond ``end``: that speed, the solution,
+    its problem and why the stretch was not traced; None if no jump converged, or if that 0 Hz is farther than
+    :data:`JUMP_NEAR` of the speed from the stall."""
     v, z = float(branch.values[-1]), branch.z[-1]
     direction = np.sign(end - v)
     k1, k2, f, rate = _nearest(rubs, scene, key, v)
     if rate == 0.0 or abs(f / rate) > JUMP_NEAR * abs(v):
         return None
     crossing = v - f / rate
-    jump = max(2.0 * direction * (crossing - v), JUMP_MIN * abs(v))
+    jump = max(direction * (crossing - v), 0.0) + JUMP_MIN * abs(v)  # just past that 0 Hz
     for attempt in range(JUMP_TRIES):
         target = v + direction * jump * 2**attempt
         if direction * (target - end) > 0.0:
