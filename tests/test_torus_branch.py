@@ -261,10 +261,10 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     """``past_stalls`` (the default): the branch of the test above, its steps held to 1 % of its first so that it
     stalls every 10 points, with the order nearest 0 Hz put 0.01 Hz ahead of each stall (``_nearest`` replaced; the
     real one is the message's, checked above): each stall is passed by a jump to 1e-4 of the speed past that 0 Hz,
-    0.01 Hz + 9.1 mHz, and the
-    continuation goes on from there, until the branch's most points; every point after a gap solves the problem built
-    from the scene at its speed (relative residual below the tolerance); the summary, the file's attributes and the
-    figure (its line broken there) show each gap."""
+    0.01 Hz + 9.1 mHz, and the continuation goes on from there, until the branch's most points (said as the branch's,
+    35); every point after a gap solves the problem built from the scene at its speed (relative residual below 1e-7,
+    the branch asking 1e-8); the summary, ``branch.txt``'s text, the file's attributes and the figure (its line broken
+    there) show each gap."""
     import rotorred as rr
     import rotorred.nonlinear.continuation as continuation
     import rotorred.scenes.torus_branch as torus_branch
@@ -287,7 +287,8 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
                                rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8,
                                                      max_points=35))
-    assert len(branch.values) == 35 and branch.stopped.startswith("stopped at max_points")
+    assert len(branch.values) == 35 and not branch.interrupted  # the branch's most points, not its last segment's
+    assert branch.stopped == f"stopped at max_points = 35 (speeds.outer = {branch.values[-1]:.9g} Hz)"
     assert [i for i, _ in branch.gaps] == [10, 20, 30]
     for i, why in branch.gaps:
         v = float(branch.values[i])
@@ -299,6 +300,8 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     text = "\n".join(branch.summary())
     assert text.count("not traced: ") == 3 and f"not traced: {branch.values[9]:.6g} to {branch.values[10]:.6g} Hz" in text
     assert branch.to_xarray().attrs["gaps"].count("a stall passed") == 3
+    from rotorred.scenes.branch_outputs import format_branch
+    assert format_branch(branch).count("not traced: ") == 3
     fig = branch.plot(lines=1)
     x = fig.axes[0].lines[0].get_xdata()
     assert np.isnan(x).sum() == 3 and len(x) == 38

@@ -71,9 +71,10 @@ def _format_torus(branch: TorusBranch) -> str:
     folds = ", ".join(f"{xs * v:.6g} {xu} ({'fold' if smooth else 'corner'})" for v, smooth in branch.folds) or "none"
     n = len(branch.values)
     head, tail = (f"INCOMPLETE: {branch.stopped}\n", "") if branch.interrupted else ("", f"{branch.stopped}\n")
-    steps = branch.point_time[1:]
+    steps, gaps = branch.point_time[1:], "".join(f"{gap}\n" for gap in branch.not_traced)
     return (f"{head}{table}\n{n} points{f' (one in {step} shown)' if step > 1 else ''}; {branch.truncation}\n"
-            f"turns: {folds}\n{tail}times: start {branch.point_time[0]:.2f} s, then {steps.sum():.2f} s "
+            f"turns: {folds}\n{gaps}{tail}"
+            f"times: start {branch.point_time[0]:.2f} s, then {steps.sum():.2f} s "
             f"({1e3 * steps.sum() / max(n - 1, 1):.0f} ms a point)")
 
 

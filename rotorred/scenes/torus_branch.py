@@ -259,6 +259,13 @@ class TorusBranch(Result):
         a[0] = -np.inf
         return np.argsort(-a)[:SHOWN_LINES]
 
+    @property
+    def not_traced(self) -> list[str]:
+        """Each gap as a line: ``not traced: A to B (unit) (why)``, the key in its shown unit."""
+        xs, xu = self.shown
+        return [f"not traced: {xs * self.values[i - 1]:.6g} to {xs * self.values[i]:.6g} {xu} ({why})"
+                for i, why in self.gaps]
+
     def line_label(self, k: int) -> str:
         """The order at position ``k`` as text, ``(k1,k2)``.
 
@@ -286,8 +293,7 @@ class TorusBranch(Result):
                 f"{1e6 * self.amplitudes[:, top].min():.4g} to {1e6 * self.amplitudes[:, top].max():.4g} µm",
                 f"turns: {len(turns)}" + (f", at {', '.join(turns[:4])}" if turns else "")
                 + (f" and {len(turns) - 4} more" if len(turns) > 4 else ""),
-                *[line for i, why in self.gaps for line in textwrap.wrap(
-                    f"not traced: {xs * self.values[i - 1]:.6g} to {xs * self.values[i]:.6g} {xu} ({why})", 110)],
+                *[line for gap in self.not_traced for line in textwrap.wrap(gap, 110)],
                 *textwrap.wrap(f"{'INCOMPLETE: ' if self.interrupted else 'stopped: '}{self.stopped}", 110),
                 f"times: start {self.point_time[0]:.3g} s, then {steps.sum():.3g} s for {p - 1} points "
                 f"({1e3 * (steps.mean() if p > 1 else 0.0):.0f} ms a point on average, "
@@ -484,7 +490,8 @@ def continue_torus(scene, model, key: str, start: float, end: float,
     divisors = options.divisors or tuple(int(round(f[s] / b)) for s, b in zip(spools, first.bases_hz))
     box = (*options.orders, *options.n_grid)
     segments, value, z, rub, notes, direction = [], float(start), first.solution.z, first.problem, [], np.sign(end - start)
-    gaps = []  # (the segment after each stall passed, why)
+    gaps, ended = [], None  # (the segment after each stall passed, why); why the branch ended, where not its last
+    # segment's own words
     reach, furthest, began = abs(end - start) / CHECKS, float(start), t0
     while True:
         if options.lines_tol is not None:  # the box against the ladder's next, here
@@ -497,7 +504,8 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         after_gap = bool(gaps) and gaps[-1][0] == len(segments)
         before = sum(len(b.values) - (0 if j == 0 or g else 1) for j, (_, b, _, g) in enumerate(segments)) \
             - (0 if after_gap or not segments else 1)  # the joined branch's points before this segment's
-        if options.max_points - before < 2:
+        if options.max_points - before < 2:  # the branch's most points (a segment's own would say fewer)
+            ended = _most_points(key, float(segments[-1][1].values[-1]), options.max_points)
             break
         branch, stamps = _segment(family, z, value, end, options, check_at, progress, before, interrupts,
                                   options.max_points - before)
@@ -518,7 +526,15 @@ def continue_torus(scene, model, key: str, start: float, end: float,
             continue
         value, z, rub = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1])
         furthest, began = value, time.perf_counter()
-    return _joined(scene, key, segments, dof, divisors, options, notes, [g[1] for g in gaps])
+    last = segments[-1][1]
+    if ended is None and len(segments) > 1 and last.stopped.startswith("stopped at max_points"):
+        ended = _most_points(key, float(last.values[-1]), options.max_points)
+    return _joined(scene, key, segments, dof, divisors, options, notes, [g[1] for g in gaps], ended)
+
+
+def _most_points(key: str, value: float, max_points: int) -> str:
+    """Why a branch of several segments ended at its most points (each segment's own continuation counts its own)."""
+    return f"stopped at max_points = {max_points} ({key} = {value:.9g} {KEYS.get(key, 'Hz')})"
 
 
 def _segment(family, z, value, end, options, check_at, progress, before, interrupts, max_points):
@@ -630,11 +646,13 @@ def _lines_change(coarse: TorusRubProblem, z_c, fine: TorusRubProblem, z_f, dof)
                else 1.0 for k in ranked)
 
 
-def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes, gaps=()) -> TorusBranch:
+def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes, gaps=(),
+            ended: str | None = None) -> TorusBranch:
     """The segments' branches as one: each segment's points after the first (that is the last one's; after a stall
     passed, its first too, past the gap: ``gaps`` say why each was not traced), their coefficients and lines on the
     last box's orders (the ones a segment lacks at 0), the times of a segment's start (the box's check, the solve at
-    the new box, or the jump past a stall) on its first point."""
+    the new box, or the jump past a stall) on its first point; ``ended``: why the branch ended, where not its last
+    segment's own words (its most points, which that segment counts alone)."""
     last = segments[-1][0].first
     h, n = last.problem.harmonics, last.problem.n
     where = {(int(k1), int(k2)): i for i, (k1, k2) in enumerate(h.orders)}
@@ -666,6 +684,6 @@ def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, no
     values = np.concatenate(values)
     return TorusBranch(scene.name, key, KEYS.get(key, "Hz"), values,
                        np.array([segments[0][0].bases(_scene_at(scene, key, v)) for v in values]), h.orders, dof,
-                       np.concatenate(amplitudes), np.concatenate(z), tuple(folds), final.stopped,
+                       np.concatenate(amplitudes), np.concatenate(z), tuple(folds), ended or final.stopped,
                        np.concatenate(iterations), np.concatenate(times), np.concatenate(slope), truncation,
-                       final.interrupt, tuple(zip(cut, gaps)))
+                       "" if ended else final.interrupt, tuple(zip(cut, gaps)))
