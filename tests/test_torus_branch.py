@@ -224,16 +224,11 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
     assert_shows_itself(branch, tmp_path, of=rr.TorusBranch)
 
 
-def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monkeypatch):
-    """The speed branch above with its steps held to 1 % of its first (real points, each converged; the span rule
-    widened to 100 % of the speed: ``tests/test_branch.py`` checks the span) stalls after 10 points: it ends, not
-    interrupted, saying where and naming the order of the box nearest 0 Hz there (found here by enumerating the 2 x 8
-    box in its 1500 Hz band); its points are kept. Unheld, the same branch reaches its end (the test above)."""
-    import rotorred as rr
+def _crawling(monkeypatch):
+    """Torus branches whose steps are held to 1 % of their first (real points, each converged), with the stall rule's
+    span widened to 100 % of the speed (``tests/test_branch.py`` checks the span): they stall every 10 points."""
     import rotorred.nonlinear.continuation as continuation
     import rotorred.scenes.torus_branch as torus_branch
-    from rotorred.scenes.run import build_model
-    from rotorred.scenes.schema import load_scene
 
     traced, first = continuation._step, []
 
@@ -243,6 +238,18 @@ def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monke
         return traced(problem, point, previous, min(ds, cap), ds_min, min(ds_max, cap), tol, curved)
     monkeypatch.setattr(continuation, "_step", held)
     monkeypatch.setattr(torus_branch, "STALL_SPAN", 1.0)
+
+
+def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monkeypatch):
+    """The speed branch above with its steps held to 1 % of its first (real points, each converged; the span rule
+    widened to 100 % of the speed: ``tests/test_branch.py`` checks the span) stalls after 10 points: it ends, not
+    interrupted, saying where and naming the order of the box nearest 0 Hz there (found here by enumerating the 2 x 8
+    box in its 1500 Hz band); its points are kept. Unheld, the same branch reaches its end (the test above)."""
+    import rotorred as rr
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+
+    _crawling(monkeypatch)
     scene = load_scene("paper-rub", {"speeds.outer": 91.37})
     branch = rr.continue_torus(scene, build_model(scene).model, "speeds.outer", 91.37, 91.8,
                                rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8))
@@ -266,21 +273,13 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     the branch asking 1e-8); the summary, ``branch.txt``'s text, the file's attributes and the figure (its line broken
     there) show each gap."""
     import rotorred as rr
-    import rotorred.nonlinear.continuation as continuation
     import rotorred.scenes.torus_branch as torus_branch
     from rotorred.scenes.run import build_model
     from rotorred.scenes.schema import load_scene
     from rotorred.scenes.quasi_periodic import default_grid
     from rotorred.scenes.torus_balance import torus_rub_problem
 
-    traced, first = continuation._step, []
-
-    def held(problem, point, previous, ds, ds_min, ds_max, tol, curved=False):
-        first.append(ds)
-        cap = 0.01 * first[0]
-        return traced(problem, point, previous, min(ds, cap), ds_min, min(ds_max, cap), tol, curved)
-    monkeypatch.setattr(continuation, "_step", held)
-    monkeypatch.setattr(torus_branch, "STALL_SPAN", 1.0)
+    _crawling(monkeypatch)
     monkeypatch.setattr(torus_branch, "_nearest", lambda rubs, scene, key, v: (7, -21, -0.07, 7.0))  # 0 Hz at v + 0.01
     scene = load_scene("paper-rub", {"speeds.outer": 91.37})
     model = build_model(scene).model
