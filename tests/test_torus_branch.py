@@ -308,6 +308,26 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     plt.close(fig)
 
 
+def test_rotorred_continue_torus_passes_stalls_unless_told_to_stop(monkeypatch, tmp_path):
+    """``rotorred continue --torus`` in the outer speed on the crawling branch above (its steps held, an order put
+    0.01 Hz ahead of each stall): by default it reaches the end and ``branch.txt`` names the stretches not traced (nine
+    here); with ``--stop-at-stalls`` the branch ends at the first stall, saying so, none named."""
+    import rotorred.scenes.torus_branch as torus_branch
+    from rotorred.cli import main
+
+    _crawling(monkeypatch)
+    monkeypatch.setattr(torus_branch, "_nearest", lambda rubs, scene, key, v: (7, -21, -0.07, 7.0))
+    texts = []
+    for extra in ([], ["--stop-at-stalls"]):
+        out = tmp_path / f"o{len(texts)}"
+        assert main(["continue", "paper-rub", "--set", "speeds.outer=91.37", "--param", "speeds.outer=91.37:91.8",
+                     "--torus", "1,3", "--orders", "2,8", "--tol", "1e-8", *extra, "--out", str(out)]) == 0
+        texts.append((out / "branch.txt").read_text())
+    passing, stopping = texts
+    assert passing.count("not traced: ") >= 3 and "reached the end, speeds.outer = 91.8 Hz" in passing  # (9 measured)
+    assert "not traced" not in stopping and "the branch stalled at speeds.outer = " in stopping
+
+
 @pytest.mark.parametrize("extra, tokens", [
     (["--torus", "1", "--param", "rub.clearance=14e-6:12e-6"], ["--torus", "1,3"]),
     (["--torus", "1,3", "--orders", "0,8", "--param", "rub.clearance=14e-6:12e-6"], ["--orders", "0,8"]),

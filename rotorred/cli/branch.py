@@ -12,7 +12,8 @@ same, interactive; ``--no-html``: none).
 With ``--torus [J,K]`` the scene's speeds are incommensurate and the response quasi-periodic: its torus of the bases
 ``(f_L / J, f_H / K)`` (default: the torus the start's line fit finds) is followed instead (``--orders H1,H2`` its box,
 band 900 Hz; ``--lines-tol TOL`` grows the box along the branch where its largest lines change by more than TOL), in ``rub.clearance``, a plate's number or a spool's speed (``speeds.<spool>``, the other spool held), its
-folds located, no stability; ``branch.csv`` then has a row a point (the key, the bases, the 10 largest lines of the
+folds located, no stability; a speed branch that stalls near an order's 0 Hz goes on past that order, the speeds between
+not traced and named in ``branch.txt`` (``--stop-at-stalls``: it ends there); ``branch.csv`` then has a row a point (the key, the bases, the 10 largest lines of the
 table DOF in µm, the corrections and the point's time), ``branch_lines.csv`` every order's line at each point, and no
 ``report.html`` (no interactive view of a torus branch yet).
 
@@ -57,6 +58,9 @@ def add_parser(subparsers):
     p.add_argument("--refine-folds", action="store_true",
                    help="with --torus: locate each fold by Brent's method on corrected points (default: interpolated "
                         "between the points either side of it, without a solve)")
+    p.add_argument("--stop-at-stalls", action="store_true",
+                   help="with --torus: a speed branch that stalls near an order's 0 Hz ends there (default: it goes on "
+                        "past that order, the speeds between not traced and named in branch.txt)")
     p.add_argument("--lines-tol", type=float, default=None, metavar="TOL",
                    help="with --torus: grow the box along the branch (bounds x1.5) where its 10 largest lines change by "
                         "more than TOL (a relative change of amplitudes in m, e.g. 0.01) against the next box "
@@ -147,7 +151,8 @@ def _run_torus(args, out, key: str, start: float, stop: float) -> int:
     orders = _pair("--orders", args.orders)
     lines_tol = None if args.lines_tol is None else checks.number("--lines-tol", args.lines_tol, gt=0.0, lt=1.0)
     options = TorusBranchOptions(orders=orders, divisors=divisors, tol=_tol(args, TorusBranchOptions.tol),
-                                 lines_tol=lines_tol, fold_refine=args.refine_folds)
+                                 lines_tol=lines_tol, fold_refine=args.refine_folds,
+                                 past_stalls=not args.stop_at_stalls)
     scene = load_scene(args.scene, _settings(args.set))
     check_torus_key(scene, key, start, stop)
     record = provenance(args, "scene", scene_toml(scene))
