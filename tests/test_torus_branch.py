@@ -308,6 +308,32 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     plt.close(fig)
 
 
+def test_stalls_passed_between_a_lines_tolerances_checks_keep_the_branch_whole(monkeypatch):
+    """The crawling branch of the test above with a lines tolerance too (its box checked each eighth of the range,
+    against the ladder up to 4 x 16): the box's checks and the stalls' jumps interleave, and the branch stays one: its
+    speeds increase point by point, a gap after every 10 points, its 60 points the most asked (said so), and every box
+    check at a speed the branch holds (none at a jump beyond its last point)."""
+    import re
+
+    import rotorred as rr
+    import rotorred.scenes.torus_branch as torus_branch
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+
+    _crawling(monkeypatch)
+    monkeypatch.setattr(torus_branch, "_nearest", lambda rubs, scene, key, v: (7, -21, -0.07, 7.0))
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    branch = rr.continue_torus(scene, build_model(scene).model, "speeds.outer", 91.37, 91.8,
+                               rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8,
+                                                     max_points=60, lines_tol=0.02, max_orders=(4, 16)))
+    assert len(branch.values) == 60 and np.all(np.diff(branch.values) > 0)
+    assert [i for i, _ in branch.gaps] == [10, 20, 30, 40, 50]
+    assert branch.stopped == f"stopped at max_points = 60 (speeds.outer = {branch.values[-1]:.9g} Hz)"
+    checks = [float(v) for v in re.findall(r"from ([0-9.]+) \(", branch.truncation)]
+    assert len(checks) >= 3 and max(checks) <= branch.values[-1]
+    assert all(np.min(np.abs(branch.values - v)) < 1e-5 * v for v in checks)
+
+
 def test_rotorred_continue_torus_passes_stalls_unless_told_to_stop(monkeypatch, tmp_path):
     """``rotorred continue --torus`` in the outer speed on the crawling branch above (its steps held, an order put
     0.01 Hz ahead of each stall): by default it reaches the end and ``branch.txt`` names the stretches not traced (nine

@@ -502,11 +502,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
                              FROZEN if key.startswith("speeds.") else 0.0)
         check_at = furthest + direction * reach if options.lines_tol is not None else None
         after_gap = bool(gaps) and gaps[-1][0] == len(segments)
-        before = sum(len(b.values) - (0 if j == 0 or g else 1) for j, (_, b, _, g) in enumerate(segments)) \
-            - (0 if after_gap or not segments else 1)  # the joined branch's points before this segment's
-        if options.max_points - before < 2:  # the branch's most points (a segment's own would say fewer)
-            ended = _most_points(key, float(segments[-1][1].values[-1]), options.max_points)
-            break
+        before = _points(segments) - (0 if after_gap or not segments else 1)  # the joined branch's before this one's
         branch, stamps = _segment(family, z, value, end, options, check_at, progress, before, interrupts,
                                   options.max_points - before)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
@@ -515,9 +511,13 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         if stalled:
             branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
         segments.append((rubs, branch, point_time, after_gap))
-        if branch.interrupt != "check":
+        checked, passing = branch.interrupt == "check", stalled and options.past_stalls
+        if (checked or passing) and options.max_points - _points(segments) < (1 if checked else 2):
+            ended = _most_points(key, float(branch.values[-1]), options.max_points)  # not a segment's own most
+            break
+        if not checked:
             jumped = time.perf_counter()  # the jump's solves: the next segment's first point's time
-            past = _past_stall(rubs, scene, key, branch, end, options) if stalled and options.past_stalls else None
+            past = _past_stall(rubs, scene, key, branch, end, options) if passing else None
             if past is None:
                 break
             value, z, rub, why = past
@@ -530,6 +530,12 @@ def continue_torus(scene, model, key: str, start: float, end: float,
     if ended is None and len(segments) > 1 and last.stopped.startswith("stopped at max_points"):
         ended = _most_points(key, float(last.values[-1]), options.max_points)
     return _joined(scene, key, segments, dof, divisors, options, notes, [g[1] for g in gaps], ended)
+
+
+def _points(segments) -> int:
+    """The joined branch's points of ``segments``: each one's, less the first of a segment that goes on from the last
+    one's last point (a box's check; not one past a stall, which starts past a gap)."""
+    return sum(len(b.values) - (0 if j == 0 or after_gap else 1) for j, (_, b, _, after_gap) in enumerate(segments))
 
 
 def _most_points(key: str, value: float, max_points: int) -> str:
