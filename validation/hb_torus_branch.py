@@ -19,10 +19,11 @@ Run::
 
     OPENBLAS_NUM_THREADS=1 python validation/hb_torus_branch.py [--orders H1,H2] [--branch rub.clearance]
 
-Prints, per branch: a row a point (the key, the bases, the corrections), the points' times, the folds (or, where none, the evidence: the tangent's parameter component keeps
-its sign over every point), and at the three points the 10 largest transient lines against the torus's at the same
-frequencies (relative differences, the worst), on each record; then one table of the issue's measures. The machine may be loaded by
-other work: the ratios are of times measured in the same run.
+Prints, per branch: a row a point (the key, the bases, the corrections), the points' times, the folds (or, where none,
+the evidence: the tangent's parameter component keeps its sign over every point), and at the three points the 10
+largest transient lines against the torus's at the same frequencies (relative differences, the worst), on each record;
+then one table of the issue's measures. The machine may be loaded by other work: the ratios are of times measured in
+the same run.
 """
 
 from __future__ import annotations
@@ -53,9 +54,10 @@ BRANCHES = (("rub.clearance", ((20e-6, 5e-6),), (19e-6, 14e-6, 6e-6), 1e6, "µm"
 #: pieces end short of that window on either side. Where an order of the box comes to 0 Hz the branch may stall, its
 #: steps shrinking in corners, and goes on past that order (TorusBranchOptions.past_stalls): down from 91.37 Hz near
 #: 91.142 Hz ((23, -53) at 91.132), up from it at 91.4569 Hz ((27, -62) at 91.4516), each stretch passed a gap of the
-#: branch. Up from 94.5 Hz the piece goes through 96.162 Hz in corners, steps in the speed alone, and on through 8:11
-#: (96.25 Hz) to 97 Hz. The last field: the branch traced again with Brent's folds (the clearance's only: the speed's
-#: pieces take minutes more)
+#: branch. Up from 94.5 Hz the piece stalls at 96.162 Hz, short of 8:11 (96.25 Hz), and passes it to 97 Hz (its corner
+#: steps there, steps in the speed alone, went through it in an earlier run: the stall rule's margin there is small).
+#: The last field: the branch traced again with Brent's folds (the clearance's only: the speed's pieces take minutes
+#: more)
 MAX_POINTS = 200  #: a piece's most points
 #: s: the later record the lines are compared on (the issue's "settled transient"): from 22 s (at 96.55 Hz, near 8:11,
 #: the 2-22 s record has not settled), 80 s long (at 6 µm the 344 Hz line of consecutive 20 s records moves by 0.7 %)

@@ -677,6 +677,11 @@ class _Compliance:
             self._kept["full"] = self.recovery(None)
         return self._kept["full"]
 
+    def rows(self, outputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(O Q_full, O X)`` of the outputs O (p, n_all): from every DOF's where they are kept, else
+        ``recovery``'s."""
+        return _projected(*self._kept["full"], outputs) if "full" in self._kept else self.recovery(outputs)
+
 
 @dataclass(frozen=True)
 class TorusProblem:
@@ -996,7 +1001,7 @@ class TorusProblem:
             (m; rad for a rotation DOF), n_all the DOFs of ``M``.
         """
         Q_full, X = self._compliance().full() if outputs is None else \
-            self._compliance().recovery(np.atleast_2d(np.asarray(outputs, float)))
+            self._compliance().rows(np.atleast_2d(np.asarray(outputs, float)))
         q, v = self.samples(z)
         f = self.harmonics.coefficients(sampled_forces(self._local_forces, q, v)[0])
         F = self.harmonics.phasors(f, self.n)

@@ -198,8 +198,7 @@ class RubTorus(Result):
     def phasors(self) -> np.ndarray:
         """Complex amplitude ``Q_k = a_k - i b_k`` of each order and output, shape (K, n_outputs) (m or rad): the line
         of order k is ``Re(Q_k exp(i (k_1 theta_1 + k_2 theta_2)))`` with ``theta_i = 2 pi f_i t``."""
-        Q = self.problem.problem.recover(self.solution.z)[:, :self.problem.n_model]
-        return Q @ self.problem.model.output_rows(list(self.outputs)).T
+        return self.problem.problem.recover(self.solution.z, self.problem.output_rows(self.outputs))
 
     @property
     def amplitudes(self) -> np.ndarray:
@@ -337,10 +336,10 @@ def torus_balance(model, operating: Operating, loads: Loads, contacts: Sequence[
                 problems[(H1, H2)] = _problem(scene, system, rp.bases_hz,
                                               replace(options, orders=(H1, H2), tolerance=None))
             return problems[(H1, H2)].problem
-        rows = rp.model.output_rows(list(outputs))
+        rows = rp.output_rows(outputs)  # every box's problem has the same DOFs
         _, solution, choice = torus_to_tolerance(
             build, options.ladder, z0, options.tolerance,
-            lambda problem, z: problem.recover(z)[:, :rp.n_model] @ rows.T, newton_tol=options.tol)
+            lambda problem, z: problem.recover(z, rows), newton_tol=options.tol)
         rp = problems[choice.orders]
     return RubTorus(rp, solution, start, outputs, operating, dict(speeds), time.perf_counter() - t0, choice)
 

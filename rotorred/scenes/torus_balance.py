@@ -81,12 +81,17 @@ class TorusRubProblem:
     n_model: int
     model: object
 
+    def output_rows(self, dofs) -> np.ndarray:
+        """The rows of the model DOFs ``dofs`` ((node, direction) each) on the problem's DOFs, the model's then the
+        plates': shape (len(dofs), n_all), for :meth:`TorusProblem.recover`'s ``outputs``."""
+        rows = np.zeros((len(dofs), self.problem.M.shape[0]))
+        rows[:, :self.n_model] = self.model.output_rows(list(dofs))
+        return rows
+
     def lines(self, z: np.ndarray, dof: tuple[int, str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every order's line at the model DOF ``dof`` = (node, direction): orders (K, 2), frequencies ``|k . f|``
         (Hz, shape (K,)) and amplitudes (m, shape (K,); the mean's absolute value for (0, 0))."""
-        row = np.zeros(self.problem.M.shape[0])  # the model's DOFs, then the plates'
-        row[:self.n_model] = self.model.output_rows([dof])[0]
-        y = self.problem.recover(z, row[None])[:, 0]
+        y = self.problem.recover(z, self.output_rows([dof]))[:, 0]
         h = self.problem.harmonics
         return h.orders, np.abs(h.frequencies(self.bases_hz)), np.abs(y)
 

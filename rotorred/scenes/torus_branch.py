@@ -490,8 +490,8 @@ def continue_torus(scene, model, key: str, start: float, end: float,
     divisors = options.divisors or tuple(int(round(f[s] / b)) for s, b in zip(spools, first.bases_hz))
     box = (*options.orders, *options.n_grid)
     segments, value, z, rub, notes, direction = [], float(start), first.solution.z, first.problem, [], np.sign(end - start)
-    gaps, ended = [], None  # (the segment after each stall passed, why); why the branch ended, where not its last
-    # segment's own words
+    gap, ended = "", None  # why the next segment starts past a gap ("": it goes on from the last point); why the
+    # branch ended, where not its last segment's own words
     reach, furthest, began = abs(end - start) / CHECKS, float(start), t0
     while True:
         if options.lines_tol is not None:  # the box against the ladder's next, here
@@ -501,8 +501,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         family = TorusFamily(rubs.problem_at, value, (key, KEYS.get(key, "Hz")),
                              FROZEN if key.startswith("speeds.") else 0.0)
         check_at = furthest + direction * reach if options.lines_tol is not None else None
-        after_gap = bool(gaps) and gaps[-1][0] == len(segments)
-        before = _points(segments) - (0 if after_gap or not segments else 1)  # the joined branch's before this one's
+        before = _points(segments) - (1 if segments and not gap else 0)  # the joined branch's before this one's
         branch, stamps = _segment(family, z, value, end, options, check_at, progress, before, interrupts,
                                   options.max_points - before)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
@@ -510,7 +509,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         stalled = branch.stopped.startswith("the branch stalled") and key.startswith("speeds.")
         if stalled:
             branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
-        segments.append((rubs, branch, point_time, after_gap))
+        segments.append((rubs, branch, point_time, gap))
         checked, passing = branch.interrupt == "check", stalled and options.past_stalls
         if (checked or passing) and options.max_points - _points(segments) < (1 if checked else 2):
             ended = _most_points(key, float(branch.values[-1]), options.max_points)  # not a segment's own most
@@ -520,22 +519,21 @@ def continue_torus(scene, model, key: str, start: float, end: float,
             past = _past_stall(rubs, scene, key, branch, end, options) if passing else None
             if past is None:
                 break
-            value, z, rub, why = past
-            gaps.append((len(segments), why))
+            value, z, rub, gap = past
             furthest, began = value, jumped
             continue
-        value, z, rub = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1])
+        value, z, rub, gap = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1]), ""
         furthest, began = value, time.perf_counter()
     last = segments[-1][1]
     if ended is None and len(segments) > 1 and last.stopped.startswith("stopped at max_points"):
         ended = _most_points(key, float(last.values[-1]), options.max_points)
-    return _joined(scene, key, segments, dof, divisors, options, notes, [g[1] for g in gaps], ended)
+    return _joined(scene, key, segments, dof, divisors, options, notes, ended)
 
 
 def _points(segments) -> int:
     """The joined branch's points of ``segments``: each one's, less the first of a segment that goes on from the last
     one's last point (a box's check; not one past a stall, which starts past a gap)."""
-    return sum(len(b.values) - (0 if j == 0 or after_gap else 1) for j, (_, b, _, after_gap) in enumerate(segments))
+    return sum(len(b.values) - (0 if j == 0 or gap else 1) for j, (_, b, _, gap) in enumerate(segments))
 
 
 def _most_points(key: str, value: float, max_points: int) -> str:
@@ -652,28 +650,28 @@ def _lines_change(coarse: TorusRubProblem, z_c, fine: TorusRubProblem, z_f, dof)
                else 1.0 for k in ranked)
 
 
-def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes, gaps=(),
+def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, notes,
             ended: str | None = None) -> TorusBranch:
-    """The segments' branches as one: each segment's points after the first (that is the last one's; after a stall
-    passed, its first too, past the gap: ``gaps`` say why each was not traced), their coefficients and lines on the
-    last box's orders (the ones a segment lacks at 0), the times of a segment's start (the box's check, the solve at
-    the new box, or the jump past a stall) on its first point; ``ended``: why the branch ended, where not its last
-    segment's own words (its most points, which that segment counts alone)."""
+    """The segments' branches as one: each segment's points after the first (that is the last one's; past a stall,
+    its first too: the segment's fourth field says why the gap before it was not traced), their coefficients and
+    lines on the last box's orders (the ones a segment lacks at 0), the times of a segment's start (the box's check,
+    the solve at the new box, or the jump past a stall) on its first point; ``ended``: why the branch ended, where not
+    its last segment's own words (its most points, which that segment counts alone)."""
     last = segments[-1][0].first
     h, n = last.problem.harmonics, last.problem.n
     where = {(int(k1), int(k2)): i for i, (k1, k2) in enumerate(h.orders)}
-    values, z, amplitudes, times, folds, iterations, slope, cut = [], [], [], [], [], [], [], []
-    for j, (rubs, branch, point_time, after_gap) in enumerate(segments):
-        keep = slice(0 if j == 0 or after_gap else 1, None)
-        if after_gap:
-            cut.append(sum(len(v) for v in values))
+    values, z, amplitudes, times, folds, iterations, slope, gaps = [], [], [], [], [], [], [], []
+    for j, (rubs, branch, point_time, gap) in enumerate(segments):
+        keep = slice(0 if j == 0 or gap else 1, None)
+        if gap:
+            gaps.append((sum(len(v) for v in values), gap))
         own = rubs.first.problem.harmonics
         with signals_held():  # a few ms a point: the branch's lines whole
             lines = np.array([rubs.rub_at(v).lines(zi, dof)[2] for v, zi in zip(branch.values, branch.z)])
         placed = np.zeros((len(branch.values), h.n_orders))
         placed[:, [where[(int(a), int(b))] for a, b in own.orders]] = lines
         t = point_time.copy()
-        if j > 0 and len(t) > 1 and not after_gap:
+        if j > 0 and len(t) > 1 and not gap:
             t[1] += t[0]  # the check and the new box's start: the first step's
         values.append(branch.values[keep])
         z.append(np.array([own.transfer(zi, n, h) for zi in branch.z[keep]]).reshape(-1, h.size * n))
@@ -692,4 +690,4 @@ def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, no
                        np.array([segments[0][0].bases(_scene_at(scene, key, v)) for v in values]), h.orders, dof,
                        np.concatenate(amplitudes), np.concatenate(z), tuple(folds), ended or final.stopped,
                        np.concatenate(iterations), np.concatenate(times), np.concatenate(slope), truncation,
-                       "" if ended else final.interrupt, tuple(zip(cut, gaps)))
+                       "" if ended else final.interrupt, tuple(gaps))

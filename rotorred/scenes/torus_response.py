@@ -120,7 +120,7 @@ def torus_record(torus, t: np.ndarray, dofs) -> tuple[dict, tuple]:
     h, w = rp.problem.harmonics, rp.problem.w
     Q = rp.problem.recover(torus.solution.z)  # (K, n_all) complex: every DOF of the model and the plates
     rubs = rp.problem.forces
-    columns = [Q[:, :rp.n_model] @ rp.model.output_rows(list(dofs)).T]
+    columns = [Q @ rp.output_rows(dofs).T]
     for rub in rubs:  # each plate's unknowns and their rates, d/dt -> i (k . w)
         columns += [Q[:, list(rub.dofs)], 1j * h.frequencies(w)[:, None] * Q[:, list(rub.dofs)]]
     x = _synthesised(np.hstack(columns), h.orders, w, np.asarray(t, float))
