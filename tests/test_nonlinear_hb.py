@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
+from rotorred.nonlinear.continuation import ContinuationOptions, _retraced, continue_branch
 from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott
 from rotorred.nonlinear.forces import CircularClearance
 from rotorred.nonlinear.fourier import Harmonics
@@ -155,6 +155,33 @@ def test_a_branch_that_comes_back_onto_its_path_stops_there():
     assert branch.stopped.startswith("the branch came back onto its own path at omega = ")
     assert "a closed loop, followed once" in branch.stopped and len(branch.omega) < 400
     assert [f.smooth for f in branch.folds] == [True, False]
+
+
+def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
+    """``_retraced`` on a helix of 40 chords (two coordinates and omega) followed by a path back along it: back on it
+    (1 % of a chord off it, as a corrector's points are) it is found, the other way, at the first point whose path
+    since the segment it lies on exceeds 20 segments (11 points back, 2 x 11 > 20), on that segment; back along a
+    parallel helix 0.4 chords away (the other sheet of a thin fold) it is not found at any point; the branch's
+    message says which (the same way: the Jeffcott loop above)."""
+    theta = 0.05 * np.arange(41)
+    helix = lambda th: np.column_stack([np.cos(th), np.sin(th), th])  # noqa: E731
+    P, going_back = helix(theta), theta[39::-1]
+    chord = float(np.linalg.norm(P[1] - P[0]))
+    radial = np.column_stack([np.cos(going_back), np.sin(going_back), np.zeros(40)])
+    tangents = -np.column_stack([-np.sin(going_back), np.cos(going_back), np.ones(40)]) / np.sqrt(2.0)
+    for offset, found_at in ((0.01, 11), (0.4, None)):
+        back, found = helix(going_back) + offset * chord * radial, None
+        for m in range(1, 40):
+            Y = np.vstack([P, back[:m]])
+            again = _retraced(Y, np.linalg.norm(np.diff(Y, axis=0), axis=1), tangents[m - 1])
+            if again is not None:
+                found = (m, *again)
+                break
+        if found_at is None:
+            assert found is None
+        else:
+            m, j, same_way = found
+            assert m == found_at and not same_way and j in (40 - m - 1, 40 - m)
 
 
 def test_a_point_that_does_not_converge_says_so():

@@ -8,6 +8,7 @@ K3 = 0.1, F = 0.1: rotorred.nonlinear.examples) continued in w_1 from 0.5 to 2.5
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -306,6 +307,45 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
     assert np.isnan(x).sum() == 3 and len(x) == 38
     import matplotlib.pyplot as plt
     plt.close(fig)
+
+
+def test_a_step_that_fails_near_an_orders_0_hz_is_passed_like_a_stall(monkeypatch):
+    """A speed branch whose step falls below ds_min (the continuation's step made to fail at every 8th point of a
+    segment: the rig's branch up from 91.37 Hz so ended at 91.4566 Hz in one run, where another stalled) near an
+    order's 0 Hz (put 0.01 Hz ahead, as above) is passed by the same jump, each gap 0.01 Hz + 1e-4 of the speed, until
+    its most points; with ``past_stalls=False`` it ends at the first failure, its words naming the order. Far from
+    any order's 0 Hz it ends there too (the stall test above: the real nearest order)."""
+    import rotorred as rr
+    import rotorred.nonlinear.continuation as continuation
+    import rotorred.scenes.torus_branch as torus_branch
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+
+    traced, calls = continuation._step, []
+
+    def failing(problem, point, previous, ds, ds_min, ds_max, tol, curved=False):
+        calls.append(point)  # a call a point: the 8th of a segment fails, and the next segment counts afresh
+        if len(calls) == 8:
+            calls.clear()
+            return None, ds, f"the step fell below ds_min = {ds_min:g} at speeds.outer = 91.4 Hz: (made to fail)"
+        return traced(problem, point, previous, ds, ds_min, ds_max, tol, curved)
+    monkeypatch.setattr(continuation, "_step", failing)
+    monkeypatch.setattr(torus_branch, "_nearest", lambda rubs, scene, key, v: (7, -21, -0.07, 7.0))  # 0 Hz at v + 0.01
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37})
+    model = build_model(scene).model
+    options = rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.001, 0.002), tol=1e-8, max_points=20)
+    branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8, options)
+    assert len(branch.values) == 20 and branch.stopped.startswith("stopped at max_points = 20")
+    assert [i for i, _ in branch.gaps] == [8, 16]
+    for i, why in branch.gaps:
+        assert branch.values[i] - branch.values[i - 1] == pytest.approx(0.01 + 1e-4 * branch.values[i - 1], rel=1e-9)
+        assert why.startswith("a stall passed: the order (7, -21) of the box at 0 Hz at ")
+    calls.clear()
+    ends = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
+                             dataclasses.replace(options, past_stalls=False))
+    assert len(ends.values) == 8 and ends.gaps == ()
+    assert ends.stopped.startswith("the step fell below ds_min = ") and ends.stopped.endswith(
+        "(made to fail) (the order (7, -21) of the box is at -0.07 Hz there); start another branch past it")
 
 
 def test_stalls_passed_between_a_lines_tolerances_checks_keep_the_branch_whole(monkeypatch):

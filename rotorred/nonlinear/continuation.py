@@ -8,7 +8,7 @@ Newton's method on ``R = 0`` together with ``t . (y - y_pred) = 0`` (the plane t
 tangent), each step shortened until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at
 most 4 iterations, up to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it
 and retries from the same point, down to ``ds_min``, where the branch stops and says where and why; a branch that comes
-back onto its own path stops there (:func:`_retraced`).
+back onto its own path, or goes back along it, stops there (:func:`_retraced`).
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
@@ -386,8 +386,12 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
         chords[len(points) - 2] = np.linalg.norm(nxt.y - points[-2].y)
         again = _retraced(path[:len(points)], chords[:len(points) - 1], nxt.t)
         if again is not None:
+            j, same_way = again
             return (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
-                    f"{again} to {again + 1} of {len(points)}): a closed loop, followed once")
+                    f"{j} to {j + 1} of {len(points)}): a closed loop, followed once" if same_way else
+                    f"the branch went back along its own path at {_at(problem, nxt.y[-1])} (traced the other way as "
+                    f"points {j} to {j + 1} of {len(points)}): it turned back at a corner onto the part it had traced, "
+                    f"which it would trace again")
         if direction * (nxt.y[-1] - omega_start) < 0.0:
             return (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
                     f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
@@ -411,14 +415,18 @@ def _stalled(problem, Y: np.ndarray, chords: np.ndarray, share: float, ds: float
             f"{ds:.3g}; start another branch past it")
 
 
-def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
-    """The index j of an earlier segment [y_j, y_j+1] of the path ``Y`` (p, size + 1) that its last point lies on,
-    going the same way (the unit tangent ``t`` there within about 18 degrees of the segment), after a path of more than
-    20 times that segment or the last step since, or None: the branch retracing itself. ``chords`` (p - 1,) are the
-    segments' lengths. On the segment means within a quarter of the larger of the segment and the last step (a chord
-    leaves its arc by L^2 kappa / 8); the path since keeps the creeping steps at a corner, on one line, apart. A branch
-    that closes on itself (an isola, or a corner that led back onto a part traced) would otherwise go round until
-    max_points: the Jeffcott rotor with ds = 0.11 went round its fold-corner loop 15 times.
+def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> tuple[int, bool] | None:
+    """``(j, same_way)``: the index j of an earlier segment [y_j, y_j+1] of the path ``Y`` (p, size + 1) that its last
+    point lies on, going the same way or the other way along it (the unit tangent ``t`` there within about 18 degrees
+    of the segment, or of its reverse), after a path of more than 20 times that segment or the last step since, or
+    None: the branch retracing itself. ``chords`` (p - 1,) are the segments' lengths. On the segment means within a
+    quarter of the larger of the segment and the last step (a chord leaves its arc by L^2 kappa / 8); the path since
+    keeps the creeping steps at a corner, on one line, apart. A branch that closes on itself (an isola, or a corner
+    that led back onto a part traced) would otherwise go round until max_points: the Jeffcott rotor with ds = 0.11
+    went round its fold-corner loop 15 times. One that goes back along its path (a step past a corner that lands on
+    the part just traced, going back: a solution curve does not cross itself, so it is that part) would trace it
+    again: the rig's outer-speed torus branch down from 91.37 Hz turned at a corner near 91.05 Hz and went back up
+    through three of its folds until it passed its start (docs/model.md §26).
 
     Only the segments whose parameter range comes within that distance of the last point's parameter are measured in
     full (a lower bound of the distance, O(p)): the check costs O(p), not O(p size), a point."""
@@ -432,8 +440,9 @@ def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> int | None:
     A, AB, length = Y[j], Y[j + 1] - Y[j], chords[j]
     u = np.clip(np.einsum("ij,ij->i", last - A, AB) / np.where(length > 0, length**2, 1.0), 0.0, 1.0)
     distance = np.linalg.norm(last - (A + u[:, None] * AB), axis=1)
-    on = j[(AB @ t > 0.95 * length) & (distance < 0.25 * scale[j])]
-    return int(on[0]) if len(on) else None
+    along = AB @ t
+    on = (np.abs(along) > 0.95 * length) & (distance < 0.25 * scale[j])
+    return (int(j[on][0]), bool(along[on][0] > 0.0)) if np.any(on) else None
 
 
 def parameter_of(problem) -> tuple[str, str]:

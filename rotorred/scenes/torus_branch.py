@@ -71,6 +71,11 @@ JUMP_MIN, JUMP_TRIES = 1e-4, 5
 #: a stall is passed only where that order's 0 Hz is within this share of the speed (the rig's at 91.1423 Hz: 1.1e-4):
 #: farther, it does not explain the stall, and the branch ends there
 JUMP_NEAR = 1e-3
+#: how a speed branch's segment ends where it cannot go on: it stalled (its steps crawling in corners), or its step
+#: fell below ds_min (the corrector and the step in the speed alone failed at every step). Near an order's 0 Hz either
+#: is passed alike (:class:`TorusBranchOptions`'s ``past_stalls``): the rig's branch up from 91.37 Hz stalled at
+#: 91.4566 Hz in one run and failed there at ds_min in another, on another machine (docs/model.md §26)
+STUCK = ("the branch stalled", "the step fell below ds_min")
 #: Newton iterations a jump's solve gets: from the stall's solution, a torus past a thin resonance converges in a
 #: few; one that does not is the next jump's
 JUMP_ITERATIONS = 15
@@ -118,6 +123,11 @@ class TorusBranchOptions:
         Locate each fold by Brent, each evaluation a corrected point (as a periodic branch's); default False: the
         turn of the cubic Hermite curve through the points either side of it, without a solve
         (:class:`rotorred.nonlinear.continuation.ContinuationOptions`; its error on the rig in docs/model.md §26).
+    past_stalls : bool
+        Where a speed branch cannot go on (:data:`STUCK`: it stalls, or its step falls below ds_min) within
+        :data:`JUMP_NEAR` of the speed from where an order of the box comes to 0 Hz, go on past that order by a jump
+        (the stretch between a gap of the branch, :attr:`TorusBranch.gaps`); default True. False: the branch ends
+        there, naming the order (``rotorred continue --torus --stop-at-stalls``).
     """
 
     orders: tuple[int, int] = DEFAULT_ORDERS
@@ -506,7 +516,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
                                   options.max_points - before)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
         point_time = np.concatenate([[stamps[1] - began], times, np.zeros(len(branch.values) - 1 - len(times))])
-        stalled = branch.stopped.startswith("the branch stalled") and key.startswith("speeds.")
+        stalled = key.startswith("speeds.") and branch.stopped.startswith(STUCK)
         if stalled:
             branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
         segments.append((rubs, branch, point_time, gap))
