@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rotorred.nonlinear.continuation import ContinuationOptions, _retraced, continue_branch
+from rotorred.nonlinear.continuation import ContinuationOptions, _retraced, _turned_back, continue_branch
 from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott
 from rotorred.nonlinear.forces import CircularClearance
 from rotorred.nonlinear.fourier import Harmonics
@@ -141,7 +141,7 @@ def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
     assert fold.smooth and abs(fold.omega / brentq(double_root, 9.0, 10.0, xtol=1e-15) - 1) < 1e-13
     free = lambda w: E_UNB * w**2 / np.hypot(1 - w**2, C * w) - GAP  # noqa: E731 - the linear response's radius - g
     assert not corner.smooth and abs(corner.omega / brentq(free, 1.01, 1.1, xtol=1e-15) - 1) < 1.2e-9
-    assert branch.stopped.startswith("reached the end")
+    assert branch.stopped.startswith("reached the end") and branch.end == "reached"
 
 
 def test_a_branch_that_comes_back_onto_its_path_stops_there():
@@ -154,6 +154,7 @@ def test_a_branch_that_comes_back_onto_its_path_stops_there():
     branch = continue_branch(problem, z0, 0.5, 12.0, ContinuationOptions(ds=0.11, ds_max=0.5, stability=False))
     assert branch.stopped.startswith("the branch came back onto its own path at omega = ")
     assert "a closed loop, followed once" in branch.stopped and len(branch.omega) < 400
+    assert branch.end == "closed loop" and branch.to_xarray().attrs["end"] == "closed loop"
     assert [f.smooth for f in branch.folds] == [True, False]
 
 
@@ -162,7 +163,9 @@ def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
     (1 % of a chord off it, as a corrector's points are) it is found, the other way, at the first point whose path
     since the segment it lies on exceeds 20 segments (11 points back, 2 x 11 > 20), on that segment; back along a
     parallel helix 0.4 chords away (the other sheet of a thin fold) it is not found at any point; the branch's
-    message says which (the same way: the Jeffcott loop above)."""
+    message says which (the same way: the Jeffcott loop above). Where it turned (``_turned_back``, the point the branch
+    then ends at, the points after it not kept) is the helix's last point: every point back on it lies on it the other
+    way, and no point of a path going on (the helix alone) does."""
     theta = 0.05 * np.arange(41)
     helix = lambda th: np.column_stack([np.cos(th), np.sin(th), th])  # noqa: E731
     P, going_back = helix(theta), theta[39::-1]
@@ -182,6 +185,14 @@ def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
         else:
             m, j, same_way = found
             assert m == found_at and not same_way and j in (40 - m - 1, 40 - m)
+            # where it turned: the helix's last point (40), every point after it on the helix the other way
+            Y = np.vstack([P, back[:m]])
+            forward = np.column_stack([-np.sin(theta), np.cos(theta), np.ones(41)]) / np.sqrt(2.0)
+            T = np.vstack([forward, tangents[:m]])
+            assert _turned_back(Y, np.linalg.norm(np.diff(Y, axis=0), axis=1), T) == 40
+    # a path going on the way it went has not turned: its last point is the turn
+    assert _turned_back(P, np.linalg.norm(np.diff(P, axis=0), axis=1),
+                        np.column_stack([-np.sin(theta), np.cos(theta), np.ones(41)]) / np.sqrt(2.0)) == 40
 
 
 def test_a_point_that_does_not_converge_says_so():

@@ -66,6 +66,9 @@ FOLD_XTOL = 1e-10
 CORNER_TURN = np.pi / 3
 #: the points a stall is judged on (:class:`ContinuationOptions`'s ``stall``)
 STALL_POINTS = 10
+#: why a branch ends (:attr:`Branch.end`), each with its own words in :attr:`Branch.stopped`: the end reached, the
+#: most points, a stall, the step below ds_min, a closed loop, back along its own path, back past the start, a signal
+ENDS = ("reached", "max_points", "stalled", "ds_min", "closed loop", "went back", "past the start", "interrupted")
 
 
 @dataclass(frozen=True)
@@ -97,6 +100,8 @@ class Branch(Result):
     stopped : str
         Why the continuation ended: "reached the end, omega = ...", or where and why it stopped early (in the
         problem's parameter: omega, or ``problem.parameter``).
+    end : str
+        The same as one of :data:`ENDS` (a caller's test: ``stopped``'s words are for people).
     iterations : ndarray, shape (p,)
         Corrector iterations of each point.
     slope : ndarray, shape (p,)
@@ -117,6 +122,7 @@ class Branch(Result):
     max_real: np.ndarray
     folds: tuple[Fold, ...]
     stopped: str
+    end: str
     iterations: np.ndarray
     slope: np.ndarray
     interrupt: str
@@ -229,7 +235,7 @@ class Branch(Result):
             coords={"parameter": ("point", self.values, {"units": _cf(unit), "long_name": name}),
                     "harmonic": ("harmonic", np.arange(self.H + 1), {"units": "1", "long_name": "harmonic k"}),
                     "dof": ("dof", np.arange(self.n), {"units": "1", "long_name": "unknown DOF"})},
-            attrs={"stopped": self.stopped, "interrupt": self.interrupt or "no"})
+            attrs={"stopped": self.stopped, "end": self.end, "interrupt": self.interrupt or "no"})
 
 
 def stability_variable(stable: np.ndarray, known: np.ndarray) -> tuple:
@@ -351,24 +357,24 @@ def continue_branch(problem: PeriodicProblem, z0: np.ndarray, omega_start: float
     start = _solved(problem, z0, omega_start, tol)
     y = np.append(start.z, omega_start)
     first = _Point(y, _tangent(problem, y, None, direction, start.evaluation), start.iterations)
-    points, folds, stopped = [first], [], f"reached the end, {_at(problem, omega_end)}"
+    points, folds = [first], []
     path = np.empty((max_points, len(first.y)))  # the points' y, for the check that the branch is not retracing itself
     path[0], chords = first.y, np.empty(max_points)  # and the chord from each point to the next
     try:  # the whole loop: an interrupt anywhere in it leaves ``points`` whole
-        stopped = _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max,
-                         max_points, tol, progress, curved, o.fold_refine, o.stall) or stopped
+        end, stopped = _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min,
+                              ds_max, max_points, tol, progress, curved, o.fold_refine, o.stall)
         interrupt = ""
     except tuple(interrupts) as exc:
-        interrupt = interrupt_name(exc, interrupts)
+        interrupt, end = interrupt_name(exc, interrupts), "interrupted"
         stopped = f"interrupted ({interrupt}) at {_at(problem, points[-1].y[-1])}, after {len(points)} points"
-    return _branch(problem, points, folds, stopped, stability, interrupt)
+    return _branch(problem, points, folds, (end, stopped), stability, interrupt)
 
 
 def _trace(problem, points, folds, path, chords, direction, omega_start, omega_end, ds, ds_min, ds_max, max_points,
-           tol, progress, curved, fold_refine: bool = True, stall: float | None = None) -> str:
+           tol, progress, curved, fold_refine: bool = True, stall: float | None = None) -> tuple[str, str]:
     """Step from ``points[-1]`` on, appending to ``points`` and ``folds`` (``path`` and ``chords`` kept with them),
-    until omega passes ``omega_end``: why it stopped, or "" when it reached the end."""
-    first_ds = ds
+    until omega passes ``omega_end``: why it stopped, ``(end, words)`` (:data:`ENDS`)."""
+    first_ds, found = ds, []  # found: the point each of ``folds`` was found before (its index in ``points``)
     while len(points) < max_points:
         if progress is not None:
             progress(len(points), points[-1].y[-1])
@@ -377,30 +383,38 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
         if nxt is not None and nxt.t[-1] * points[-1].t[-1] < 0.0:
             folds.append(_locate_fold(problem, points[-1], nxt, tol) if fold_refine else
                          _interpolated_fold(problem, points[-1], nxt))
+            found.append(len(points))
         if nxt is None:
-            return why
+            return "ds_min", why
         points.append(nxt)
         if direction * (nxt.y[-1] - omega_end) >= 0.0:
-            return ""
+            return "reached", f"reached the end, {_at(problem, omega_end)}"
         path[len(points) - 1] = nxt.y
         chords[len(points) - 2] = np.linalg.norm(nxt.y - points[-2].y)
         again = _retraced(path[:len(points)], chords[:len(points) - 1], nxt.t)
         if again is not None:
             j, same_way = again
-            return (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} (traced before as points "
-                    f"{j} to {j + 1} of {len(points)}): a closed loop, followed once" if same_way else
-                    f"the branch went back along its own path at {_at(problem, nxt.y[-1])} (traced the other way as "
-                    f"points {j} to {j + 1} of {len(points)}): it turned back at a corner onto the part it had traced, "
-                    f"which it would trace again")
+            if same_way:
+                return "closed loop", (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} "
+                                       f"(traced before as points {j} to {j + 1} of {len(points)}): a closed loop, "
+                                       f"followed once")
+            turn, traced = _turned_back(path[:len(points)], chords[:len(points) - 1],
+                                        np.array([p.t for p in points])), len(points)
+            del points[turn + 1:]  # the points after the turn are the traced part's again: not kept
+            kept = sum(1 for i in found if i <= turn + 1)  # the turn's own fold (a corner) is the branch's
+            del folds[len(folds) - len(found) + kept:]
+            return "went back", (f"the branch went back along its own path after {_at(problem, points[-1].y[-1])}: it "
+                                 f"turned back there onto the part it had traced, and the {traced - turn - 1} points "
+                                 f"after the turn, traced the other way as points {j} to {j + 1} before, are not kept")
         if direction * (nxt.y[-1] - omega_start) < 0.0:
-            return (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
-                    f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
+            return "past the start", (f"the branch turned back past the start, {_at(problem, omega_start)} (at "
+                                      f"{_at(problem, nxt.y[-1])}, after {len(folds)} fold{'s' * (len(folds) != 1)})")
         if stall is not None and len(points) >= STALL_POINTS:
             why = _stalled(problem, path[len(points) - STALL_POINTS:len(points)],
                            chords[len(points) - STALL_POINTS:len(points) - 1], stall, first_ds)
             if why:
-                return why
-    return f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
+                return "stalled", why
+    return "max_points", f"stopped at max_points = {max_points} ({_at(problem, points[-1].y[-1])})"
 
 
 def _stalled(problem, Y: np.ndarray, chords: np.ndarray, share: float, ds: float) -> str:
@@ -437,12 +451,35 @@ def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> tuple[int, bo
     travelled = np.sum(chords) - np.cumsum(chords[:k])  # from each segment's end to the last point
     lo, hi = np.minimum(Y[:k, -1], Y[1:k + 1, -1]), np.maximum(Y[:k, -1], Y[1:k + 1, -1])
     j = np.flatnonzero((travelled > 20.0 * scale) & (last[-1] > lo - 0.25 * scale) & (last[-1] < hi + 0.25 * scale))
+    on, along = _on_segments(Y, chords, last, step, t, j)
+    return (int(j[on][0]), bool(along[on][0] > 0.0)) if np.any(on) else None
+
+
+def _turned_back(Y: np.ndarray, chords: np.ndarray, T: np.ndarray) -> int:
+    """The index of the point where a path that went back along itself turned: the points after it each lie on a
+    segment of the path before them going the other way (:func:`_on_segments`, with their unit tangents ``T`` (p,
+    size + 1)), the turn itself does not. ``Y`` (p, size + 1) the path's points, ``chords`` (p - 1,) its segments'
+    lengths. A point going on (the way the path went) is never on a segment the other way, so the walk back from the
+    last point stops at the turn."""
+    i = len(Y) - 1
+    while i >= 2 and np.any(_on_segments(Y[:i], chords[:i - 1], Y[i], chords[i - 1], T[i], np.arange(i - 1), -1)[0]):
+        i -= 1
+    return i
+
+
+def _on_segments(Y: np.ndarray, chords: np.ndarray, last: np.ndarray, step: float, t: np.ndarray, j: np.ndarray,
+                 way: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Which of the segments ``j`` of the path ``Y`` (their lengths ``chords[j]``) the point ``last``, reached by a
+    step of length ``step`` with the unit tangent ``t``, lies on: within a quarter of the larger of the segment and the
+    step (a chord leaves its arc by L^2 kappa / 8), the tangent within about 18 degrees of the segment (``way`` 1: the
+    same way, -1: the other way, 0: either). Returns the mask over ``j`` and the segments' components along ``t``."""
+    scale = np.maximum(chords[j], step)
     A, AB, length = Y[j], Y[j + 1] - Y[j], chords[j]
     u = np.clip(np.einsum("ij,ij->i", last - A, AB) / np.where(length > 0, length**2, 1.0), 0.0, 1.0)
     distance = np.linalg.norm(last - (A + u[:, None] * AB), axis=1)
     along = AB @ t
-    on = (np.abs(along) > 0.95 * length) & (distance < 0.25 * scale[j])
-    return (int(j[on][0]), bool(along[on][0] > 0.0)) if np.any(on) else None
+    aligned = np.abs(along) if way == 0 else way * along
+    return (aligned > 0.95 * length) & (distance < 0.25 * scale), along
 
 
 def parameter_of(problem) -> tuple[str, str]:
@@ -464,12 +501,13 @@ def _at(problem, value: float) -> str:
     return f"{name} = {_value(problem, value):.9g} {unit}"
 
 
-def _branch(problem, points, folds, stopped, stability, interrupt="") -> Branch:
+def _branch(problem, points, folds, ending: tuple[str, str], stability, interrupt="") -> Branch:
     y = np.array([p.y for p in points])
     omega, z = y[:, -1], y[:, :-1]
     max_real = np.array([floquet(problem, zi, wi).max_real for zi, wi in zip(z, omega)]) if stability \
         else np.full(len(points), np.nan)
-    return Branch(omega, z, max_real, tuple(folds), stopped, np.array([p.iterations for p in points]),
+    end, stopped = ending
+    return Branch(omega, z, max_real, tuple(folds), stopped, end, np.array([p.iterations for p in points]),
                   np.array([p.t[-1] for p in points]), interrupt, problem.n, parameter_of(problem),
                   np.array([_value(problem, w) for w in omega]))
 

@@ -75,7 +75,7 @@ JUMP_NEAR = 1e-3
 #: fell below ds_min (the corrector and the step in the speed alone failed at every step). Near an order's 0 Hz either
 #: is passed alike (:class:`TorusBranchOptions`'s ``past_stalls``): the rig's branch up from 91.37 Hz stalled at
 #: 91.4566 Hz in one run and failed there at ds_min in another, on another machine (docs/model.md §26)
-STUCK = ("the branch stalled", "the step fell below ds_min")
+STUCK = ("stalled", "ds_min")
 #: Newton iterations a jump's solve gets: from the stall's solution, a torus past a thin resonance converges in a
 #: few; one that does not is the next jump's
 JUMP_ITERATIONS = 15
@@ -516,7 +516,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
                                   options.max_points - before)
         times = np.diff(np.array(stamps[1:]))[:len(branch.values) - 1]  # each step, from one call to the next
         point_time = np.concatenate([[stamps[1] - began], times, np.zeros(len(branch.values) - 1 - len(times))])
-        stalled = key.startswith("speeds.") and branch.stopped.startswith(STUCK)
+        stalled = key.startswith("speeds.") and branch.end in STUCK
         if stalled:
             branch = dataclasses.replace(branch, stopped=_nearest_order(rubs, scene, key, branch))
         segments.append((rubs, branch, point_time, gap))
@@ -535,7 +535,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
         value, z, rub, gap = float(branch.values[-1]), branch.z[-1], rubs.rub_at(branch.values[-1]), ""
         furthest, began = value, time.perf_counter()
     last = segments[-1][1]
-    if ended is None and len(segments) > 1 and last.stopped.startswith("stopped at max_points"):
+    if ended is None and len(segments) > 1 and last.end == "max_points":
         ended = _most_points(key, float(last.values[-1]), options.max_points)
     return _joined(scene, key, segments, dof, divisors, options, notes, ended)
 
