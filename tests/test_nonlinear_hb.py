@@ -165,7 +165,7 @@ def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
     parallel helix 0.4 chords away (the other sheet of a thin fold) it is not found at any point; the branch's
     message says which (the same way: the Jeffcott loop above). Where it turned (``_turned_back``, the point the branch
     then ends at, the points after it not kept) is the helix's last point: every point back on it lies on it the other
-    way, and no point of a path going on (the helix alone) does."""
+    way, and no point of a path going on (the helix alone) does; or the last corner the path passed before that point."""
     theta = 0.05 * np.arange(41)
     helix = lambda th: np.column_stack([np.cos(th), np.sin(th), th])  # noqa: E731
     P, going_back = helix(theta), theta[39::-1]
@@ -189,7 +189,11 @@ def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
             Y = np.vstack([P, back[:m]])
             forward = np.column_stack([-np.sin(theta), np.cos(theta), np.ones(41)]) / np.sqrt(2.0)
             T = np.vstack([forward, tangents[:m]])
-            assert _turned_back(Y, np.linalg.norm(np.diff(Y, axis=0), axis=1), T) == 40
+            chords = np.linalg.norm(np.diff(Y, axis=0), axis=1)
+            assert _turned_back(Y, chords, T) == 40
+            # a corner before it is where the path reversed (the points since, on the helix or near it, dropped);
+            # a corner after it is not
+            assert _turned_back(Y, chords, T, corners=[12, 33]) == 33 and _turned_back(Y, chords, T, [44]) == 40
     # a path going on the way it went has not turned: its last point is the turn
     assert _turned_back(P, np.linalg.norm(np.diff(P, axis=0), axis=1),
                         np.column_stack([-np.sin(theta), np.cos(theta), np.ones(41)]) / np.sqrt(2.0)) == 40

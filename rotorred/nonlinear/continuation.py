@@ -398,8 +398,9 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
                 return "closed loop", (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} "
                                        f"(traced before as points {j} to {j + 1} of {len(points)}): a closed loop, "
                                        f"followed once")
+            corners = [i - 1 for i, f in zip(found, folds[len(folds) - len(found):]) if not f.smooth]
             turn, traced = _turned_back(path[:len(points)], chords[:len(points) - 1],
-                                        np.array([p.t for p in points])), len(points)
+                                        np.array([p.t for p in points]), corners), len(points)
             del points[turn + 1:]  # the points after the turn are the traced part's again: not kept
             kept = sum(1 for i in found if i <= turn + 1)  # the turn's own fold (a corner) is the branch's
             del folds[len(folds) - len(found) + kept:]
@@ -455,16 +456,20 @@ def _retraced(Y: np.ndarray, chords: np.ndarray, t: np.ndarray) -> tuple[int, bo
     return (int(j[on][0]), bool(along[on][0] > 0.0)) if np.any(on) else None
 
 
-def _turned_back(Y: np.ndarray, chords: np.ndarray, T: np.ndarray) -> int:
-    """The index of the point where a path that went back along itself turned: the points after it each lie on a
-    segment of the path before them going the other way (:func:`_on_segments`, with their unit tangents ``T`` (p,
-    size + 1)), the turn itself does not. ``Y`` (p, size + 1) the path's points, ``chords`` (p - 1,) its segments'
-    lengths. A point going on (the way the path went) is never on a segment the other way, so the walk back from the
-    last point stops at the turn."""
+def _turned_back(Y: np.ndarray, chords: np.ndarray, T: np.ndarray, corners=()) -> int:
+    """The index of the point where a path that went back along itself turned. From the last point back, each point
+    that lies on a segment of the path before it going the other way (:func:`_on_segments`, with the points' unit
+    tangents ``T`` (p, size + 1)) is the traced part's again; the first that does not ends the walk (a point going on,
+    the way the path went, is never on a segment the other way). The turn is then the last of ``corners`` (the
+    indices of the points before the corners the path passed) at or before that point, or that point where there is
+    none: a path reverses onto itself only at a corner (a step that jumped: a solution curve neither crosses nor joins
+    itself smoothly), and between the corner and the walk's end its points follow the traced part the other way,
+    some farther from its chords than the walk's quarter of a chord (the rig's outer-speed branch, docs/model.md §15).
+    ``Y`` (p, size + 1) the path's points, ``chords`` (p - 1,) its segments' lengths."""
     i = len(Y) - 1
     while i >= 2 and np.any(_on_segments(Y[:i], chords[:i - 1], Y[i], chords[i - 1], T[i], np.arange(i - 1), -1)[0]):
         i -= 1
-    return i
+    return max([c for c in corners if c <= i], default=i)
 
 
 def _on_segments(Y: np.ndarray, chords: np.ndarray, last: np.ndarray, step: float, t: np.ndarray, j: np.ndarray,
