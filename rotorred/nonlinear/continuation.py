@@ -400,7 +400,7 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
                                        f"followed once")
             corners = [i - 1 for i, f in zip(found, folds[len(folds) - len(found):]) if not f.smooth]
             turn, traced = _turned_back(path[:len(points)], chords[:len(points) - 1],
-                                        np.array([p.t for p in points]), corners), len(points)
+                                        np.array([p.t for p in points]), [c for c in corners if c > j + 1]), len(points)
             del points[turn + 1:]  # the points after the turn are the traced part's again: not kept
             kept = sum(1 for i in found if i <= turn + 1)  # the turn's own fold (a corner) is the branch's
             del folds[len(folds) - len(found) + kept:]
@@ -461,11 +461,12 @@ def _turned_back(Y: np.ndarray, chords: np.ndarray, T: np.ndarray, corners=()) -
     that lies on a segment of the path before it going the other way (:func:`_on_segments`, with the points' unit
     tangents ``T`` (p, size + 1)) is the traced part's again; the first that does not ends the walk (a point going on,
     the way the path went, is never on a segment the other way). The turn is then the last of ``corners`` (the
-    indices of the points before the corners the path passed) at or before that point, or that point where there is
-    none: a path reverses onto itself only at a corner (a step that jumped: a solution curve neither crosses nor joins
-    itself smoothly), and between the corner and the walk's end its points follow the traced part the other way,
-    some farther from its chords than the walk's quarter of a chord (the rig's outer-speed branch, docs/model.md §15).
-    ``Y`` (p, size + 1) the path's points, ``chords`` (p - 1,) its segments' lengths."""
+    indices of the points before the corners the path passed after the segment it went back along) at or before that
+    point, or that point where there is none: a path reverses onto itself only at a corner (a step that jumped: a
+    solution curve neither crosses nor joins itself smoothly), and between the corner and the walk's end its points
+    follow the traced part the other way, some farther from its chords than the walk's quarter of a chord (the rig's
+    outer-speed branch, docs/model.md §15). ``Y`` (p, size + 1) the path's points, ``chords`` (p - 1,) its segments'
+    lengths."""
     i = len(Y) - 1
     while i >= 2 and np.any(_on_segments(Y[:i], chords[:i - 1], Y[i], chords[i - 1], T[i], np.arange(i - 1), -1)[0]):
         i -= 1
