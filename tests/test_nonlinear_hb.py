@@ -165,7 +165,8 @@ def test_a_path_that_goes_back_along_itself_is_found_the_other_way():
     parallel helix 0.4 chords away (the other sheet of a thin fold) it is not found at any point; the branch's
     message says which (the same way: the Jeffcott loop above). Where it turned (``_turned_back``, the point the branch
     then ends at, the points after it not kept) is the helix's last point: every point back on it lies on it the other
-    way, and no point of a path going on (the helix alone) does; or the last corner the path passed before that point."""
+    way, and no point of a path going on (the helix alone) does; or the last corner the path passed before that
+    point."""
     theta = 0.05 * np.arange(41)
     helix = lambda th: np.column_stack([np.cos(th), np.sin(th), th])  # noqa: E731
     P, going_back = helix(theta), theta[39::-1]

@@ -398,9 +398,10 @@ def _trace(problem, points, folds, path, chords, direction, omega_start, omega_e
                 return "closed loop", (f"the branch came back onto its own path at {_at(problem, nxt.y[-1])} "
                                        f"(traced before as points {j} to {j + 1} of {len(points)}): a closed loop, "
                                        f"followed once")
-            corners = [i - 1 for i, f in zip(found, folds[len(folds) - len(found):]) if not f.smooth]
-            turn, traced = _turned_back(path[:len(points)], chords[:len(points) - 1],
-                                        np.array([p.t for p in points]), [c for c in corners if c > j + 1]), len(points)
+            # the points before the corners passed after segment j: where the path may have reversed onto it
+            corners = [i - 1 for i, f in zip(found, folds[len(folds) - len(found):]) if not f.smooth and i - 1 > j + 1]
+            traced = len(points)
+            turn = _turned_back(path[:traced], chords[:traced - 1], np.array([p.t for p in points]), corners)
             del points[turn + 1:]  # the points after the turn are the traced part's again: not kept
             kept = sum(1 for i in found if i <= turn + 1)  # the turn's own fold (a corner) is the branch's
             del folds[len(folds) - len(found) + kept:]
