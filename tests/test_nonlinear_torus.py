@@ -443,6 +443,37 @@ def test_a_problem_with_other_forces_shares_the_compliance_and_is_a_fresh_build(
     assert moved._compliance() is first._compliance()
 
 
+def test_the_clearance_derivative_is_the_central_difference_of_the_residual():
+    """``TorusProblem.dR_dclearance`` (a column of the sampled Jacobian, what a clearance branch's corrector borders
+    its Jacobian with) against central differences of the residuals of the problems at 13 µm +- h (residuals only, no
+    Jacobian). Their difference falls as h^2, the difference's own error (measured: 2.8e-7 at h = 1e-3 of the
+    clearance, 2.8e-9 at 1e-4, a ratio of 100.0; 1.0e-10 at 1e-5, round-off then): the observed order is 2 within 0.1,
+    which a wrong derivative (an O(1) difference) could not give. No sample of the grid is within 1.3e-7 m of the
+    gap's edge (the law's kink; h <= 1.3e-8 m), so the differences are smooth."""
+    from rotorred.scenes.run import build_model
+    from rotorred.scenes.schema import load_scene
+    from rotorred.scenes.torus_balance import torus_rub_problem
+
+    c = 13e-6
+    scene = load_scene("paper-rub", {"speeds.outer": 91.37, "rub.clearance": c})
+    model = build_model(scene).model
+    problem = torus_rub_problem(scene, model, (70.0, 91.37 / 3), 2, 8, 16, 64).problem
+    z = 3.0 * problem.linear_response()  # in contact on part of the grid
+    rub, (force, idx) = problem.forces[0], problem._local_forces[0]
+    penetration = problem.samples(z)[0][:, idx] @ force.gradient - c
+    assert np.min(np.abs(penetration - rub.plate.offset)) > 1e-3 * c  # farther than the largest h
+    exact = problem.dR_dclearance(z)
+    assert np.linalg.norm(exact) > 1.0  # in contact: the clearance moves the residual
+
+    def error(relative):
+        h = relative * c
+        up, down = (problem.with_forces((rub.with_clearance(c + d),) + problem.forces[1:]) for d in (h, -h))
+        return np.linalg.norm(exact - (up.residual(z) - down.residual(z)) / (2 * h)) / np.linalg.norm(exact)
+    coarse, fine = error(1e-3), error(1e-4)
+    assert math.log10(coarse / fine) == pytest.approx(2.0, abs=0.1)
+    assert error(1e-5) <= 1e-9
+
+
 def test_a_spool_frequency_held_by_several_far_apart_orders_is_its_lowest():
     """At outer 91 Hz the bases (70, 91/3) Hz are 13:10: in the box |k1| <= 32, |k2| <= 80 (band 900 Hz) 70 Hz is the
     order (1, 0) and (12, -30) (and more), 91 Hz (0, 3) and (13, -27). The spool's order is the lowest, the others 42

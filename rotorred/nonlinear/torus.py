@@ -883,6 +883,27 @@ class TorusProblem:
         self._cache["evaluated"] = (np.array(z, copy=True), R, dq, dv)
         return R, dq, dv
 
+    def dR_dclearance(self, z: np.ndarray, rub: int = 0) -> np.ndarray:
+        """``dR/dclearance = G dF_nl/dclearance`` at z for the clearance of the rub ``forces[rub]``: the forces'
+        derivative by the DOF the clearance enters the gap with (``PlateRub.clearance_dof``), a column of the sampled
+        Jacobian the residual at z has computed (no residual more; docs/model.md §26).
+
+        Parameters
+        ----------
+        z : ndarray, shape (size,)
+            Harmonic-major coefficients of the ``dofs`` (m; rad for a rotation DOF).
+        rub : int
+            Index in ``forces`` of the rub (a force with ``clearance_dof``).
+
+        Returns
+        -------
+        ndarray, shape (size,)
+            (m/m: dimensionless).
+        """
+        force, idx = self._local_forces[rub]
+        dq = self._evaluated(z)[1]
+        return self.apply(self.harmonics.coefficients(dq[:, :, idx[force.clearance_dof]]))
+
     def _sampled_terms(self, z: np.ndarray):
         """R and the Jacobian's terms at z: the distinct shapes of the sampled force derivatives (N_1 N_2, b) (a shape
         shared by several DOF pairs, e.g. a rub's rank-1 Jacobian, counts once) and the terms ``(b, kind, A)``: shape

@@ -140,12 +140,16 @@ class TorusFamily:
         built at while it is within ``frozen |value|`` (>= 0): exact in z, first order in ``value - v_c``. Where a
         value's problem costs its compliance (a speed: every order's dynamic stiffness solved) this halves the
         problems built, and the next steps' derivatives cost two residuals.
+    derivative : callable, optional
+        ``derivative(problem, z) -> dR/dvalue`` (size,), exact, in place of the difference of two residuals (a
+        clearance: :meth:`TorusProblem.dR_dclearance`, a column of the sampled Jacobian at z, no residual more).
     """
 
     build: Callable[[float], TorusProblem]
     reference: float
     parameter: tuple = ("value", "-")
     frozen: float = 0.0
+    derivative: Callable[[TorusProblem, np.ndarray], np.ndarray] | None = None
     _problems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     _state: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -273,7 +277,9 @@ class TorusFamily:
         R = p.residual(z)
         relative = float(np.linalg.norm(R)) / p.scale
 
-        def dR_ds():  # the difference of two problems' residuals at z: exact in z, kept near a value
+        def dR_ds():  # the problem's own derivative, or the difference of two problems' residuals at z
+            if self.derivative is not None:
+                return self.derivative(p, z) / self.scale
             kept = self._state["column"]
             if kept is None or abs(kept[0] - value) > self.frozen * abs(value):
                 kept = (value, *self._pair(value, p))

@@ -49,6 +49,10 @@ __all__ = ["TorusBranchOptions", "TorusBranch", "continue_torus", "check_torus_k
 #: a speed's dR/dvalue is computed afresh where the speed moved by more than this share since it last was
 #: (:class:`rotorred.nonlinear.torus_continuation.TorusFamily`): a point's corrections share one
 FROZEN = 1e-3
+#: the keys whose dR/dvalue the problem gives exactly (:class:`TorusFamily`'s ``derivative``; the others by the
+#: difference of two residuals): the clearance (of the first plate, the key's, :func:`_scene_at`), a column of the
+#: sampled Jacobian (docs/model.md §26)
+DERIVATIVES = {"rub.clearance": lambda problem, z: problem.dR_dclearance(z, 0)}
 #: lines of the output DOF a branch's summary and files show: the largest at the start
 SHOWN_LINES = 10
 #: the ladder of boxes a lines tolerance climbs (:class:`TorusBranchOptions`): each box's bounds times this
@@ -509,7 +513,7 @@ def continue_torus(scene, model, key: str, start: float, end: float,
             notes.append(f"{notes and 'then ' or ''}{box[0]}x{box[1]} from {value:.6g} ({note})")
         rubs = _Family(scene, model, key, rub, divisors)
         family = TorusFamily(rubs.problem_at, value, (key, KEYS.get(key, "Hz")),
-                             FROZEN if key.startswith("speeds.") else 0.0)
+                             FROZEN if key.startswith("speeds.") else 0.0, DERIVATIVES.get(key))
         check_at = furthest + direction * reach if options.lines_tol is not None else None
         before = _points(segments) - (1 if segments and not gap else 0)  # the joined branch's before this one's
         branch, stamps = _segment(family, z, value, end, options, check_at, progress, before, interrupts,
