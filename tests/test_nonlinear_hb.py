@@ -7,11 +7,14 @@ circular clearance g = 1 with contact stiffness k_c = 100, no friction.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from rotorred.checks import InputError
 from rotorred.nonlinear.continuation import ContinuationOptions, _retraced, _turned_back, continue_branch
 from rotorred.nonlinear.examples import C, E_UNB, GAP, K3, K_C, F, duffing, jeffcott
 from rotorred.nonlinear.forces import CircularClearance
@@ -147,7 +150,8 @@ def test_jeffcott_full_annular_rub_is_the_closed_form_circular_orbit():
 def test_a_branch_that_comes_back_onto_its_path_stops_there():
     """The Jeffcott rotor started with ds = 0.11 (0.1 in the test above) goes round its fold and corner and back onto
     the free branch it started on: the branch stops where it meets its own path, saying so, after one loop (320
-    points), where it went round 15 times until max_points = 5000 before."""
+    points), where it went round 15 times until max_points = 5000 before. Its end code is "closed loop", and a branch
+    whose code is none of ``ENDS`` is refused."""
     problem = jeffcott(5, 128)
     z0 = np.zeros(problem.size)
     z0[2] = z0[5] = E_UNB * 0.25 / (1 - 0.25)
@@ -156,6 +160,8 @@ def test_a_branch_that_comes_back_onto_its_path_stops_there():
     assert "a closed loop, followed once" in branch.stopped and len(branch.omega) < 400
     assert branch.end == "closed loop" and branch.to_xarray().attrs["end"] == "closed loop"
     assert [f.smooth for f in branch.folds] == [True, False]
+    with pytest.raises(InputError, match="end.*must be one of 'reached', 'max_points'"):  # a code outside ENDS
+        dataclasses.replace(branch, end="looped")
 
 
 def test_a_path_that_goes_back_along_itself_is_found_the_other_way():

@@ -16,7 +16,7 @@ from rotorred.checks import InputError
 from rotorred.nonlinear.forces import CubicSpring
 from rotorred.nonlinear.fourier import Harmonics, alias_free_samples
 from rotorred.nonlinear.hb import NotConverged, PeriodicProblem, solve_periodic
-from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, alias_free_grid, solve_torus
+from rotorred.nonlinear.torus import TorusHarmonics, TorusProblem, TorusSeries, alias_free_grid, solve_torus
 
 # the cubic oscillator x'' + C x' + x + K3 x^3 = F1 cos(w1 t) + F2 cos(w2 t), both tones near its resonance
 C, K3, F1, F2 = 0.2, 0.5, 0.15, 0.1
@@ -441,6 +441,25 @@ def test_a_problem_with_other_forces_shares_the_compliance_and_is_a_fresh_build(
     assert np.linalg.norm(first.residual(z) - moved.residual(z)) > 1e-3 * np.linalg.norm(moved.residual(z))
     assert np.linalg.norm(moved.residual(z) - fresh.residual(z)) <= 1e-14 * np.linalg.norm(fresh.residual(z))
     assert moved._compliance() is first._compliance()
+
+
+def test_the_torus_series_is_the_direct_sum_at_any_times_its_phase_table_kept_only_for_its_step():
+    """``TorusSeries`` against the direct sum ``Re sum_k Q_k exp(i (k . w) t)`` (one exponential per order and time):
+    at uniform times (its kept phase table: 1500 times, two blocks), again at other uniform times of the same step
+    (the table reused) and of another step (made afresh), at uneven times and at one time: the same to 1e-13 of the
+    largest value (measured 1.3e-14 at most; a table kept for the wrong step is off by 1.3 of it)."""
+    rng = np.random.default_rng(3)
+    h = TorusHarmonics(3, 5, 16, 32)
+    w = (2.0, 2.0 * math.sqrt(2.0))
+    Q = rng.standard_normal((h.n_orders, 2)) + 1j * rng.standard_normal((h.n_orders, 2))
+    series = TorusSeries(h.orders, Q, w)
+
+    def direct(t):
+        return (np.exp(1j * np.outer(t, h.frequencies(w))) @ Q).real
+    for t in (np.arange(1500) * 0.01, 3.7 + np.arange(700) * 0.01, np.arange(900) * 0.013,
+              np.sort(rng.uniform(0.0, 20.0, 300)), np.array([1.234])):
+        x = direct(t)
+        assert np.max(np.abs(series(t) - x)) <= 1e-13 * np.max(np.abs(x))
 
 
 def test_the_clearance_derivative_is_the_central_difference_of_the_residual():

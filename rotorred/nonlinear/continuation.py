@@ -130,6 +130,9 @@ class Branch(Result):
     parameter: tuple[str, str]
     values: np.ndarray
 
+    def __post_init__(self):
+        checks.choice("end", self.end, ENDS)
+
     @property
     def stable(self) -> np.ndarray:
         """Whether each point is stable (False where stability was not computed)."""

@@ -59,7 +59,7 @@ from rotorred.nonlinear.torus_toeplitz import toeplitz_real_form
 from rotorred.results import Result
 from rotorred.signals.spectra import pyfftw
 
-__all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "solve_torus", "alias_free_grid"]
+__all__ = ["TorusHarmonics", "TorusProblem", "TorusSolution", "TorusSeries", "solve_torus", "alias_free_grid"]
 
 #: the loosest and the tightest relative tolerance of GMRES on a Newton step (the inexact Newton's forcing term,
 #: :func:`solve_torus`)
@@ -68,6 +68,8 @@ FORCING_MAX, KRYLOV_FLOOR = 1e-2, 1e-12
 FORCING_ORDER = 1.5
 #: orders whose dynamic stiffnesses are built and solved at once (:meth:`TorusProblem._compliance`)
 COMPLIANCE_CHUNK = 256
+#: times a torus series is summed at at once (:class:`TorusSeries`: its table of phases, 29 MB at 1799 orders)
+SERIES_BLOCK = 1024
 #: the compliance by the modes (:func:`modal_compliance`) is taken where it matches the direct solve at a few orders to
 #: this relative difference, else the direct solve serves
 MODAL_MATCH = 1e-8
@@ -566,6 +568,52 @@ class TorusHarmonics:
         Q[0] = fit.mean
         Q[used] = np.where(f[used] > 0, fit.coefficients, fit.coefficients.conj())
         return self.from_phasors(Q[:, None])
+
+
+class TorusSeries:
+    """A torus's series along ``theta = w t``: ``Re sum_k Q_k exp(i (k . w) t)`` at any times, the one rule for a
+    torus's trajectory (a scene's record, :func:`rotorred.scenes.torus_response.torus_record`; the state the stability
+    integrates along, :func:`rotorred.nonlinear.torus_stability.torus_lyapunov`).
+
+    By blocks of :data:`SERIES_BLOCK` times, ``exp(i (k . w) t) = exp(i (k . w) t_b) exp(i (k . w) (t - t_b))``, t_b
+    the block's first time: for times at a constant step (a record's, an integration's) the second factor's table is
+    the same for every block, computed once and kept for the next calls at that step, and a block costs one
+    (times x orders) by (orders x p) product.
+
+    Parameters
+    ----------
+    orders : ndarray, shape (K, 2), int
+        The orders ``(k_1, k_2)`` (:attr:`TorusHarmonics.orders`).
+    Q : ndarray, shape (K, p), complex
+        Each order's complex amplitudes of p signals (any units).
+    w : (float, float)
+        The base frequencies (rad/s).
+    """
+
+    def __init__(self, orders: np.ndarray, Q: np.ndarray, w):
+        self.wk = np.asarray(orders, float) @ np.asarray(w, float)
+        self.Q = np.asarray(Q, complex)
+        self._kept_step, self._table = None, np.zeros((0, len(self.wk)), complex)  # the table, and its step
+
+    def __call__(self, t) -> np.ndarray:
+        """The signals at the times ``t`` (s): shape (len(t), p)."""
+        t = np.atleast_1d(np.asarray(t, float))
+        step = np.diff(t)
+        uniform = len(t) > 1 and np.ptp(step) <= 1e-9 * abs(step[0])
+        out = np.empty((len(t), self.Q.shape[1]))
+        for start in range(0, len(t), SERIES_BLOCK):
+            tb = t[start:start + SERIES_BLOCK]
+            table = self._phases(tb, float(step[0])) if uniform else np.exp(1j * np.outer(tb - tb[0], self.wk))
+            out[start:start + len(tb)] = (table[:len(tb)] @ (self.Q * np.exp(1j * self.wk * tb[0])[:, None])).real
+        return out
+
+    def _phases(self, tb: np.ndarray, step: float) -> np.ndarray:
+        """``exp(i (k . w) j step)`` for ``j < len(tb)``: the kept table where it has that step (to 1e-9 of it) and
+        rows enough, else computed and kept."""
+        same = self._kept_step is not None and abs(self._kept_step - step) <= 1e-9 * abs(step)
+        if not same or len(self._table) < len(tb):
+            self._kept_step, self._table = step, np.exp(1j * np.outer(tb - tb[0], self.wk))
+        return self._table
 
 
 class _GridTransform:

@@ -48,6 +48,7 @@ import scipy.linalg as sla
 
 from rotorred import checks, progress as feedback
 from rotorred.nonlinear.hb import local_forces, sampled_forces
+from rotorred.nonlinear.torus import TorusSeries
 from rotorred.results import Result
 
 __all__ = ["LyapunovOptions", "TorusStability", "torus_lyapunov", "torus_trajectory"]
@@ -234,33 +235,19 @@ def torus_trajectory(problem, z: np.ndarray, t: np.ndarray, dofs: str = "unknown
         checks.fail("dofs", dofs, "must be 'unknowns' or 'all'")
     h = problem.harmonics
     Q = h.phasors(z, problem.n) if dofs == "unknowns" else problem.recover(z)
-    return _Series(h, Q, problem.w)(np.atleast_1d(np.asarray(t, float)))
+    return _series(h, Q, problem.w)(t)
 
 
-class _Series:
-    """The torus's amplitudes laid out by order, ``(k_1, k_2 + H_2)``, for a sum along ``theta = w t`` that costs
-    products, not exponentials: ``sum_k Q_k e^{i k.w t} = sum_{k_1} e^{i k_1 w_1 t} (sum_{k_2} Q_{k_1 k_2}
-    e^{i k_2 w_2 t})``, the inner sums one matrix product for all ``k_1``."""
+def _series(harmonics, Q: np.ndarray, w):
+    """``t -> (q, dq/dt)`` along the torus of amplitudes Q (K, p): one :class:`rotorred.nonlinear.torus.TorusSeries`
+    of Q and of its rates ``i (k . w) Q``, shape (len(t), p) each."""
+    p = Q.shape[1]
+    series = TorusSeries(harmonics.orders, np.hstack([Q, 1j * harmonics.frequencies(w)[:, None] * Q]), w)
 
-    def __init__(self, harmonics, Q: np.ndarray, w):
-        H1, H2 = harmonics.H1, harmonics.H2
-        k1, k2 = harmonics.orders[:, 0], harmonics.orders[:, 1]
-        wk = harmonics.frequencies(w)[:, None]
-        self.w, self.H2 = w, H2
-        self.Q = np.zeros((2, H1 + 1, 2 * H2 + 1, Q.shape[1]), complex)  # the series of q and of dq/dt
-        self.Q[0, k1, k2 + H2], self.Q[1, k1, k2 + H2] = Q, 1j * wk * Q
-
-    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """q and dq/dt at the times t, shape (len(t), p) each."""
-        _, H1p, H2p, p = self.Q.shape
-        out = np.empty((2, t.size, p))
-        for lo in range(0, t.size, CHUNK):
-            tt = t[lo:lo + CHUNK]
-            E1 = np.exp(1j * np.outer(tt, self.w[0] * np.arange(H1p)))  # (m, H1 + 1)
-            E2 = np.exp(1j * np.outer(tt, self.w[1] * np.arange(-self.H2, self.H2 + 1)))  # (m, 2 H2 + 1)
-            inner = np.einsum("tj,sijc->stic", E2, self.Q, optimize=True)  # (2, m, H1 + 1, p)
-            out[:, lo:lo + CHUNK] = np.einsum("ti,stic->stc", E1, inner).real
-        return out[0], out[1]
+    def along(t):
+        x = series(t)
+        return x[:, :p], x[:, p:]
+    return along
 
 
 def _step(problem, options: LyapunovOptions) -> float:
@@ -313,7 +300,7 @@ def torus_lyapunov(problem, z: np.ndarray, options: LyapunovOptions = LyapunovOp
     dt = _step(problem, options)
     per_block = 2 * max(1, math.ceil(options.periods * math.pi / min(problem.w) / dt / options.blocks))  # even
     Y0 = np.linalg.qr(np.random.default_rng(options.seed).standard_normal((m, options.count)))[0]
-    torus = (A0, lower, _Series(problem.harmonics, problem.harmonics.phasors(z, problem.n), problem.w),
+    torus = (A0, lower, _series(problem.harmonics, problem.harmonics.phasors(z, problem.n), problem.w),
              local_forces(problem.forces, problem.dofs))
     T_block = per_block * dt
     with feedback.bar(1.5 * per_block * options.blocks, "torus stability", "step", progress=options.progress,

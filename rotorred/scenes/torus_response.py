@@ -26,14 +26,12 @@ import numpy as np
 
 from rotorred import checks
 from rotorred.checks import InputError
+from rotorred.nonlinear.torus import TorusSeries
 from rotorred.scenes.harmonic_balance import contact_history
 from rotorred.signals.lines import line_label
 
 __all__ = ["torus_options", "solve_scene_torus", "torus_record", "spool_bases", "base_labels", "order_label",
            "describe_torus"]
-
-#: record times synthesised at once (the (times x orders) phases of a block: 8 MB a 512 orders)
-BLOCK = 1024
 
 
 def torus_options(scene):
@@ -100,8 +98,8 @@ def torus_record(torus, t: np.ndarray, dofs) -> tuple[dict, tuple]:
     :class:`rotorred.transient.results.ContactHistory` per plate from the law at those instants
     (:func:`rotorred.scenes.harmonic_balance.contact_history`).
 
-    The series ``Re sum_k Q_k exp(i (k_1 w_1 + k_2 w_2) t)`` (phase origin t = 0, as the unbalance's) is summed in
-    blocks of :data:`BLOCK` times (:func:`_synthesised`).
+    The series ``Re sum_k Q_k exp(i (k_1 w_1 + k_2 w_2) t)`` (phase origin t = 0, as the unbalance's) is
+    :class:`rotorred.nonlinear.torus.TorusSeries`'s.
 
     Parameters
     ----------
@@ -123,28 +121,12 @@ def torus_record(torus, t: np.ndarray, dofs) -> tuple[dict, tuple]:
     columns = [Q @ rp.output_rows(dofs).T]
     for rub in rubs:  # each plate's unknowns and their rates, d/dt -> i (k . w)
         columns += [Q[:, list(rub.dofs)], 1j * h.frequencies(w)[:, None] * Q[:, list(rub.dofs)]]
-    x = _synthesised(np.hstack(columns), h.orders, w, np.asarray(t, float))
+    x = TorusSeries(h.orders, np.hstack(columns), w)(t)
     outputs = {d: x[:, j] for j, d in enumerate(dofs)}
     at = len(dofs)
     contacts = tuple(contact_history(rub, x[:, at + 8 * i:at + 8 * i + 4], x[:, at + 8 * i + 4:at + 8 * i + 8])
                      for i, rub in enumerate(rubs))
     return outputs, contacts
-
-
-def _synthesised(Q: np.ndarray, orders: np.ndarray, w, t: np.ndarray) -> np.ndarray:
-    """``Re sum_k Q_k exp(i (k . w) t)`` at the times ``t``, shape (n, p), for the amplitudes ``Q`` (K, p): by blocks of
-    :data:`BLOCK` times, ``exp(i (k . w) t) = exp(i (k . w) t_b) exp(i (k . w) (t - t_b))`` with ``t_b`` the block's
-    first time, the second factor's table computed once for times at a constant step (a record's)."""
-    wk = orders @ np.asarray(w, float)
-    step = np.diff(t)
-    uniform = len(t) > 1 and np.ptp(step) <= 1e-9 * abs(step[0])
-    out, table = np.empty((len(t), Q.shape[1])), None
-    for start in range(0, len(t), BLOCK):
-        tb = t[start:start + BLOCK]
-        if table is None or not uniform:
-            table = np.exp(1j * np.outer(tb - tb[0], wk))
-        out[start:start + len(tb)] = (table[:len(tb)] @ (Q * np.exp(1j * wk * tb[0])[:, None])).real
-    return out
 
 
 def spool_bases(torus, f_L: float, f_H: float) -> tuple:
