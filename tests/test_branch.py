@@ -43,7 +43,7 @@ def test_a_clearance_branch_solves_the_scene_at_each_clearance_and_turns_at_its_
     of its nearest point, and the peak at 45 um is the linear response's."""
     scene, model = rig
     branch = continue_scene(scene, model, "rub.clearance", 45e-6, 25e-6, BranchOptions(H, N, stability=False))
-    assert branch.stopped == "reached the end, clearance = 2.5e-05 m"
+    assert branch.stopped == "reached the end, clearance = 2.5e-05 m" and branch.end == "reached"
     for i in np.linspace(0, len(branch.values) - 1, 5).astype(int):
         at = load_scene("paper-rub", {"rub.clearance": float(branch.values[i])})
         assert _residual(at, model, branch.z[i]) < 1e-9
@@ -112,7 +112,7 @@ def test_stability_changes_are_classified_by_the_critical_multiplier():
     critical = np.array([0.5, -1.2, -0.9, 0.5 + 0.6j, 0.8 + 0.8j, 1.3])
     branch = SceneBranch("paper-rub", "rub.clearance", "m", values, values, ((18, "y"),), np.zeros((6, 1)),
                          np.zeros((6, 4)), np.zeros((6, 3)), critical, (), "reached the end", np.ones(6, int), 0.0, 0.0,
-                         0.0)
+                         0.0, end="reached")
     assert [kind for _, _, kind in branch.bifurcations] == ["period-doubling", "period-doubling", "Neimark-Sacker"]
     assert [(a, b) for a, b, _ in branch.bifurcations] == [(0.0, 1.0), (1.0, 2.0), (3.0, 4.0)]
     assert list(branch.stable) == [True, False, True, True, False, False]
@@ -328,6 +328,7 @@ def test_sigint_in_the_stability_phase_keeps_every_point_traced(tmp_path):
     assert stable[:known] == [str(int(m < 1)) for m in mu[:known]] and {"0", "1"} <= set(stable[:known])
     assert set(stable[known:]) == {"unknown"}
     assert np.allclose(ds["rub_clearance"].values, values, rtol=1e-8) and ds.attrs["interrupted"] == "SIGINT"
+    assert ds.attrs["end"] == "interrupted"  # the tracing reached its end; the signal ended the stability
     assert list(ds["stable"].values) == [int(s) if s != "unknown" else -1 for s in stable]
     assert ds["stable"].attrs["flag_meanings"] == "stable unstable unknown"
     assert np.isnan(ds["critical_multiplier_re"].values[known:]).all()
@@ -346,6 +347,7 @@ def test_sigterm_while_tracing_keeps_the_points_so_far(tmp_path):
     assert f"at rub.clearance = {values[-1]:.9g} m" in text
     assert {r[-2] for r in rows} == {"unknown"} and list(ds["stable"].values) == [-1] * 6
     assert ds.attrs["interrupted"] == "SIGTERM" and ds.attrs["stopped"] == text.splitlines()[0][len("INCOMPLETE: "):]
+    assert ds.attrs["end"] == "interrupted"
 
 
 def test_a_harmonic_balance_scene_records_its_periodic_solution(rig):

@@ -215,7 +215,7 @@ def test_a_speed_branch_moves_the_bases_and_each_point_is_the_scenes_torus_there
     model = build_model(scene).model
     branch = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
                                rr.TorusBranchOptions(orders=(2, 8), divisors=(1, 3), steps=(0.02, 0.05), tol=1e-8))
-    assert branch.stopped.startswith("reached the end") and len(branch.values) >= 3
+    assert branch.stopped.startswith("reached the end") and len(branch.values) >= 3 and branch.end == "reached"
     assert np.allclose(branch.bases_hz[:, 0], 70.0, rtol=1e-12)
     assert np.allclose(branch.bases_hz[:, 1], branch.values / 3, rtol=1e-12)
     for v, z in zip(branch.values, branch.z):
@@ -259,6 +259,7 @@ def test_a_speed_branch_that_stalls_ends_saying_where_and_near_which_order(monke
     f = {k: k[0] * 70.0 + k[1] * v / 3 for k in box if abs(k[0] * 70.0 + k[1] * v / 3) <= 1500.0}
     k = min(f, key=lambda key: abs(f[key]))
     assert len(branch.values) == 10 and not branch.interrupted and branch.gaps == ()  # its 0 Hz far: not passed
+    assert branch.end == "stalled" and branch.to_xarray().attrs["end"] == "stalled"
     assert branch.stopped.startswith(f"the branch stalled at speeds.outer = {v:.9g} Hz: its last 10 points lie "
                                      f"within {np.ptp(branch.values):.3g} Hz and moved ")
     assert branch.stopped.endswith(f"(the order ({k[0]}, {k[1]}) of the box is at {f[k]:+.3g} Hz there); start "
@@ -289,6 +290,7 @@ def test_a_stall_near_an_orders_0_hz_is_passed_and_the_gap_shown(monkeypatch, tm
                                                      max_points=35))
     assert len(branch.values) == 35 and not branch.interrupted  # the branch's most points, not its last segment's
     assert branch.stopped == f"stopped at max_points = 35 (speeds.outer = {branch.values[-1]:.9g} Hz)"
+    assert branch.end == "max_points"
     assert [i for i, _ in branch.gaps] == [10, 20, 30]
     for i, why in branch.gaps:
         v = float(branch.values[i])
@@ -343,7 +345,7 @@ def test_a_step_that_fails_near_an_orders_0_hz_is_passed_like_a_stall(monkeypatc
     calls.clear()
     ends = rr.continue_torus(scene, model, "speeds.outer", 91.37, 91.8,
                              dataclasses.replace(options, past_stalls=False))
-    assert len(ends.values) == 8 and ends.gaps == ()
+    assert len(ends.values) == 8 and ends.gaps == () and ends.end == "ds_min"
     assert ends.stopped.startswith("the step fell below ds_min = ") and ends.stopped.endswith(
         "(made to fail) (the order (7, -21) of the box is at -0.07 Hz there); start another branch past it")
 

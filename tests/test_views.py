@@ -144,7 +144,7 @@ def _branch(critical) -> rr.SceneBranch:
     return rr.SceneBranch("paper-rub", "rub.clearance", "m", values, np.full(p, 10.0), ((14, "y"), (18, "x")),
                           np.column_stack([np.linspace(1, 2, p), np.linspace(3, 4, p)]) * 1e-6, np.zeros((p, 3)),
                           np.zeros((p, 2)), np.asarray(critical, complex), ((30e-6, True),), "reached the end",
-                          np.ones(p, int), 0.0, 0.0, 0.0)
+                          np.ones(p, int), 0.0, 0.0, 0.0, end="reached")
 
 
 def test_the_branch_view_draws_stable_solid_unstable_dashed_and_marks_folds_and_bifurcations():

@@ -43,7 +43,7 @@ import scipy.linalg as sla
 from rotorred import checks
 from rotorred.model.operating import Operating
 from rotorred.nonlinear.condensed import ClearanceFamily
-from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch, stability_variable
+from rotorred.nonlinear.continuation import ENDS, ContinuationOptions, continue_branch, stability_variable
 from rotorred.nonlinear.hb import Evaluation, NotConverged, solve_periodic
 from rotorred.nonlinear.stability import floquet_by_monodromy
 from rotorred.progress import INTERRUPTS, interrupt_name
@@ -201,6 +201,9 @@ class SceneBranch(Result):
         Wall time of the cold start, the continuation and the stability of every point (s).
     interrupt : str
         The signal that ended the branch ("SIGINT", "SIGTERM": the caller's ``interrupts``), or "".
+    end : str
+        Why the branch ended as a code, one of :data:`rotorred.nonlinear.continuation.ENDS` ("interrupted" also where
+        a signal ended the stability after the branch); keyword-only.
     """
 
     scene: str
@@ -220,6 +223,10 @@ class SceneBranch(Result):
     solve_time: float
     stability_time: float
     interrupt: str = ""
+    end: str = field(kw_only=True)
+
+    def __post_init__(self):
+        checks.choice("end", self.end, ENDS)
 
     @property
     def known(self) -> np.ndarray:
@@ -338,7 +345,7 @@ class SceneBranch(Result):
                     "dof": ("dof", [dof_name(d) for d in self.dofs], {"units": "1", "long_name": "output DOF"}),
                     "harmonic": ("harmonic", np.arange(self.lines.shape[1]),
                                  {"units": "1", "long_name": "harmonic k of f0"})},
-            attrs={"scene": self.scene, "stopped": self.stopped, "interrupted": self.interrupt or "no",
+            attrs={"scene": self.scene, "stopped": self.stopped, "end": self.end, "interrupted": self.interrupt or "no",
                    "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds),
                    "bifurcations": "; ".join(f"{kind} between {a:.9g} and {b:.9g}"
                                              for a, b, kind in self.bifurcations)})
@@ -548,7 +555,8 @@ def continue_scene(scene, model, key: str, start: float, end: float, options: Br
         interrupt, key, values, critical, stability, None if branch.interrupt else branch.stopped)
     return SceneBranch(scene.name, key, KEYS.get(key, "Hz"), values, outputs[0], dofs, outputs[1], branch.z, outputs[2],
                        critical, tuple((to_value(f.omega), f.smooth) for f in branch.folds), stopped,
-                       branch.iterations, t1 - t0, t2 - t1, stability_time, interrupt)
+                       branch.iterations, t1 - t0, t2 - t1, stability_time, interrupt,
+                       end="interrupted" if interrupt else branch.end)
 
 
 def scene_at(scene, key: str, value: float):

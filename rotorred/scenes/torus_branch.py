@@ -24,13 +24,13 @@ import dataclasses
 import textwrap
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from rotorred import checks
 from rotorred.model.operating import Operating
-from rotorred.nonlinear.continuation import ContinuationOptions, continue_branch
+from rotorred.nonlinear.continuation import ENDS, ContinuationOptions, continue_branch
 from rotorred.nonlinear.hb import NotConverged
 from rotorred.nonlinear.torus import TorusProblem, solve_torus
 from rotorred.nonlinear.torus_continuation import TorusFamily
@@ -231,6 +231,9 @@ class TorusBranch(Result):
     gaps : tuple of (int, str)
         Each stretch of the key not traced (a stall passed, :class:`TorusBranchOptions`'s ``past_stalls``): the
         position of the first point after it, and why.
+    end : str
+        Why the branch ended as a code, one of :data:`rotorred.nonlinear.continuation.ENDS`: its last segment's, or
+        "max_points" where the branch's most points ended it; keyword-only.
     """
 
     scene: str
@@ -250,6 +253,10 @@ class TorusBranch(Result):
     truncation: str
     interrupt: str = ""
     gaps: tuple = ()
+    end: str = field(kw_only=True)
+
+    def __post_init__(self):
+        checks.choice("end", self.end, ENDS)
 
     @property
     def interrupted(self) -> bool:
@@ -363,7 +370,7 @@ class TorusBranch(Result):
                                                                    "rotorred_key": self.key}),
                     "k1": ("order", self.orders[:, 0], {"units": "1", "long_name": "order of f_1"}),
                     "k2": ("order", self.orders[:, 1], {"units": "1", "long_name": "order of f_2"})},
-            attrs={"scene": self.scene, "stopped": self.stopped, "interrupted": self.interrupt or "no",
+            attrs={"scene": self.scene, "stopped": self.stopped, "end": self.end, "interrupted": self.interrupt or "no",
                    "truncation": self.truncation,
                    "folds": "; ".join(f"{v:.9g} {'fold' if s else 'corner'}" for v, s in self.folds),
                    "gaps": "; ".join(f"{self.values[i - 1]:.9g} to {self.values[i]:.9g}: {why}"
@@ -704,4 +711,4 @@ def _joined(scene, key, segments, dof, divisors, options: TorusBranchOptions, no
                        np.array([segments[0][0].bases(_scene_at(scene, key, v)) for v in values]), h.orders, dof,
                        np.concatenate(amplitudes), np.concatenate(z), tuple(folds), ended or final.stopped,
                        np.concatenate(iterations), np.concatenate(times), np.concatenate(slope), truncation,
-                       "" if ended else final.interrupt, tuple(gaps))
+                       "" if ended else final.interrupt, tuple(gaps), end="max_points" if ended else final.end)
