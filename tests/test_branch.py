@@ -21,6 +21,7 @@ from rotorred.scenes.branch import BranchOptions, SceneBranch, continue_scene
 from rotorred.scenes.harmonic_balance import rub_problem
 from rotorred.scenes.run import build_model
 from rotorred.scenes.schema import load_scene
+from rotorred.scenes.torus_branch import TorusBranch
 
 H, N = 20, 128  # coarse: the tests check the machinery, validation/hb_rig.py the rig at 100 harmonics
 
@@ -417,3 +418,22 @@ def test_the_cold_solution_through_coarser_truncations_is_the_cold_start_at_its_
     direct = cold_start(rp.problem, rp.omega)
     assert rp.problem.evaluate(z, rp.omega).relative < 1e-9
     assert np.linalg.norm(z - direct) < 1e-10 * np.linalg.norm(direct)
+
+
+def test_the_file_formats_page_lists_every_end_code_and_attribute_of_branch_nc(rig):
+    """docs/maps.md names each code a branch may end with (continuation.ENDS) and each attribute of both kinds of
+    ``branch.nc`` (a periodic branch's to_xarray, built here on a short branch)."""
+    from pathlib import Path
+
+    from rotorred.nonlinear.continuation import ENDS
+    text = " ".join((Path(__file__).parents[1] / "docs" / "maps.md").read_text(encoding="utf-8").split())
+    assert all(f"`{code}`" in text for code in ENDS)
+    scene, model = rig
+    branch = continue_scene(scene, model, "rub.clearance", 45e-6, 40e-6,
+                            BranchOptions(harmonics=H, samples=N, max_points=2, stability=False))
+    torus = TorusBranch("paper-rub", "rub.clearance", "m", np.array([2e-5, 1.9e-5]), np.full((2, 2), 30.0),
+                        np.array([[0, 0], [1, 0]]), (14, "y"), np.ones((2, 2)), np.zeros((2, 6)), (), "reached",
+                        np.array([0, 2]), np.ones(2), np.ones(2), "test", end="reached")
+    names = set(branch.to_xarray().attrs) | set(torus.to_xarray().attrs)
+    assert {"end", "gaps", "truncation", "bifurcations"} <= names
+    assert all(f"`{name}`" in text for name in names)

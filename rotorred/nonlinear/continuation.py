@@ -5,10 +5,11 @@ From a point and its unit tangent ``t`` (the null vector of ``[dR/dz, dR/domega]
 the predictor steps ``ds`` along the tangent, or with ``curved`` along the branch to second order,
 ``y + ds t + ds^2 / 2 kappa`` (``kappa`` the change of ``t`` from the previous point over the chord); the corrector is
 Newton's method on ``R = 0`` together with ``t . (y - y_pred) = 0`` (the plane through the prediction, normal to the
-tangent), each step shortened until it lowers the residual. Step control: ``ds`` grows by 1.5 after a correction of at
-most 4 iterations, up to ``ds_max``; a failed correction, or one that jumps (the point more than 2 ds away), halves it
-and retries from the same point, down to ``ds_min``, where the branch stops and says where and why; a branch that comes
-back onto its own path, or goes back along it, stops there (:func:`_retraced`).
+tangent), each step shortened until it lowers the residual. Step control: ``ds`` grows by :data:`GROWTH` (1.5) after
+a correction of at most :data:`GROW_ITERATIONS` (4) iterations, up to ``ds_max``; a failed correction, or one that
+jumps (the point more than 2 ds away), halves it and retries from the same point, down to ``ds_min``, where the branch
+stops and says where and why; a branch that comes back onto its own path, or goes back along it, stops there
+(:func:`_retraced`).
 
 A *fold* (turning point, saddle-node) is where ``d omega / ds`` changes sign between two points: it is
 located by Brent's method on ``d omega / ds`` along the arclength between them, each evaluation a corrected
@@ -47,6 +48,12 @@ STABILITY_FLAGS = MappingProxyType({1: "stable", 0: "unstable", -1: "unknown"})
 #: a corrected point farther than this many steps ds from the last has left the branch for another part of the
 #: curve: the step is halved instead
 MAX_JUMP = 2.0
+#: step control: ds grows by this factor after a correction of at most :data:`GROW_ITERATIONS` Newton iterations (up
+#: to ds_max), is kept after a longer one and halved after a failed one. *Choice*: on the rig's torus branches
+#: (docs/model.md §26, ``validation/hb_torus_step_rule.py``) a gentler growth fails fewer steps but, on the
+#: outer-speed branch, resolves the thin resonance tongues of the box's orders in many more points
+GROWTH = 1.5
+GROW_ITERATIONS = 4
 #: the predictor is second order where the tangent turns by at most this (rad) over a step, first order beyond
 MAX_TURN = 0.2
 #: with ``curved``, a corrector iteration must leave at most this fraction of the last residual, else the step is
@@ -602,7 +609,7 @@ def _step(problem, point: _Point, previous: _Point | None, ds, ds_min, ds_max, t
         done = _arclength(problem, point, previous if smooth else None, ds, tol, clean=ds == first,
                           contraction=CONTRACTION if curved else None)
         if done is not None:
-            return done[0], (min(ds * 1.5, ds_max) if done[1] <= 4 else ds), ""
+            return done[0], (min(ds * GROWTH, ds_max) if done[1] <= GROW_ITERATIONS else ds), ""
         if not cornered and (ds <= first / 64 or ds / 2 < ds_min or point.corner):
             cornered = True
             corner = _past_a_corner(problem, point, previous, max(first, 64 * ds_min), tol, point.corner)
