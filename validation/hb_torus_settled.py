@@ -55,7 +55,7 @@ def checked(times: np.ndarray) -> list[int]:
 def drift(result, analysis) -> tuple[float, float]:
     """The change of the 10 largest lines (of the whole record's fit) on consecutive :data:`WINDOW` s windows from
     2 s against the last window, on the record's torus: the largest of the amplitude vector's relative change (its
-    norm, as the settling rule's state) and the largest of any one line's."""
+    norm, as the settling rule's state) and the largest of any one line's the last window finds."""
     t, x = result.t, result.outputs[OUTPUT]
     largest = sorted(analysis.fit.lines, key=lambda ln: -ln.amplitude)[:10]
     options = FitOptions(torus=(analysis.fit.torus.k, analysis.fit.torus.j))
@@ -67,7 +67,8 @@ def drift(result, analysis) -> tuple[float, float]:
         rows.append([found.get(round(ln.frequency_hz, 6), np.nan) for ln in largest])
     rows = np.nan_to_num(np.array(rows))
     norm = np.linalg.norm(rows - rows[-1], axis=1) / np.linalg.norm(rows[-1])
-    return float(np.max(norm)), float(np.max(np.abs(rows / rows[-1] - 1.0)))
+    kept = rows[-1] > 0.0  # (a line the last window's fit does not find: in the norm only)
+    return float(np.max(norm)), float(np.max(np.abs(rows[:, kept] / rows[-1, kept] - 1.0)))
 
 
 def at_point(key: str, value: float):
